@@ -1,0 +1,78 @@
+//! `catflip analyze`: the seed's closed forms beside the true dynamics of its
+//! schedule.
+
+use crate::analytic::{ClosedForms, analytic_plan, closed_forms};
+use crate::config::Config;
+use crate::error::Result;
+use crate::path::PhasedPlan;
+use crate::plan::{Schedule, ShapePlan};
+use crate::simulate::{SimReport, dynamic_cfg, kinematic_cfg};
+use serde::Serialize;
+
+/// Peak joint torque along a plan, sampled densely in every phase, N m.
+pub fn peak_along(cfg: &Config, plan: &dyn ShapePlan, per_phase: usize) -> (f64, [f64; 3]) {
+    let cat = cfg.cat();
+    let b = plan.phase_bounds();
+    let norm = cfg.norm();
+    let mut per = [0.0f64; 3];
+    for i in 0..3 {
+        for k in 0..=per_phase {
+            let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+            per[i] = per[i].max(norm.of(plan.torque_in(&cat, i, t)));
+        }
+    }
+    (per.iter().cloned().fold(0.0, f64::max), per)
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Analysis {
+    pub name: String,
+    pub joint: &'static str,
+    #[serde(flatten)]
+    pub closed: ClosedForms,
+    /// True inverse-dynamics peak along the seed's schedule, N m.
+    pub peak_torque_nm: f64,
+    pub phase_peak_torque_nm: [f64; 3],
+    /// True peak over the seed's estimate (erratum E7).
+    pub peak_over_seed_estimate: f64,
+    /// Kinematic simulation of the schedule.
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    pub momentum_drift_nms: f64,
+    #[serde(skip)]
+    pub plan: PhasedPlan,
+    #[serde(skip)]
+    pub kinematic: SimReport,
+}
+
+pub fn analyze(cfg: &Config) -> Result<Analysis> {
+    let closed = closed_forms(cfg);
+    let plan = analytic_plan(cfg);
+    let (peak, per) = peak_along(cfg, &plan, 2000);
+    let kin = kinematic_cfg(cfg, &plan)?;
+    Ok(Analysis {
+        name: cfg.name.clone(),
+        joint: cfg.cat.joint.name(),
+        peak_over_seed_estimate: peak / closed.seed_torque_estimate_nm,
+        closed,
+        peak_torque_nm: peak,
+        phase_peak_torque_nm: per,
+        flip_deg: kin.flip_deg,
+        flip_error_rad: kin.flip_error_rad,
+        tilt_deg: kin.tilt_deg,
+        momentum_drift_nms: kin.momentum_drift_nms,
+        plan,
+        kinematic: kin,
+    })
+}
+
+/// Schedule of the analytic plan, sampled for output.
+pub fn analytic_schedule(cfg: &Config, plan: &PhasedPlan) -> Schedule {
+    Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase)
+}
+
+/// Dynamic verification of any plan.
+pub fn verify(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
+    dynamic_cfg(cfg, plan)
+}

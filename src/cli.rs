@@ -1,0 +1,219 @@
+//! Argument parsing into a checked configuration, and the terminal tables.
+
+use anyhow::{Context, Result};
+use catflip::Config;
+use catflip::analyze::{analytic_schedule, analyze, verify};
+use catflip::output::Output;
+use catflip::plan::Schedule;
+use catflip::simulate::SimReport;
+use clap::{Args, Parser, Subcommand};
+use std::path::{Path, PathBuf};
+
+#[derive(Parser)]
+#[command(
+    name = "catflip",
+    version,
+    about = "Joint-torque schedules that turn a falling two-body cat right side up"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Args, Clone)]
+struct Common {
+    /// TOML configuration (see configs/).
+    config: PathBuf,
+    /// Override a config key, e.g. `--set cat.joint=universal` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Print one JSON object instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Folder that receives `<name>/` (default `output`).
+    #[arg(long, default_value = "output")]
+    out: PathBuf,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// The seed's closed forms and its cosine schedule, evaluated with the true dynamics.
+    Analyze(Common),
+    /// Forward-simulate a torque schedule (default: the analytic one) in the full model.
+    Simulate {
+        #[command(flatten)]
+        common: Common,
+        /// Schedule CSV to apply (as written by catflip); its torque is the feed-forward.
+        #[arg(long)]
+        schedule: Option<PathBuf>,
+    },
+}
+
+fn load(c: &Common) -> Result<Config> {
+    Ok(Config::load(&c.config, &c.set)?)
+}
+
+fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
+    c.out.join(&cfg.name)
+}
+
+pub fn run() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Analyze(c) => cmd_analyze(&c),
+        Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
+    }
+}
+
+fn row(label: &str, value: String) {
+    println!("  {label:<34} {value}");
+}
+
+fn cmd_analyze(c: &Common) -> Result<()> {
+    let cfg = load(c)?;
+    let a = analyze(&cfg)?;
+    let sched = analytic_schedule(&cfg, &a.plan);
+    let json = serde_json::to_string_pretty(&a)?;
+    let mut out = Output::default();
+    out.add("analytic.csv", sched.to_csv());
+    out.add("analyze.json", json.clone());
+    let written = out.commit(&out_dir(c, &cfg))?;
+    if c.json {
+        println!("{json}");
+        return Ok(());
+    }
+    let cf = &a.closed;
+    println!("catflip analyze: {} ({} joint)", a.name, a.joint);
+    row(
+        "fall time",
+        format!(
+            "{:.4} s (manoeuvre {:.4} s)",
+            cf.fall_time_s, cf.available_time_s
+        ),
+    );
+    row(
+        "theta / bend",
+        format!("{:.3} / {:.3} deg", cf.theta_deg, cf.bend_deg),
+    );
+    row(
+        "I_t, I_a, I_yy",
+        format!("{:.6}, {:.6}, {:.6} kg m^2", cf.i_t, cf.i_a, cf.i_yy),
+    );
+    row("C", format!("{:.6}", cf.c));
+    row("twist pi/C", format!("{:.6} rad", cf.twist_rad));
+    row(
+        "omega0 (twist phase)",
+        format!("{:.4} rad/s", cf.omega0_rad_s),
+    );
+    row(
+        "one-turn theta (F6)",
+        format!("{:.3} deg", cf.one_turn_theta_deg),
+    );
+    row(
+        "phase durations",
+        format!(
+            "{:.4} / {:.4} / {:.4} s",
+            cf.phase_durations_s[0], cf.phase_durations_s[1], cf.phase_durations_s[2]
+        ),
+    );
+    row(
+        "seed I* estimate (E7)",
+        format!("{:.4} N m", cf.seed_torque_estimate_nm),
+    );
+    row(
+        "true peak torque",
+        format!(
+            "{:.4} N m (fold {:.4}, twist {:.4}, unfold {:.4}; {:.2}x the estimate)",
+            a.peak_torque_nm,
+            a.phase_peak_torque_nm[0],
+            a.phase_peak_torque_nm[1],
+            a.phase_peak_torque_nm[2],
+            a.peak_over_seed_estimate
+        ),
+    );
+    row(
+        "flip (kinematic sim)",
+        format!("{:.9} deg (error {:.2e} rad)", a.flip_deg, a.flip_error_rad),
+    );
+    row("tilt", format!("{:.3e} deg", a.tilt_deg));
+    row(
+        "momentum drift",
+        format!("{:.2e} N m s", a.momentum_drift_nms),
+    );
+    for w in written {
+        row("wrote", w.display().to_string());
+    }
+    Ok(())
+}
+
+fn print_sim(title: &str, r: &SimReport) {
+    println!("{title}");
+    row(
+        "flip",
+        format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
+    );
+    row("tilt", format!("{:.3e} deg", r.tilt_deg));
+    row(
+        "final shape / rate error",
+        format!(
+            "{:.2e} rad / {:.2e} rad/s",
+            r.final_shape_error_rad, r.final_rate_error_rad_s
+        ),
+    );
+    row(
+        "max tracking error",
+        format!("{:.2e} rad", r.max_tracking_error_rad),
+    );
+    row(
+        "peak applied torque",
+        format!("{:.4} N m", r.peak_torque_nm),
+    );
+    row(
+        "momentum drift",
+        format!("{:.2e} N m s", r.momentum_drift_nms),
+    );
+    row("accepted steps", format!("{}", r.steps));
+}
+
+fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
+    let cfg = load(c)?;
+    let (source, report) = match schedule {
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("cannot read schedule {}", p.display()))?;
+            let s = Schedule::from_csv(&text, &p.display().to_string())?;
+            (p.display().to_string(), verify(&cfg, &s)?)
+        }
+        None => {
+            let plan = catflip::analytic::analytic_plan(&cfg);
+            ("analytic schedule".to_string(), verify(&cfg, &plan)?)
+        }
+    };
+    let mut trace = String::from("t_s,flip_rad,tilt_rad,q1_rad,q2_rad,tau1_nm,tau2_nm\n");
+    for p in &report.trace {
+        trace.push_str(&format!(
+            "{:.9},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n",
+            p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
+        ));
+    }
+    let mut out = Output::default();
+    out.add("simulation.csv", trace);
+    let written = out.commit(&out_dir(c, &cfg))?;
+    if c.json {
+        let mut v = serde_json::to_value(&report)?;
+        v["source"] = serde_json::Value::String(source);
+        println!("{}", serde_json::to_string_pretty(&v)?);
+    } else {
+        print_sim(
+            &format!(
+                "catflip simulate: {} ({source}, dynamic, feed-forward + PD)",
+                cfg.name
+            ),
+            &report,
+        );
+        for w in written {
+            row("wrote", w.display().to_string());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,512 @@
+//! Checked configuration: TOML in, validated [`Config`] out.
+//!
+//! Unknown keys are rejected (serde `deny_unknown_fields`); every number is
+//! range-checked with a message that names the key, the value and the range.
+//! `--set a.b=value` overrides are applied to the TOML tree before parsing, so
+//! they go through the same checks.
+
+use crate::error::{Error, Result};
+use crate::model::{Cat, InertiaFormula, Joint, TorqueNorm};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    /// Names the output folder `output/<name>/`.
+    pub name: String,
+    pub cat: CatConfig,
+    pub fall: FallConfig,
+    #[serde(default)]
+    pub analytic: AnalyticConfig,
+    #[serde(default)]
+    pub limits: LimitsConfig,
+    #[serde(default)]
+    pub simulate: SimulateConfig,
+    #[serde(default)]
+    pub phased: PhasedConfig,
+    #[serde(default)]
+    pub free: FreeConfig,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CatConfig {
+    /// kg, each half.
+    pub mass: f64,
+    /// m, each half.
+    pub length: f64,
+    /// m.
+    pub radius: f64,
+    /// `no-twist` (default) or `universal`.
+    #[serde(default = "default_joint")]
+    pub joint: Joint,
+}
+
+fn default_joint() -> Joint {
+    Joint::NoTwist
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FallConfig {
+    /// m, drop height.
+    pub height: f64,
+    /// m/s^2 (default 9.81).
+    #[serde(default = "default_gravity")]
+    pub gravity: f64,
+    /// s left free before landing (default 0).
+    #[serde(default)]
+    pub margin: f64,
+}
+
+fn default_gravity() -> f64 {
+    9.81
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct AnalyticConfig {
+    /// Angle between the halves during the twist, degrees (default 45, the seed's pi/4).
+    pub theta_deg: f64,
+    /// Fractions of the manoeuvre time for fold, twist, unfold (default 0.2, 0.6, 0.2).
+    pub split: [f64; 3],
+    /// Use the seed's transverse inertia `m (r^2 + l^2)/12` (erratum E1) to reproduce
+    /// its printed example (default false).
+    pub seed_inertia: bool,
+}
+
+impl Default for AnalyticConfig {
+    fn default() -> Self {
+        Self {
+            theta_deg: 45.0,
+            split: [0.2, 0.6, 0.2],
+            seed_inertia: false,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct LimitsConfig {
+    /// N m, largest joint torque the motors can give (default: none).
+    pub max_torque: Option<f64>,
+    /// Degrees, largest bend the optimisers may use (default: none; 175 in practice).
+    pub max_bend_deg: Option<f64>,
+    /// Peak norm: `euclidean` or `per-motor` (default: euclidean for no-twist, per-motor for universal).
+    pub norm: Option<TorqueNorm>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimulateConfig {
+    /// Relative tolerance of the adaptive integrator (default 1e-10).
+    pub rtol: f64,
+    /// Absolute tolerance (default 1e-12).
+    pub atol: f64,
+    /// Add PD tracking of the planned shape to the feed-forward torque (default true).
+    pub pd: bool,
+    /// PD bandwidth, Hz, about the straight cat's inertia (default 10).
+    pub pd_bandwidth_hz: f64,
+    /// PD damping ratio (default 1).
+    pub pd_damping: f64,
+    /// Rows per phase in written schedules (default 200).
+    pub samples_per_phase: usize,
+}
+
+impl Default for SimulateConfig {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-10,
+            atol: 1e-12,
+            pd: true,
+            pd_bandwidth_hz: 10.0,
+            pd_damping: 1.0,
+            samples_per_phase: 200,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PhasedConfig {
+    /// Grid intervals per phase of the path-timing SOCP (default 80).
+    pub nodes: usize,
+    /// Bend search range, degrees (default 5 to 170).
+    pub bend_min_deg: f64,
+    pub bend_max_deg: f64,
+    /// Points of the coarse bend scan before refinement (default 12).
+    pub scan_points: usize,
+    /// Bend tolerance of the refinement, degrees (default 0.05).
+    pub bend_tol_deg: f64,
+}
+
+impl Default for PhasedConfig {
+    fn default() -> Self {
+        Self {
+            nodes: 80,
+            bend_min_deg: 5.0,
+            bend_max_deg: 170.0,
+            scan_points: 12,
+            bend_tol_deg: 0.05,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct FreeConfig {
+    /// Collocation nodes per phase (default 40).
+    pub nodes: usize,
+    /// SCP iteration limit (default 60).
+    pub max_iterations: usize,
+    /// Stop when the predicted improvement falls below this fraction of the peak (default 1e-5).
+    pub tolerance: f64,
+    /// Flip tolerance of the converged design, rad (default 1e-6).
+    pub attitude_tolerance: f64,
+}
+
+impl Default for FreeConfig {
+    fn default() -> Self {
+        Self {
+            nodes: 40,
+            max_iterations: 60,
+            tolerance: 1e-5,
+            attitude_tolerance: 1e-6,
+        }
+    }
+}
+
+fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::Invalid {
+            key: key.into(),
+            value: format!("{value}"),
+            expected: expected.into(),
+        })
+    }
+}
+
+impl Config {
+    /// Reads, overrides and validates a config file.
+    pub fn load(path: &Path, overrides: &[String]) -> Result<Config> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::ConfigRead {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Self::from_toml(&text, &path.display().to_string(), overrides)
+    }
+
+    pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| Error::ConfigParse {
+            origin: origin.into(),
+            message: e.to_string(),
+        })?;
+        for arg in overrides {
+            apply_override(&mut table, arg)?;
+        }
+        let merged = toml::to_string(&table).expect("a TOML table serialises");
+        let cfg: Config = toml::from_str(&merged).map_err(|e| Error::ConfigParse {
+            origin: if overrides.is_empty() {
+                origin.into()
+            } else {
+                format!("{origin} (with --set overrides)")
+            },
+            message: e.to_string(),
+        })?;
+        cfg.validate()?;
+        Ok(cfg)
+    }
+
+    pub fn validate(&self) -> Result<()> {
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.')
+            || self.name.starts_with('.')
+        {
+            return Err(Error::Invalid {
+                key: "name".into(),
+                value: format!("{:?}", self.name),
+                expected: "a non-empty folder name of letters, digits, '-', '_' or '.'".into(),
+            });
+        }
+        let c = &self.cat;
+        check(
+            "cat.mass",
+            c.mass,
+            c.mass > 0.0,
+            "must be > 0 kg (mass of each half)",
+        )?;
+        check(
+            "cat.length",
+            c.length,
+            c.length > 0.0,
+            "must be > 0 m (length of each half)",
+        )?;
+        check(
+            "cat.radius",
+            c.radius,
+            c.radius > 0.0 && c.radius < c.length,
+            "must be > 0 m and less than cat.length",
+        )?;
+        let f = &self.fall;
+        check("fall.height", f.height, f.height > 0.0, "must be > 0 m")?;
+        check(
+            "fall.gravity",
+            f.gravity,
+            f.gravity > 0.0,
+            "must be > 0 m/s^2",
+        )?;
+        check("fall.margin", f.margin, f.margin >= 0.0, "must be >= 0 s")?;
+        let ft = self.fall_time();
+        check(
+            "fall.margin",
+            f.margin,
+            f.margin < 0.95 * ft,
+            &format!("must leave time to move: less than 95 % of the fall time {ft:.4} s"),
+        )?;
+        let a = &self.analytic;
+        check(
+            "analytic.theta_deg",
+            a.theta_deg,
+            a.theta_deg > 0.0 && a.theta_deg < 180.0,
+            "must be in (0, 180) degrees",
+        )?;
+        for (i, x) in a.split.iter().enumerate() {
+            check(
+                &format!("analytic.split[{i}]"),
+                *x,
+                *x > 0.0,
+                "each fraction must be > 0",
+            )?;
+        }
+        let sum: f64 = a.split.iter().sum();
+        check(
+            "analytic.split",
+            sum,
+            (sum - 1.0).abs() < 1e-9,
+            "fractions must sum to 1 (sum shown)",
+        )?;
+        if let Some(t) = self.limits.max_torque {
+            check("limits.max_torque", t, t > 0.0, "must be > 0 N m")?;
+        }
+        if let Some(b) = self.limits.max_bend_deg {
+            check(
+                "limits.max_bend_deg",
+                b,
+                b > 0.0 && b < 180.0,
+                "must be in (0, 180) degrees",
+            )?;
+        }
+        let s = &self.simulate;
+        check(
+            "simulate.rtol",
+            s.rtol,
+            s.rtol > 0.0 && s.rtol <= 1e-2,
+            "must be in (0, 1e-2]",
+        )?;
+        check(
+            "simulate.atol",
+            s.atol,
+            s.atol > 0.0 && s.atol <= 1e-2,
+            "must be in (0, 1e-2]",
+        )?;
+        check(
+            "simulate.pd_bandwidth_hz",
+            s.pd_bandwidth_hz,
+            s.pd_bandwidth_hz > 0.0,
+            "must be > 0 Hz",
+        )?;
+        check(
+            "simulate.pd_damping",
+            s.pd_damping,
+            s.pd_damping > 0.0,
+            "must be > 0",
+        )?;
+        let n = s.samples_per_phase as f64;
+        check(
+            "simulate.samples_per_phase",
+            n,
+            (2.0..=100_000.0).contains(&n),
+            "must be in 2..=100000",
+        )?;
+        let p = &self.phased;
+        check(
+            "phased.nodes",
+            p.nodes as f64,
+            (4..=2000).contains(&p.nodes),
+            "must be in 4..=2000",
+        )?;
+        check(
+            "phased.bend_min_deg",
+            p.bend_min_deg,
+            p.bend_min_deg > 0.0,
+            "must be > 0 degrees",
+        )?;
+        check(
+            "phased.bend_max_deg",
+            p.bend_max_deg,
+            p.bend_max_deg > p.bend_min_deg && p.bend_max_deg < 180.0,
+            "must exceed phased.bend_min_deg and be < 180 degrees",
+        )?;
+        check(
+            "phased.scan_points",
+            p.scan_points as f64,
+            (3..=200).contains(&p.scan_points),
+            "must be in 3..=200",
+        )?;
+        check(
+            "phased.bend_tol_deg",
+            p.bend_tol_deg,
+            p.bend_tol_deg > 0.0,
+            "must be > 0 degrees",
+        )?;
+        let fr = &self.free;
+        check(
+            "free.nodes",
+            fr.nodes as f64,
+            (4..=400).contains(&fr.nodes),
+            "must be in 4..=400",
+        )?;
+        check(
+            "free.max_iterations",
+            fr.max_iterations as f64,
+            fr.max_iterations >= 1,
+            "must be >= 1",
+        )?;
+        check(
+            "free.tolerance",
+            fr.tolerance,
+            fr.tolerance > 0.0 && fr.tolerance < 1.0,
+            "must be in (0, 1)",
+        )?;
+        check(
+            "free.attitude_tolerance",
+            fr.attitude_tolerance,
+            fr.attitude_tolerance > 0.0,
+            "must be > 0 rad",
+        )?;
+        Ok(())
+    }
+
+    /// The cat with the inertia formula the config asks for.
+    pub fn cat(&self) -> Cat {
+        Cat {
+            mass: self.cat.mass,
+            length: self.cat.length,
+            radius: self.cat.radius,
+            joint: self.cat.joint,
+            inertia: if self.analytic.seed_inertia {
+                InertiaFormula::Seed
+            } else {
+                InertiaFormula::SolidCylinder
+            },
+        }
+    }
+
+    /// `sqrt(2 h / g)`, s.
+    pub fn fall_time(&self) -> f64 {
+        (2.0 * self.fall.height / self.fall.gravity).sqrt()
+    }
+
+    /// Time for the manoeuvre: fall time minus margin, s.
+    pub fn available_time(&self) -> f64 {
+        self.fall_time() - self.fall.margin
+    }
+
+    pub fn norm(&self) -> TorqueNorm {
+        self.limits
+            .norm
+            .unwrap_or(TorqueNorm::default_for(self.cat.joint))
+    }
+
+    /// Largest bend the optimisers may use, rad.
+    pub fn max_bend(&self) -> f64 {
+        self.limits.max_bend_deg.unwrap_or(175.0).to_radians()
+    }
+}
+
+/// Applies `a.b.c=value` to a TOML table; `value` is read as TOML, else as a string.
+pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
+    let err = |m: &str| Error::Override {
+        arg: arg.into(),
+        message: m.into(),
+    };
+    let (key, raw) = arg
+        .split_once('=')
+        .ok_or_else(|| err("expected KEY=VALUE, e.g. cat.joint=universal"))?;
+    let key = key.trim();
+    let parts: Vec<&str> = key.split('.').collect();
+    if parts.iter().any(|p| p.is_empty()) {
+        return Err(err("the key has an empty part"));
+    }
+    let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
+        Ok(mut t) => t.remove("v").expect("parsed key"),
+        Err(_) => toml::Value::String(raw.trim().to_string()),
+    };
+    let mut cur = table;
+    for p in &parts[..parts.len() - 1] {
+        let entry = cur
+            .entry(p.to_string())
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        cur = entry
+            .as_table_mut()
+            .ok_or_else(|| err(&format!("`{p}` is not a table")))?;
+    }
+    cur.insert(parts[parts.len() - 1].to_string(), value);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SEED: &str = r#"
+name = "seed"
+[cat]
+mass = 1.0
+length = 1.0
+radius = 0.1
+[fall]
+height = 10.0
+gravity = 9.8
+"#;
+
+    #[test]
+    fn parses_and_overrides() {
+        let c = Config::from_toml(
+            SEED,
+            "t",
+            &["cat.joint=universal".into(), "analytic.theta_deg=60".into()],
+        )
+        .unwrap();
+        assert_eq!(c.cat.joint, Joint::Universal);
+        assert_eq!(c.analytic.theta_deg, 60.0);
+        assert!((c.fall_time() - (20.0f64 / 9.8).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn rejects_each_kind_of_bad_input() {
+        let cases: &[(&str, &[&str], &str)] = &[
+            (SEED, &["cat.mass=-1"], "cat.mass"),
+            (SEED, &["cat.masss=1"], "masss"),
+            (SEED, &["cat.joint=hinge"], "hinge"),
+            (SEED, &["analytic.split=[0.5, 0.6, 0.2]"], "analytic.split"),
+            (SEED, &["fall.margin=5"], "fall.margin"),
+            (SEED, &["cat.mass"], "KEY=VALUE"),
+            ("name = \"x\"\n[cat]\nmass = 1", &[], "length"),
+            ("name = \"x\" [", &[], "TOML"),
+        ];
+        for (text, ov, needle) in cases {
+            let ov: Vec<String> = ov.iter().map(|s| s.to_string()).collect();
+            let e = Config::from_toml(text, "t", &ov)
+                .expect_err(needle)
+                .to_string();
+            assert!(e.contains(needle), "`{e}` should mention `{needle}`");
+        }
+    }
+}

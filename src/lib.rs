@@ -1,0 +1,20 @@
+//! catflip: torque schedules that turn a falling two-body cat right side up.
+//!
+//! The physics contract is MODEL.md (shared with the project): two identical
+//! cylinders joined at the middle, released at rest, zero angular momentum.
+pub mod analytic;
+pub mod analyze;
+pub mod config;
+pub mod dynamics;
+pub mod error;
+pub mod model;
+pub mod ode;
+pub mod output;
+pub mod path;
+pub mod plan;
+pub mod simulate;
+pub mod small;
+pub mod so3;
+
+pub use config::Config;
+pub use error::{Error, Result};

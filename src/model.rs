@@ -1,0 +1,472 @@
+//! The two-cylinder cat of MODEL.md: geometry, joint kinematics and the locked
+//! inertia terms of the zero-momentum reduction, written once generically so
+//! that num-dual evaluates exact first and second derivatives of them.
+//!
+//! Kinetic energy, all vectors in body A's frame (MODEL.md section 1):
+//! with `w = S(q) q_dot` the relative angular velocity of B, `d` the vector
+//! from A's to B's centre of mass, `s = R_rel (0,0,l/2)` the vector from the
+//! joint to B's centre of mass and `mu = m/2` the reduced mass of the pair,
+//!
+//! `T = 1/2 w_A' I_c w_A + 1/2 (w_A + w)' I_B (w_A + w) + 1/2 mu |w_A x d + w x s|^2`
+//!   `= 1/2 w_A' J w_A + w_A' Kt w + 1/2 w' Nt w`
+//!
+//! with `J = I_c + I_B + mu hat(d)'hat(d)`, `Kt = I_B + mu hat(d)'hat(s)`,
+//! `Nt = I_B + mu hat(s)'hat(s)` and `hat(a)'hat(b) = (a.b) I - b a'`.
+//! Zero angular momentum gives `w_A = -J^-1 K q_dot` with `K = Kt S`, and the
+//! reduced mass matrix is `M = S' Nt S - K' J^-1 K`.
+
+use crate::small::*;
+use nalgebra::{Const, U1};
+use num_dual::{Derivative, Dual2SVec64, DualSVec64};
+use serde::{Deserialize, Serialize};
+
+/// How the two halves are joined (MODEL.md section 2).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Joint {
+    /// Kane & Scher: `q` is the rotation vector of B relative to A in A's x-y plane.
+    NoTwist,
+    /// Two revolute motors: `R_rel = Rx(q1) Ry(q2)`.
+    Universal,
+}
+
+impl Joint {
+    pub fn name(self) -> &'static str {
+        match self {
+            Joint::NoTwist => "no-twist",
+            Joint::Universal => "universal",
+        }
+    }
+}
+
+/// Which norm of the joint torque vector is the "peak" (MODEL.md section 3).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TorqueNorm {
+    /// `|tau|_2`: one actuator that can push in any direction (default for no-twist).
+    Euclidean,
+    /// `max_i |tau_i|`: one motor per axis (default for universal).
+    PerMotor,
+}
+
+impl TorqueNorm {
+    pub fn of(self, tau: [f64; 2]) -> f64 {
+        match self {
+            TorqueNorm::Euclidean => tau[0].hypot(tau[1]),
+            TorqueNorm::PerMotor => tau[0].abs().max(tau[1].abs()),
+        }
+    }
+    pub fn default_for(joint: Joint) -> Self {
+        match joint {
+            Joint::NoTwist => TorqueNorm::Euclidean,
+            Joint::Universal => TorqueNorm::PerMotor,
+        }
+    }
+}
+
+/// Which transverse-inertia formula to use (MODEL.md E1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum InertiaFormula {
+    /// Solid cylinder, `m (3 r^2 + l^2) / 12`.
+    #[default]
+    SolidCylinder,
+    /// The seed's `m (r^2 + l^2) / 12` (erratum E1), only to reproduce its example.
+    Seed,
+}
+
+/// Two identical cylinders joined at the middle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cat {
+    /// Mass of each half, kg.
+    pub mass: f64,
+    /// Length of each half, m.
+    pub length: f64,
+    /// Radius, m.
+    pub radius: f64,
+    pub joint: Joint,
+    pub inertia: InertiaFormula,
+}
+
+impl Cat {
+    /// Transverse inertia of one half about its own centre of mass, `I_t`.
+    pub fn i_t(&self) -> f64 {
+        let (m, r, l) = (self.mass, self.radius, self.length);
+        match self.inertia {
+            InertiaFormula::SolidCylinder => m * (3.0 * r * r + l * l) / 12.0,
+            InertiaFormula::Seed => m * (r * r + l * l) / 12.0,
+        }
+    }
+
+    /// Axial inertia of one half, `I_a = m r^2 / 2`.
+    pub fn i_a(&self) -> f64 {
+        self.mass * self.radius * self.radius / 2.0
+    }
+
+    /// Rotation of B relative to A, in A's frame.
+    pub fn rel_rotation<T: Real>(&self, q: [T; 2]) -> M3<T> {
+        match self.joint {
+            Joint::NoTwist => {
+                let v = [q[0], q[1], T::zero()];
+                let (a, b, _) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
+                let h = hat(v);
+                mat_add(
+                    &mat_add(&eye3(), &mat_scale(a, &h)),
+                    &mat_scale(b, &mat_mul(&h, &h)),
+                )
+            }
+            Joint::Universal => mat_mul(&rot_x(q[0]), &rot_y(q[1])),
+        }
+    }
+
+    /// Columns of `S(q)`: B's angular velocity relative to A is `S(q) q_dot` (A frame).
+    pub fn rel_rate_jacobian<T: Real>(&self, q: [T; 2]) -> [V3<T>; 2] {
+        match self.joint {
+            Joint::NoTwist => {
+                // Left Jacobian of SO(3): R_dot R' = hat(J_l(v) v_dot).
+                let v = [q[0], q[1], T::zero()];
+                let (_, b, c) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
+                let h = hat(v);
+                let jl = mat_add(
+                    &mat_add(&eye3(), &mat_scale(b, &h)),
+                    &mat_scale(c, &mat_mul(&h, &h)),
+                );
+                [
+                    [jl[0][0], jl[1][0], jl[2][0]],
+                    [jl[0][1], jl[1][1], jl[2][1]],
+                ]
+            }
+            Joint::Universal => {
+                let z = T::zero();
+                [[T::one(), z, z], [z, q[0].cos(), q[0].sin()]]
+            }
+        }
+    }
+
+    /// Joint-to-B vector `s` and A-to-B vector `d`, both in A's frame.
+    pub fn offsets<T: Real>(&self, rel: &M3<T>) -> (V3<T>, V3<T>) {
+        let half = c::<T>(self.length / 2.0);
+        let s = [rel[0][2] * half, rel[1][2] * half, rel[2][2] * half];
+        let d = [s[0], s[1], s[2] + half];
+        (s, d)
+    }
+
+    /// Principal inertia of one half in its own frame.
+    pub fn body_inertia<T: Real>(&self) -> M3<T> {
+        let mut m = zero3();
+        m[0][0] = c(self.i_t());
+        m[1][1] = c(self.i_t());
+        m[2][2] = c(self.i_a());
+        m
+    }
+
+    /// Reduced mass matrix `M(q)` and connection `A(q) = J^-1 K` (body rate `w_A = -A q_dot`).
+    pub fn locked_terms<T: Real>(&self, q: [T; 2]) -> ([[T; 2]; 2], [V3<T>; 2]) {
+        let rel = self.rel_rotation(q);
+        let sj = self.rel_rate_jacobian(q);
+        let (s, d) = self.offsets(&rel);
+        let mu = c::<T>(self.mass / 2.0);
+        let ic = self.body_inertia::<T>();
+        let ib = mat_mul(&mat_mul(&rel, &ic), &transpose(&rel));
+        let gram = |a: V3<T>, b: V3<T>| {
+            // hat(a)' hat(b) = (a.b) I - b a'
+            let mut m = mat_scale(dot(a, b), &eye3());
+            let o = outer(b, a);
+            for i in 0..3 {
+                for j in 0..3 {
+                    m[i][j] -= o[i][j];
+                }
+            }
+            m
+        };
+        let j = mat_add(&mat_add(&ic, &ib), &mat_scale(mu, &gram(d, d)));
+        let kt = mat_add(&ib, &mat_scale(mu, &gram(d, s)));
+        let nt = mat_add(&ib, &mat_scale(mu, &gram(s, s)));
+        let k = [mat_vec(&kt, sj[0]), mat_vec(&kt, sj[1])];
+        let a = [solve3(&j, k[0]), solve3(&j, k[1])];
+        let mut m = [[T::zero(); 2]; 2];
+        for r in 0..2 {
+            for cidx in 0..2 {
+                m[r][cidx] = dot(sj[r], mat_vec(&nt, sj[cidx])) - dot(k[r], a[cidx]);
+            }
+        }
+        (m, a)
+    }
+
+    /// Body A's angular velocity (A frame) at zero total angular momentum.
+    pub fn body_rate(&self, q: [f64; 2], qd: [f64; 2]) -> [f64; 3] {
+        let (_, a) = self.locked_terms(q);
+        [
+            -(a[0][0] * qd[0] + a[1][0] * qd[1]),
+            -(a[0][1] * qd[0] + a[1][1] * qd[1]),
+            -(a[0][2] * qd[0] + a[1][2] * qd[1]),
+        ]
+    }
+}
+
+fn rot_x<T: Real>(a: T) -> M3<T> {
+    let (s, co) = (a.sin(), a.cos());
+    let (z, o) = (T::zero(), T::one());
+    [[o, z, z], [z, co, -s], [z, s, co]]
+}
+
+fn rot_y<T: Real>(a: T) -> M3<T> {
+    let (s, co) = (a.sin(), a.cos());
+    let (z, o) = (T::zero(), T::one());
+    [[co, z, s], [z, o, z], [-s, z, co]]
+}
+
+/// `(sin t / t, (1 - cos t)/t^2, (t - sin t)/t^3)` as functions of `x = t^2`.
+/// Series below `x = 1e-2` keep them (and their dual parts) finite at `t = 0`.
+fn rodrigues_coefficients<T: Real>(x: T) -> (T, T, T) {
+    if x.re() < 1e-2 {
+        let series = |k: &[f64]| {
+            let mut acc = T::zero();
+            for &coef in k.iter().rev() {
+                acc = acc * x + c::<T>(coef);
+            }
+            acc
+        };
+        (
+            series(&[1.0, -1.0 / 6.0, 1.0 / 120.0, -1.0 / 5040.0, 1.0 / 362880.0]),
+            series(&[
+                0.5,
+                -1.0 / 24.0,
+                1.0 / 720.0,
+                -1.0 / 40320.0,
+                1.0 / 3628800.0,
+            ]),
+            series(&[
+                1.0 / 6.0,
+                -1.0 / 120.0,
+                1.0 / 5040.0,
+                -1.0 / 362880.0,
+                1.0 / 39916800.0,
+            ]),
+        )
+    } else {
+        let t = x.sqrt();
+        let (s, co) = (t.sin(), t.cos());
+        (s / t, (T::one() - co) / x, (t - s) / (x * t))
+    }
+}
+
+/// `M(q)`, `A(q)` and their exact derivatives at one shape.
+///
+/// `dm[k][i][j] = dM_ij/dq_k`, `d2m[k][l][i][j] = d2M_ij/dq_k dq_l`,
+/// `a[j]` is column j of `A` (a 3-vector), `da[k][j] = dA_{.j}/dq_k`.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ShapeTerms {
+    pub m: [[f64; 2]; 2],
+    pub dm: [[[f64; 2]; 2]; 2],
+    pub d2m: [[[[f64; 2]; 2]; 2]; 2],
+    pub a: [[f64; 3]; 2],
+    pub da: [[[f64; 3]; 2]; 2],
+}
+
+impl ShapeTerms {
+    /// Value and first derivatives (forward dynamics, path timing).
+    pub fn first(cat: &Cat, q: [f64; 2]) -> Self {
+        let x = [
+            DualSVec64::<2>::from_re(q[0]).derivative(0),
+            DualSVec64::<2>::from_re(q[1]).derivative(1),
+        ];
+        let (m, a) = cat.locked_terms(x);
+        let g = |v: &DualSVec64<2>| -> [f64; 2] {
+            let e = v.eps.unwrap_generic(Const::<2>, U1);
+            [e[0], e[1]]
+        };
+        let mut t = ShapeTerms::default();
+        for i in 0..2 {
+            for j in 0..2 {
+                t.m[i][j] = m[i][j].re;
+                let gr = g(&m[i][j]);
+                for k in 0..2 {
+                    t.dm[k][i][j] = gr[k];
+                }
+            }
+        }
+        for j in 0..2 {
+            for r in 0..3 {
+                t.a[j][r] = a[j][r].re;
+                let gr = g(&a[j][r]);
+                for k in 0..2 {
+                    t.da[k][j][r] = gr[k];
+                }
+            }
+        }
+        t
+    }
+
+    /// Value, first and second derivatives (torque linearisation).
+    pub fn second(cat: &Cat, q: [f64; 2]) -> Self {
+        let x = [
+            Dual2SVec64::<2>::from_re(q[0]).derivative(0),
+            Dual2SVec64::<2>::from_re(q[1]).derivative(1),
+        ];
+        let (m, a) = cat.locked_terms(x);
+        let parts = |v: &Dual2SVec64<2>| -> ([f64; 2], [[f64; 2]; 2]) {
+            let g = unwrap_row(&v.v1);
+            let h = v.v2.unwrap_generic(Const::<2>, Const::<2>);
+            (g, [[h[(0, 0)], h[(0, 1)]], [h[(1, 0)], h[(1, 1)]]])
+        };
+        let mut t = ShapeTerms::default();
+        for i in 0..2 {
+            for j in 0..2 {
+                t.m[i][j] = m[i][j].re;
+                let (gr, he) = parts(&m[i][j]);
+                for k in 0..2 {
+                    t.dm[k][i][j] = gr[k];
+                    for l in 0..2 {
+                        t.d2m[k][l][i][j] = he[k][l];
+                    }
+                }
+            }
+        }
+        for j in 0..2 {
+            for r in 0..3 {
+                t.a[j][r] = a[j][r].re;
+                let (gr, _) = parts(&a[j][r]);
+                for k in 0..2 {
+                    t.da[k][j][r] = gr[k];
+                }
+            }
+        }
+        t
+    }
+
+    /// Body rate `w_A = -A q_dot`.
+    pub fn body_rate(&self, qd: [f64; 2]) -> [f64; 3] {
+        let mut w = [0.0; 3];
+        for (r, wr) in w.iter_mut().enumerate() {
+            *wr = -(self.a[0][r] * qd[0] + self.a[1][r] * qd[1]);
+        }
+        w
+    }
+
+    /// `d w_A / d q_k` at rate `qd` (columns k = 0, 1).
+    pub fn body_rate_dq(&self, qd: [f64; 2]) -> [[f64; 3]; 2] {
+        let mut out = [[0.0; 3]; 2];
+        for (k, col) in out.iter_mut().enumerate() {
+            for (r, x) in col.iter_mut().enumerate() {
+                *x = -(self.da[k][0][r] * qd[0] + self.da[k][1][r] * qd[1]);
+            }
+        }
+        out
+    }
+}
+
+fn unwrap_row(d: &Derivative<f64, U1, Const<2>>) -> [f64; 2] {
+    let g = d.unwrap_generic(U1, Const::<2>);
+    [g[0], g[1]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub fn seed_cat(joint: Joint) -> Cat {
+        Cat {
+            mass: 1.0,
+            length: 1.0,
+            radius: 0.1,
+            joint,
+            inertia: InertiaFormula::SolidCylinder,
+        }
+    }
+
+    #[test]
+    fn straight_cat_mass_matrix_is_half_transverse_inertia() {
+        for joint in [Joint::NoTwist, Joint::Universal] {
+            let cat = seed_cat(joint);
+            let t = ShapeTerms::second(&cat, [0.0, 0.0]);
+            let half = cat.i_t() / 2.0;
+            assert!((t.m[0][0] - half).abs() < 1e-14, "{joint:?} {:?}", t.m);
+            assert!((t.m[1][1] - half).abs() < 1e-14);
+            assert!(t.m[0][1].abs() < 1e-14);
+            for x in
+                t.dm.iter()
+                    .flatten()
+                    .flatten()
+                    .chain(t.d2m.iter().flatten().flatten().flatten())
+            {
+                assert!(x.is_finite());
+            }
+        }
+    }
+
+    #[test]
+    fn no_twist_rotation_is_exponential_map() {
+        let cat = seed_cat(Joint::NoTwist);
+        let q = [0.7, -0.4];
+        let r = cat.rel_rotation::<f64>(q);
+        let n = nalgebra::Rotation3::new(nalgebra::Vector3::new(q[0], q[1], 0.0));
+        for i in 0..3 {
+            for j in 0..3 {
+                assert!((r[i][j] - n[(i, j)]).abs() < 1e-14);
+            }
+        }
+    }
+
+    #[test]
+    fn rate_jacobian_matches_finite_difference_of_rotation() {
+        for joint in [Joint::NoTwist, Joint::Universal] {
+            let cat = seed_cat(joint);
+            for q in [[0.7f64, -0.4], [0.01, 0.02], [2.0, 1.0]] {
+                let sj = cat.rel_rate_jacobian::<f64>(q);
+                let r = nalgebra::Matrix3::from_fn(|i, j| cat.rel_rotation::<f64>(q)[i][j]);
+                for k in 0..2 {
+                    let h = 1e-6;
+                    let mut qp = q;
+                    let mut qm = q;
+                    qp[k] += h;
+                    qm[k] -= h;
+                    let rp = nalgebra::Matrix3::from_fn(|i, j| cat.rel_rotation::<f64>(qp)[i][j]);
+                    let rm = nalgebra::Matrix3::from_fn(|i, j| cat.rel_rotation::<f64>(qm)[i][j]);
+                    let w = (rp - rm) / (2.0 * h) * r.transpose();
+                    let v = [w[(2, 1)], w[(0, 2)], w[(1, 0)]];
+                    for i in 0..3 {
+                        assert!((v[i] - sj[k][i]).abs() < 1e-8, "{joint:?} {q:?} {k}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn dual_derivatives_match_finite_differences() {
+        for joint in [Joint::NoTwist, Joint::Universal] {
+            let cat = seed_cat(joint);
+            for q in [[0.9, 0.3], [0.05, -0.08], [-1.7, 2.1]] {
+                let t = ShapeTerms::second(&cat, q);
+                let h = 1e-5;
+                for k in 0..2 {
+                    let mut qp = q;
+                    let mut qm = q;
+                    qp[k] += h;
+                    qm[k] -= h;
+                    let tp = ShapeTerms::first(&cat, qp);
+                    let tm = ShapeTerms::first(&cat, qm);
+                    for i in 0..2 {
+                        for j in 0..2 {
+                            let fd = (tp.m[i][j] - tm.m[i][j]) / (2.0 * h);
+                            assert!((fd - t.dm[k][i][j]).abs() < 1e-8);
+                            for l in 0..2 {
+                                let fd2 = (tp.dm[l][i][j] - tm.dm[l][i][j]) / (2.0 * h);
+                                assert!(
+                                    (fd2 - t.d2m[k][l][i][j]).abs() < 1e-7,
+                                    "{fd2} {}",
+                                    t.d2m[k][l][i][j]
+                                );
+                            }
+                        }
+                        for r in 0..3 {
+                            let fd = (tp.a[i][r] - tm.a[i][r]) / (2.0 * h);
+                            assert!((fd - t.da[k][i][r]).abs() < 1e-8);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,320 @@
+//! Shape trajectories in time (plans) and their sampled form (schedules).
+
+use crate::dynamics::inverse_dynamics;
+use crate::error::{Error, Result};
+use crate::model::{Cat, TorqueNorm};
+use serde::Serialize;
+
+/// The three phases of the manoeuvre.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Phase {
+    Fold,
+    Twist,
+    Unfold,
+}
+
+impl Phase {
+    pub const ALL: [Phase; 3] = [Phase::Fold, Phase::Twist, Phase::Unfold];
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Fold => "fold",
+            Phase::Twist => "twist",
+            Phase::Unfold => "unfold",
+        }
+    }
+    pub fn parse(s: &str) -> Option<Phase> {
+        Phase::ALL.into_iter().find(|p| p.name() == s)
+    }
+}
+
+/// Shape, rate and acceleration at one instant.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeState {
+    pub q: [f64; 2],
+    pub qd: [f64; 2],
+    pub qdd: [f64; 2],
+    pub phase: Phase,
+}
+
+/// A prescribed shape trajectory over `[0, duration]`.
+pub trait ShapePlan {
+    /// Phase boundaries `[0, t1, t2, T]` (four instants, non-decreasing).
+    fn phase_bounds(&self) -> Vec<f64>;
+    /// State at `t` in phase `i` (`t` within that phase's bounds). Phases meet at
+    /// rest but their accelerations, and so their torques, may jump at a junction:
+    /// this gives each side its own value.
+    fn state_in(&self, i: usize, t: f64) -> ShapeState;
+    /// State at `t`, in the phase that starts at or before `t`.
+    fn state(&self, t: f64) -> ShapeState {
+        let b = self.phase_bounds();
+        let i = (0..3).find(|&i| t < b[i + 1]).unwrap_or(2);
+        self.state_in(i, t)
+    }
+    fn duration(&self) -> f64 {
+        *self.phase_bounds().last().unwrap()
+    }
+    /// Feed-forward torque at `t` in phase `i`: by default the inverse dynamics along the plan.
+    fn torque_in(&self, cat: &Cat, i: usize, t: f64) -> [f64; 2] {
+        let s = self.state_in(i, t);
+        inverse_dynamics(cat, s.q, s.qd, s.qdd)
+    }
+}
+
+/// One row of a torque schedule (SI units).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Row {
+    pub t: f64,
+    pub phase: Phase,
+    pub q: [f64; 2],
+    pub qd: [f64; 2],
+    pub qdd: [f64; 2],
+    pub tau: [f64; 2],
+}
+
+/// A plan sampled in time with its joint torque: what a user feeds to a
+/// simulator or a motor controller.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Schedule {
+    pub rows: Vec<Row>,
+}
+
+pub const CSV_HEADER: &str =
+    "t_s,phase,q1_rad,q2_rad,qd1_rad_s,qd2_rad_s,qdd1_rad_s2,qdd2_rad_s2,tau1_nm,tau2_nm";
+
+impl Schedule {
+    /// Samples `per_phase` intervals in each phase, both ends included: a
+    /// junction instant appears twice, once as the end of a phase and once as
+    /// the start of the next, so that a torque jump there is kept exactly.
+    pub fn sample(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize) -> Schedule {
+        let b = plan.phase_bounds();
+        let mut rows = Vec::with_capacity(3 * per_phase + 1);
+        for i in 0..3 {
+            for k in 0..=per_phase {
+                let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+                let s = plan.state_in(i, t);
+                let tau = plan.torque_in(cat, i, t);
+                rows.push(Row {
+                    t,
+                    phase: s.phase,
+                    q: s.q,
+                    qd: s.qd,
+                    qdd: s.qdd,
+                    tau,
+                });
+            }
+        }
+        Schedule { rows }
+    }
+
+    pub fn peak(&self, norm: TorqueNorm) -> f64 {
+        self.rows.iter().map(|r| norm.of(r.tau)).fold(0.0, f64::max)
+    }
+
+    pub fn to_csv(&self) -> String {
+        let mut s = String::from(CSV_HEADER);
+        s.push('\n');
+        for r in &self.rows {
+            s.push_str(&format!(
+                "{:.9},{},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n",
+                r.t,
+                r.phase.name(),
+                r.q[0],
+                r.q[1],
+                r.qd[0],
+                r.qd[1],
+                r.qdd[0],
+                r.qdd[1],
+                r.tau[0],
+                r.tau[1]
+            ));
+        }
+        s
+    }
+
+    /// Parses a schedule CSV written by [`Schedule::to_csv`] (columns by header name).
+    pub fn from_csv(text: &str, origin: &str) -> Result<Schedule> {
+        let bad = |line: usize, msg: String| Error::Schedule {
+            file: origin.to_string(),
+            line,
+            message: msg,
+        };
+        let mut lines = text
+            .lines()
+            .enumerate()
+            .filter(|(_, l)| !l.trim().is_empty());
+        let (_, header) = lines
+            .next()
+            .ok_or_else(|| bad(1, "empty file; expected a header line".into()))?;
+        let cols: Vec<&str> = header.split(',').map(str::trim).collect();
+        let want = [
+            "t_s",
+            "phase",
+            "q1_rad",
+            "q2_rad",
+            "qd1_rad_s",
+            "qd2_rad_s",
+            "tau1_nm",
+            "tau2_nm",
+        ];
+        let mut idx = [0usize; 8];
+        for (k, w) in want.iter().enumerate() {
+            idx[k] = cols.iter().position(|c| c == w).ok_or_else(|| {
+                bad(
+                    1,
+                    format!("missing column `{w}`; a schedule needs the columns of `{CSV_HEADER}`"),
+                )
+            })?;
+        }
+        let qdd_idx = [
+            cols.iter().position(|c| *c == "qdd1_rad_s2"),
+            cols.iter().position(|c| *c == "qdd2_rad_s2"),
+        ];
+        let mut rows = Vec::new();
+        for (n, line) in lines {
+            let f: Vec<&str> = line.split(',').map(str::trim).collect();
+            let num = |i: usize| -> Result<f64> {
+                let v = f
+                    .get(i)
+                    .ok_or_else(|| bad(n + 1, format!("only {} fields", f.len())))?;
+                let x: f64 = v.parse().map_err(|_| {
+                    bad(
+                        n + 1,
+                        format!("`{v}` is not a number (column `{}`)", cols[i]),
+                    )
+                })?;
+                if !x.is_finite() {
+                    return Err(bad(
+                        n + 1,
+                        format!("non-finite value in column `{}`", cols[i]),
+                    ));
+                }
+                Ok(x)
+            };
+            let ph = f.get(idx[1]).copied().unwrap_or("");
+            let phase = Phase::parse(ph).ok_or_else(|| {
+                bad(
+                    n + 1,
+                    format!("unknown phase `{ph}`; use fold, twist or unfold"),
+                )
+            })?;
+            let qdd = match qdd_idx {
+                [Some(a), Some(b)] => [num(a)?, num(b)?],
+                _ => [f64::NAN; 2],
+            };
+            let row = Row {
+                t: num(idx[0])?,
+                phase,
+                q: [num(idx[2])?, num(idx[3])?],
+                qd: [num(idx[4])?, num(idx[5])?],
+                qdd,
+                tau: [num(idx[6])?, num(idx[7])?],
+            };
+            if let Some(prev) = rows.last() {
+                let p: &Row = prev;
+                let ok = row.t > p.t || (row.t == p.t && row.phase > p.phase);
+                if !ok || row.phase < p.phase {
+                    return Err(bad(
+                        n + 1,
+                        format!(
+                            "time {} / phase {} after time {} / phase {}: times must increase, repeating only where a phase begins, and phases must come in the order fold, twist, unfold",
+                            row.t,
+                            row.phase.name(),
+                            p.t,
+                            p.phase.name()
+                        ),
+                    ));
+                }
+            }
+            rows.push(row);
+        }
+        let sched = Schedule { rows };
+        for p in Phase::ALL {
+            if sched.phase_range(p).len() < 2 {
+                return Err(bad(
+                    1,
+                    format!("phase {} needs at least two rows", p.name()),
+                ));
+            }
+        }
+        Ok(sched)
+    }
+
+    /// Rows of one phase (phases are stored in order).
+    fn phase_range(&self, p: Phase) -> std::ops::Range<usize> {
+        self.rows.partition_point(|r| r.phase < p)..self.rows.partition_point(|r| r.phase <= p)
+    }
+
+    /// Interval `k` (rows `k`, `k + 1` of phase `i`) holding `t`, and `t` clamped to it.
+    fn locate(&self, i: usize, t: f64) -> (usize, f64) {
+        let r = self.phase_range(Phase::ALL[i]);
+        let rows = &self.rows[r.clone()];
+        let n = rows.len();
+        let k = rows
+            .partition_point(|x| x.t <= t)
+            .saturating_sub(1)
+            .min(n - 2);
+        (r.start + k, t.clamp(rows[k].t, rows[k + 1].t))
+    }
+}
+
+/// A sampled schedule is itself a plan: cubic Hermite in `q` (from `q`, `q_dot`),
+/// linear in the recorded torque, which is the feed-forward.
+impl ShapePlan for Schedule {
+    fn phase_bounds(&self) -> Vec<f64> {
+        let mut b = vec![self.rows[0].t];
+        for p in [Phase::Twist, Phase::Unfold] {
+            b.push(self.rows[self.phase_range(p).start].t);
+        }
+        b.push(self.rows.last().unwrap().t);
+        b
+    }
+
+    fn state_in(&self, i: usize, t: f64) -> ShapeState {
+        let (k, t) = self.locate(i, t);
+        let (a, b) = (&self.rows[k], &self.rows[k + 1]);
+        let h = b.t - a.t;
+        let x = (t - a.t) / h;
+        let (h00, h10, h01, h11) = (
+            2.0 * x * x * x - 3.0 * x * x + 1.0,
+            x * x * x - 2.0 * x * x + x,
+            -2.0 * x * x * x + 3.0 * x * x,
+            x * x * x - x * x,
+        );
+        let (d00, d10, d01, d11) = (
+            6.0 * x * x - 6.0 * x,
+            3.0 * x * x - 4.0 * x + 1.0,
+            -6.0 * x * x + 6.0 * x,
+            3.0 * x * x - 2.0 * x,
+        );
+        let (s00, s10, s01, s11) = (
+            12.0 * x - 6.0,
+            6.0 * x - 4.0,
+            -12.0 * x + 6.0,
+            6.0 * x - 2.0,
+        );
+        let mut st = ShapeState {
+            q: [0.0; 2],
+            qd: [0.0; 2],
+            qdd: [0.0; 2],
+            phase: a.phase,
+        };
+        for j in 0..2 {
+            st.q[j] = h00 * a.q[j] + h10 * h * a.qd[j] + h01 * b.q[j] + h11 * h * b.qd[j];
+            st.qd[j] = (d00 * a.q[j] + d10 * h * a.qd[j] + d01 * b.q[j] + d11 * h * b.qd[j]) / h;
+            st.qdd[j] =
+                (s00 * a.q[j] + s10 * h * a.qd[j] + s01 * b.q[j] + s11 * h * b.qd[j]) / (h * h);
+        }
+        st
+    }
+
+    fn torque_in(&self, _cat: &Cat, i: usize, t: f64) -> [f64; 2] {
+        let (k, t) = self.locate(i, t);
+        let (a, b) = (&self.rows[k], &self.rows[k + 1]);
+        let x = (t - a.t) / (b.t - a.t);
+        [
+            a.tau[0] + x * (b.tau[0] - a.tau[0]),
+            a.tau[1] + x * (b.tau[1] - a.tau[1]),
+        ]
+    }
+}

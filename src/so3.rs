@@ -1,0 +1,140 @@
+//! Attitude helpers: flip and tilt of a final attitude, quaternion kinematics,
+//! and the SO(3) maps the free-form optimiser linearises.
+
+use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
+
+pub fn to_na(m: &[[f64; 3]; 3]) -> Matrix3<f64> {
+    Matrix3::from_fn(|i, j| m[i][j])
+}
+
+pub fn from_na(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|i| [0, 1, 2].map(|j| m[(i, j)]))
+}
+
+/// Flip (signed rotation about the initial spine, `(-pi, pi]`) and tilt
+/// (angle between final and initial spine) of an attitude, both in radians.
+///
+/// Swing-twist decomposition `R = swing * Rz(flip)`; the twist angle of a unit
+/// quaternion about z is `2 atan2(q_z, q_w)`.
+pub fn flip_and_tilt(q: &UnitQuaternion<f64>) -> (f64, f64) {
+    let flip = wrap(2.0 * q.k.atan2(q.w));
+    let spine = q * Vector3::z();
+    let tilt = spine.z.clamp(-1.0, 1.0).acos();
+    (flip, tilt)
+}
+
+/// Wraps an angle to `(-pi, pi]`.
+pub fn wrap(a: f64) -> f64 {
+    let mut x = a % (2.0 * std::f64::consts::PI);
+    if x <= -std::f64::consts::PI {
+        x += 2.0 * std::f64::consts::PI;
+    } else if x > std::f64::consts::PI {
+        x -= 2.0 * std::f64::consts::PI;
+    }
+    x
+}
+
+/// Distance of a flip from pi in either sense: `pi - |flip|`, radians.
+pub fn flip_error(flip: f64) -> f64 {
+    std::f64::consts::PI - flip.abs()
+}
+
+/// Quaternion stored as `[w, x, y, z]` in integrator states.
+pub fn quat_from(y: &[f64]) -> UnitQuaternion<f64> {
+    UnitQuaternion::new_normalize(Quaternion::new(y[0], y[1], y[2], y[3]))
+}
+
+/// `d/dt q = 1/2 q (0, w)` for a body-frame rate `w`.
+pub fn quat_rate(y: &[f64], w: [f64; 3]) -> [f64; 4] {
+    let (qw, qx, qy, qz) = (y[0], y[1], y[2], y[3]);
+    [
+        0.5 * (-qx * w[0] - qy * w[1] - qz * w[2]),
+        0.5 * (qw * w[0] + qy * w[2] - qz * w[1]),
+        0.5 * (qw * w[1] + qz * w[0] - qx * w[2]),
+        0.5 * (qw * w[2] + qx * w[1] - qy * w[0]),
+    ]
+}
+
+/// Renormalises the quaternion in `y[..4]`.
+pub fn normalize_quat(y: &mut [f64]) {
+    let n = (y[0] * y[0] + y[1] * y[1] + y[2] * y[2] + y[3] * y[3]).sqrt();
+    for x in y.iter_mut().take(4) {
+        *x /= n;
+    }
+}
+
+pub fn hat(v: &Vector3<f64>) -> Matrix3<f64> {
+    Matrix3::new(0.0, -v.z, v.y, v.z, 0.0, -v.x, -v.y, v.x, 0.0)
+}
+
+pub fn exp(v: &Vector3<f64>) -> Matrix3<f64> {
+    *Rotation3::new(*v).matrix()
+}
+
+/// Rotation vector of `r`, accurate near the identity (atan2 of sine and cosine parts).
+pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
+    let v = 0.5
+        * Vector3::new(
+            r[(2, 1)] - r[(1, 2)],
+            r[(0, 2)] - r[(2, 0)],
+            r[(1, 0)] - r[(0, 1)],
+        );
+    let (s, c) = (v.norm(), 0.5 * (r.trace() - 1.0));
+    if c < -0.9 {
+        return Rotation3::from_matrix_unchecked(*r).scaled_axis();
+    }
+    if s < 1e-300 {
+        return v;
+    }
+    v * (s.atan2(c) / s)
+}
+
+/// Right Jacobian of SO(3): `exp(v + dv) = exp(v) exp(J_r(v) dv)` to first order.
+pub fn right_jacobian(v: &Vector3<f64>) -> Matrix3<f64> {
+    let t2 = v.norm_squared();
+    let h = hat(v);
+    let (b, c) = if t2 < 1e-8 {
+        (0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0)
+    } else {
+        let t = t2.sqrt();
+        ((1.0 - t.cos()) / t2, (t - t.sin()) / (t2 * t))
+    };
+    Matrix3::identity() - b * h + c * h * h
+}
+
+/// Inverse of the right Jacobian.
+pub fn right_jacobian_inv(v: &Vector3<f64>) -> Matrix3<f64> {
+    right_jacobian(v)
+        .try_inverse()
+        .unwrap_or_else(Matrix3::identity)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn flip_and_tilt_of_known_rotations() {
+        let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 2.5);
+        let (f, t) = flip_and_tilt(&q);
+        assert!((f - 2.5).abs() < 1e-14 && t.abs() < 1e-7);
+        let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.3);
+        let (f, t) = flip_and_tilt(&q);
+        assert!(f.abs() < 1e-14 && (t - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn right_jacobian_matches_finite_difference() {
+        let v = Vector3::new(0.4, -1.1, 0.7);
+        let jr = right_jacobian(&v);
+        let h = 1e-6;
+        for k in 0..3 {
+            let mut dv = Vector3::zeros();
+            dv[k] = h;
+            let d = log(&(exp(&v).transpose() * exp(&(v + dv)))) / h;
+            for i in 0..3 {
+                assert!((d[i] - jr[(i, k)]).abs() < 1e-5, "{d} {jr}");
+            }
+        }
+    }
+}

@@ -1,0 +1,182 @@
+//! The real binary on a temporary directory.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_catflip"))
+}
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+}
+
+fn run(args: &[&str], dir: &Path) -> Output {
+    bin()
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(&["analyze", cfg.to_str().unwrap(), "--json"], dir.path());
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for key in [
+        "fall_time_s",
+        "theta_deg",
+        "bend_deg",
+        "I_t",
+        "I_a",
+        "I_yy",
+        "C",
+        "omega0_rad_s",
+        "twist_rad",
+        "one_turn_theta_deg",
+        "seed_torque_estimate_nm",
+        "peak_torque_nm",
+        "flip_deg",
+        "tilt_deg",
+        "phase_durations_s",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert!((v["flip_deg"].as_f64().unwrap().abs() - 180.0).abs() < 1e-6);
+    let csv = std::fs::read_to_string(dir.path().join("output/seed/analytic.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header = lines.next().unwrap();
+    assert!(header.starts_with("t_s,phase,"));
+    // the CSV's peak agrees with the JSON's (the JSON samples more densely)
+    let peak = lines
+        .map(|l| {
+            let f: Vec<f64> = l.split(',').skip(8).map(|x| x.parse().unwrap()).collect();
+            f[0].hypot(f[1])
+        })
+        .fold(0.0, f64::max);
+    let jp = v["peak_torque_nm"].as_f64().unwrap();
+    assert!(
+        peak <= jp * (1.0 + 1e-9) && peak > 0.99 * jp,
+        "{peak} vs {jp}"
+    );
+}
+
+#[test]
+fn simulate_replays_a_written_schedule() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(&["analyze", cfg.to_str().unwrap()], dir.path());
+    assert!(o.status.success());
+    let sched = dir.path().join("output/seed/analytic.csv");
+    let o = run(
+        &[
+            "simulate",
+            cfg.to_str().unwrap(),
+            "--schedule",
+            sched.to_str().unwrap(),
+            "--json",
+        ],
+        dir.path(),
+    );
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["flip_error_rad"].as_f64().unwrap().abs() < 1e-6, "{out}");
+    assert!(v["momentum_drift_nms"].as_f64().unwrap() < 1e-12);
+}
+
+#[test]
+fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = std::fs::read_to_string(configs().join("seed.toml")).unwrap();
+    let cases: Vec<(&str, String, Vec<&str>, &str)> = vec![
+        (
+            "negative mass",
+            seed.replace("mass = 1.0", "mass = -1.0"),
+            vec![],
+            "cat.mass",
+        ),
+        (
+            "unknown key",
+            seed.replace("radius = 0.1", "radius = 0.1\nradus = 0.2"),
+            vec![],
+            "radus",
+        ),
+        (
+            "malformed",
+            seed.replace("[fall]", "[fall"),
+            vec![],
+            "TOML parse error",
+        ),
+        (
+            "unknown joint",
+            seed.replace("\"no-twist\"", "\"hinge\""),
+            vec![],
+            "hinge",
+        ),
+        (
+            "bad split",
+            seed.clone(),
+            vec!["--set", "analytic.split=[0.2, 0.2, 0.2]"],
+            "analytic.split",
+        ),
+        (
+            "bad override",
+            seed.clone(),
+            vec!["--set", "fall.height"],
+            "KEY=VALUE",
+        ),
+    ];
+    for (what, body, extra, needle) in cases {
+        let path = dir.path().join("bad.toml");
+        std::fs::write(&path, body).unwrap();
+        let mut args = vec!["analyze", path.to_str().unwrap()];
+        args.extend(extra);
+        let o = run(&args, dir.path());
+        let (_, err) = text(&o);
+        assert!(!o.status.success(), "{what} should fail");
+        assert!(
+            err.contains(needle),
+            "{what}: `{err}` should name `{needle}`"
+        );
+        assert!(
+            !dir.path().join("output").exists(),
+            "{what} left output behind"
+        );
+    }
+    let o = run(&["analyze", "no-such.toml"], dir.path());
+    assert!(!o.status.success() && text(&o).1.contains("no-such.toml"));
+    // a broken schedule names the file, the line and the column
+    let cfg = configs().join("seed.toml");
+    let sched = dir.path().join("s.csv");
+    std::fs::write(
+        &sched,
+        "t_s,phase,q1_rad,q2_rad,qd1_rad_s,qd2_rad_s,tau1_nm,tau2_nm\n0,fold,0,0,0,0,x,0\n",
+    )
+    .unwrap();
+    let o = run(
+        &[
+            "simulate",
+            cfg.to_str().unwrap(),
+            "--schedule",
+            sched.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    let (_, err) = text(&o);
+    assert!(
+        !o.status.success() && err.contains("line 2") && err.contains("tau1_nm"),
+        "{err}"
+    );
+}
