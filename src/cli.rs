@@ -47,6 +47,21 @@ enum Command {
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
+    /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
+    Optimize {
+        #[command(flatten)]
+        common: Common,
+        #[arg(long, value_enum, default_value = "phased")]
+        mode: Mode,
+        /// Print each iteration (bend evaluations, SCP iterations).
+        #[arg(long)]
+        verbose: bool,
+    },
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+enum Mode {
+    Phased,
 }
 
 fn load(c: &Common) -> Result<Config> {
@@ -62,6 +77,11 @@ pub fn run() -> Result<()> {
     match cli.command {
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
+        Command::Optimize {
+            common,
+            mode,
+            verbose,
+        } => cmd_optimize(&common, mode, verbose),
     }
 }
 
@@ -213,6 +233,83 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
         );
         for w in written {
             row("wrote", w.display().to_string());
+        }
+    }
+    Ok(())
+}
+
+fn cmd_optimize(c: &Common, mode: Mode, verbose: bool) -> Result<()> {
+    let cfg = load(c)?;
+    match mode {
+        Mode::Phased => {
+            let r = catflip::phased::optimize(&cfg, |e| {
+                if verbose {
+                    eprintln!(
+                        "  bend {:8.3} deg   unit peak {:10.5} N m s^2   peak {:9.5} N m",
+                        e.bend_deg, e.unit_peak, e.peak_nm
+                    );
+                }
+            })?;
+            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
+            let json = serde_json::to_string_pretty(&r)?;
+            let mut out = Output::default();
+            out.add("phased.csv", sched.to_csv());
+            out.add("phased.json", json.clone());
+            let written = out.commit(&out_dir(c, &cfg))?;
+            if c.json {
+                println!("{json}");
+                return Ok(());
+            }
+            println!(
+                "catflip optimize --mode phased: {} ({} joint), status {:?}",
+                cfg.name,
+                cfg.cat.joint.name(),
+                r.status
+            );
+            row(
+                "peak torque",
+                format!(
+                    "{:.5} N m (SOCP bound {:.5})",
+                    r.peak_torque_nm, r.socp_peak_torque_nm
+                ),
+            );
+            row(
+                "bend / theta",
+                format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+            );
+            row("twist", format!("{:.6} rad", r.twist_rad));
+            let d = r.phase_durations_s;
+            row(
+                "phase durations",
+                format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
+            );
+            row(
+                "seed cosine schedule, same bend",
+                format!(
+                    "{:.5} N m ({:.2}x the optimum)",
+                    r.analytic_peak_same_bend_nm, r.improvement_factor
+                ),
+            );
+            row(
+                "flip (dynamic sim)",
+                format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
+            );
+            row("tilt", format!("{:.3e} deg", r.tilt_deg));
+            row(
+                "sim peak torque",
+                format!("{:.5} N m", r.sim_peak_torque_nm),
+            );
+            row(
+                "solve time",
+                format!(
+                    "{:.3} s ({} bend evaluations)",
+                    r.solve_time_s,
+                    r.evaluations.len()
+                ),
+            );
+            for w in written {
+                row("wrote", w.display().to_string());
+            }
         }
     }
     Ok(())

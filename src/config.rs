@@ -130,7 +130,7 @@ impl Default for SimulateConfig {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PhasedConfig {
-    /// Grid intervals per phase of the path-timing SOCP (default 80).
+    /// Grid intervals per phase of the path-timing SOCP (default 40).
     pub nodes: usize,
     /// Bend search range, degrees (default 5 to 170).
     pub bend_min_deg: f64,
@@ -144,7 +144,7 @@ pub struct PhasedConfig {
 impl Default for PhasedConfig {
     fn default() -> Self {
         Self {
-            nodes: 80,
+            nodes: 40,
             bend_min_deg: 5.0,
             bend_max_deg: 170.0,
             scan_points: 12,

@@ -5,16 +5,19 @@
 pub mod analytic;
 pub mod analyze;
 pub mod config;
+pub mod conic;
 pub mod dynamics;
 pub mod error;
 pub mod model;
 pub mod ode;
 pub mod output;
 pub mod path;
+pub mod phased;
 pub mod plan;
 pub mod simulate;
 pub mod small;
 pub mod so3;
+pub mod timing;
 
 pub use config::Config;
 pub use error::{Error, Result};

@@ -66,48 +66,163 @@ pub enum Timing {
     Grid(GridTiming),
 }
 
-/// Path timing with `beta = s_dot^2` linear in `s` on each interval
-/// (constant `a = s_ddot`), as the phase SOCP assumes. Unit total time; the
-/// phase duration scales it.
+/// Path timing with `a = s_ddot` continuous and piecewise linear in `s`, so
+/// `beta = s_dot^2` is piecewise quadratic (`beta' = 2 a`), as the phase SOCP
+/// assumes. Scaled to unit total time; the phase duration scales it (F3).
+///
+/// `s(t)` has no closed form: the time of each grid interval is integrated by
+/// Gauss-Legendre quadrature (with `v = w^2` substitutions that absorb the
+/// `1/sqrt(beta)` singularity at a rest end), tabulated on sub-steps, and
+/// inverted by cubic Hermite interpolation in time; `s_dot = sqrt(beta(s))`
+/// and `s_ddot = a(s)` are then evaluated exactly at that `s`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GridTiming {
     /// Grid in `s`, `s[0] = 0`, `s[K] = 1`.
     pub s: Vec<f64>,
-    /// `s_dot^2` at the grid points in unit time.
+    /// `s_dot^2` at the grid points, unit time.
     pub beta: Vec<f64>,
+    /// `s_ddot` at the grid points, unit time.
+    pub a: Vec<f64>,
     /// Unit-time instants of the grid points.
     pub t: Vec<f64>,
+    /// Duration of the timing as given, before rescaling to 1 s.
+    pub raw_time: f64,
+    /// Sub-step table: (time, s) pairs, `SUB` per interval.
+    #[serde(skip)]
+    table: Vec<(f64, f64)>,
 }
 
+const SUB: usize = 8;
+const GL_X: [f64; 6] = [
+    -0.932_469_514_203_152,
+    -0.661_209_386_466_264_5,
+    -0.238_619_186_083_196_9,
+    0.238_619_186_083_196_9,
+    0.661_209_386_466_264_5,
+    0.932_469_514_203_152,
+];
+const GL_W: [f64; 6] = [
+    0.171_324_492_379_170_3,
+    0.360_761_573_048_138_6,
+    0.467_913_934_572_691,
+    0.467_913_934_572_691,
+    0.360_761_573_048_138_6,
+    0.171_324_492_379_170_3,
+];
+
 impl GridTiming {
-    pub fn new(s: Vec<f64>, beta: Vec<f64>) -> Self {
-        let mut t = vec![0.0];
-        for k in 0..s.len() - 1 {
-            let ds = s[k + 1] - s[k];
-            let denom = beta[k].max(0.0).sqrt() + beta[k + 1].max(0.0).sqrt();
-            t.push(t[k] + 2.0 * ds / denom);
+    /// From grid values of `beta` and `a` (any total time; rescaled to 1 s).
+    pub fn new(s: Vec<f64>, beta: Vec<f64>, a: Vec<f64>) -> Self {
+        let mut g = Self {
+            s,
+            beta: beta.iter().map(|b| b.max(0.0)).collect(),
+            a,
+            t: Vec::new(),
+            raw_time: 0.0,
+            table: Vec::new(),
+        };
+        g.tabulate();
+        let total = g.table.last().unwrap().0;
+        g.raw_time = total;
+        // rescale to unit time: t' = t / T0, beta' = beta T0^2, a' = a T0^2
+        let t2 = total * total;
+        g.beta.iter_mut().for_each(|b| *b *= t2);
+        g.a.iter_mut().for_each(|x| *x *= t2);
+        g.tabulate();
+        g
+    }
+
+    /// The same timing run backwards along the reversed path (`s -> 1 - s`).
+    pub fn reversed(&self) -> Self {
+        let s = self.s.iter().rev().map(|x| 1.0 - x).collect();
+        let beta = self.beta.iter().rev().copied().collect();
+        let a = self.a.iter().rev().map(|x| -x).collect();
+        let mut g = Self {
+            s,
+            beta,
+            a,
+            t: Vec::new(),
+            raw_time: self.raw_time,
+            table: Vec::new(),
+        };
+        g.tabulate();
+        g
+    }
+
+    fn interval(&self, s: f64) -> usize {
+        let n = self.s.len() - 1;
+        self.s
+            .partition_point(|x| *x <= s)
+            .saturating_sub(1)
+            .min(n - 1)
+    }
+
+    /// `beta(s)` and `a(s)`.
+    pub fn beta_a(&self, s: f64) -> (f64, f64) {
+        let k = self.interval(s);
+        let ds = self.s[k + 1] - self.s[k];
+        let u = (s - self.s[k]).clamp(0.0, ds);
+        let (a0, a1) = (self.a[k], self.a[k + 1]);
+        let beta = self.beta[k] + 2.0 * a0 * u + (a1 - a0) * u * u / ds;
+        (beta.max(0.0), a0 + (a1 - a0) * u / ds)
+    }
+
+    /// Time to go from `s0` to `s1` (same interval).
+    fn seg_time(&self, s0: f64, s1: f64) -> f64 {
+        let h = 0.5 * (s1 - s0);
+        let w_max = h.sqrt();
+        let mut sum = 0.0;
+        for (x, w) in GL_X.iter().zip(GL_W) {
+            let wv = 0.5 * w_max * (x + 1.0);
+            let jac = 0.5 * w_max * w;
+            for v in [s0 + wv * wv, s1 - wv * wv] {
+                let (b, _) = self.beta_a(v);
+                if b > 0.0 {
+                    sum += jac * 2.0 * wv / b.sqrt();
+                }
+            }
         }
-        let total = *t.last().unwrap();
-        // renormalise to unit time so that the phase duration scales exactly
-        let scale = 1.0 / total;
-        let beta = beta.iter().map(|b| b.max(0.0) / (scale * scale)).collect();
-        let t = t.iter().map(|x| x * scale).collect();
-        Self { s, beta, t }
+        sum
+    }
+
+    fn tabulate(&mut self) {
+        let n = self.s.len() - 1;
+        let mut table = vec![(0.0, 0.0)];
+        let mut t = vec![0.0];
+        let mut now = 0.0;
+        for k in 0..n {
+            for j in 0..SUB {
+                let s0 = self.s[k] + (self.s[k + 1] - self.s[k]) * j as f64 / SUB as f64;
+                let s1 = self.s[k] + (self.s[k + 1] - self.s[k]) * (j + 1) as f64 / SUB as f64;
+                now += self.seg_time(s0, s1);
+                table.push((now, s1));
+            }
+            t.push(now);
+        }
+        self.table = table;
+        self.t = t;
     }
 
     /// `(s, s_dot, s_ddot)` at unit time `tau`.
     fn eval(&self, tau: f64) -> (f64, f64, f64) {
-        let n = self.t.len() - 1;
-        let k = match self.t.binary_search_by(|x| x.partial_cmp(&tau).unwrap()) {
-            Ok(i) => i.min(n - 1),
-            Err(i) => i.saturating_sub(1).min(n - 1),
-        };
-        let ds = self.s[k + 1] - self.s[k];
-        let a = (self.beta[k + 1] - self.beta[k]) / (2.0 * ds);
-        let v0 = self.beta[k].sqrt();
-        let dt = (tau - self.t[k]).clamp(0.0, self.t[k + 1] - self.t[k]);
-        let s = (self.s[k] + v0 * dt + 0.5 * a * dt * dt).min(self.s[k + 1]);
-        ((s), (v0 + a * dt).max(0.0), a)
+        let tb = &self.table;
+        let n = tb.len() - 1;
+        let j = tb
+            .partition_point(|e| e.0 <= tau)
+            .saturating_sub(1)
+            .min(n - 1);
+        let ((t0, s0), (t1, s1)) = (tb[j], tb[j + 1]);
+        let h = t1 - t0;
+        let x = ((tau - t0) / h).clamp(0.0, 1.0);
+        let v0 = self.beta_a(s0).0.sqrt();
+        let v1 = self.beta_a(s1).0.sqrt();
+        let s = (2.0 * x * x * x - 3.0 * x * x + 1.0) * s0
+            + (x * x * x - 2.0 * x * x + x) * h * v0
+            + (-2.0 * x * x * x + 3.0 * x * x) * s1
+            + (x * x * x - x * x) * h * v1;
+        let s = s.clamp(s0, s1);
+        let (b, a) = self.beta_a(s);
+        (s, b.sqrt(), a)
     }
 }
 
@@ -202,11 +317,19 @@ mod tests {
     fn timings_are_rest_to_rest_with_consistent_derivatives() {
         fd_check(&Timing::Cosine, 0.7);
         fd_check(&Timing::CosineRate, 1.3);
-        // a triangular beta profile: accelerate then decelerate
+        // beta = s (1 - s), a = beta'/2 = 1/2 - s: accelerate then decelerate
         let k = 10;
         let s: Vec<f64> = (0..=k).map(|i| i as f64 / k as f64).collect();
-        let beta: Vec<f64> = s.iter().map(|x| x.min(1.0 - x)).collect();
-        fd_check(&Timing::Grid(GridTiming::new(s, beta)), 0.9);
+        let beta: Vec<f64> = s.iter().map(|x| x * (1.0 - x)).collect();
+        let a: Vec<f64> = s.iter().map(|x| 0.5 - x).collect();
+        let g = GridTiming::new(s, beta, a);
+        // exact: s_dot = sqrt(s (1 - s)) gives s = (1 - cos t)/2 in time pi, rescaled to 1
+        for tau in [0.1, 0.37, 0.5, 0.81] {
+            let (sv, _, _) = g.eval(tau);
+            let want = 0.5 * (1.0 - (std::f64::consts::PI * tau).cos());
+            assert!((sv - want).abs() < 1e-7, "{tau}: {sv} vs {want}");
+        }
+        fd_check(&Timing::Grid(g), 0.9);
     }
 
     #[test]

@@ -180,3 +180,78 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
         "{err}"
     );
 }
+
+#[test]
+fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(
+        &[
+            "optimize",
+            cfg.to_str().unwrap(),
+            "--mode",
+            "phased",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for key in [
+        "mode",
+        "status",
+        "peak_torque_nm",
+        "bend_deg",
+        "theta_deg",
+        "twist_rad",
+        "phase_durations_s",
+        "flip_deg",
+        "tilt_deg",
+        "sim_peak_torque_nm",
+        "solve_time_s",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["mode"], "phased");
+    assert_eq!(v["status"], "solved");
+    let on_disk: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("output/seed/phased.json")).unwrap(),
+    )
+    .unwrap();
+    assert_eq!(on_disk["peak_torque_nm"], v["peak_torque_nm"]);
+    let csv = std::fs::read_to_string(dir.path().join("output/seed/phased.csv")).unwrap();
+    let last: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
+    let total: f64 = v["phase_durations_s"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .sum();
+    assert!(
+        (last[0].parse::<f64>().unwrap() - total).abs() < 1e-6,
+        "schedule ends at the manoeuvre time"
+    );
+}
+
+#[test]
+fn impossible_torque_limit_fails_with_the_least_height_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(
+        &[
+            "optimize",
+            cfg.to_str().unwrap(),
+            "--set",
+            "limits.max_torque=0.1",
+        ],
+        dir.path(),
+    );
+    let (_, err) = text(&o);
+    assert!(!o.status.success());
+    assert!(
+        err.contains("impossible") && err.contains("fall.height") && err.contains("at least"),
+        "{err}"
+    );
+    assert!(!dir.path().join("output").exists());
+}

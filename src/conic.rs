@@ -1,0 +1,279 @@
+//! A conic program with a fixed sparsity pattern, solved (and re-solved after
+//! in-place data updates) with Clarabel.
+//!
+//! Problem builders emit the constraint matrix as a sequence of `(row, col,
+//! value)` slots in the same order every time; the first emission fixes the
+//! CSC pattern and the slot-to-nonzero map, later ones only refill values
+//! (never dropping zeros), so the solver's symbolic factorisation is reused.
+
+use crate::error::{Error, Result};
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{
+    DefaultSettings, DefaultSettingsBuilder, DefaultSolver, IPSolver, SolverStatus, SupportedConeT,
+};
+
+/// Cones in the order their rows appear.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Cone {
+    Zero(usize),
+    Nonneg(usize),
+    Soc(usize),
+}
+
+/// Outcome of one solve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SolveStatus {
+    Solved,
+    /// Solved to reduced accuracy.
+    AlmostSolved,
+    Infeasible,
+    Unbounded,
+    IterationLimit,
+    NumericalError,
+}
+
+impl SolveStatus {
+    fn from_clarabel(s: SolverStatus) -> Self {
+        match s {
+            SolverStatus::Solved => SolveStatus::Solved,
+            SolverStatus::AlmostSolved => SolveStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                SolveStatus::Infeasible
+            }
+            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
+                SolveStatus::Unbounded
+            }
+            SolverStatus::MaxIterations | SolverStatus::MaxTime => SolveStatus::IterationLimit,
+            _ => SolveStatus::NumericalError,
+        }
+    }
+
+    pub fn ok(self) -> bool {
+        matches!(self, SolveStatus::Solved | SolveStatus::AlmostSolved)
+    }
+}
+
+/// Linear objective, constraint rows `A x + s = b`, `s` in the cones.
+#[derive(Debug, Clone, Default)]
+pub struct ConicData {
+    pub n: usize,
+    pub q: Vec<f64>,
+    /// Optional diagonal quadratic term `1/2 x' diag(p) x` (fixed pattern: all `n` entries).
+    pub p_diag: Option<Vec<f64>>,
+    pub rows: Vec<usize>,
+    pub cols: Vec<usize>,
+    pub vals: Vec<f64>,
+    pub b: Vec<f64>,
+    pub cones: Vec<Cone>,
+}
+
+impl ConicData {
+    pub fn new(n: usize) -> Self {
+        Self {
+            n,
+            q: vec![0.0; n],
+            ..Default::default()
+        }
+    }
+
+    /// Appends a row; returns its index.
+    pub fn row(&mut self, entries: &[(usize, f64)], b: f64) -> usize {
+        let r = self.b.len();
+        for &(c, v) in entries {
+            self.rows.push(r);
+            self.cols.push(c);
+            self.vals.push(v);
+        }
+        self.b.push(b);
+        r
+    }
+
+    pub fn cone(&mut self, c: Cone) {
+        match (self.cones.last_mut(), c) {
+            (Some(Cone::Zero(k)), Cone::Zero(m)) => *k += m,
+            (Some(Cone::Nonneg(k)), Cone::Nonneg(m)) => *k += m,
+            _ => self.cones.push(c),
+        }
+    }
+
+    pub fn m(&self) -> usize {
+        self.b.len()
+    }
+}
+
+/// A Clarabel solver bound to one sparsity pattern.
+pub struct ConicSolver {
+    solver: DefaultSolver<f64>,
+    slot: Vec<usize>,
+    nnz: usize,
+    n: usize,
+    m: usize,
+    cones: Vec<Cone>,
+    has_p: bool,
+}
+
+fn settings() -> DefaultSettings<f64> {
+    DefaultSettingsBuilder::default()
+        .verbose(false)
+        .presolve_enable(false)
+        .input_sparse_dropzeros(false)
+        .max_iter(200)
+        .build()
+        .expect("valid Clarabel settings")
+}
+
+fn csc(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
+    // order slots by (col, row), merging duplicates
+    let mut order: Vec<usize> = (0..rows.len()).collect();
+    order.sort_by_key(|&i| (cols[i], rows[i]));
+    let mut colptr = vec![0usize; n + 1];
+    let mut rowval = Vec::new();
+    let mut slot = vec![0usize; rows.len()];
+    let mut last: Option<(usize, usize)> = None;
+    for &i in &order {
+        let key = (cols[i], rows[i]);
+        if last != Some(key) {
+            rowval.push(rows[i]);
+            colptr[cols[i] + 1] += 1;
+            last = Some(key);
+        }
+        slot[i] = rowval.len() - 1;
+    }
+    for c in 0..n {
+        colptr[c + 1] += colptr[c];
+    }
+    debug_assert!(rows.iter().all(|&r| r < m));
+    (colptr, rowval, slot)
+}
+
+fn p_matrix(n: usize, diag: Option<&Vec<f64>>) -> CscMatrix<f64> {
+    match diag {
+        Some(d) => CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), d.clone()),
+        None => CscMatrix::zeros((n, n)),
+    }
+}
+
+impl ConicSolver {
+    pub fn new(data: &ConicData) -> Result<Self> {
+        let (m, n) = (data.m(), data.n);
+        let (colptr, rowval, slot) = csc(m, n, &data.rows, &data.cols);
+        let nnz = rowval.len();
+        let mut nz = vec![0.0; nnz];
+        for (i, &s) in slot.iter().enumerate() {
+            nz[s] += data.vals[i];
+        }
+        let a = CscMatrix::new(m, n, colptr, rowval, nz);
+        let cones: Vec<SupportedConeT<f64>> = data
+            .cones
+            .iter()
+            .map(|c| match *c {
+                Cone::Zero(k) => SupportedConeT::ZeroConeT(k),
+                Cone::Nonneg(k) => SupportedConeT::NonnegativeConeT(k),
+                Cone::Soc(k) => SupportedConeT::SecondOrderConeT(k),
+            })
+            .collect();
+        let p = p_matrix(n, data.p_diag.as_ref());
+        let solver =
+            DefaultSolver::new(&p, &data.q, &a, &data.b, &cones, settings()).map_err(|e| {
+                Error::Solver {
+                    what: "setting up the conic program".into(),
+                    status: "setup error".into(),
+                    hint: format!("{e}; this is a bug in the problem builder, please report it"),
+                }
+            })?;
+        Ok(Self {
+            solver,
+            slot,
+            nnz,
+            n,
+            m,
+            cones: data.cones.clone(),
+            has_p: data.p_diag.is_some(),
+        })
+    }
+
+    /// Whether `data` has this solver's pattern (same slots, sizes, cones).
+    pub fn fits(&self, data: &ConicData) -> bool {
+        data.n == self.n
+            && data.m() == self.m
+            && data.vals.len() == self.slot.len()
+            && data.cones == self.cones
+            && data.p_diag.is_some() == self.has_p
+    }
+
+    /// Replaces all data values in place (same pattern).
+    pub fn update(&mut self, data: &ConicData) -> Result<()> {
+        assert!(self.fits(data), "conic data pattern changed");
+        let mut nz = vec![0.0; self.nnz];
+        for (i, &s) in self.slot.iter().enumerate() {
+            nz[s] += data.vals[i];
+        }
+        let err = |e: clarabel::solver::DataUpdateError| Error::Solver {
+            what: "updating the conic program".into(),
+            status: "update error".into(),
+            hint: e.to_string(),
+        };
+        self.solver.update_A(&nz).map_err(err)?;
+        self.solver.update_b(&data.b).map_err(err)?;
+        self.solver.update_q(&data.q).map_err(err)?;
+        if let Some(d) = &data.p_diag {
+            self.solver.update_P(d).map_err(err)?;
+        }
+        Ok(())
+    }
+
+    /// Solves; returns the status, the primal solution and the objective.
+    pub fn solve(&mut self) -> (SolveStatus, Vec<f64>, f64) {
+        self.solver.solve();
+        let s = &self.solver.solution;
+        (SolveStatus::from_clarabel(s.status), s.x.clone(), s.obj_val)
+    }
+}
+
+/// Builds a solver for `data`, or refills `slot`'s solver if the pattern fits.
+pub fn solve_reusing(
+    slot: &mut Option<ConicSolver>,
+    data: &ConicData,
+) -> Result<(SolveStatus, Vec<f64>, f64)> {
+    match slot {
+        Some(s) if s.fits(data) => s.update(data)?,
+        _ => *slot = Some(ConicSolver::new(data)?),
+    }
+    Ok(slot.as_mut().unwrap().solve())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn small_socp_and_update_in_place() {
+        // minimise t s.t. ||(x - 1, y - 2)|| <= t, x + y = c: optimum distance from (1,2) to the line
+        let build = |c: f64| {
+            let mut d = ConicData::new(3);
+            d.q[2] = 1.0;
+            d.row(&[(0, 1.0), (1, 1.0)], c);
+            d.cone(Cone::Zero(1));
+            d.row(&[(2, -1.0)], 0.0);
+            d.row(&[(0, -1.0)], -1.0);
+            d.row(&[(1, -1.0)], -2.0);
+            d.cone(Cone::Soc(3));
+            d
+        };
+        let mut slot = None;
+        for c in [0.0, 3.0, 7.0] {
+            let (st, x, _) = solve_reusing(&mut slot, &build(c)).unwrap();
+            assert_eq!(st, SolveStatus::Solved);
+            let want = (c - 3.0f64).abs() / 2f64.sqrt();
+            assert!((x[2] - want).abs() < 1e-7, "{c}: {} vs {want}", x[2]);
+        }
+        // infeasible: x + y = 1 and x + y = 2
+        let mut d = ConicData::new(2);
+        d.row(&[(0, 1.0), (1, 1.0)], 1.0);
+        d.row(&[(0, 1.0), (1, 1.0)], 2.0);
+        d.cone(Cone::Zero(2));
+        let (st, _, _) = ConicSolver::new(&d).unwrap().solve();
+        assert_eq!(st, SolveStatus::Infeasible);
+    }
+}

@@ -1,0 +1,347 @@
+//! The certified least-peak-torque fold / twist / unfold design (MODEL.md F5).
+//!
+//! For a bend `b` each phase is a rest-to-rest traversal of a fixed path, so
+//! its least peak in time `T_i` is `p_i(b) / T_i^2` (F3) with `p_i` from the
+//! phase SOCP ([`crate::timing`]). The best split is `T_i ~ sqrt(p_i)` and the
+//! phased peak is `(sum_i sqrt(p_i))^2 / T^2`. The bend is then searched by a
+//! coarse scan (which includes the one-turn bend of F6 and the config's bend)
+//! and golden-section refinement inside the best bracket: derivative-free, so
+//! it stays correct where the objective has kinks (a phase taking over the peak).
+
+use crate::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::analyze::peak_along;
+use crate::config::Config;
+use crate::conic::SolveStatus;
+use crate::error::{Error, Result};
+use crate::model::{Cat, Joint};
+use crate::ode::OdeSettings;
+use crate::path::{Path, PhasedPlan, Timing};
+use crate::simulate::{SimReport, dynamic_cfg, kinematic};
+use crate::timing::{PhaseTiming, TimingProblem};
+use serde::Serialize;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// A phased design at one bend.
+#[derive(Debug, Clone)]
+pub struct BendDesign {
+    pub bend: f64,
+    /// Rotation of the bend direction during the twist, rad.
+    pub twist: f64,
+    pub phases: [PhaseTiming; 3],
+}
+
+impl BendDesign {
+    /// `(sum sqrt(p_i))^2`: the peak if the whole manoeuvre took 1 s.
+    pub fn unit_peak(&self) -> f64 {
+        self.phases
+            .iter()
+            .map(|p| p.unit_peak.sqrt())
+            .sum::<f64>()
+            .powi(2)
+    }
+
+    /// Optimal split of `total` seconds (`T_i ~ sqrt(p_i)`).
+    pub fn durations(&self, total: f64) -> [f64; 3] {
+        let r = self.phases.each_ref().map(|p| p.unit_peak.sqrt());
+        let s: f64 = r.iter().sum();
+        r.map(|x| total * x / s)
+    }
+
+    /// Least peak with a fixed split of `total`: `max_i p_i / T_i^2`.
+    pub fn peak_with(&self, durations: [f64; 3]) -> f64 {
+        (0..3)
+            .map(|i| self.phases[i].unit_peak / durations[i].powi(2))
+            .fold(0.0, f64::max)
+    }
+
+    pub fn plan(&self, durations: [f64; 3]) -> PhasedPlan {
+        PhasedPlan {
+            paths: Path::phased(self.bend, self.twist),
+            timings: self
+                .phases
+                .each_ref()
+                .map(|p| Timing::Grid(p.timing.clone())),
+            durations,
+        }
+    }
+}
+
+/// Twist of the bend direction that flips the cat by exactly pi.
+///
+/// `no-twist`: `pi / C` (F1, exact). `universal`: F1 is only approximate (F4),
+/// so the twist is root-found on the integrated attitude; by F2 the timing is
+/// irrelevant and a unit-time cosine plan is used.
+pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
+    let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
+    let guess = PI / c;
+    if cat.joint == Joint::NoTwist {
+        return Ok(guess);
+    }
+    let ode = OdeSettings {
+        rtol: 1e-11,
+        atol: 1e-13,
+        ..Default::default()
+    };
+    let flip = |tw: f64| -> Result<f64> {
+        let r = kinematic(cat, &cosine_plan(bend, tw, [1.0, 1.0, 1.0]), &ode)?;
+        Ok(r.trace.last().map(|p| p.flip).unwrap_or(0.0))
+    };
+    let f0 = flip(guess)?;
+    let target = PI * f0.signum();
+    let (mut x0, mut y0) = (guess, f0 - target);
+    let mut x1 = guess * target / f0;
+    for _ in 0..30 {
+        let y1 = flip(x1)? - target;
+        if y1.abs() < 1e-11 {
+            return Ok(x1);
+        }
+        let x2 = x1 - y1 * (x1 - x0) / (y1 - y0);
+        (x0, y0, x1) = (x1, y1, x2);
+    }
+    Err(Error::Unreachable {
+        reason: format!(
+            "no twist angle flips the universal-joint cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            bend.to_degrees()
+        ),
+    })
+}
+
+/// One evaluation of the bend search, as reported to an observer.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct BendEvaluation {
+    pub bend_deg: f64,
+    pub unit_peak: f64,
+    pub peak_nm: f64,
+}
+
+/// Designs the phases at one bend.
+///
+/// For the `no-twist` joint the unfold is the fold run backwards and rotated
+/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`) and the
+/// torque is invariant under time reversal, so the unfold reuses the fold's
+/// timing reversed (the discrete SOCP has the same symmetry, tested).
+pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
+    let twist = twist_for(cat, bend)?;
+    let paths = Path::phased(bend, twist);
+    let fold = problem.solve(cat, &paths[0])?;
+    let twist_phase = problem.solve(cat, &paths[1])?;
+    let unfold = match cat.joint {
+        Joint::NoTwist => PhaseTiming {
+            timing: fold.timing.reversed(),
+            ..fold.clone()
+        },
+        Joint::Universal => problem.solve(cat, &paths[2])?,
+    };
+    Ok(BendDesign {
+        bend,
+        twist,
+        phases: [fold, twist_phase, unfold],
+    })
+}
+
+/// Everything the phased optimiser reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct PhasedResult {
+    pub mode: &'static str,
+    pub status: SolveStatus,
+    /// Peak joint torque of the written schedule (inverse dynamics, sampled
+    /// densely), N m: what the motors must give.
+    pub peak_torque_nm: f64,
+    /// The SOCPs' certified bound on the grid and midpoints, N m; it differs from
+    /// `peak_torque_nm` by the grid's second-order error.
+    pub socp_peak_torque_nm: f64,
+    /// Peak if the manoeuvre took 1 s (F7: `T_min = sqrt(P / tau_max)`), N m s^2.
+    pub unit_peak_nm_s2: f64,
+    pub bend_deg: f64,
+    pub theta_deg: f64,
+    pub twist_rad: f64,
+    pub phase_durations_s: [f64; 3],
+    pub phase_unit_peaks_nm_s2: [f64; 3],
+    /// The seed's cosine schedule at the same bend and the config's split, N m.
+    pub analytic_peak_same_bend_nm: f64,
+    /// Least peak at the same bend with the config's split, N m.
+    pub optimum_same_split_nm: f64,
+    /// `analytic_peak_same_bend_nm / peak_torque_nm`.
+    pub improvement_factor: f64,
+    /// From the dynamic simulation (feed-forward + PD).
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    pub sim_peak_torque_nm: f64,
+    pub momentum_drift_nms: f64,
+    pub nodes: usize,
+    pub evaluations: Vec<BendEvaluation>,
+    pub solve_time_s: f64,
+    #[serde(skip)]
+    pub plan: PhasedPlan,
+    #[serde(skip)]
+    pub design: Option<BendDesign>,
+    #[serde(skip)]
+    pub sim: Option<SimReport>,
+}
+
+/// Bend search: scan, then golden section in the best bracket.
+pub fn search_bend(
+    cfg: &Config,
+    problem: &mut TimingProblem,
+    mut observe: impl FnMut(&BendEvaluation),
+) -> Result<(BendDesign, Vec<BendEvaluation>)> {
+    let cat = cfg.cat();
+    let t = cfg.available_time();
+    let lo = cfg.phased.bend_min_deg.to_radians();
+    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
+    if hi <= lo {
+        return Err(Error::Invalid {
+            key: "limits.max_bend_deg".into(),
+            value: format!("{}", cfg.max_bend().to_degrees()),
+            expected: format!(
+                "must exceed phased.bend_min_deg = {}",
+                cfg.phased.bend_min_deg
+            ),
+        });
+    }
+    let mut evals = Vec::new();
+    let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
+        let d = design_at(&cat, problem, b)?;
+        let e = BendEvaluation {
+            bend_deg: b.to_degrees(),
+            unit_peak: d.unit_peak(),
+            peak_nm: d.unit_peak() / (t * t),
+        };
+        observe(&e);
+        evals.push(e);
+        Ok(d)
+    };
+    let n = cfg.phased.scan_points;
+    let mut xs: Vec<f64> = (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect();
+    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
+    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
+    for b in [one_turn, seed_bend] {
+        if b > lo && b < hi {
+            xs.push(b);
+        }
+    }
+    xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    let mut designs = Vec::new();
+    for &x in &xs {
+        designs.push(eval(x, &mut evals)?);
+    }
+    let best = (0..xs.len())
+        .min_by(|&i, &j| {
+            designs[i]
+                .unit_peak()
+                .partial_cmp(&designs[j].unit_peak())
+                .unwrap()
+        })
+        .unwrap();
+    let (mut a, mut b) = (xs[best.saturating_sub(1)], xs[(best + 1).min(xs.len() - 1)]);
+    let mut best_d = designs.swap_remove(best);
+    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let tol = cfg.phased.bend_tol_deg.to_radians();
+    let mut x1 = b - g * (b - a);
+    let mut x2 = a + g * (b - a);
+    let mut d1 = eval(x1, &mut evals)?;
+    let mut d2 = eval(x2, &mut evals)?;
+    while b - a > tol {
+        if d1.unit_peak() <= d2.unit_peak() {
+            b = x2;
+            (x2, d2) = (x1, d1);
+            x1 = b - g * (b - a);
+            d1 = eval(x1, &mut evals)?;
+        } else {
+            a = x1;
+            (x1, d1) = (x2, d2);
+            x2 = a + g * (b - a);
+            d2 = eval(x2, &mut evals)?;
+        }
+    }
+    for d in [d1, d2] {
+        if d.unit_peak() < best_d.unit_peak() {
+            best_d = d;
+        }
+    }
+    Ok((best_d, evals))
+}
+
+/// F7: least drop height at which `unit_peak / T^2 <= tau_max`, m.
+pub fn least_height(cfg: &Config, unit_peak: f64, tau_max: f64) -> f64 {
+    let t_min = (unit_peak / tau_max).sqrt() + cfg.fall.margin;
+    0.5 * cfg.fall.gravity * t_min * t_min
+}
+
+/// Checks a design's peak against `limits.max_torque`.
+pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Result<()> {
+    if let Some(lim) = cfg.limits.max_torque
+        && peak > lim * (1.0 + 1e-9)
+    {
+        return Err(Error::Unreachable {
+            reason: format!(
+                "the {what} needs {peak:.4} N m but limits.max_torque = {lim} N m; drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
+                least_height(cfg, unit_peak, lim)
+            ),
+        });
+    }
+    Ok(())
+}
+
+/// The phased optimiser: bend search, optimal split, reconstruction, verification.
+pub fn optimize(cfg: &Config, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    let start = Instant::now();
+    let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
+    let (design, evals) = search_bend(cfg, &mut problem, observe)?;
+    let solve_time = start.elapsed().as_secs_f64();
+    finish(cfg, design, evals, solve_time)
+}
+
+/// Reconstruction, comparison and verification of a chosen design.
+pub fn finish(
+    cfg: &Config,
+    design: BendDesign,
+    evals: Vec<BendEvaluation>,
+    solve_time: f64,
+) -> Result<PhasedResult> {
+    let t = cfg.available_time();
+    let durations = design.durations(t);
+    let socp_peak = design.unit_peak() / (t * t);
+    let plan = design.plan(durations);
+    let (peak, _) = peak_along(cfg, &plan, 16 * cfg.phased.nodes);
+    check_limit(cfg, peak * t * t, peak, "phased design")?;
+    let split = cfg.analytic.split.map(|f| f * t);
+    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);
+    let sim = dynamic_cfg(cfg, &plan)?;
+    let status = design
+        .phases
+        .iter()
+        .map(|p| p.status)
+        .find(|s| *s != SolveStatus::Solved)
+        .unwrap_or(SolveStatus::Solved);
+    Ok(PhasedResult {
+        mode: "phased",
+        status,
+        peak_torque_nm: peak,
+        socp_peak_torque_nm: socp_peak,
+        unit_peak_nm_s2: peak * t * t,
+        bend_deg: design.bend.to_degrees(),
+        theta_deg: 180.0 - design.bend.to_degrees(),
+        twist_rad: design.twist,
+        phase_durations_s: durations,
+        phase_unit_peaks_nm_s2: design.phases.each_ref().map(|p| p.unit_peak),
+        analytic_peak_same_bend_nm: analytic_peak,
+        optimum_same_split_nm: design.peak_with(split),
+        improvement_factor: analytic_peak / peak,
+        flip_deg: sim.flip_deg,
+        flip_error_rad: sim.flip_error_rad,
+        tilt_deg: sim.tilt_deg,
+        sim_peak_torque_nm: sim.peak_torque_nm,
+        momentum_drift_nms: sim.momentum_drift_nms,
+        nodes: cfg.phased.nodes,
+        evaluations: evals,
+        solve_time_s: solve_time,
+        plan,
+        design: Some(design),
+        sim: Some(sim),
+    })
+}

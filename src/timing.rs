@@ -1,0 +1,221 @@
+//! Least-peak-torque timing of one rest-to-rest phase along a fixed path:
+//! a second-order cone program in the path-timing variables (Verscheure et
+//! al., IEEE TAC 2009; MODEL.md F5), peak torque minimised under a unit time
+//! budget instead of time under a torque bound.
+//!
+//! Along `q(s)`, `s` in `[0, 1]`: `q_dot = q' s_dot`, `q_ddot = q' s_ddot + q'' s_dot^2`,
+//! so with `a = s_ddot` and `beta = s_dot^2` the torque is linear:
+//! `tau(s) = m(s) a + c(s) beta`, `m = M q'`, `c = M q'' + Gamma(q', q')`.
+//! On a grid of `K` intervals `a` is continuous and piecewise linear, so
+//! `beta` is piecewise quadratic with `beta_{k+1} - beta_k = ds (a_k + a_{k+1})`
+//! (exact). Interval time is approximated by `2 ds / (sqrt(beta_k) + sqrt(beta_{k+1}))`
+//! (exact for linear `beta`), made convex with `c_k <= sqrt(beta_k)` (SOC) and
+//! `d_k >= 1 / (c_k + c_{k+1})` (hyperbolic SOC); `sum 2 ds d_k <= 1`. The
+//! reconstruction integrates the true time and rescales to 1 s, and the peak is
+//! rescaled with it (F3). The torque is bounded at every grid point and every
+//! interval midpoint, where `a = (a_k + a_{k+1})/2` and
+//! `beta = beta_k + ds (3 a_k + a_{k+1}) / 4`: the torque is then continuous
+//! and the bound holds between points to second order in `ds`.
+
+use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::dynamics::christoffel;
+use crate::error::{Error, Result};
+use crate::model::{Cat, ShapeTerms, TorqueNorm};
+use crate::path::{GridTiming, Path};
+
+/// Result of one phase: unit-time least peak and the timing that attains it.
+#[derive(Debug, Clone)]
+pub struct PhaseTiming {
+    /// Least peak joint torque when the phase takes 1 s, N m s^2 (F3: divide by `T^2`):
+    /// the SOCP's bound after the reconstruction's exact rescaling to 1 s.
+    pub unit_peak: f64,
+    /// The SOCP's objective itself (its time model is second-order accurate).
+    pub socp_peak: f64,
+    pub timing: GridTiming,
+    pub status: SolveStatus,
+}
+
+/// The phase SOCP on a fixed grid; its solver is reused across paths and bends.
+pub struct TimingProblem {
+    k: usize,
+    norm: TorqueNorm,
+    solver: Option<ConicSolver>,
+}
+
+struct Index {
+    k: usize,
+}
+
+impl Index {
+    fn beta(&self, i: usize) -> usize {
+        i
+    }
+    fn a(&self, i: usize) -> usize {
+        self.k + 1 + i
+    }
+    fn c(&self, i: usize) -> usize {
+        2 * self.k + 2 + i
+    }
+    fn d(&self, i: usize) -> usize {
+        3 * self.k + 3 + i
+    }
+    fn t(&self) -> usize {
+        4 * self.k + 3
+    }
+    fn n(&self) -> usize {
+        4 * self.k + 4
+    }
+}
+
+/// `m(s) = M q'` and `c(s) = M q'' + Gamma(q', q')` at `s`.
+pub fn path_coefficients(cat: &Cat, path: &Path, s: f64) -> ([f64; 2], [f64; 2]) {
+    let [q, d1, d2] = path.eval(s);
+    let t = ShapeTerms::first(cat, q);
+    let g = christoffel(&t);
+    let mut m = [0.0; 2];
+    let mut c = [0.0; 2];
+    for i in 0..2 {
+        for j in 0..2 {
+            m[i] += t.m[i][j] * d1[j];
+            c[i] += t.m[i][j] * d2[j];
+            for k in 0..2 {
+                c[i] += g[i][j][k] * d1[j] * d1[k];
+            }
+        }
+    }
+    (m, c)
+}
+
+impl TimingProblem {
+    /// `k` grid intervals; `norm` picks SOC rows (Euclidean) or linear rows (per motor).
+    pub fn new(k: usize, norm: TorqueNorm) -> Self {
+        Self {
+            k,
+            norm,
+            solver: None,
+        }
+    }
+
+    pub fn intervals(&self) -> usize {
+        self.k
+    }
+
+    fn build(&self, cat: &Cat, path: &Path) -> ConicData {
+        let k = self.k;
+        let ix = Index { k };
+        let ds = 1.0 / k as f64;
+        // coefficients at grid points (even entries) and midpoints (odd entries)
+        let coef: Vec<_> = (0..=2 * k)
+            .map(|i| path_coefficients(cat, path, i as f64 * ds / 2.0))
+            .collect();
+        let mut d = ConicData::new(ix.n());
+        d.q[ix.t()] = 1.0;
+        // rest to rest, and beta' = 2 a with a piecewise linear
+        d.row(&[(ix.beta(0), 1.0)], 0.0);
+        d.row(&[(ix.beta(k), 1.0)], 0.0);
+        for i in 0..k {
+            d.row(
+                &[
+                    (ix.beta(i + 1), 1.0),
+                    (ix.beta(i), -1.0),
+                    (ix.a(i), -ds),
+                    (ix.a(i + 1), -ds),
+                ],
+                0.0,
+            );
+        }
+        d.cone(Cone::Zero(k + 2));
+        // time budget
+        let row: Vec<_> = (0..k).map(|i| (ix.d(i), 2.0 * ds)).collect();
+        d.row(&row, 1.0);
+        d.cone(Cone::Nonneg(1));
+        // torque at point p (grid point p/2 if even, midpoint of interval p/2 if odd):
+        // tau_j = sum of (variable, coefficient)
+        let torque_row = |p: usize, j: usize| -> Vec<(usize, f64)> {
+            let (m, c) = coef[p];
+            let i = p / 2;
+            if p.is_multiple_of(2) {
+                vec![(ix.a(i), m[j]), (ix.beta(i), c[j])]
+            } else {
+                vec![
+                    (ix.a(i), 0.5 * m[j] + 0.75 * ds * c[j]),
+                    (ix.a(i + 1), 0.5 * m[j] + 0.25 * ds * c[j]),
+                    (ix.beta(i), c[j]),
+                ]
+            }
+        };
+        let points = 2 * k + 1;
+        match self.norm {
+            TorqueNorm::PerMotor => {
+                for p in 0..points {
+                    for j in 0..2 {
+                        let mut up = torque_row(p, j);
+                        let mut down: Vec<_> = up.iter().map(|&(v, x)| (v, -x)).collect();
+                        up.push((ix.t(), -1.0));
+                        down.push((ix.t(), -1.0));
+                        d.row(&up, 0.0);
+                        d.row(&down, 0.0);
+                    }
+                }
+                d.cone(Cone::Nonneg(4 * points));
+            }
+            TorqueNorm::Euclidean => {
+                for p in 0..points {
+                    d.row(&[(ix.t(), -1.0)], 0.0);
+                    for j in 0..2 {
+                        let row: Vec<_> = torque_row(p, j).iter().map(|&(v, x)| (v, -x)).collect();
+                        d.row(&row, 0.0);
+                    }
+                    d.cone(Cone::Soc(3));
+                }
+            }
+        }
+        // c_i <= sqrt(beta_i): ||(2 c, beta - 1)|| <= beta + 1
+        for i in 0..=k {
+            d.row(&[(ix.beta(i), -1.0)], 1.0);
+            d.row(&[(ix.c(i), -2.0)], 0.0);
+            d.row(&[(ix.beta(i), -1.0)], -1.0);
+            d.cone(Cone::Soc(3));
+        }
+        // d_i (c_i + c_{i+1}) >= 1: ||(2, d - u)|| <= d + u
+        for i in 0..k {
+            d.row(
+                &[(ix.d(i), -1.0), (ix.c(i), -1.0), (ix.c(i + 1), -1.0)],
+                0.0,
+            );
+            d.row(&[], 2.0);
+            d.row(&[(ix.d(i), -1.0), (ix.c(i), 1.0), (ix.c(i + 1), 1.0)], 0.0);
+            d.cone(Cone::Soc(3));
+        }
+        d
+    }
+
+    /// Solves the phase along `path` in unit time.
+    pub fn solve(&mut self, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
+        let data = self.build(cat, path);
+        let (status, x, _) = solve_reusing(&mut self.solver, &data)?;
+        if !status.ok() {
+            return Err(Error::Solver {
+                what: format!("path-timing SOCP ({} intervals)", self.k),
+                status: format!("{status:?}"),
+                hint: "try a different phased.nodes or bend range (phased.bend_min_deg / bend_max_deg)".into(),
+            });
+        }
+        let ix = Index { k: self.k };
+        let s: Vec<f64> = (0..=self.k).map(|i| i as f64 / self.k as f64).collect();
+        let beta: Vec<f64> = (0..=self.k).map(|i| x[ix.beta(i)].max(0.0)).collect();
+        let a: Vec<f64> = (0..=self.k).map(|i| x[ix.a(i)]).collect();
+        let mut beta_fixed = beta;
+        beta_fixed[0] = 0.0;
+        beta_fixed[self.k] = 0.0;
+        let timing = GridTiming::new(s, beta_fixed, a);
+        // (a, beta) were scaled by T0^2 to reach unit time; torque is linear in them
+        let socp_peak = x[ix.t()];
+        Ok(PhaseTiming {
+            unit_peak: socp_peak * timing.raw_time.powi(2),
+            socp_peak,
+            timing,
+            status,
+        })
+    }
+}
