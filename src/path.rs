@@ -73,7 +73,7 @@ pub enum Timing {
 /// `s(t)` has no closed form: the time of each grid interval is integrated by
 /// Gauss-Legendre quadrature (with `v = w^2` substitutions that absorb the
 /// `1/sqrt(beta)` singularity at a rest end), tabulated on sub-steps, and
-/// inverted by cubic Hermite interpolation in time; `s_dot = sqrt(beta(s))`
+/// inverted by cubic Hermite interpolation in time refined by Newton steps; `s_dot = sqrt(beta(s))`
 /// and `s_ddot = a(s)` are then evaluated exactly at that `s`.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct GridTiming {
@@ -220,7 +220,16 @@ impl GridTiming {
             + (x * x * x - 2.0 * x * x + x) * h * v0
             + (-2.0 * x * x * x + 3.0 * x * x) * s1
             + (x * x * x - x * x) * h * v1;
-        let s = s.clamp(s0, s1);
+        let mut s = s.clamp(s0, s1);
+        // Newton on t(s) = tau, dt/ds = 1/sqrt(beta): makes s(t) consistent with
+        // s_dot = sqrt(beta(s)) to quadrature accuracy
+        for _ in 0..2 {
+            let v = self.beta_a(s).0.sqrt();
+            if s <= s0 || v <= 0.0 {
+                break;
+            }
+            s = (s + (tau - t0 - self.seg_time(s0, s)) * v).clamp(s0, s1);
+        }
         let (b, a) = self.beta_a(s);
         (s, b.sqrt(), a)
     }
