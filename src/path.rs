@@ -316,8 +316,9 @@ mod tests {
         let (s0, v0, _) = timing.eval(0.0, dur);
         let (s1, v1, _) = timing.eval(dur, dur);
         assert!(s0.abs() < 1e-12 && (s1 - 1.0).abs() < 1e-12);
+        // sqrt(beta) near a rest end turns one ulp of s into ~1e-8 of s_dot
         assert!(
-            v0.abs() < 1e-12 && v1.abs() < 1e-9,
+            v0.abs() < 1e-7 && v1.abs() < 1e-7,
             "rest to rest: {v0} {v1}"
         );
     }
