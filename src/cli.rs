@@ -53,6 +53,9 @@ enum Command {
         common: Common,
         #[arg(long, value_enum, default_value = "phased")]
         mode: Mode,
+        /// Seed of the free-form optimiser.
+        #[arg(long, value_enum, default_value = "phased")]
+        seed: SeedArg,
         /// Print each iteration (bend evaluations, SCP iterations).
         #[arg(long)]
         verbose: bool,
@@ -62,6 +65,13 @@ enum Command {
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
 enum Mode {
     Phased,
+    Free,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+enum SeedArg {
+    Phased,
+    Analytic,
 }
 
 fn load(c: &Common) -> Result<Config> {
@@ -80,8 +90,9 @@ pub fn run() -> Result<()> {
         Command::Optimize {
             common,
             mode,
+            seed,
             verbose,
-        } => cmd_optimize(&common, mode, verbose),
+        } => cmd_optimize(&common, mode, seed, verbose),
     }
 }
 
@@ -238,7 +249,7 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
-fn cmd_optimize(c: &Common, mode: Mode, verbose: bool) -> Result<()> {
+fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<()> {
     let cfg = load(c)?;
     match mode {
         Mode::Phased => {
@@ -305,6 +316,85 @@ fn cmd_optimize(c: &Common, mode: Mode, verbose: bool) -> Result<()> {
                     "{:.3} s ({} bend evaluations)",
                     r.solve_time_s,
                     r.evaluations.len()
+                ),
+            );
+            for w in written {
+                row("wrote", w.display().to_string());
+            }
+        }
+        Mode::Free => {
+            let seed = match seed {
+                SeedArg::Phased => catflip::free::Seed::Phased,
+                SeedArg::Analytic => catflip::free::Seed::Analytic,
+            };
+            if verbose {
+                eprintln!(
+                    "  iter      merit       peak     infeas     radius        rho  step   ms"
+                );
+            }
+            let r = catflip::free::optimize(&cfg, seed, |it| {
+                if verbose {
+                    eprintln!(
+                        "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
+                        it.iteration,
+                        it.merit,
+                        it.peak,
+                        it.infeasibility,
+                        it.radius,
+                        it.rho,
+                        if it.accepted { "ok" } else { "rej" },
+                        it.solve_ms
+                    );
+                }
+            })?;
+            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
+            let json = serde_json::to_string_pretty(&r)?;
+            let mut out = Output::default();
+            out.add("free.csv", sched.to_csv());
+            out.add("free.json", json.clone());
+            let written = out.commit(&out_dir(c, &cfg))?;
+            if c.json {
+                println!("{json}");
+                return Ok(());
+            }
+            println!(
+                "catflip optimize --mode free: {} ({} joint), status {:?}, seed {}",
+                cfg.name,
+                cfg.cat.joint.name(),
+                r.status,
+                r.seed
+            );
+            row(
+                "peak torque",
+                format!(
+                    "{:.5} N m (at nodes {:.5})",
+                    r.peak_torque_nm, r.node_peak_torque_nm
+                ),
+            );
+            row(
+                "largest bend / theta",
+                format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+            );
+            row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+            let d = r.phase_durations_s;
+            row(
+                "phase durations",
+                format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
+            );
+            row(
+                "flip (dynamic sim)",
+                format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
+            );
+            row("tilt", format!("{:.3e} deg", r.tilt_deg));
+            row(
+                "sim peak torque",
+                format!("{:.5} N m", r.sim_peak_torque_nm),
+            );
+            row(
+                "solve time",
+                format!(
+                    "{:.3} s ({} SCP iterations, {} nodes per phase)",
+                    r.solve_time_s, r.scp_iterations, r.nodes
                 ),
             );
             for w in written {

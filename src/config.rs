@@ -158,9 +158,9 @@ impl Default for PhasedConfig {
 pub struct FreeConfig {
     /// Collocation nodes per phase (default 40).
     pub nodes: usize,
-    /// SCP iteration limit (default 60).
+    /// SCP iteration limit (default 150).
     pub max_iterations: usize,
-    /// Stop when the predicted improvement falls below this fraction of the peak (default 1e-5).
+    /// Stop when the predicted improvement falls below this fraction of the merit (default 1e-4).
     pub tolerance: f64,
     /// Flip tolerance of the converged design, rad (default 1e-6).
     pub attitude_tolerance: f64,
@@ -170,8 +170,8 @@ impl Default for FreeConfig {
     fn default() -> Self {
         Self {
             nodes: 40,
-            max_iterations: 60,
-            tolerance: 1e-5,
+            max_iterations: 150,
+            tolerance: 1e-4,
             attitude_tolerance: 1e-6,
         }
     }

@@ -4,16 +4,19 @@
 //! cylinders joined at the middle, released at rest, zero angular momentum.
 pub mod analytic;
 pub mod analyze;
+pub mod collocation;
 pub mod config;
 pub mod conic;
 pub mod dynamics;
 pub mod error;
+pub mod free;
 pub mod model;
 pub mod ode;
 pub mod output;
 pub mod path;
 pub mod phased;
 pub mod plan;
+pub mod scp;
 pub mod simulate;
 pub mod small;
 pub mod so3;

@@ -255,3 +255,48 @@ fn impossible_torque_limit_fails_with_the_least_height_and_writes_nothing() {
     );
     assert!(!dir.path().join("output").exists());
 }
+
+#[test]
+fn optimize_free_reports_iterations_and_nodes() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(
+        &[
+            "optimize",
+            cfg.to_str().unwrap(),
+            "--mode",
+            "free",
+            "--seed",
+            "analytic",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    for key in [
+        "mode",
+        "status",
+        "peak_torque_nm",
+        "bend_deg",
+        "theta_deg",
+        "twist_rad",
+        "phase_durations_s",
+        "flip_deg",
+        "tilt_deg",
+        "sim_peak_torque_nm",
+        "solve_time_s",
+        "scp_iterations",
+        "nodes",
+    ] {
+        assert!(v.get(key).is_some(), "missing {key}");
+    }
+    assert_eq!(v["mode"], "free");
+    assert_eq!(v["seed"], "analytic");
+    assert_eq!(
+        v["iterations"].as_array().unwrap().len() as u64,
+        v["scp_iterations"].as_u64().unwrap()
+    );
+    assert!(dir.path().join("output/seed/free.csv").exists());
+}

@@ -1,0 +1,279 @@
+//! Multi-phase transcription of a shape trajectory for direct collocation.
+//!
+//! One [`Transcription`] owns the grid (phases x nodes), the decision-variable
+//! indexing and the phase durations. Each phase runs in its own normalised
+//! time `s = t / T_p` in `[0, 1]`; each node carries `q`, `q^ = dq/ds` and
+//! `q^^ = d2q/ds2` (2 each), and each phase has a free duration `T_p`. The
+//! physical rates are `q_dot = q^ / T_p`, `q_ddot = q^^ / T_p^2`.
+//!
+//! Why normalised time: the defects become linear (exact constraints, no
+//! penalty), the attitude depends on the path only (MODEL.md F2) and so not on
+//! the durations, and the duration enters the torque only as `1 / T_p^2` (F3).
+//!
+//! Scheme: first-order-hold acceleration. `q^^` is linear on each interval of
+//! `h = 1 / (N - 1)` and the double integrator is integrated exactly:
+//! `q^_{k+1} - q^_k - h (q^^_k + q^^_{k+1}) / 2 = 0`,
+//! `q_{k+1} - q_k - h q^_k - h^2 (2 q^^_k + q^^_{k+1}) / 6 = 0`;
+//! the interpolation is the matching cubic in `q`, and the same interpolation
+//! reconstructs the schedule.
+
+use crate::plan::{Phase, ShapePlan, ShapeState};
+
+/// Grid and variable layout.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transcription {
+    pub phases: usize,
+    /// Nodes per phase (both ends included).
+    pub nodes: usize,
+}
+
+/// Node values bounding one interval (normalised time).
+#[derive(Debug, Clone, Copy)]
+pub struct IntervalData {
+    pub q0: [f64; 2],
+    pub v0: [f64; 2],
+    pub a0: [f64; 2],
+    pub a1: [f64; 2],
+    pub h: f64,
+}
+
+/// Interpolant at a fraction `c` of an interval, with the (scalar, per
+/// component) coefficients of `q` and `q^` on `(q0, q^0, q^^0, q^^1)`.
+pub struct Interp {
+    pub q: [f64; 2],
+    pub v: [f64; 2],
+    pub a: [f64; 2],
+    pub dq: [f64; 4],
+    pub dv: [f64; 4],
+}
+
+impl IntervalData {
+    pub fn at(&self, c: f64) -> Interp {
+        let h = self.h;
+        let tau = c * h;
+        let (t2, c3h2) = (tau * tau, c * c * c * h * h);
+        let dq = [1.0, tau, t2 / 2.0 - c3h2 / 6.0, c3h2 / 6.0];
+        let dv = [0.0, 1.0, tau - c * c * h / 2.0, c * c * h / 2.0];
+        let mut it = Interp {
+            q: [0.0; 2],
+            v: [0.0; 2],
+            a: [0.0; 2],
+            dq,
+            dv,
+        };
+        for j in 0..2 {
+            let x = [self.q0[j], self.v0[j], self.a0[j], self.a1[j]];
+            it.q[j] = (0..4).map(|i| dq[i] * x[i]).sum();
+            it.v[j] = (0..4).map(|i| dv[i] * x[i]).sum();
+            it.a[j] = self.a0[j] + (self.a1[j] - self.a0[j]) * c;
+        }
+        it
+    }
+}
+
+impl Transcription {
+    pub const PER_NODE: usize = 6;
+
+    pub fn new(phases: usize, nodes: usize) -> Self {
+        assert!(nodes >= 2 && phases >= 1);
+        Self { phases, nodes }
+    }
+
+    /// Number of decision variables: node variables plus one duration per phase.
+    pub fn dim(&self) -> usize {
+        self.phases * self.nodes * Self::PER_NODE + self.phases
+    }
+
+    pub fn node(&self, p: usize, k: usize) -> usize {
+        (p * self.nodes + k) * Self::PER_NODE
+    }
+    pub fn q(&self, p: usize, k: usize) -> usize {
+        self.node(p, k)
+    }
+    pub fn v(&self, p: usize, k: usize) -> usize {
+        self.node(p, k) + 2
+    }
+    pub fn a(&self, p: usize, k: usize) -> usize {
+        self.node(p, k) + 4
+    }
+    pub fn duration(&self, p: usize) -> usize {
+        self.phases * self.nodes * Self::PER_NODE + p
+    }
+
+    /// Normalised interval length `1 / (N - 1)`.
+    pub fn h(&self) -> f64 {
+        1.0 / (self.nodes - 1) as f64
+    }
+
+    pub fn get2(z: &[f64], i: usize) -> [f64; 2] {
+        [z[i], z[i + 1]]
+    }
+
+    pub fn interval(&self, z: &[f64], p: usize, k: usize) -> IntervalData {
+        IntervalData {
+            q0: Self::get2(z, self.q(p, k)),
+            v0: Self::get2(z, self.v(p, k)),
+            a0: Self::get2(z, self.a(p, k)),
+            a1: Self::get2(z, self.a(p, k + 1)),
+            h: self.h(),
+        }
+    }
+
+    /// Physical `(q, q_dot, q_ddot)` at node `k` of phase `p`.
+    pub fn physical(&self, z: &[f64], p: usize, k: usize) -> ([f64; 2], [f64; 2], [f64; 2]) {
+        let t = z[self.duration(p)];
+        let (v, a) = (Self::get2(z, self.v(p, k)), Self::get2(z, self.a(p, k)));
+        (
+            Self::get2(z, self.q(p, k)),
+            v.map(|x| x / t),
+            a.map(|x| x / (t * t)),
+        )
+    }
+
+    /// Number of defect rows: 4 per interval.
+    pub fn defect_count(&self) -> usize {
+        4 * self.phases * (self.nodes - 1)
+    }
+
+    /// The defects `D z` (linear; radians in normalised time) and, if asked,
+    /// their constant Jacobian with rows offset by `row0`.
+    pub fn defects(
+        &self,
+        z: &[f64],
+        row0: usize,
+        jac: Option<&mut Vec<(usize, usize, f64)>>,
+    ) -> Vec<f64> {
+        let mut out = Vec::with_capacity(self.defect_count());
+        let mut jac = jac;
+        self.for_each_defect(|row| {
+            if let Some(j) = jac.as_deref_mut() {
+                j.extend(row.iter().map(|&(i, c)| (row0 + out.len(), i, c)));
+            }
+            out.push(row.iter().map(|&(i, c)| c * z[i]).sum());
+        });
+        out
+    }
+
+    fn for_each_defect(&self, mut f: impl FnMut(&[(usize, f64)])) {
+        let h = self.h();
+        for p in 0..self.phases {
+            for k in 0..self.nodes - 1 {
+                for j in 0..2 {
+                    let v = [
+                        (self.v(p, k + 1) + j, 1.0),
+                        (self.v(p, k) + j, -1.0),
+                        (self.a(p, k) + j, -h / 2.0),
+                        (self.a(p, k + 1) + j, -h / 2.0),
+                    ];
+                    let q = [
+                        (self.q(p, k + 1) + j, 1.0),
+                        (self.q(p, k) + j, -1.0),
+                        (self.v(p, k) + j, -h),
+                        (self.a(p, k) + j, -h * h / 3.0),
+                        (self.a(p, k + 1) + j, -h * h / 6.0),
+                    ];
+                    f(&v);
+                    f(&q);
+                }
+            }
+        }
+    }
+
+    /// Samples a plan at the nodes (uniform in time within each phase).
+    pub fn sample(&self, plan: &dyn ShapePlan) -> Vec<f64> {
+        let b = plan.phase_bounds();
+        let mut z = vec![0.0; self.dim()];
+        for p in 0..self.phases {
+            let t = b[p + 1] - b[p];
+            for k in 0..self.nodes {
+                let s = plan.state_in(p, b[p] + t * k as f64 * self.h());
+                z[self.q(p, k)..self.q(p, k) + 2].copy_from_slice(&s.q);
+                z[self.v(p, k)..self.v(p, k) + 2].copy_from_slice(&s.qd.map(|x| x * t));
+                z[self.a(p, k)..self.a(p, k) + 2].copy_from_slice(&s.qdd.map(|x| x * t * t));
+            }
+            z[self.duration(p)] = t;
+        }
+        z
+    }
+}
+
+/// A transcribed solution as a plan, with the scheme's interpolation.
+#[derive(Debug, Clone)]
+pub struct CollocationPlan {
+    pub tr: Transcription,
+    pub z: Vec<f64>,
+}
+
+impl ShapePlan for CollocationPlan {
+    fn phase_bounds(&self) -> Vec<f64> {
+        let mut b = vec![0.0];
+        for p in 0..self.tr.phases {
+            b.push(b[p] + self.z[self.tr.duration(p)]);
+        }
+        b
+    }
+
+    fn state_in(&self, i: usize, t: f64) -> ShapeState {
+        let b = self.phase_bounds();
+        let dur = b[i + 1] - b[i];
+        let s = ((t - b[i]) / dur).clamp(0.0, 1.0);
+        let h = self.tr.h();
+        let k = ((s / h).floor() as usize).min(self.tr.nodes - 2);
+        let c = ((s - k as f64 * h) / h).clamp(0.0, 1.0);
+        let it = self.tr.interval(&self.z, i, k).at(c);
+        ShapeState {
+            q: it.q,
+            qd: it.v.map(|x| x / dur),
+            qdd: it.a.map(|x| x / (dur * dur)),
+            phase: Phase::ALL[i.min(2)],
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolant_satisfies_the_defects_exactly_and_has_consistent_derivatives() {
+        let d = IntervalData {
+            q0: [0.3, -0.2],
+            v0: [1.0, 0.5],
+            a0: [2.0, -1.0],
+            a1: [-3.0, 4.0],
+            h: 0.1,
+        };
+        let e = d.at(1.0);
+        for j in 0..2 {
+            let v1 = d.v0[j] + d.h * (d.a0[j] + d.a1[j]) / 2.0;
+            let q1 = d.q0[j] + d.h * d.v0[j] + d.h * d.h * (2.0 * d.a0[j] + d.a1[j]) / 6.0;
+            assert!((e.v[j] - v1).abs() < 1e-15 && (e.q[j] - q1).abs() < 1e-15);
+        }
+        let eps = 1e-7;
+        for c in [0.2, 0.7] {
+            let (p, m) = (d.at(c + eps), d.at(c - eps));
+            for j in 0..2 {
+                assert!(((p.q[j] - m.q[j]) / (2.0 * eps * d.h) - d.at(c).v[j]).abs() < 1e-6);
+                assert!(((p.v[j] - m.v[j]) / (2.0 * eps * d.h) - d.at(c).a[j]).abs() < 1e-6);
+            }
+        }
+    }
+
+    #[test]
+    fn sampling_a_plan_and_reading_it_back_agree_at_the_nodes() {
+        let plan = crate::analytic::plan(1.0, 3.0, [0.3, 0.5, 0.4]);
+        let tr = Transcription::new(3, 7);
+        let z = tr.sample(&plan);
+        let cp = CollocationPlan { tr, z };
+        for i in 0..3 {
+            let b = plan.phase_bounds();
+            // just after node 3, so that the interval starting there is used
+            let t = b[i] + (b[i + 1] - b[i]) * (3.0 / 6.0 + 1e-12);
+            let (x, y) = (plan.state_in(i, t), cp.state_in(i, t));
+            for j in 0..2 {
+                assert!((x.q[j] - y.q[j]).abs() < 1e-9 && (x.qd[j] - y.qd[j]).abs() < 1e-8);
+                assert!((x.qdd[j] - y.qdd[j]).abs() < 1e-6);
+            }
+        }
+    }
+}

@@ -1,0 +1,503 @@
+//! The free-form optimiser: multi-phase direct collocation of the shape with
+//! successive convexification ([`crate::scp`]) on Clarabel.
+//!
+//! Decision variables: `q, dq/ds, d2q/ds2` at `N` nodes in each of the three
+//! phases (normalised time `s`) and the three phase durations
+//! ([`Transcription`], first-order-hold acceleration). Objective: peak joint
+//! torque at the nodes and interval midpoints, `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact
+//! inverse dynamics in normalised time (F3). Exact constraints: straight and
+//! at rest at both ends, continuity of `q` across phases, total time within the
+//! fall, optional bend limit. Penalised equalities (virtual control): the
+//! collocation defects (linear, so their model is exact and a seed that does
+//! not satisfy them is still a feasible start), continuity of the physical rate
+//! across phases (`q^_p / T_p = q^_{p+1} / T_{p+1}`) and the final-attitude
+//! error `log(Rz(pi)' R_A(T))` (flip and tilt together, on SO(3)).
+//!
+//! The attitude map integrates `dR_A/ds = R_A hat(w^)`, `w^ = -A(q) q^`, along
+//! the interpolant with the fourth-order Magnus method (two Gauss points, `S`
+//! sub-steps per interval); by F2 it does not depend on the durations. Its
+//! derivative is the exact derivative of that discrete map: a perturbation
+//! `dOmega_j` of step `j` moves the final attitude by `R_{j+1} J_r(Omega_j) dOmega_j`
+//! in the world frame.
+
+use crate::collocation::{CollocationPlan, Transcription};
+use crate::config::Config;
+use crate::conic::{Cone, ConicData};
+use crate::dynamics::{linearize_torque, torque_from};
+use crate::error::Result;
+use crate::model::{Cat, ShapeTerms, TorqueNorm};
+use crate::scp::{
+    Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets, solve,
+};
+use crate::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
+use nalgebra::{Matrix3, Vector3};
+use serde::Serialize;
+
+/// A torque check point: interval index, normalised `(q, q^, q^^)`, and the
+/// interpolation coefficients of `q`, `q^`, `q^^` on the interval's node values.
+type CheckPoint = (usize, [f64; 2], [f64; 2], [f64; 2], [[f64; 4]; 3]);
+
+/// Magnus sub-steps per collocation interval.
+const SUB: usize = 2;
+
+/// The free-form problem for one config.
+pub struct FreeProblem {
+    pub cat: Cat,
+    pub tr: Transcription,
+    pub norm: TorqueNorm,
+    pub available: f64,
+    pub min_phase: f64,
+    pub max_bend: Option<f64>,
+    pub max_torque: Option<f64>,
+    scales: Vec<f64>,
+}
+
+impl FreeProblem {
+    pub fn new(cfg: &Config, nodes: usize, z0: &[f64]) -> Self {
+        let tr = Transcription::new(3, nodes);
+        let available = cfg.available_time();
+        let mut sq = 0.1f64;
+        let mut sv = 0.1f64;
+        let mut sa = 0.1f64;
+        for p in 0..3 {
+            for k in 0..nodes {
+                for j in 0..2 {
+                    sq = sq.max(z0[tr.q(p, k) + j].abs());
+                    sv = sv.max(z0[tr.v(p, k) + j].abs());
+                    sa = sa.max(z0[tr.a(p, k) + j].abs());
+                }
+            }
+        }
+        let mut scales = vec![0.0; tr.dim()];
+        for p in 0..3 {
+            for k in 0..nodes {
+                for j in 0..2 {
+                    scales[tr.q(p, k) + j] = sq;
+                    scales[tr.v(p, k) + j] = sv;
+                    scales[tr.a(p, k) + j] = sa;
+                }
+            }
+            scales[tr.duration(p)] = 0.1 * available;
+        }
+        Self {
+            cat: cfg.cat(),
+            tr,
+            norm: cfg.norm(),
+            available,
+            min_phase: 0.02 * available,
+            max_bend: cfg.limits.max_bend_deg.map(f64::to_radians),
+            max_torque: cfg.limits.max_torque,
+            scales,
+        }
+    }
+
+    /// Final attitude of body A and, if asked, the world-frame Jacobian
+    /// `dW / dz` (3 rows, one column per variable).
+    pub fn attitude(&self, z: &[f64], want_jac: bool) -> (Matrix3<f64>, Vec<Vector3<f64>>) {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        let mut r = Matrix3::identity();
+        let mut g = if want_jac {
+            vec![Vector3::zeros(); tr.dim()]
+        } else {
+            Vec::new()
+        };
+        let s3 = 3f64.sqrt();
+        let cm = s3 / 12.0;
+        let hs = tr.h() / SUB as f64;
+        for p in 0..3 {
+            for k in 0..n - 1 {
+                let d = tr.interval(z, p, k);
+                for j in 0..SUB {
+                    let cs = [
+                        (j as f64 + 0.5 - s3 / 6.0) / SUB as f64,
+                        (j as f64 + 0.5 + s3 / 6.0) / SUB as f64,
+                    ];
+                    let pts = cs.map(|c| d.at(c));
+                    let terms = pts.each_ref().map(|it| ShapeTerms::first(&self.cat, it.q));
+                    let w = [0, 1].map(|i| Vector3::from(terms[i].body_rate(pts[i].v)));
+                    let omega = hs / 2.0 * (w[0] + w[1]) + cm * hs * hs * w[0].cross(&w[1]);
+                    r *= exp(&omega);
+                    if !want_jac {
+                        continue;
+                    }
+                    let m = r * right_jacobian(&omega);
+                    let dpdw = [
+                        hs / 2.0 * Matrix3::identity() - cm * hs * hs * hat(&w[1]),
+                        hs / 2.0 * Matrix3::identity() + cm * hs * hs * hat(&w[0]),
+                    ];
+                    for i in 0..2 {
+                        let it = &pts[i];
+                        let wq = terms[i].body_rate_dq(it.v);
+                        let wv = [0, 1].map(|c| -Vector3::from(terms[i].a[c]));
+                        let pm = m * dpdw[i];
+                        for c in 0..2 {
+                            let wqc = Vector3::from(wq[c]);
+                            let cols = [
+                                tr.q(p, k) + c,
+                                tr.v(p, k) + c,
+                                tr.a(p, k) + c,
+                                tr.a(p, k + 1) + c,
+                            ];
+                            for (idx, col) in cols.into_iter().enumerate() {
+                                g[col] += pm * (wqc * it.dq[idx] + wv[c] * it.dv[idx]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        (r, g)
+    }
+
+    /// Attitude error `log(Rz(pi)' R)`, rad.
+    pub fn attitude_error(r: &Matrix3<f64>) -> Vector3<f64> {
+        let target = Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0));
+        log(&(target.transpose() * r))
+    }
+
+    /// Normalised-time state at the torque check points of phase `p`: every
+    /// node and every interval midpoint (the midpoints bound the torque between
+    /// nodes to second order), with the interpolation coefficients on
+    /// `(q_k, q^_k, q^^_k, q^^_{k+1})` of interval `k`.
+    fn check_points(&self, z: &[f64], p: usize) -> Vec<CheckPoint> {
+        let tr = &self.tr;
+        let mut out = Vec::with_capacity(2 * tr.nodes - 1);
+        for k in 0..tr.nodes {
+            let kk = k.min(tr.nodes - 2);
+            let d = tr.interval(z, p, kk);
+            for c in if k < tr.nodes - 1 {
+                vec![0.0, 0.5]
+            } else {
+                vec![1.0]
+            } {
+                let it = d.at(c);
+                out.push((kk, it.q, it.v, it.a, [it.dq, it.dv, [0.0, 0.0, 1.0 - c, c]]));
+            }
+        }
+        out
+    }
+
+    fn torques(&self, z: &[f64]) -> Vec<f64> {
+        let mut out = Vec::with_capacity(12 * self.tr.nodes);
+        for p in 0..3 {
+            let t2 = z[self.tr.duration(p)].powi(2);
+            for (_, q, v, a, _) in self.check_points(z, p) {
+                let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
+                out.extend(tau.iter().map(|x| x / t2));
+            }
+        }
+        out
+    }
+
+    /// Physical rate continuity across the two junctions, scaled to radians:
+    /// `T (q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1})`, with its Jacobian.
+    fn rate_continuity(&self, z: &[f64], row0: usize, jac: Option<&mut Triplets>) -> Vec<f64> {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        let sc = self.available;
+        let mut r = Vec::with_capacity(4);
+        let mut jac = jac;
+        for p in 0..2 {
+            let (ta, tb) = (z[tr.duration(p)], z[tr.duration(p + 1)]);
+            for j in 0..2 {
+                let (ia, ib) = (tr.v(p, n - 1) + j, tr.v(p + 1, 0) + j);
+                let row = row0 + r.len();
+                r.push(sc * (z[ia] / ta - z[ib] / tb));
+                if let Some(jac) = jac.as_deref_mut() {
+                    jac.push((row, ia, sc / ta));
+                    jac.push((row, ib, -sc / tb));
+                    jac.push((row, tr.duration(p), -sc * z[ia] / (ta * ta)));
+                    jac.push((row, tr.duration(p + 1), sc * z[ib] / (tb * tb)));
+                }
+            }
+        }
+        r
+    }
+}
+
+impl ScpProblem for FreeProblem {
+    fn dim(&self) -> usize {
+        self.tr.dim()
+    }
+    fn term_dim(&self) -> usize {
+        2
+    }
+    fn norm(&self) -> TorqueNorm {
+        self.norm
+    }
+    fn scales(&self) -> Vec<f64> {
+        self.scales.clone()
+    }
+    fn peak_limit(&self) -> Option<f64> {
+        self.max_torque
+    }
+
+    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let mut r = self.tr.defects(z, 0, None);
+        r.extend(self.rate_continuity(z, r.len(), None));
+        let (rf, _) = self.attitude(z, false);
+        r.extend(Self::attitude_error(&rf).iter());
+        (self.torques(z), r)
+    }
+
+    fn linearize(&self, z: &[f64]) -> Linearization {
+        let tr = &self.tr;
+        let mut rj: Triplets = Vec::new();
+        let mut residual = tr.defects(z, 0, Some(&mut rj));
+        let more = self.rate_continuity(z, residual.len(), Some(&mut rj));
+        residual.extend(more);
+        let (rf, g) = self.attitude(z, true);
+        let e = Self::attitude_error(&rf);
+        let je = right_jacobian_inv(&e) * rf.transpose();
+        let row0 = residual.len();
+        residual.extend(e.iter());
+        for (col, gc) in g.iter().enumerate() {
+            let d = je * gc;
+            for i in 0..3 {
+                rj.push((row0 + i, col, d[i]));
+            }
+        }
+        let mut terms = Vec::new();
+        let mut tj: Triplets = Vec::new();
+        for p in 0..3 {
+            let t = z[tr.duration(p)];
+            let (s2, s3) = (1.0 / (t * t), -2.0 / (t * t * t));
+            for (k, q, v, a, coef) in self.check_points(z, p) {
+                // normalised-time inverse dynamics; physical torque = tau^ / T^2
+                let lin = linearize_torque(&ShapeTerms::second(&self.cat, q), v, a);
+                for i in 0..2 {
+                    let row = terms.len();
+                    terms.push(lin.tau[i] * s2);
+                    for l in 0..2 {
+                        let cols = [
+                            tr.q(p, k) + l,
+                            tr.v(p, k) + l,
+                            tr.a(p, k) + l,
+                            tr.a(p, k + 1) + l,
+                        ];
+                        for (idx, col) in cols.into_iter().enumerate() {
+                            let g = lin.d_q[i][l] * coef[0][idx]
+                                + lin.d_qd[i][l] * coef[1][idx]
+                                + lin.d_qdd[i][l] * coef[2][idx];
+                            tj.push((row, col, g * s2));
+                        }
+                    }
+                    tj.push((row, tr.duration(p), lin.tau[i] * s3));
+                }
+            }
+        }
+        Linearization {
+            terms,
+            terms_jac: tj,
+            residual,
+            residual_jac: rj,
+        }
+    }
+
+    fn add_constraints(&self, d: &mut ConicData, z: &[f64], var: &dyn Fn(usize) -> usize) {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        // z + dz = 0 at both ends; continuity of q across phases
+        let mut zero = 0;
+        for (p, k) in [(0, 0), (2, n - 1)] {
+            for base in [tr.q(p, k), tr.v(p, k)] {
+                for j in 0..2 {
+                    d.row(&[(var(base + j), 1.0)], -z[base + j]);
+                    zero += 1;
+                }
+            }
+        }
+        for p in 0..2 {
+            for (a, b) in [(tr.q(p, n - 1), tr.q(p + 1, 0))] {
+                for j in 0..2 {
+                    d.row(
+                        &[(var(a + j), 1.0), (var(b + j), -1.0)],
+                        z[b + j] - z[a + j],
+                    );
+                    zero += 1;
+                }
+            }
+        }
+        d.cone(Cone::Zero(zero));
+        // total time within the fall; each phase at least min_phase
+        let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
+        let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        d.row(&durs, self.available - total);
+        for p in 0..3 {
+            d.row(
+                &[(var(tr.duration(p)), -1.0)],
+                z[tr.duration(p)] - self.min_phase,
+            );
+        }
+        d.cone(Cone::Nonneg(4));
+        // bend limit |q| <= b_max at every node
+        if let Some(b) = self.max_bend {
+            for p in 0..3 {
+                for k in 0..n {
+                    let i = tr.q(p, k);
+                    d.row(&[], b);
+                    d.row(&[(var(i), -1.0)], z[i]);
+                    d.row(&[(var(i + 1), -1.0)], z[i + 1]);
+                    d.cone(Cone::Soc(3));
+                }
+            }
+        }
+    }
+}
+
+/// What the free-form optimiser reports.
+#[derive(Debug, Clone, Serialize)]
+pub struct FreeResult {
+    pub mode: &'static str,
+    pub status: ScpStatus,
+    /// Dense inverse-dynamics peak along the reconstructed schedule, N m.
+    pub peak_torque_nm: f64,
+    /// Peak at the collocation nodes and interval midpoints (the SCP objective), N m.
+    pub node_peak_torque_nm: f64,
+    /// Largest bend along the motion, and the angle between the halves there.
+    pub bend_deg: f64,
+    pub theta_deg: f64,
+    /// Total rotation of the bend direction (unwrapped), rad.
+    pub twist_rad: f64,
+    pub phase_durations_s: [f64; 3],
+    /// Final attitude error of the optimiser's own map, rad.
+    pub attitude_error_rad: f64,
+    /// From the dynamic simulation (feed-forward + PD) of the schedule.
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    pub sim_peak_torque_nm: f64,
+    pub momentum_drift_nms: f64,
+    /// From the kinematic simulation of the planned shape.
+    pub kinematic_flip_error_rad: f64,
+    pub kinematic_tilt_deg: f64,
+    pub seed: String,
+    pub scp_iterations: usize,
+    pub nodes: usize,
+    pub solve_time_s: f64,
+    pub iterations: Vec<ScpIteration>,
+    #[serde(skip)]
+    pub plan: CollocationPlan,
+}
+
+/// Which schedule seeds the SCP.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Seed {
+    Phased,
+    Analytic,
+}
+
+impl Seed {
+    pub fn name(self) -> &'static str {
+        match self {
+            Seed::Phased => "phased",
+            Seed::Analytic => "analytic",
+        }
+    }
+}
+
+/// Runs the SCP from a seed plan at `nodes` per phase.
+pub fn optimize_from(
+    cfg: &Config,
+    seed_plan: &dyn crate::plan::ShapePlan,
+    seed: &str,
+    nodes: usize,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    let start = std::time::Instant::now();
+    let tr = Transcription::new(3, nodes);
+    let mut z0 = tr.sample(seed_plan);
+    // fit the seed into the available time (F3 time scaling of the same path)
+    let total: f64 = (0..3).map(|p| z0[tr.duration(p)]).sum();
+    if total > cfg.available_time() {
+        let k = cfg.available_time() / total;
+        for p in 0..3 {
+            z0[tr.duration(p)] *= k;
+        }
+    }
+    let problem = FreeProblem::new(cfg, nodes, &z0);
+    let settings = ScpSettings {
+        max_iterations: cfg.free.max_iterations,
+        tolerance: cfg.free.tolerance,
+        feasibility: cfg.free.attitude_tolerance,
+        ..Default::default()
+    };
+    let res = solve(&problem, z0, &settings, observe)?;
+    let solve_time = start.elapsed().as_secs_f64();
+    let (rf, _) = problem.attitude(&res.z, false);
+    let att = FreeProblem::attitude_error(&rf).norm();
+    let plan = CollocationPlan {
+        tr,
+        z: res.z.clone(),
+    };
+    let (peak, _) = crate::analyze::peak_along(cfg, &plan, 8 * nodes);
+    let sim = crate::simulate::dynamic_cfg(cfg, &plan)?;
+    let kin = crate::simulate::kinematic_cfg(cfg, &plan)?;
+    let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
+    for p in 0..3 {
+        for k in 0..nodes {
+            let q = Transcription::get2(&res.z, tr.q(p, k));
+            let b = q[0].hypot(q[1]);
+            bend = bend.max(b);
+            if b > 1e-3 {
+                let phi = q[1].atan2(q[0]);
+                if let Some(l) = last_phi {
+                    twist += crate::so3::wrap(phi - l);
+                }
+                last_phi = Some(phi);
+            }
+        }
+    }
+    crate::phased::check_limit(
+        cfg,
+        peak * cfg.available_time().powi(2),
+        peak,
+        "free-form design",
+    )?;
+    Ok(FreeResult {
+        mode: "free",
+        status: res.status,
+        peak_torque_nm: peak,
+        node_peak_torque_nm: res.peak,
+        bend_deg: bend.to_degrees(),
+        theta_deg: 180.0 - bend.to_degrees(),
+        twist_rad: twist,
+        phase_durations_s: [0, 1, 2].map(|p| res.z[tr.duration(p)]),
+        attitude_error_rad: att,
+        flip_deg: sim.flip_deg,
+        flip_error_rad: sim.flip_error_rad,
+        tilt_deg: sim.tilt_deg,
+        sim_peak_torque_nm: sim.peak_torque_nm,
+        momentum_drift_nms: sim.momentum_drift_nms,
+        kinematic_flip_error_rad: kin.flip_error_rad,
+        kinematic_tilt_deg: kin.tilt_deg,
+        seed: seed.into(),
+        scp_iterations: res.iterations.len(),
+        nodes,
+        solve_time_s: solve_time,
+        iterations: res.iterations,
+        plan,
+    })
+}
+
+/// The free-form optimiser with the config's nodes and the chosen seed.
+pub fn optimize(
+    cfg: &Config,
+    seed: Seed,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    match seed {
+        Seed::Phased => {
+            let ph = crate::phased::optimize(cfg, |_| {})?;
+            optimize_from(cfg, &ph.plan, seed.name(), cfg.free.nodes, observe)
+        }
+        Seed::Analytic => optimize_from(
+            cfg,
+            &crate::analytic::analytic_plan(cfg),
+            seed.name(),
+            cfg.free.nodes,
+            observe,
+        ),
+    }
+}

@@ -1,0 +1,389 @@
+//! Successive convexification for least-peak problems.
+//!
+//! A problem is: minimise `max_k |f_k(z)|` (Euclidean or per-component norm)
+//! subject to nonlinear equalities `r(z) = 0` and exact convex constraints
+//! (linear rows and second-order cones on affine functions of `z`). Each
+//! iteration linearises `f` and `r` about the current `z`, adds virtual
+//! controls `nu = nu+ - nu-` to the linearised equalities (penalised by `w |nu|_1`,
+//! which keeps every subproblem feasible), bounds the step by a scaled trust
+//! region, and solves one conic program with Clarabel; the data pattern is the
+//! same every iteration, so the solver is updated in place.
+//!
+//! Steps are judged on the exact penalty `phi(z) = max_k |f_k(z)| + w |r(z)|_1`:
+//! `rho = (phi(z) - phi(z + dz)) / (phi(z) - L(dz))` with `L` the subproblem's
+//! model value. When `rho < 0.75` a second-order correction (one more conic
+//! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
+//! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
+//! halves when `rho < 0.1` and doubles when `rho > 0.5`.
+//! Stop: predicted decrease below `tolerance * phi` with `max |r| <= feasibility`
+//! (converged); the penalty grows tenfold when the model stalls while still
+//! infeasible; an iteration limit or a collapsed trust region end the run.
+
+use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus};
+use crate::error::{Error, Result};
+use crate::model::TorqueNorm;
+use serde::Serialize;
+use std::time::Instant;
+
+/// Sparse Jacobian rows: `(row, column, value)`; the set of entries must not
+/// depend on `z` (emit zeros too), so the conic pattern stays fixed.
+pub type Triplets = Vec<(usize, usize, f64)>;
+
+/// Values and Jacobians at one point.
+#[derive(Debug, Clone, Default)]
+pub struct Linearization {
+    /// `f_k(z)`, each of length `term_dim`, flattened.
+    pub terms: Vec<f64>,
+    /// Jacobian of the flattened terms.
+    pub terms_jac: Triplets,
+    /// `r(z)`.
+    pub residual: Vec<f64>,
+    pub residual_jac: Triplets,
+}
+
+/// A least-peak problem the driver can convexify.
+pub trait ScpProblem {
+    /// Number of decision variables.
+    fn dim(&self) -> usize;
+    /// Length of each peak term `f_k`.
+    fn term_dim(&self) -> usize;
+    fn norm(&self) -> TorqueNorm;
+    /// `(terms, residual)` without derivatives (merit evaluation).
+    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>);
+    fn linearize(&self, z: &[f64]) -> Linearization;
+    /// Adds the exact convex constraints in the step `dz = x[var(i)]`,
+    /// i.e. in `z + dz`. The rows must have a fixed pattern.
+    fn add_constraints(&self, data: &mut ConicData, z: &[f64], var: &dyn Fn(usize) -> usize);
+    /// Trust-region scale of each variable (the radius is in these units).
+    fn scales(&self) -> Vec<f64>;
+    /// Optional hard bound on the peak.
+    fn peak_limit(&self) -> Option<f64> {
+        None
+    }
+}
+
+/// Driver settings; defaults in each field's doc.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ScpSettings {
+    /// Iteration limit (default 150).
+    pub max_iterations: usize,
+    /// Converged when the predicted decrease is below this fraction of the merit (default 1e-4).
+    pub tolerance: f64,
+    /// Largest `|r|` accepted as feasible (default 1e-6).
+    pub feasibility: f64,
+    /// Initial trust radius in scaled units (default 0.5).
+    pub initial_radius: f64,
+    /// Penalty weight relative to the initial peak (default 2): the exact L1
+    /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
+    /// model more curved and the steps shorter. It grows tenfold when needed.
+    pub weight: f64,
+}
+
+impl Default for ScpSettings {
+    fn default() -> Self {
+        Self {
+            max_iterations: 150,
+            tolerance: 1e-4,
+            feasibility: 1e-6,
+            initial_radius: 0.5,
+            weight: 2.0,
+        }
+    }
+}
+
+/// One iteration, as reported to the observer.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct ScpIteration {
+    pub iteration: usize,
+    /// Merit before the step.
+    pub merit: f64,
+    pub peak: f64,
+    /// `max |r|` before the step.
+    pub infeasibility: f64,
+    pub radius: f64,
+    pub weight: f64,
+    pub predicted: f64,
+    pub actual: f64,
+    pub rho: f64,
+    pub accepted: bool,
+    /// Merit after the iteration (equal to `merit` when rejected).
+    pub merit_after: f64,
+    pub solve_ms: f64,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ScpStatus {
+    Converged,
+    IterationLimit,
+    /// The trust region shrank to nothing without converging.
+    Stalled,
+}
+
+#[derive(Debug, Clone)]
+pub struct ScpResult {
+    pub z: Vec<f64>,
+    pub status: ScpStatus,
+    pub peak: f64,
+    pub infeasibility: f64,
+    pub iterations: Vec<ScpIteration>,
+}
+
+fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
+    terms
+        .chunks(d)
+        .map(|f| match norm {
+            TorqueNorm::Euclidean => f.iter().map(|x| x * x).sum::<f64>().sqrt(),
+            TorqueNorm::PerMotor => f.iter().fold(0.0f64, |m, x| m.max(x.abs())),
+        })
+        .fold(0.0, f64::max)
+}
+
+fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> (f64, f64, f64) {
+    let (terms, r) = p.evaluate(z);
+    let peak = peak_of(&terms, p.term_dim(), p.norm());
+    let l1: f64 = r.iter().map(|x| x.abs()).sum();
+    let inf = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    (peak + w * l1, peak, inf)
+}
+
+/// The convex subproblem at `z`: variables `[dz, t, nu+, nu-]`.
+fn subproblem(
+    p: &dyn ScpProblem,
+    z: &[f64],
+    lin: &Linearization,
+    scales: &[f64],
+    radius: f64,
+    w: f64,
+) -> ConicData {
+    let n = p.dim();
+    let m = lin.residual.len();
+    let (t, np, nm) = (n, n + 1, n + 1 + m);
+    let mut d = ConicData::new(n + 1 + 2 * m);
+    d.q[t] = 1.0;
+    for i in 0..m {
+        d.q[np + i] = w;
+        d.q[nm + i] = w;
+    }
+    // a light proximal term keeps the step unique where the model is flat
+    let mut p_diag = vec![0.0; d.n];
+    for i in 0..n {
+        p_diag[i] = 1e-9 / (scales[i] * scales[i]);
+    }
+    d.p_diag = Some(p_diag);
+    // linearised equalities with virtual control: r + J dz - nu+ + nu- = 0
+    let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+    for &(r, c, v) in &lin.residual_jac {
+        rows[r].push((c, v));
+    }
+    for (i, mut row) in rows.into_iter().enumerate() {
+        row.push((np + i, -1.0));
+        row.push((nm + i, 1.0));
+        d.row(&row, -lin.residual[i]);
+    }
+    d.cone(Cone::Zero(m));
+    p.add_constraints(&mut d, z, &|i| i);
+    // peak epigraph
+    let dim = p.term_dim();
+    let nterms = lin.terms.len() / dim;
+    let mut jac: Vec<Vec<(usize, f64)>> = vec![Vec::new(); lin.terms.len()];
+    for &(r, c, v) in &lin.terms_jac {
+        jac[r].push((c, v));
+    }
+    match p.norm() {
+        TorqueNorm::Euclidean => {
+            for k in 0..nterms {
+                d.row(&[(t, -1.0)], 0.0);
+                for j in 0..dim {
+                    let r = k * dim + j;
+                    let row: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
+                    d.row(&row, lin.terms[r]);
+                }
+                d.cone(Cone::Soc(dim + 1));
+            }
+        }
+        TorqueNorm::PerMotor => {
+            for r in 0..lin.terms.len() {
+                let mut up = jac[r].clone();
+                up.push((t, -1.0));
+                d.row(&up, -lin.terms[r]);
+                let mut down: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
+                down.push((t, -1.0));
+                d.row(&down, lin.terms[r]);
+            }
+            d.cone(Cone::Nonneg(2 * lin.terms.len()));
+        }
+    }
+    // nu >= 0, trust region, peak limit
+    for i in 0..2 * m {
+        d.row(&[(np + i, -1.0)], 0.0);
+    }
+    for i in 0..n {
+        d.row(&[(i, 1.0)], radius * scales[i]);
+        d.row(&[(i, -1.0)], radius * scales[i]);
+    }
+    let mut rows = 2 * m + 2 * n;
+    if let Some(lim) = p.peak_limit() {
+        d.row(&[(t, 1.0)], lim);
+        rows += 1;
+    }
+    d.cone(Cone::Nonneg(rows));
+    d
+}
+
+/// Second-order correction at the trial point `z+ = z + dz`: the least
+/// scaled-norm `dc` with `J dc = (r + J dz) - r(z+)` (back onto the model's
+/// prediction of the residual) that keeps the exact constraints. This undoes
+/// the curvature of `r` (here the attitude's, a holonomy that is quadratic in
+/// the path) that would otherwise force tiny trust regions.
+fn correction(
+    p: &dyn ScpProblem,
+    z_trial: &[f64],
+    lin: &Linearization,
+    target_minus_actual: &[f64],
+    scales: &[f64],
+) -> ConicData {
+    let n = p.dim();
+    let m = target_minus_actual.len();
+    let mut d = ConicData::new(n);
+    d.p_diag = Some(scales.iter().map(|s| 1.0 / (s * s)).collect());
+    let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
+    for &(r, c, v) in &lin.residual_jac {
+        rows[r].push((c, v));
+    }
+    for (i, row) in rows.into_iter().enumerate() {
+        d.row(&row, target_minus_actual[i]);
+    }
+    d.cone(Cone::Zero(m));
+    p.add_constraints(&mut d, z_trial, &|i| i);
+    d
+}
+
+/// Runs the SCP from `z0`, reporting each iteration to `observe`.
+pub fn solve(
+    p: &dyn ScpProblem,
+    z0: Vec<f64>,
+    settings: &ScpSettings,
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<ScpResult> {
+    let scales = p.scales();
+    let mut z = z0;
+    let (_, peak0, _) = merit(p, &z, 0.0);
+    let mut w = settings.weight * peak0.max(1e-12);
+    let mut radius = settings.initial_radius;
+    let mut solver: Option<ConicSolver> = None;
+    let mut corrector: Option<ConicSolver> = None;
+    let mut iterations = Vec::new();
+    let mut status = ScpStatus::IterationLimit;
+    for it in 0..settings.max_iterations {
+        let (phi, peak, inf) = merit(p, &z, w);
+        let lin = p.linearize(&z);
+        let data = subproblem(p, &z, &lin, &scales, radius, w);
+        let clock = Instant::now();
+        match &mut solver {
+            Some(s) => s.update(&data)?,
+            None => solver = Some(ConicSolver::new(&data)?),
+        }
+        let (st, x, _) = solver.as_mut().unwrap().solve();
+        let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
+        if !st.ok() {
+            if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
+                return Err(Error::Unreachable {
+                    reason: "the convexified problem has no solution within limits.max_torque: raise the limit or fall.height".into(),
+                });
+            }
+            return Err(Error::Solver {
+                what: format!("SCP subproblem {it}"),
+                status: format!("{st:?}"),
+                hint: "try another seed (--seed), more free.nodes, or report the config".into(),
+            });
+        }
+        let n = p.dim();
+        let m = lin.residual.len();
+        let model = x[n] + w * x[n + 1..n + 1 + 2 * m].iter().sum::<f64>();
+        let predicted = phi - model;
+        let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
+        let (mut phi_t, _, _) = merit(p, &trial, w);
+        if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
+            // model residual at the trial point: r + J dz (= nu+ - nu-)
+            let nu: Vec<f64> = (0..m).map(|i| x[n + 1 + i] - x[n + 1 + m + i]).collect();
+            let (_, r_trial) = p.evaluate(&trial);
+            let rhs: Vec<f64> = (0..m).map(|i| nu[i] - r_trial[i]).collect();
+            let cd = correction(p, &trial, &lin, &rhs, &scales);
+            let solved = match &mut corrector {
+                Some(s) => s.update(&cd).map(|_| s.solve()),
+                None => ConicSolver::new(&cd).map(|mut s| {
+                    let r = s.solve();
+                    corrector = Some(s);
+                    r
+                }),
+            };
+            if let Ok((cs, dc, _)) = solved
+                && cs.ok()
+            {
+                let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
+                let (phi_c, _, _) = merit(p, &corrected, w);
+                if phi_c < phi_t {
+                    trial = corrected;
+                    phi_t = phi_c;
+                }
+            }
+        }
+        let actual = phi - phi_t;
+        let rho = if predicted > 0.0 {
+            actual / predicted
+        } else {
+            0.0
+        };
+        let accepted = predicted > 0.0 && rho > 0.1;
+        let rec = ScpIteration {
+            iteration: it,
+            merit: phi,
+            peak,
+            infeasibility: inf,
+            radius,
+            weight: w,
+            predicted,
+            actual,
+            rho,
+            accepted,
+            merit_after: if accepted { phi_t } else { phi },
+            solve_ms,
+        };
+        observe(&rec);
+        iterations.push(rec);
+        if accepted {
+            z = trial;
+        }
+        if rho < 0.1 {
+            radius *= 0.5;
+        } else if rho > 0.5 {
+            radius = (radius * 2.0).min(1e3);
+        }
+        let (_, _, inf_now) = merit(p, &z, w);
+        if predicted <= settings.tolerance * phi.abs().max(1e-300) {
+            if inf_now <= settings.feasibility {
+                status = ScpStatus::Converged;
+                break;
+            }
+            // stuck infeasible: the penalty is too weak
+            w *= 10.0;
+        }
+        if radius < 1e-10 {
+            status = if inf_now <= settings.feasibility {
+                ScpStatus::Converged
+            } else {
+                ScpStatus::Stalled
+            };
+            break;
+        }
+    }
+    let (_, peak, infeasibility) = merit(p, &z, w);
+    Ok(ScpResult {
+        z,
+        status,
+        peak,
+        infeasibility,
+        iterations,
+    })
+}

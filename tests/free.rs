@@ -1,0 +1,272 @@
+//! The free-form optimiser: linearisation, SCP machinery, and results.
+
+use catflip::Config;
+use catflip::analytic::analytic_plan;
+use catflip::collocation::Transcription;
+use catflip::free::FreeProblem;
+use catflip::scp::ScpProblem;
+
+fn cfg(name: &str, overrides: &[&str]) -> Config {
+    let p = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Config::load(std::path::Path::new(&p), &ov).unwrap()
+}
+
+fn dense(trip: &[(usize, usize, f64)], rows: usize, cols: usize) -> Vec<Vec<f64>> {
+    let mut d = vec![vec![0.0; cols]; rows];
+    for &(r, c, v) in trip {
+        d[r][c] += v;
+    }
+    d
+}
+
+#[test]
+fn linearisation_matches_finite_differences_of_the_nonlinear_maps() {
+    for joint in ["no-twist", "universal"] {
+        let c = cfg("seed", &[&format!("cat.joint={joint}")]);
+        let nodes = 6;
+        let tr = Transcription::new(3, nodes);
+        let mut z = tr.sample(&analytic_plan(&c));
+        // move off the seed so that nothing is special
+        for (i, x) in z.iter_mut().enumerate() {
+            *x += 0.01 * ((i * 37 % 11) as f64 - 5.0) / 5.0;
+        }
+        let p = FreeProblem::new(&c, nodes, &z);
+        let lin = p.linearize(&z);
+        let (terms, res) = p.evaluate(&z);
+        for (a, b) in terms.iter().zip(&lin.terms) {
+            assert!((a - b).abs() < 1e-10);
+        }
+        for (a, b) in res.iter().zip(&lin.residual) {
+            assert!((a - b).abs() < 1e-10);
+        }
+        let jt = dense(&lin.terms_jac, terms.len(), p.dim());
+        let jr = dense(&lin.residual_jac, res.len(), p.dim());
+        let h = 1e-6;
+        for col in 0..p.dim() {
+            let mut zp = z.clone();
+            zp[col] += h;
+            let mut zm = z.clone();
+            zm[col] -= h;
+            let ((tp, rp), (tm, rm)) = (p.evaluate(&zp), p.evaluate(&zm));
+            for r in 0..terms.len() {
+                let fd = (tp[r] - tm[r]) / (2.0 * h);
+                assert!(
+                    (fd - jt[r][col]).abs() < 1e-5 * (1.0 + fd.abs()),
+                    "{joint} torque row {r} col {col}: {fd} vs {}",
+                    jt[r][col]
+                );
+            }
+            for r in 0..res.len() {
+                let fd = (rp[r] - rm[r]) / (2.0 * h);
+                assert!(
+                    (fd - jr[r][col]).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "{joint} residual row {r} col {col}: {fd} vs {}",
+                    jr[r][col]
+                );
+            }
+        }
+    }
+}
+
+/// A rest-to-rest double integrator (unit mass, move 1 m in 1 s) with least
+/// peak force, solved by the same transcription and SCP driver. Known optimum:
+/// bang-bang, |F| = 4 D / T^2 = 4 N, switching at mid-time.
+struct DoubleIntegrator {
+    tr: Transcription,
+}
+
+impl ScpProblem for DoubleIntegrator {
+    fn dim(&self) -> usize {
+        self.tr.dim()
+    }
+    fn term_dim(&self) -> usize {
+        1
+    }
+    fn norm(&self) -> catflip::model::TorqueNorm {
+        catflip::model::TorqueNorm::PerMotor
+    }
+    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
+        let t = z[self.tr.duration(0)];
+        let f = (0..self.tr.nodes)
+            .map(|k| z[self.tr.a(0, k)] / (t * t))
+            .collect();
+        (f, self.tr.defects(z, 0, None))
+    }
+    fn linearize(&self, z: &[f64]) -> catflip::scp::Linearization {
+        let (terms, _) = self.evaluate(z);
+        let t = z[self.tr.duration(0)];
+        let mut tj = Vec::new();
+        for k in 0..self.tr.nodes {
+            tj.push((k, self.tr.a(0, k), 1.0 / (t * t)));
+            tj.push((
+                k,
+                self.tr.duration(0),
+                -2.0 * z[self.tr.a(0, k)] / (t * t * t),
+            ));
+        }
+        let mut rj = Vec::new();
+        let residual = self.tr.defects(z, 0, Some(&mut rj));
+        catflip::scp::Linearization {
+            terms,
+            terms_jac: tj,
+            residual,
+            residual_jac: rj,
+        }
+    }
+    fn add_constraints(
+        &self,
+        d: &mut catflip::conic::ConicData,
+        z: &[f64],
+        var: &dyn Fn(usize) -> usize,
+    ) {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        // second coordinate fixed at zero throughout; first from 0 to 1, at rest
+        let mut rows = 0;
+        let mut fix = |d: &mut catflip::conic::ConicData, i: usize, value: f64| {
+            d.row(&[(var(i), 1.0)], value - z[i]);
+            rows += 1;
+        };
+        for k in 0..n {
+            fix(d, tr.q(0, k) + 1, 0.0);
+            fix(d, tr.v(0, k) + 1, 0.0);
+            fix(d, tr.a(0, k) + 1, 0.0);
+        }
+        fix(d, tr.q(0, 0), 0.0);
+        fix(d, tr.v(0, 0), 0.0);
+        fix(d, tr.q(0, n - 1), 1.0);
+        fix(d, tr.v(0, n - 1), 0.0);
+        fix(d, tr.duration(0), 1.0);
+        d.cone(catflip::conic::Cone::Zero(rows));
+    }
+    fn scales(&self) -> Vec<f64> {
+        vec![1.0; self.dim()]
+    }
+}
+
+#[test]
+fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
+    for nodes in [21, 41] {
+        let tr = Transcription::new(1, nodes);
+        let mut z = vec![0.0; tr.dim()];
+        // seed: the smooth cosine move, peak pi^2 / 2 = 4.93 N
+        for k in 0..nodes {
+            let s = k as f64 / (nodes - 1) as f64;
+            let w = std::f64::consts::PI;
+            z[tr.q(0, k)] = 0.5 * (1.0 - (w * s).cos());
+            z[tr.v(0, k)] = 0.5 * w * (w * s).sin();
+            z[tr.a(0, k)] = 0.5 * w * w * (w * s).cos();
+        }
+        z[tr.duration(0)] = 1.0;
+        let p = DoubleIntegrator { tr };
+        let r = catflip::scp::solve(&p, z, &catflip::scp::ScpSettings::default(), |_| {}).unwrap();
+        assert_eq!(
+            r.status,
+            catflip::scp::ScpStatus::Converged,
+            "{nodes} nodes"
+        );
+        // first-order-hold force needs one interval to switch: peak 4 / (1 - h/2)^2-ish above 4
+        let h = 1.0 / (nodes - 1) as f64;
+        assert!(
+            r.peak >= 4.0 - 1e-6 && r.peak < 4.0 * (1.0 + 2.5 * h),
+            "{nodes}: peak {}",
+            r.peak
+        );
+        // bang-bang: saturated almost everywhere, one sign change
+        let f: Vec<f64> = (0..nodes).map(|k| r.z[tr.a(0, k)]).collect();
+        let saturated = f
+            .iter()
+            .filter(|x| (x.abs() - r.peak).abs() < 1e-3 * r.peak)
+            .count();
+        assert!(saturated >= nodes - 3, "{nodes}: {f:?}");
+        let changes = f
+            .windows(2)
+            .filter(|w| w[0].signum() != w[1].signum() && w[1].abs() > 1e-9)
+            .count();
+        assert!(changes <= 1, "{f:?}");
+        assert!(r.infeasibility < 1e-6);
+    }
+}
+
+#[test]
+fn accepted_scp_steps_never_increase_the_penalised_objective() {
+    let c = cfg("seed", &[]);
+    let mut seen = 0;
+    let r = catflip::free::optimize(&c, catflip::free::Seed::Analytic, |it| {
+        if it.accepted {
+            seen += 1;
+            assert!(
+                it.merit_after <= it.merit,
+                "iteration {}: {} -> {}",
+                it.iteration,
+                it.merit,
+                it.merit_after
+            );
+        } else {
+            assert_eq!(it.merit_after, it.merit);
+        }
+    })
+    .unwrap();
+    assert!(seen > 5);
+    assert_eq!(r.status, catflip::scp::ScpStatus::Converged);
+}
+
+#[test]
+fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
+    let c = cfg("seed", &[]);
+    let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+    for seed in [catflip::free::Seed::Phased, catflip::free::Seed::Analytic] {
+        let r = catflip::free::optimize(&c, seed, |_| {}).unwrap();
+        assert_eq!(r.status, catflip::scp::ScpStatus::Converged, "{seed:?}");
+        assert!(
+            r.flip_error_rad.abs() < 1e-3 && r.kinematic_flip_error_rad.abs() < 1e-3,
+            "{seed:?}"
+        );
+        assert!(r.tilt_deg.to_radians() < 1e-3);
+        assert!(
+            r.peak_torque_nm <= phased.peak_torque_nm,
+            "{seed:?}: {} > {}",
+            r.peak_torque_nm,
+            phased.peak_torque_nm
+        );
+        // the simulated peak is the schedule's (feed-forward plus small PD corrections)
+        assert!((r.sim_peak_torque_nm - r.peak_torque_nm).abs() < 0.01 * r.peak_torque_nm);
+        assert!(r.momentum_drift_nms < 1e-12);
+    }
+}
+
+#[test]
+fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
+    for name in ["seed", "domestic-cat"] {
+        let c = cfg(name, &[]);
+        let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+        let a = catflip::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        let b = catflip::free::optimize_from(&c, &phased.plan, "phased", 80, |_| {}).unwrap();
+        let rel = (a.peak_torque_nm - b.peak_torque_nm).abs() / b.peak_torque_nm;
+        assert!(
+            rel < 0.01,
+            "{name}: {} vs {}",
+            a.peak_torque_nm,
+            b.peak_torque_nm
+        );
+        assert!(a.flip_error_rad.abs() < 1e-3 && b.flip_error_rad.abs() < 1e-3);
+    }
+}
+
+#[test]
+fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
+    for name in ["seed", "domestic-cat", "robot-universal"] {
+        let c = cfg(name, &[]);
+        let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+        let free =
+            catflip::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {}).unwrap();
+        assert!(
+            free.peak_torque_nm <= phased.peak_torque_nm,
+            "{name}: {} > {}",
+            free.peak_torque_nm,
+            phased.peak_torque_nm
+        );
+        assert!(free.flip_error_rad.abs() < 1e-3, "{name}");
+    }
+}
