@@ -37,6 +37,8 @@ struct Common {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: analytic, phased and free-form schedules, verified by simulation, with a report.
+    Run(Common),
     /// The seed's closed forms and its cosine schedule, evaluated with the true dynamics.
     Analyze(Common),
     /// Forward-simulate a torque schedule (default: the analytic one) in the full model.
@@ -85,6 +87,7 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
 pub fn run() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Run(c) => cmd_run(&c),
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -402,5 +405,111 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             }
         }
     }
+    Ok(())
+}
+
+/// Stage lines on stderr; live iteration counters when stderr is a terminal.
+fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
+    use catflip::run::Progress;
+    use std::io::{IsTerminal, Write};
+    let live = std::io::stderr().is_terminal() && !quiet;
+    move |p| {
+        if quiet {
+            return;
+        }
+        let mut e = std::io::stderr();
+        match p {
+            Progress::Stage { index, total, name } => {
+                let _ = write!(e, "[{index}/{total}] {name} ...");
+                if live {
+                    let _ = writeln!(e);
+                }
+            }
+            Progress::StageDone { seconds } => {
+                if live {
+                    let _ = write!(e, "\r\x1b[2K");
+                }
+                let _ = writeln!(e, " done in {seconds:.2} s");
+            }
+            Progress::Bend {
+                evaluations,
+                bend_deg,
+                peak_nm,
+            } if live => {
+                let _ = write!(
+                    e,
+                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {peak_nm:.5} N m"
+                );
+            }
+            Progress::Scp(it) if live => {
+                let _ = write!(
+                    e,
+                    "\r\x1b[2K      SCP iteration {:3}: peak {:.5} N m, max |r| {:.1e}, radius {:.1e}",
+                    it.iteration, it.peak, it.infeasibility, it.radius
+                );
+            }
+            _ => {}
+        }
+        let _ = e.flush();
+    }
+}
+
+fn cmd_run(c: &Common) -> Result<()> {
+    let cfg = load(c)?;
+    let r = catflip::run::run(&cfg, progress_display(c.json))?;
+    let dir = out_dir(c, &cfg);
+    let written = r.output.commit(&dir)?;
+    if c.json {
+        println!("{}", serde_json::to_string_pretty(&r.summary)?);
+        return Ok(());
+    }
+    let s = &r.summary;
+    println!();
+    println!(
+        "catflip run: {} ({} joint, peak norm {:?})",
+        s.name, s.joint, s.peak_norm
+    );
+    let header = [
+        "method",
+        "status",
+        "peak N m",
+        "bend deg",
+        "durations s",
+        "flip err rad",
+        "tilt deg",
+        "sim peak N m",
+        "solve s",
+    ];
+    let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
+    let widths: Vec<usize> = (0..header.len())
+        .map(|j| {
+            rows.iter()
+                .map(|r| r[j].len())
+                .chain([header[j].len()])
+                .max()
+                .unwrap()
+        })
+        .collect();
+    let line = |cells: Vec<String>| {
+        let parts: Vec<String> = cells
+            .iter()
+            .enumerate()
+            .map(|(j, c)| format!("{c:>w$}", w = widths[j]))
+            .collect();
+        println!("  {}", parts.join("  "));
+    };
+    line(header.iter().map(|h| h.to_string()).collect());
+    for row in rows {
+        line(row);
+    }
+    println!(
+        "  free-form / phased peak {:.3}, phased / analytic {:.3}; {} SCP iterations at {} nodes per phase",
+        s.free_over_phased, s.phased_over_analytic, s.scp_iterations, s.nodes
+    );
+    println!(
+        "  report: {} ({} files)",
+        dir.join("index.html").display(),
+        written.len()
+    );
     Ok(())
 }

@@ -32,6 +32,8 @@ pub enum Error {
     Unreachable { reason: String },
     #[error("simulation failed: {0}")]
     Simulation(String),
+    #[error("drawing a figure failed: {0}")]
+    Report(String),
     #[error("cannot write {path}: {source}")]
     Write {
         path: PathBuf,

@@ -16,6 +16,8 @@ pub mod output;
 pub mod path;
 pub mod phased;
 pub mod plan;
+pub mod report;
+pub mod run;
 pub mod scp;
 pub mod simulate;
 pub mod small;
