@@ -9,6 +9,13 @@ use crate::plan::{Schedule, ShapePlan};
 use crate::simulate::{SimReport, dynamic_cfg, kinematic_cfg};
 use serde::Serialize;
 
+/// Samples per phase of the reported ("dense") peaks: at least 2000 and a
+/// multiple of the written schedules' rows, so every written row is among them.
+pub fn dense_samples(cfg: &Config) -> usize {
+    let n = cfg.simulate.samples_per_phase;
+    n * 2000usize.div_ceil(n)
+}
+
 /// Peak joint torque along a plan, sampled densely in every phase, N m.
 pub fn peak_along(cfg: &Config, plan: &dyn ShapePlan, per_phase: usize) -> (f64, [f64; 3]) {
     let cat = cfg.cat();
@@ -49,7 +56,7 @@ pub struct Analysis {
 pub fn analyze(cfg: &Config) -> Result<Analysis> {
     let closed = closed_forms(cfg);
     let plan = analytic_plan(cfg);
-    let (peak, per) = peak_along(cfg, &plan, 2000);
+    let (peak, per) = peak_along(cfg, &plan, dense_samples(cfg));
     let kin = kinematic_cfg(cfg, &plan)?;
     Ok(Analysis {
         name: cfg.name.clone(),

@@ -49,6 +49,27 @@ enum Command {
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
+    /// Sweep a numeric config key over a range; every point designed by each method, in parallel.
+    Sweep {
+        #[command(flatten)]
+        common: Common,
+        /// KEY=FROM:TO:COUNT, e.g. fall.height=0.5:10:40.
+        #[arg(long = "set-range", value_name = "KEY=FROM:TO:COUNT")]
+        range: String,
+        /// Methods to compute, comma separated (default all three).
+        #[arg(long, value_delimiter = ',', default_value = "analytic,phased,free")]
+        methods: Vec<String>,
+        /// Points computed at once (default: the machine's cores).
+        #[arg(long)]
+        threads: Option<usize>,
+    },
+    /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model.
+    Export {
+        #[arg(value_enum)]
+        format: ExportFormat,
+        #[command(flatten)]
+        common: Common,
+    },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
         #[command(flatten)]
@@ -62,6 +83,14 @@ enum Command {
         #[arg(long)]
         verbose: bool,
     },
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+enum ExportFormat {
+    /// URDF for pyBullet (as the seed used).
+    Urdf,
+    /// MJCF for MuJoCo.
+    Mjcf,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
@@ -88,6 +117,13 @@ pub fn run() -> Result<()> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(c) => cmd_run(&c),
+        Command::Sweep {
+            common,
+            range,
+            methods,
+            threads,
+        } => cmd_sweep(&common, &range, &methods, threads),
+        Command::Export { format, common } => cmd_export(&common, format),
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -511,5 +547,100 @@ fn cmd_run(c: &Common) -> Result<()> {
         dir.join("index.html").display(),
         written.len()
     );
+    Ok(())
+}
+
+fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>) -> Result<()> {
+    let cfg = load(c)?;
+    let spec: catflip::sweep::SweepSpec = range.parse()?;
+    let mut m = catflip::sweep::Methods {
+        analytic: false,
+        phased: false,
+        free: false,
+    };
+    for name in methods {
+        match name.trim() {
+            "analytic" => m.analytic = true,
+            "phased" => m.phased = true,
+            "free" => m.free = true,
+            other => anyhow::bail!(
+                "unknown method `{other}` in --methods; use analytic, phased and/or free"
+            ),
+        }
+    }
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let quiet = c.json;
+    let points = catflip::sweep::sweep(&c.config, &c.set, &spec, m, threads, |done, total| {
+        if !quiet {
+            eprint!("\r  sweep {}: {done}/{total} points", spec.key);
+        }
+    })?;
+    if !quiet {
+        eprintln!();
+    }
+    let key = spec.key.replace('.', "_");
+    let mut out = Output::default();
+    out.add(
+        format!("sweep-{key}.csv"),
+        catflip::sweep::to_csv(&spec.key, &points),
+    );
+    for (name, svg) in catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)? {
+        out.add(name, svg);
+    }
+    let written = out.commit(&out_dir(c, &cfg))?;
+    if c.json {
+        println!("{}", serde_json::to_string_pretty(&points)?);
+        return Ok(());
+    }
+    println!(
+        "catflip sweep: {} over {} ({} points, {threads} at a time)",
+        cfg.name,
+        spec.key,
+        points.len()
+    );
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
+    println!(
+        "  {:>12} {:>12} {:>12} {:>12} {:>12}",
+        spec.key, "analytic N m", "phased N m", "free N m", "least h (m)"
+    );
+    for p in &points {
+        let h = p.least_height_free_m.or(p.least_height_phased_m);
+        println!(
+            "  {:>12.5} {:>12} {:>12} {:>12} {:>12}{}",
+            p.value,
+            show(p.analytic_peak_nm),
+            show(p.phased_peak_nm),
+            show(p.free_peak_nm),
+            show(h),
+            p.error
+                .as_ref()
+                .map(|e| format!("  error: {e}"))
+                .unwrap_or_default()
+        );
+    }
+    for w in written {
+        row("wrote", w.display().to_string());
+    }
+    Ok(())
+}
+
+fn cmd_export(c: &Common, format: ExportFormat) -> Result<()> {
+    let cfg = load(c)?;
+    let (name, text) = match format {
+        ExportFormat::Urdf => (format!("{}.urdf", cfg.name), catflip::export::urdf(&cfg)),
+        ExportFormat::Mjcf => (
+            format!("{}.mjcf.xml", cfg.name),
+            catflip::export::mjcf(&cfg),
+        ),
+    };
+    let mut out = Output::default();
+    out.add(name, text);
+    for w in out.commit(&out_dir(c, &cfg))? {
+        println!("wrote {}", w.display());
+    }
     Ok(())
 }

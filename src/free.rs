@@ -431,7 +431,7 @@ pub fn optimize_from(
         tr,
         z: res.z.clone(),
     };
-    let (peak, _) = crate::analyze::peak_along(cfg, &plan, 8 * nodes);
+    let (peak, _) = crate::analyze::peak_along(cfg, &plan, crate::analyze::dense_samples(cfg));
     let sim = crate::simulate::dynamic_cfg(cfg, &plan)?;
     let kin = crate::simulate::kinematic_cfg(cfg, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);

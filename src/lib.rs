@@ -9,6 +9,7 @@ pub mod config;
 pub mod conic;
 pub mod dynamics;
 pub mod error;
+pub mod export;
 pub mod free;
 pub mod model;
 pub mod ode;
@@ -22,6 +23,7 @@ pub mod scp;
 pub mod simulate;
 pub mod small;
 pub mod so3;
+pub mod sweep;
 pub mod timing;
 
 pub use config::Config;

@@ -307,7 +307,7 @@ pub fn finish(
     let durations = design.durations(t);
     let socp_peak = design.unit_peak() / (t * t);
     let plan = design.plan(durations);
-    let (peak, _) = peak_along(cfg, &plan, 16 * cfg.phased.nodes);
+    let (peak, _) = peak_along(cfg, &plan, crate::analyze::dense_samples(cfg));
     check_limit(cfg, peak * t * t, peak, "phased design")?;
     let split = cfg.analytic.split.map(|f| f * t);
     let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);

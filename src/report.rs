@@ -377,7 +377,13 @@ pub fn lines(
         let yr = range(series.iter().flat_map(|s| s.1.iter().copied()));
         let mut c = chart(root, title, xr, (yr.0.min(0.0), yr.1), xdesc, ydesc)?;
         for (i, (name, ys)) in series.iter().enumerate() {
-            let col = color(i);
+            // the methods keep their colours across all figures
+            let col = match name.as_str() {
+                "analytic" => color(0),
+                "phased" => color(1),
+                "free" => color(2),
+                _ => color(i + 1),
+            };
             let pts: Vec<(f64, f64)> = x
                 .iter()
                 .zip(ys)

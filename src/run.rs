@@ -204,7 +204,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .clone()
         .expect("phased result carries its simulation");
     let fr_sim = dynamic_cfg(cfg, &fr.plan)?;
-    let (a_peak, _) = peak_along(cfg, &a.plan, 2000);
+    let (a_peak, _) = peak_along(cfg, &a.plan, crate::analyze::dense_samples(cfg));
     let methods = vec![
         summarize(
             "analytic",

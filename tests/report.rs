@@ -1,0 +1,239 @@
+//! The main job, sweeps and exports, through the real binary and the library.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+}
+
+fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+/// Peak of the torque columns of a schedule CSV in the given norm.
+fn csv_peak(text: &str, per_motor: bool) -> f64 {
+    let mut lines = text.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header[0], "t_s");
+    let i1 = header.iter().position(|h| *h == "tau1_nm").unwrap();
+    let mut last_t = f64::NEG_INFINITY;
+    let mut peak = 0.0f64;
+    for l in lines {
+        let f: Vec<&str> = l.split(',').collect();
+        let t: f64 = f[0].parse().unwrap();
+        assert!(t >= last_t, "time column must not decrease");
+        last_t = t;
+        let (a, b): (f64, f64) = (f[i1].parse().unwrap(), f[i1 + 1].parse().unwrap());
+        peak = peak.max(if per_motor {
+            a.abs().max(b.abs())
+        } else {
+            a.hypot(b)
+        });
+    }
+    peak
+}
+
+#[test]
+fn run_writes_a_complete_consistent_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let (ok, out, err) = run(&["run", cfg.to_str().unwrap()], dir.path());
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("analytic") && out.contains("phased") && out.contains("free"),
+        "{out}"
+    );
+    let base = dir.path().join("output/seed");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
+    let methods = summary["methods"].as_array().unwrap();
+    assert_eq!(methods.len(), 3);
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    for m in methods {
+        let name = m["method"].as_str().unwrap();
+        let peak = m["peak_torque_nm"].as_f64().unwrap();
+        // the schedule file agrees with the JSON peak (the JSON samples more densely)
+        let csv = std::fs::read_to_string(base.join(m["schedule_csv"].as_str().unwrap())).unwrap();
+        let p = csv_peak(&csv, false);
+        assert!(
+            p <= peak * (1.0 + 1e-6) && p >= 0.98 * peak,
+            "{name}: CSV {p} vs JSON {peak}"
+        );
+        // the table shows the same number
+        assert!(
+            html.contains(&format!("{peak:.5}")),
+            "{name} peak missing from index.html"
+        );
+        assert!(m["flip_error_rad"].as_f64().unwrap().abs() < 1e-3, "{name}");
+    }
+    let peaks: Vec<f64> = methods
+        .iter()
+        .map(|m| m["peak_torque_nm"].as_f64().unwrap())
+        .collect();
+    assert!(peaks[2] <= peaks[1] && peaks[1] <= peaks[0]);
+    assert!((summary["free_over_phased"].as_f64().unwrap() - peaks[2] / peaks[1]).abs() < 1e-12);
+    for fig in summary["figures"].as_array().unwrap() {
+        let name = fig.as_str().unwrap();
+        assert!(html.contains(name));
+        let text = std::fs::read_to_string(base.join(name)).unwrap();
+        let doc = roxmltree::Document::parse(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let texts: Vec<String> = doc
+            .descendants()
+            .filter(|n| n.tag_name().name() == "text")
+            .map(|n| n.text().unwrap_or("").to_string())
+            .collect();
+        assert!(texts.len() > 5, "{name} has too little text");
+        assert!(
+            texts.iter().any(|t| t.contains("time (s)")
+                || t.contains("iteration")
+                || t.contains("q1 (deg)")),
+            "{name}: {texts:?}"
+        );
+    }
+    let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
+    assert!(
+        torque.contains(&format!("peak {:.4} N m", peaks[2])),
+        "peaks are marked in the torque figure"
+    );
+}
+
+#[test]
+fn sweep_agrees_with_single_runs() {
+    let cfg_path = configs().join("seed.toml");
+    let spec: catflip::sweep::SweepSpec = "fall.height=5:10:2".parse().unwrap();
+    let methods = catflip::sweep::Methods {
+        analytic: true,
+        phased: true,
+        free: true,
+    };
+    let points = catflip::sweep::sweep(&cfg_path, &[], &spec, methods, 2, |_, _| {}).unwrap();
+    assert_eq!(points.len(), 2);
+    for p in &points {
+        let cfg = catflip::Config::load(&cfg_path, &[format!("fall.height={}", p.value)]).unwrap();
+        let (a, _) = catflip::analyze::peak_along(
+            &cfg,
+            &catflip::analytic::analytic_plan(&cfg),
+            catflip::analyze::dense_samples(&cfg),
+        );
+        let ph = catflip::phased::optimize(&cfg, |_| {}).unwrap();
+        let fr =
+            catflip::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+        assert!((p.analytic_peak_nm.unwrap() - a).abs() <= 1e-12 * a);
+        assert!((p.phased_peak_nm.unwrap() - ph.peak_torque_nm).abs() <= 1e-12 * a);
+        assert!((p.free_peak_nm.unwrap() - fr.peak_torque_nm).abs() <= 1e-9 * fr.peak_torque_nm);
+        assert!(p.error.is_none());
+    }
+    // F3 across the sweep: peak ~ 1 / T^2 ~ 1 / height
+    let r = points[0].phased_peak_nm.unwrap() / points[1].phased_peak_nm.unwrap();
+    assert!((r - 2.0).abs() < 1e-6, "{r}");
+}
+
+#[test]
+fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let c = cfg.to_str().unwrap();
+    let (ok, _, err) = run(
+        &[
+            "sweep",
+            c,
+            "--set-range",
+            "cat.mass=0.5:1:2",
+            "--methods",
+            "analytic,phased",
+            "--set",
+            "limits.max_torque=0.5",
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass.csv")).unwrap();
+    let rows: Vec<&str> = csv.lines().collect();
+    assert_eq!(rows.len(), 3);
+    assert!(rows[0].starts_with("cat.mass,"));
+    // with a torque limit, the least drop height of F7 is there
+    assert!(
+        dir.path()
+            .join("output/seed/sweep-cat_mass-least-height.svg")
+            .exists()
+    );
+    let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
+    assert!(h > 10.0, "{h}");
+    for bad in ["cat.mass=1:2", "cat.masss=1:2:3", "cat.mass=-1:2:3"] {
+        let (ok, _, err) = run(&["sweep", c, "--set-range", bad], dir.path());
+        assert!(!ok && !err.is_empty(), "{bad} should fail");
+    }
+}
+
+#[test]
+fn exports_parse_and_carry_the_model_masses_and_inertias() {
+    for name in ["seed", "robot-universal"] {
+        let cfg = catflip::Config::load(&configs().join(format!("{name}.toml")), &[]).unwrap();
+        let cat = cfg.cat();
+        let close = |s: &str, want: f64| (s.parse::<f64>().unwrap() - want).abs() < 1e-8;
+        let urdf = catflip::export::urdf(&cfg);
+        let doc = roxmltree::Document::parse(&urdf).unwrap();
+        let masses: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("mass"))
+            .collect();
+        assert_eq!(masses.len(), 2);
+        assert!(
+            masses
+                .iter()
+                .all(|m| close(m.attribute("value").unwrap(), cat.mass))
+        );
+        for i in doc.descendants().filter(|n| n.has_tag_name("inertia")) {
+            assert!(
+                close(i.attribute("ixx").unwrap(), cat.i_t())
+                    && close(i.attribute("izz").unwrap(), cat.i_a())
+            );
+        }
+        let joints: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("joint"))
+            .collect();
+        match cat.joint {
+            catflip::model::Joint::Universal => assert!(
+                joints.len() == 2
+                    && joints
+                        .iter()
+                        .all(|j| j.attribute("type") == Some("revolute"))
+            ),
+            catflip::model::Joint::NoTwist => {
+                assert!(joints.len() == 1 && joints[0].attribute("type") == Some("spherical"))
+            }
+        }
+        let mjcf = catflip::export::mjcf(&cfg);
+        let doc = roxmltree::Document::parse(&mjcf).unwrap();
+        let inertials: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("inertial"))
+            .collect();
+        assert_eq!(inertials.len(), 2);
+        for n in inertials {
+            assert!(close(n.attribute("mass").unwrap(), cat.mass));
+            let d: Vec<&str> = n.attribute("diaginertia").unwrap().split(' ').collect();
+            assert!(close(d[0], cat.i_t()) && close(d[1], cat.i_t()) && close(d[2], cat.i_a()));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("robot-universal.toml");
+    let (ok, _, err) = run(&["export", "mjcf", cfg.to_str().unwrap()], dir.path());
+    assert!(ok, "{err}");
+    assert!(
+        dir.path()
+            .join("output/robot-universal/robot-universal.mjcf.xml")
+            .exists()
+    );
+}
