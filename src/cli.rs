@@ -288,6 +288,50 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
     Ok(())
 }
 
+/// Writes `<stem>.csv` and `<stem>.json`; prints the JSON and returns `None` with `--json`.
+fn write_design(
+    c: &Common,
+    cfg: &Config,
+    stem: &str,
+    plan: &dyn catflip::plan::ShapePlan,
+    json: String,
+) -> Result<Option<Vec<PathBuf>>> {
+    let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+    let mut out = Output::default();
+    out.add(format!("{stem}.csv"), sched.to_csv());
+    out.add(format!("{stem}.json"), json.clone());
+    let written = out.commit(&out_dir(c, cfg))?;
+    if c.json {
+        println!("{json}");
+        return Ok(None);
+    }
+    Ok(Some(written))
+}
+
+/// The rows both optimisers print: timing, verification, solve time, files.
+fn design_rows(
+    durations: [f64; 3],
+    sim: (f64, f64, f64, f64),
+    solve: String,
+    written: Vec<PathBuf>,
+) {
+    let d = durations;
+    row(
+        "phase durations",
+        format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
+    );
+    row(
+        "flip (dynamic sim)",
+        format!("{:.6} deg (error {:.2e} rad)", sim.0, sim.1),
+    );
+    row("tilt", format!("{:.3e} deg", sim.2));
+    row("sim peak torque", format!("{:.5} N m", sim.3));
+    row("solve time", solve);
+    for w in written {
+        row("wrote", w.display().to_string());
+    }
+}
+
 fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<()> {
     let cfg = load(c)?;
     match mode {
@@ -300,16 +344,16 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
-            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
-            let json = serde_json::to_string_pretty(&r)?;
-            let mut out = Output::default();
-            out.add("phased.csv", sched.to_csv());
-            out.add("phased.json", json.clone());
-            let written = out.commit(&out_dir(c, &cfg))?;
-            if c.json {
-                println!("{json}");
+            let Some(written) = write_design(
+                c,
+                &cfg,
+                "phased",
+                &r.plan,
+                serde_json::to_string_pretty(&r)?,
+            )?
+            else {
                 return Ok(());
-            }
+            };
             println!(
                 "catflip optimize --mode phased: {} ({} joint), status {:?}",
                 cfg.name,
@@ -328,11 +372,6 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
             );
             row("twist", format!("{:.6} rad", r.twist_rad));
-            let d = r.phase_durations_s;
-            row(
-                "phase durations",
-                format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
-            );
             row(
                 "seed cosine schedule, same bend",
                 format!(
@@ -340,26 +379,21 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     r.analytic_peak_same_bend_nm, r.improvement_factor
                 ),
             );
-            row(
-                "flip (dynamic sim)",
-                format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
-            );
-            row("tilt", format!("{:.3e} deg", r.tilt_deg));
-            row(
-                "sim peak torque",
-                format!("{:.5} N m", r.sim_peak_torque_nm),
-            );
-            row(
-                "solve time",
+            design_rows(
+                r.phase_durations_s,
+                (
+                    r.flip_deg,
+                    r.flip_error_rad,
+                    r.tilt_deg,
+                    r.sim_peak_torque_nm,
+                ),
                 format!(
                     "{:.3} s ({} bend evaluations)",
                     r.solve_time_s,
                     r.evaluations.len()
                 ),
+                written,
             );
-            for w in written {
-                row("wrote", w.display().to_string());
-            }
         }
         Mode::Free => {
             let seed = match seed {
@@ -386,16 +420,11 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
-            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
-            let json = serde_json::to_string_pretty(&r)?;
-            let mut out = Output::default();
-            out.add("free.csv", sched.to_csv());
-            out.add("free.json", json.clone());
-            let written = out.commit(&out_dir(c, &cfg))?;
-            if c.json {
-                println!("{json}");
+            let Some(written) =
+                write_design(c, &cfg, "free", &r.plan, serde_json::to_string_pretty(&r)?)?
+            else {
                 return Ok(());
-            }
+            };
             println!(
                 "catflip optimize --mode free: {} ({} joint), status {:?}, seed {}",
                 cfg.name,
@@ -406,7 +435,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             row(
                 "peak torque",
                 format!(
-                    "{:.5} N m (at nodes {:.5})",
+                    "{:.5} N m (at check points {:.5})",
                     r.peak_torque_nm, r.node_peak_torque_nm
                 ),
             );
@@ -415,30 +444,20 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
             );
             row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
-            let d = r.phase_durations_s;
-            row(
-                "phase durations",
-                format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
-            );
-            row(
-                "flip (dynamic sim)",
-                format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
-            );
-            row("tilt", format!("{:.3e} deg", r.tilt_deg));
-            row(
-                "sim peak torque",
-                format!("{:.5} N m", r.sim_peak_torque_nm),
-            );
-            row(
-                "solve time",
+            design_rows(
+                r.phase_durations_s,
+                (
+                    r.flip_deg,
+                    r.flip_error_rad,
+                    r.tilt_deg,
+                    r.sim_peak_torque_nm,
+                ),
                 format!(
                     "{:.3} s ({} SCP iterations, {} nodes per phase)",
                     r.solve_time_s, r.scp_iterations, r.nodes
                 ),
+                written,
             );
-            for w in written {
-                row("wrote", w.display().to_string());
-            }
         }
     }
     Ok(())
@@ -505,17 +524,7 @@ fn cmd_run(c: &Common) -> Result<()> {
         "catflip run: {} ({} joint, peak norm {:?})",
         s.name, s.joint, s.peak_norm
     );
-    let header = [
-        "method",
-        "status",
-        "peak N m",
-        "bend deg",
-        "durations s",
-        "flip err rad",
-        "tilt deg",
-        "sim peak N m",
-        "solve s",
-    ];
+    let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
     let widths: Vec<usize> = (0..header.len())
         .map(|j| {

@@ -264,17 +264,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         analytic: a.closed.clone(),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
     };
-    let header = [
-        "method",
-        "status",
-        "peak N m",
-        "bend deg",
-        "durations s",
-        "flip error rad",
-        "tilt deg",
-        "sim peak N m",
-        "solve s",
-    ];
+    let header = TABLE_HEADER;
     let rows: Vec<Vec<String>> = summary.methods.iter().map(table_row).collect();
     let notes = vec![
         format!(
@@ -317,6 +307,19 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         iterations: fr.iterations,
     })
 }
+
+/// Columns of the comparison table (terminal and index.html).
+pub const TABLE_HEADER: [&str; 9] = [
+    "method",
+    "status",
+    "peak N m",
+    "bend deg",
+    "durations s",
+    "flip error rad",
+    "tilt deg",
+    "sim peak N m",
+    "solve s",
+];
 
 /// One line of the comparison table.
 pub fn table_row(m: &MethodSummary) -> Vec<String> {

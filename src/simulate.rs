@@ -98,59 +98,104 @@ fn finish(
     })
 }
 
-/// Attitude along a prescribed shape trajectory.
-pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<SimReport> {
+/// Records attitude, momentum and torque at every accepted step.
+struct Recorder<'a> {
+    cat: &'a Cat,
+    trace: Vec<TracePoint>,
+    unwrap: Unwrap,
+    steps: usize,
+    drift: f64,
+}
+
+impl<'a> Recorder<'a> {
+    fn new(cat: &'a Cat) -> Self {
+        Self {
+            cat,
+            trace: Vec::new(),
+            unwrap: Unwrap {
+                last: 0.0,
+                acc: 0.0,
+            },
+            steps: 0,
+            drift: 0.0,
+        }
+    }
+
+    /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from `q`, `qd`.
+    fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) {
+        self.steps += 1;
+        let qa = quat_from(quat);
+        let (f, tilt) = flip_and_tilt(&qa);
+        let ra = from_na(qa.to_rotation_matrix().matrix());
+        let l = angular_momentum(self.cat, &ra, self.cat.body_rate(q, qd), q, qd);
+        self.drift = self
+            .drift
+            .max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
+        self.trace.push(TracePoint {
+            t,
+            flip: self.unwrap.push(f),
+            tilt,
+            q,
+            tau,
+        });
+    }
+
+    fn finish(self, quat: &[f64], status: OdeStatus) -> Result<SimReport> {
+        let mut r = finish(quat, self.trace, self.steps, status)?;
+        r.momentum_drift_nms = self.drift;
+        Ok(r)
+    }
+}
+
+/// Integrates phase by phase (restarting at the boundaries, where the forcing
+/// may jump); `rhs` and `observe` get the phase index.
+fn over_phases<const N: usize>(
+    plan: &dyn ShapePlan,
+    y0: [f64; N],
+    ode: &OdeSettings,
+    rhs: impl Fn(usize, f64, &[f64; N]) -> [f64; N],
+    mut observe: impl FnMut(usize, f64, &[f64; N]),
+) -> ([f64; N], OdeStatus) {
     let b = plan.phase_bounds();
-    let mut y = [1.0, 0.0, 0.0, 0.0];
-    let mut trace = Vec::new();
-    let mut un = Unwrap {
-        last: 0.0,
-        acc: 0.0,
-    };
-    let mut steps = 0;
-    let mut status = OdeStatus::Done;
-    let mut drift = 0.0f64;
+    let mut y = y0;
     for i in 0..3 {
         if b[i + 1] <= b[i] {
             continue;
         }
-        let (lo, hi) = (b[i], b[i + 1]);
         let (yy, st) = integrate(
-            |t, y: &[f64; 4]| {
-                let s = plan.state_in(i, t);
-                quat_rate(y, cat.body_rate(s.q, s.qd))
-            },
+            |t, y| rhs(i, t, y),
             |y| normalize_quat(y),
-            lo,
+            b[i],
             y,
-            hi,
+            b[i + 1],
             ode,
-            |t, y| {
-                steps += 1;
-                let s = plan.state_in(i, t);
-                let qa = quat_from(y);
-                let (f, tl) = flip_and_tilt(&qa);
-                let ra = from_na(qa.to_rotation_matrix().matrix());
-                let w = cat.body_rate(s.q, s.qd);
-                let l = angular_momentum(cat, &ra, w, s.q, s.qd);
-                drift = drift.max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
-                trace.push(TracePoint {
-                    t,
-                    flip: un.push(f),
-                    tilt: tl,
-                    q: s.q,
-                    tau: [0.0; 2],
-                });
-            },
+            |t, y| observe(i, t, y),
         );
         y = yy;
         if st != OdeStatus::Done {
-            status = st;
-            break;
+            return (y, st);
         }
     }
-    let mut r = finish(&y, trace, steps, status)?;
-    r.momentum_drift_nms = drift;
+    (y, OdeStatus::Done)
+}
+
+/// Attitude along a prescribed shape trajectory.
+pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<SimReport> {
+    let mut rec = Recorder::new(cat);
+    let (y, status) = over_phases(
+        plan,
+        [1.0, 0.0, 0.0, 0.0],
+        ode,
+        |i, t, y| {
+            let s = plan.state_in(i, t);
+            quat_rate(y, cat.body_rate(s.q, s.qd))
+        },
+        |i, t, y| {
+            let s = plan.state_in(i, t);
+            rec.record(t, y, s.q, s.qd, [0.0; 2]);
+        },
+    );
+    let mut r = rec.finish(&y, status)?;
     let end = plan.state(plan.duration());
     r.final_shape_error_rad = end.q[0].hypot(end.q[1]);
     r.final_rate_error_rad_s = end.qd[0].hypot(end.qd[1]);
@@ -218,70 +263,36 @@ pub fn dynamic(
     ctrl: &Controller,
     ode: &OdeSettings,
 ) -> Result<SimReport> {
-    let b = plan.phase_bounds();
-    let s0 = plan.state(b[0]);
-    let mut y = [1.0, 0.0, 0.0, 0.0, s0.q[0], s0.q[1], s0.qd[0], s0.qd[1]];
-    let mut trace = Vec::new();
-    let mut un = Unwrap {
-        last: 0.0,
-        acc: 0.0,
+    let s0 = plan.state(plan.phase_bounds()[0]);
+    let applied = |i: usize, t: f64, y: &[f64; 8]| {
+        let s = plan.state_in(i, t);
+        let ff = plan.torque_in(cat, i, t);
+        (ctrl.apply(ff, [y[4], y[5]], [y[6], y[7]], s.q, s.qd), s.q)
     };
-    let (mut steps, mut drift, mut peak, mut track) = (0usize, 0.0f64, 0.0f64, 0.0f64);
-    let mut status = OdeStatus::Done;
-    for i in 0..3 {
-        if b[i + 1] <= b[i] {
-            continue;
-        }
-        let (lo, hi) = (b[i], b[i + 1]);
-        let applied = |t: f64, y: &[f64; 8]| {
-            let s = plan.state_in(i, t);
-            let ff = plan.torque_in(cat, i, t);
-            (ctrl.apply(ff, [y[4], y[5]], [y[6], y[7]], s.q, s.qd), s.q)
-        };
-        let (yy, st) = integrate(
-            |t, y: &[f64; 8]| {
-                let (tau, _) = applied(t, y);
-                let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
-                let terms = ShapeTerms::first(cat, q);
-                let h = bias(&terms, qd);
-                let qdd = solve2(&terms.m, [tau[0] - h[0], tau[1] - h[1]]);
-                let w = terms.body_rate(qd);
-                let dq = quat_rate(y, w);
-                [dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1]]
-            },
-            |y| normalize_quat(y),
-            lo,
-            y,
-            hi,
-            ode,
-            |t, y| {
-                steps += 1;
-                let (tau, qref) = applied(t, y);
-                let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
-                peak = peak.max(ctrl.norm.of(tau));
-                track = track.max((q[0] - qref[0]).hypot(q[1] - qref[1]));
-                let qa = quat_from(y);
-                let (f, tl) = flip_and_tilt(&qa);
-                let ra = from_na(qa.to_rotation_matrix().matrix());
-                let l = angular_momentum(cat, &ra, cat.body_rate(q, qd), q, qd);
-                drift = drift.max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
-                trace.push(TracePoint {
-                    t,
-                    flip: un.push(f),
-                    tilt: tl,
-                    q,
-                    tau,
-                });
-            },
-        );
-        y = yy;
-        if st != OdeStatus::Done {
-            status = st;
-            break;
-        }
-    }
-    let mut r = finish(&y, trace, steps, status)?;
-    r.momentum_drift_nms = drift;
+    let mut rec = Recorder::new(cat);
+    let (mut peak, mut track) = (0.0f64, 0.0f64);
+    let (y, status) = over_phases(
+        plan,
+        [1.0, 0.0, 0.0, 0.0, s0.q[0], s0.q[1], s0.qd[0], s0.qd[1]],
+        ode,
+        |i, t, y| {
+            let (tau, _) = applied(i, t, y);
+            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            let terms = ShapeTerms::first(cat, q);
+            let h = bias(&terms, qd);
+            let qdd = solve2(&terms.m, [tau[0] - h[0], tau[1] - h[1]]);
+            let dq = quat_rate(y, terms.body_rate(qd));
+            [dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1]]
+        },
+        |i, t, y| {
+            let (tau, qref) = applied(i, t, y);
+            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            peak = peak.max(ctrl.norm.of(tau));
+            track = track.max((q[0] - qref[0]).hypot(q[1] - qref[1]));
+            rec.record(t, y, q, qd, tau);
+        },
+    );
+    let mut r = rec.finish(&y, status)?;
     r.peak_torque_nm = peak;
     r.max_tracking_error_rad = track;
     r.final_shape_error_rad = y[4].hypot(y[5]);

@@ -75,7 +75,7 @@ pub struct Methods {
 
 /// One point of a sweep. Peaks are computed without the torque limit; with a
 /// limit, the least drop height at which each design meets it (F7) is given.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Default, Serialize)]
 pub struct SweepPoint {
     pub value: f64,
     pub analytic_peak_nm: Option<f64>,
@@ -91,14 +91,7 @@ pub struct SweepPoint {
 fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
     let mut p = SweepPoint {
         value,
-        analytic_peak_nm: None,
-        phased_peak_nm: None,
-        free_peak_nm: None,
-        phased_bend_deg: None,
-        free_bend_deg: None,
-        least_height_phased_m: None,
-        least_height_free_m: None,
-        error: None,
+        ..Default::default()
     };
     let limit = cfg.limits.max_torque;
     let mut cfg = cfg.clone();
@@ -164,14 +157,8 @@ pub fn sweep(
                     }
                     let p = point(&configs[i], values[i], methods).unwrap_or_else(|e| SweepPoint {
                         value: values[i],
-                        analytic_peak_nm: None,
-                        phased_peak_nm: None,
-                        free_peak_nm: None,
-                        phased_bend_deg: None,
-                        free_bend_deg: None,
-                        least_height_phased_m: None,
-                        least_height_free_m: None,
                         error: Some(e.to_string()),
+                        ..Default::default()
                     });
                     results.lock().unwrap()[i] = Some(p);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
