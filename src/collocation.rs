@@ -119,17 +119,6 @@ impl Transcription {
         }
     }
 
-    /// Physical `(q, q_dot, q_ddot)` at node `k` of phase `p`.
-    pub fn physical(&self, z: &[f64], p: usize, k: usize) -> ([f64; 2], [f64; 2], [f64; 2]) {
-        let t = z[self.duration(p)];
-        let (v, a) = (Self::get2(z, self.v(p, k)), Self::get2(z, self.a(p, k)));
-        (
-            Self::get2(z, self.q(p, k)),
-            v.map(|x| x / t),
-            a.map(|x| x / (t * t)),
-        )
-    }
-
     /// Number of defect rows: 4 per interval.
     pub fn defect_count(&self) -> usize {
         4 * self.phases * (self.nodes - 1)

@@ -7,7 +7,7 @@
 //! below are exact too.
 
 use crate::model::{Cat, ShapeTerms};
-use crate::small::{Real, add3, cross, mat_mul, mat_vec, scale3, transpose};
+use crate::small::{add3, cross, mat_mul, mat_vec, scale3, transpose};
 use num_dual::Dual64;
 
 /// `c[i][j][k] = dM_ij/dq_k - 1/2 dM_jk/dq_i`.
@@ -169,9 +169,6 @@ pub fn angular_momentum(
     }
     l
 }
-
-#[allow(dead_code)]
-fn _assert_real<T: Real>() {}
 
 #[cfg(test)]
 mod tests {

@@ -15,10 +15,6 @@ impl Output {
         self.files.push((name.into(), contents.into()));
     }
 
-    pub fn names(&self) -> impl Iterator<Item = &str> {
-        self.files.iter().map(|(n, _)| n.as_str())
-    }
-
     /// Writes every file into `dir` (created if missing); returns their paths.
     pub fn commit(self, dir: &Path) -> Result<Vec<PathBuf>> {
         let werr = |path: &Path, source| Error::Write {

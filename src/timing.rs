@@ -96,10 +96,6 @@ impl TimingProblem {
         }
     }
 
-    pub fn intervals(&self) -> usize {
-        self.k
-    }
-
     fn build(&self, cat: &Cat, path: &Path) -> ConicData {
         let k = self.k;
         let ix = Index { k };

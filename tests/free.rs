@@ -270,3 +270,17 @@ fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
         assert!(free.flip_error_rad.abs() < 1e-3, "{name}");
     }
 }
+
+#[test]
+fn bend_limit_holds_in_both_optimisers() {
+    let c = cfg("seed", &["limits.max_bend_deg=30"]);
+    let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+    assert!(phased.bend_deg <= 30.0 + 1e-9, "{}", phased.bend_deg);
+    let free = catflip::free::optimize_from(&c, &phased.plan, "phased", 20, |_| {}).unwrap();
+    assert!(free.bend_deg <= 30.0 + 1e-6, "{}", free.bend_deg);
+    assert!(free.flip_error_rad.abs() < 1e-3);
+    // the limit costs torque against the unconstrained design (optimum bend ~ 42 deg)
+    let open = catflip::free::optimize_from(&cfg("seed", &[]), &phased.plan, "phased", 20, |_| {})
+        .unwrap();
+    assert!(free.peak_torque_nm > open.peak_torque_nm);
+}
