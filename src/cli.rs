@@ -145,7 +145,7 @@ fn cmd_analyze(c: &Common) -> Result<()> {
     let sched = analytic_schedule(&cfg, &a.plan);
     let json = serde_json::to_string_pretty(&a)?;
     let mut out = Output::default();
-    out.add("analytic.csv", sched.to_csv());
+    sched.add_to(&mut out, "analytic");
     out.add("analyze.json", json.clone());
     let written = out.commit(&out_dir(c, &cfg))?;
     if c.json {
@@ -298,7 +298,7 @@ fn write_design(
 ) -> Result<Option<Vec<PathBuf>>> {
     let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
     let mut out = Output::default();
-    out.add(format!("{stem}.csv"), sched.to_csv());
+    sched.add_to(&mut out, stem);
     out.add(format!("{stem}.json"), json.clone());
     let written = out.commit(&out_dir(c, cfg))?;
     if c.json {

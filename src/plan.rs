@@ -61,14 +61,19 @@ pub trait ShapePlan {
     }
 }
 
-/// One row of a torque schedule (SI units).
+/// One row of a torque schedule (SI units; JSON names carry the units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Row {
+    #[serde(rename = "t_s")]
     pub t: f64,
     pub phase: Phase,
+    #[serde(rename = "q_rad")]
     pub q: [f64; 2],
+    #[serde(rename = "qd_rad_s")]
     pub qd: [f64; 2],
+    #[serde(rename = "qdd_rad_s2")]
     pub qdd: [f64; 2],
+    #[serde(rename = "tau_nm")]
     pub tau: [f64; 2],
 }
 
@@ -109,6 +114,18 @@ impl Schedule {
 
     pub fn peak(&self, norm: TorqueNorm) -> f64 {
         self.rows.iter().map(|r| norm.of(r.tau)).fold(0.0, f64::max)
+    }
+
+    /// The schedule as JSON: `{"rows": [{"t_s", "phase", "q_rad", "qd_rad_s",
+    /// "qdd_rad_s2", "tau_nm"}, ...]}`, the same rows as the CSV.
+    pub fn to_json(&self) -> String {
+        serde_json::to_string(self).expect("a schedule serialises")
+    }
+
+    /// Adds `<stem>.csv` and `<stem>.schedule.json` to an output.
+    pub fn add_to(&self, out: &mut crate::output::Output, stem: &str) {
+        out.add(format!("{stem}.csv"), self.to_csv());
+        out.add(format!("{stem}.schedule.json"), self.to_json());
     }
 
     pub fn to_csv(&self) -> String {

@@ -52,6 +52,7 @@ pub struct MethodSummary {
     pub final_shape_error_rad: f64,
     pub solve_time_s: f64,
     pub schedule_csv: String,
+    pub schedule_json: String,
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -103,6 +104,7 @@ fn summarize(
         final_shape_error_rad: sim.final_shape_error_rad,
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
+        schedule_json: format!("{method}.schedule.json"),
     }
 }
 
@@ -153,10 +155,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let a = analyze(cfg)?;
     let a_sim = dynamic_cfg(cfg, &a.plan)?;
     let a_time = clock.elapsed().as_secs_f64();
-    output.add(
-        "analytic.csv",
-        Schedule::sample(&cat, &a.plan, per).to_csv(),
-    );
+    Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "analytic");
     progress(Progress::StageDone { seconds: a_time });
 
     progress(Progress::Stage {
@@ -174,7 +173,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             peak_nm: e.peak_nm,
         });
     })?;
-    output.add("phased.csv", Schedule::sample(&cat, &ph.plan, per).to_csv());
+    Schedule::sample(&cat, &ph.plan, per).add_to(&mut output, "phased");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });
@@ -188,7 +187,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let fr = crate::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
         progress(Progress::Scp(it))
     })?;
-    output.add("free.csv", Schedule::sample(&cat, &fr.plan, per).to_csv());
+    Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });

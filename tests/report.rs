@@ -69,6 +69,26 @@ fn run_writes_a_complete_consistent_report() {
             p <= peak * (1.0 + 1e-6) && p >= 0.98 * peak,
             "{name}: CSV {p} vs JSON {peak}"
         );
+        // the JSON schedule holds the same rows
+        let js: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(base.join(m["schedule_json"].as_str().unwrap())).unwrap(),
+        )
+        .unwrap();
+        let rows = js["rows"].as_array().unwrap();
+        assert_eq!(rows.len(), csv.lines().count() - 1);
+        let jp = rows
+            .iter()
+            .map(|r| {
+                r["tau_nm"][0]
+                    .as_f64()
+                    .unwrap()
+                    .hypot(r["tau_nm"][1].as_f64().unwrap())
+            })
+            .fold(0.0, f64::max);
+        assert!(
+            (jp - p).abs() < 1e-9 * p,
+            "{name}: JSON schedule {jp} vs CSV {p}"
+        );
         // the table shows the same number
         assert!(
             html.contains(&format!("{peak:.5}")),
