@@ -19,7 +19,7 @@
 //! (converged); the penalty grows tenfold when the model stalls while still
 //! infeasible; an iteration limit or a collapsed trust region end the run.
 
-use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus};
+use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::error::{Error, Result};
 use crate::model::TorqueNorm;
 use serde::Serialize;
@@ -259,7 +259,92 @@ fn correction(
     d
 }
 
-/// Runs the SCP from `z0`, reporting each iteration to `observe`.
+/// Fixed-pattern Clarabel solvers reused across iterations.
+#[derive(Default)]
+struct Solvers {
+    subproblem: Option<ConicSolver>,
+    correction: Option<ConicSolver>,
+}
+
+/// One SCP iteration at `z`: linearise, solve the convex subproblem, try a
+/// second-order correction, and judge the trial point. Returns the record
+/// (with `accepted` decided) and the trial point.
+fn iterate(
+    p: &dyn ScpProblem,
+    z: &[f64],
+    radius: f64,
+    w: f64,
+    iteration: usize,
+    scales: &[f64],
+    solvers: &mut Solvers,
+) -> Result<(ScpIteration, Vec<f64>)> {
+    let (phi, peak, inf) = merit(p, z, w);
+    let lin = p.linearize(z);
+    let data = subproblem(p, z, &lin, scales, radius, w);
+    let clock = Instant::now();
+    let (st, x, _) = solve_reusing(&mut solvers.subproblem, &data)?;
+    let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
+    if !st.ok() {
+        if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
+            return Err(Error::Unreachable {
+                reason: "the convexified problem has no solution within limits.max_torque: raise the limit or fall.height"
+                    .into(),
+            });
+        }
+        return Err(Error::Solver {
+            what: format!("SCP subproblem {iteration}"),
+            status: format!("{st:?}"),
+            hint: "try another seed (--seed), more free.nodes, or report the config".into(),
+        });
+    }
+    let (n, m) = (p.dim(), lin.residual.len());
+    let model = x[n] + w * x[n + 1..n + 1 + 2 * m].iter().sum::<f64>();
+    let predicted = phi - model;
+    let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
+    let (mut phi_t, _, _) = merit(p, &trial, w);
+    if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
+        // back onto the model's residual at the trial point, r + J dz = nu+ - nu-
+        let (_, r_trial) = p.evaluate(&trial);
+        let rhs: Vec<f64> = (0..m)
+            .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - r_trial[i])
+            .collect();
+        let cd = correction(p, &trial, &lin, &rhs, scales);
+        if let Ok((cs, dc, _)) = solve_reusing(&mut solvers.correction, &cd)
+            && cs.ok()
+        {
+            let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
+            let (phi_c, _, _) = merit(p, &corrected, w);
+            if phi_c < phi_t {
+                (trial, phi_t) = (corrected, phi_c);
+            }
+        }
+    }
+    let actual = phi - phi_t;
+    let rho = if predicted > 0.0 {
+        actual / predicted
+    } else {
+        0.0
+    };
+    let accepted = predicted > 0.0 && rho > 0.1;
+    let rec = ScpIteration {
+        iteration,
+        merit: phi,
+        peak,
+        infeasibility: inf,
+        radius,
+        weight: w,
+        predicted,
+        actual,
+        rho,
+        accepted,
+        merit_after: if accepted { phi_t } else { phi },
+        solve_ms,
+    };
+    Ok((rec, trial))
+}
+
+/// The driver: runs [`iterate`] from `z0`, owns the trust radius, the penalty
+/// weight and the stopping rules, and reports each iteration to `observe`.
 pub fn solve(
     p: &dyn ScpProblem,
     z0: Vec<f64>,
@@ -271,97 +356,23 @@ pub fn solve(
     let (_, peak0, _) = merit(p, &z, 0.0);
     let mut w = settings.weight * peak0.max(1e-12);
     let mut radius = settings.initial_radius;
-    let mut solver: Option<ConicSolver> = None;
-    let mut corrector: Option<ConicSolver> = None;
+    let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
     for it in 0..settings.max_iterations {
-        let (phi, peak, inf) = merit(p, &z, w);
-        let lin = p.linearize(&z);
-        let data = subproblem(p, &z, &lin, &scales, radius, w);
-        let clock = Instant::now();
-        match &mut solver {
-            Some(s) => s.update(&data)?,
-            None => solver = Some(ConicSolver::new(&data)?),
-        }
-        let (st, x, _) = solver.as_mut().unwrap().solve();
-        let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
-        if !st.ok() {
-            if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
-                return Err(Error::Unreachable {
-                    reason: "the convexified problem has no solution within limits.max_torque: raise the limit or fall.height".into(),
-                });
-            }
-            return Err(Error::Solver {
-                what: format!("SCP subproblem {it}"),
-                status: format!("{st:?}"),
-                hint: "try another seed (--seed), more free.nodes, or report the config".into(),
-            });
-        }
-        let n = p.dim();
-        let m = lin.residual.len();
-        let model = x[n] + w * x[n + 1..n + 1 + 2 * m].iter().sum::<f64>();
-        let predicted = phi - model;
-        let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
-        let (mut phi_t, _, _) = merit(p, &trial, w);
-        if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
-            // model residual at the trial point: r + J dz (= nu+ - nu-)
-            let nu: Vec<f64> = (0..m).map(|i| x[n + 1 + i] - x[n + 1 + m + i]).collect();
-            let (_, r_trial) = p.evaluate(&trial);
-            let rhs: Vec<f64> = (0..m).map(|i| nu[i] - r_trial[i]).collect();
-            let cd = correction(p, &trial, &lin, &rhs, &scales);
-            let solved = match &mut corrector {
-                Some(s) => s.update(&cd).map(|_| s.solve()),
-                None => ConicSolver::new(&cd).map(|mut s| {
-                    let r = s.solve();
-                    corrector = Some(s);
-                    r
-                }),
-            };
-            if let Ok((cs, dc, _)) = solved
-                && cs.ok()
-            {
-                let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
-                let (phi_c, _, _) = merit(p, &corrected, w);
-                if phi_c < phi_t {
-                    trial = corrected;
-                    phi_t = phi_c;
-                }
-            }
-        }
-        let actual = phi - phi_t;
-        let rho = if predicted > 0.0 {
-            actual / predicted
-        } else {
-            0.0
-        };
-        let accepted = predicted > 0.0 && rho > 0.1;
-        let rec = ScpIteration {
-            iteration: it,
-            merit: phi,
-            peak,
-            infeasibility: inf,
-            radius,
-            weight: w,
-            predicted,
-            actual,
-            rho,
-            accepted,
-            merit_after: if accepted { phi_t } else { phi },
-            solve_ms,
-        };
+        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers)?;
         observe(&rec);
         iterations.push(rec);
-        if accepted {
+        if rec.accepted {
             z = trial;
         }
-        if rho < 0.1 {
+        if rec.rho < 0.1 {
             radius *= 0.5;
-        } else if rho > 0.5 {
+        } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
         let (_, _, inf_now) = merit(p, &z, w);
-        if predicted <= settings.tolerance * phi.abs().max(1e-300) {
+        if rec.predicted <= settings.tolerance * rec.merit.abs().max(1e-300) {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
                 break;
