@@ -100,6 +100,17 @@ impl Transcription {
         self.phases * self.nodes * Self::PER_NODE + p
     }
 
+    /// Columns of `(q_k, q^_k, q^^_k, q^^_{k+1})`, component `j`: the variables
+    /// an interval's interpolant depends on (order of [`Interp`] coefficients).
+    pub fn interval_columns(&self, p: usize, k: usize, j: usize) -> [usize; 4] {
+        [
+            self.q(p, k) + j,
+            self.v(p, k) + j,
+            self.a(p, k) + j,
+            self.a(p, k + 1) + j,
+        ]
+    }
+
     /// Normalised interval length `1 / (N - 1)`.
     pub fn h(&self) -> f64 {
         1.0 / (self.nodes - 1) as f64

@@ -133,12 +133,7 @@ impl FreeProblem {
                         let pm = m * dpdw[i];
                         for c in 0..2 {
                             let wqc = Vector3::from(wq[c]);
-                            let cols = [
-                                tr.q(p, k) + c,
-                                tr.v(p, k) + c,
-                                tr.a(p, k) + c,
-                                tr.a(p, k + 1) + c,
-                            ];
+                            let cols = tr.interval_columns(p, k, c);
                             for (idx, col) in cols.into_iter().enumerate() {
                                 g[col] += pm * (wqc * it.dq[idx] + wv[c] * it.dv[idx]);
                             }
@@ -270,12 +265,7 @@ impl ScpProblem for FreeProblem {
                     let row = terms.len();
                     terms.push(lin.tau[i] * s2);
                     for l in 0..2 {
-                        let cols = [
-                            tr.q(p, k) + l,
-                            tr.v(p, k) + l,
-                            tr.a(p, k) + l,
-                            tr.a(p, k + 1) + l,
-                        ];
+                        let cols = tr.interval_columns(p, k, l);
                         for (idx, col) in cols.into_iter().enumerate() {
                             let g = lin.d_q[i][l] * coef[0][idx]
                                 + lin.d_qd[i][l] * coef[1][idx]
