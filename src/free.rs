@@ -29,6 +29,7 @@ use crate::model::{Cat, ShapeTerms, TorqueNorm};
 use crate::scp::{
     Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets, solve,
 };
+use crate::simulate::SimReport;
 use crate::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
@@ -369,6 +370,9 @@ pub struct FreeResult {
     pub iterations: Vec<ScpIteration>,
     #[serde(skip)]
     pub plan: CollocationPlan,
+    /// The dynamic simulation the reported flip, tilt and peak come from.
+    #[serde(skip)]
+    pub sim: SimReport,
 }
 
 /// Which schedule seeds the SCP.
@@ -422,6 +426,13 @@ pub fn optimize_from(
         z: res.z.clone(),
     };
     let (peak, _) = crate::analyze::peak_along(cfg, &plan, crate::analyze::dense_samples(cfg));
+    // a limit that the design breaks fails before any simulation is spent on it
+    crate::phased::check_limit(
+        cfg,
+        peak * cfg.available_time().powi(2),
+        peak,
+        "free-form design",
+    )?;
     let sim = crate::simulate::dynamic_cfg(cfg, &plan)?;
     let kin = crate::simulate::kinematic_cfg(cfg, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
@@ -439,12 +450,6 @@ pub fn optimize_from(
             }
         }
     }
-    crate::phased::check_limit(
-        cfg,
-        peak * cfg.available_time().powi(2),
-        peak,
-        "free-form design",
-    )?;
     Ok(FreeResult {
         mode: "free",
         status: res.status,
@@ -468,6 +473,7 @@ pub fn optimize_from(
         solve_time_s: solve_time,
         iterations: res.iterations,
         plan,
+        sim,
     })
 }
 

@@ -200,9 +200,9 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let clock = Instant::now();
     let ph_sim = ph
         .sim
-        .clone()
+        .as_ref()
         .expect("phased result carries its simulation");
-    let fr_sim = dynamic_cfg(cfg, &fr.plan)?;
+    let fr_sim = &fr.sim;
     let (a_peak, _) = peak_along(cfg, &a.plan, crate::analyze::dense_samples(cfg));
     let methods = vec![
         summarize(
@@ -222,7 +222,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             format!("{:?}", ph.status).to_lowercase(),
             ph.peak_torque_nm,
             (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
-            &ph_sim,
+            ph_sim,
             ph.solve_time_s,
         ),
         summarize(
@@ -230,14 +230,14 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             format!("{:?}", fr.status).to_lowercase(),
             fr.peak_torque_nm,
             (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
-            &fr_sim,
+            fr_sim,
             fr.solve_time_s,
         ),
     ];
     let traces = vec![
         trace(cfg, "analytic", &a.plan, &a_sim, 300),
-        trace(cfg, "phased", &ph.plan, &ph_sim, 300),
-        trace(cfg, "free", &fr.plan, &fr_sim, 300),
+        trace(cfg, "phased", &ph.plan, ph_sim, 300),
+        trace(cfg, "free", &fr.plan, fr_sim, 300),
     ];
     let norm_name = match cfg.norm() {
         crate::model::TorqueNorm::Euclidean => "Euclidean",

@@ -202,23 +202,24 @@ fn assert_keys(v: &serde_json::Value, keys: &[&str]) {
     }
 }
 
+/// Runs the binary with `--json`, asserts success and parses stdout.
+fn run_json(args: &[&str], dir: &Path) -> serde_json::Value {
+    let mut all = args.to_vec();
+    all.push("--json");
+    let o = run(&all, dir);
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    serde_json::from_str(&out).unwrap()
+}
+
 #[test]
 fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = configs().join("seed.toml");
-    let o = run(
-        &[
-            "optimize",
-            cfg.to_str().unwrap(),
-            "--mode",
-            "phased",
-            "--json",
-        ],
+    let v = run_json(
+        &["optimize", cfg.to_str().unwrap(), "--mode", "phased"],
         dir.path(),
     );
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_keys(&v, &OPTIMIZE_KEYS);
     assert_eq!(v["mode"], "phased");
     assert_eq!(v["status"], "solved");
@@ -267,7 +268,7 @@ fn impossible_torque_limit_fails_with_the_least_height_and_writes_nothing() {
 fn optimize_free_reports_iterations_and_nodes() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = configs().join("seed.toml");
-    let o = run(
+    let v = run_json(
         &[
             "optimize",
             cfg.to_str().unwrap(),
@@ -275,13 +276,9 @@ fn optimize_free_reports_iterations_and_nodes() {
             "free",
             "--seed",
             "analytic",
-            "--json",
         ],
         dir.path(),
     );
-    let (out, err) = text(&o);
-    assert!(o.status.success(), "{err}");
-    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_keys(&v, &OPTIMIZE_KEYS);
     assert_keys(&v, &["scp_iterations", "nodes"]);
     assert_eq!(v["mode"], "free");
