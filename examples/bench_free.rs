@@ -13,12 +13,12 @@ fn main() -> anyhow::Result<()> {
         .transpose()?
         .unwrap_or(cfg.free.nodes);
     let t = Instant::now();
-    let phased = catflip::phased::optimize(&cfg, |_| {})?;
+    let phased = catflip::design::phased::optimize(&cfg, |_| {})?;
     let seed_time = t.elapsed().as_secs_f64();
     let mut best = f64::INFINITY;
     let mut last = None;
     for _ in 0..3 {
-        let r = catflip::free::optimize_from(&cfg, &phased.plan, "phased", nodes, |_| {})?;
+        let r = catflip::design::free::optimize_from(&cfg, &phased.plan, "phased", nodes, |_| {})?;
         best = best.min(r.solve_time_s);
         last = Some(r);
     }

@@ -2,24 +2,25 @@
 //! free-form optimum seeded by it, verified by simulation and written as CSV.
 //! `cargo run --release --example design [-- configs/domestic-cat.toml]`
 use catflip::Config;
-use catflip::plan::Schedule;
+use catflip::design::plan::Schedule;
 
 fn main() -> anyhow::Result<()> {
     let path = std::env::args()
         .nth(1)
         .unwrap_or_else(|| "configs/domestic-cat.toml".into());
     let cfg = Config::load(std::path::Path::new(&path), &[])?;
-    let phased = catflip::phased::optimize(&cfg, |_| {})?;
+    let phased = catflip::design::phased::optimize(&cfg, |_| {})?;
     println!(
         "phased: peak {:.4} N m at bend {:.1} deg",
         phased.peak_torque_nm, phased.bend_deg
     );
-    let free = catflip::free::optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |it| {
-        println!(
-            "  SCP {:3}: peak {:.5} N m, max |r| {:.1e}",
-            it.iteration, it.peak, it.infeasibility
-        )
-    })?;
+    let free =
+        catflip::design::free::optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |it| {
+            println!(
+                "  SCP {:3}: peak {:.5} N m, max |r| {:.1e}",
+                it.iteration, it.peak, it.infeasibility
+            )
+        })?;
     println!(
         "free-form: peak {:.4} N m ({:.1} % of phased), simulated flip error {:.1e} rad",
         free.peak_torque_nm,

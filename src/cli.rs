@@ -2,10 +2,10 @@
 
 use anyhow::{Context, Result};
 use catflip::Config;
-use catflip::analyze::{analytic_schedule, analyze, verify};
+use catflip::design::plan::Schedule;
 use catflip::output::Output;
-use catflip::plan::Schedule;
-use catflip::simulate::SimReport;
+use catflip::verify::analyze::{analytic_schedule, analyze, verify};
+use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
@@ -255,7 +255,7 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
             (p.display().to_string(), verify(&cfg, &s)?)
         }
         None => {
-            let plan = catflip::analytic::analytic_plan(&cfg);
+            let plan = catflip::design::analytic::analytic_plan(&cfg);
             ("analytic schedule".to_string(), verify(&cfg, &plan)?)
         }
     };
@@ -293,7 +293,7 @@ fn write_design(
     c: &Common,
     cfg: &Config,
     stem: &str,
-    plan: &dyn catflip::plan::ShapePlan,
+    plan: &dyn catflip::design::plan::ShapePlan,
     json: String,
 ) -> Result<Option<Vec<PathBuf>>> {
     let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
@@ -336,7 +336,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
     let cfg = load(c)?;
     match mode {
         Mode::Phased => {
-            let r = catflip::phased::optimize(&cfg, |e| {
+            let r = catflip::design::phased::optimize(&cfg, |e| {
                 if verbose {
                     eprintln!(
                         "  bend {:8.3} deg   unit peak {:10.5} N m s^2   peak {:9.5} N m",
@@ -397,15 +397,15 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
         }
         Mode::Free => {
             let seed = match seed {
-                SeedArg::Phased => catflip::free::Seed::Phased,
-                SeedArg::Analytic => catflip::free::Seed::Analytic,
+                SeedArg::Phased => catflip::design::free::Seed::Phased,
+                SeedArg::Analytic => catflip::design::free::Seed::Analytic,
             };
             if verbose {
                 eprintln!(
                     "  iter      merit       peak     infeas     radius        rho  step   ms"
                 );
             }
-            let r = catflip::free::optimize(&cfg, seed, |it| {
+            let r = catflip::design::free::optimize(&cfg, seed, |it| {
                 if verbose {
                     eprintln!(
                         "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",

@@ -1,30 +1,23 @@
 //! catflip: torque schedules that turn a falling two-body cat right side up.
 //!
-//! The physics contract is MODEL.md (shared with the project): two identical
-//! cylinders joined at the middle, released at rest, zero angular momentum.
-pub mod analytic;
-pub mod analyze;
-pub mod collocation;
+//! The pipeline, one folder a stage (the physics is in `docs/model.md`):
+//! - [`model`]: the two-cylinder cat, its zero-momentum shape dynamics and attitude maths;
+//! - [`design`]: the analytic, phased and free-form torque schedules;
+//! - [`verify`]: forward simulation of a schedule in the full model;
+//! - [`report`] and [`export`]: figures and HTML, simulator models and controls.
+//!
+//! [`run`] and [`sweep`] drive the whole pipeline; [`config`] checks the input
+//! and [`output`] writes a command's files all together or not at all.
 pub mod config;
-pub mod conic;
-pub mod dynamics;
+pub mod design;
 pub mod error;
 pub mod export;
-pub mod free;
 pub mod model;
-pub mod ode;
 pub mod output;
-pub mod path;
-pub mod phased;
-pub mod plan;
 pub mod report;
 pub mod run;
-pub mod scp;
-pub mod simulate;
-pub mod small;
-pub mod so3;
 pub mod sweep;
-pub mod timing;
+pub mod verify;
 
 pub use config::Config;
 pub use error::{Error, Result};

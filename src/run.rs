@@ -1,15 +1,15 @@
 //! `catflip run`: the main job. Analytic schedule, phased and free-form
 //! optimisation, forward verification of all three, and the report.
 
-use crate::analytic::ClosedForms;
-use crate::analyze::{analyze, peak_along};
 use crate::config::Config;
+use crate::design::analytic::ClosedForms;
+use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::scp::ScpIteration;
 use crate::error::Result;
 use crate::output::Output;
-use crate::plan::{Schedule, ShapePlan};
 use crate::report::{self, MethodTrace};
-use crate::scp::ScpIteration;
-use crate::simulate::{SimReport, dynamic_cfg};
+use crate::verify::analyze::{analyze, peak_along};
+use crate::verify::simulate::{SimReport, dynamic_cfg};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -165,7 +165,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     });
     let clock = Instant::now();
     let mut evaluations = 0;
-    let ph = crate::phased::optimize(cfg, |e| {
+    let ph = crate::design::phased::optimize(cfg, |e| {
         evaluations += 1;
         progress(Progress::Bend {
             evaluations,
@@ -184,7 +184,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "free-form optimiser (collocation + SCP, seeded by the phased design)",
     });
     let clock = Instant::now();
-    let fr = crate::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
+    let fr = crate::design::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
         progress(Progress::Scp(it))
     })?;
     Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
@@ -203,7 +203,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .as_ref()
         .expect("phased result carries its simulation");
     let fr_sim = &fr.sim;
-    let (a_peak, _) = peak_along(cfg, &a.plan, crate::analyze::dense_samples(cfg));
+    let (a_peak, _) = peak_along(cfg, &a.plan, crate::verify::analyze::dense_samples(cfg));
     let methods = vec![
         summarize(
             "analytic",

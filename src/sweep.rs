@@ -1,11 +1,11 @@
 //! Parameter sweeps: any numeric config key over a range, every point
 //! designed by each method, points evaluated in parallel.
 
-use crate::analytic::analytic_plan;
-use crate::analyze::peak_along;
 use crate::config::Config;
+use crate::design::analytic::analytic_plan;
+use crate::design::phased::least_height;
 use crate::error::{Error, Result};
-use crate::phased::least_height;
+use crate::verify::analyze::peak_along;
 use serde::Serialize;
 use std::path::Path;
 use std::sync::Mutex;
@@ -102,20 +102,26 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
             peak_along(
                 &cfg,
                 &analytic_plan(&cfg),
-                crate::analyze::dense_samples(&cfg),
+                crate::verify::analyze::dense_samples(&cfg),
             )
             .0,
         );
     }
     if methods.phased || methods.free {
-        let ph = crate::phased::optimize(&cfg, |_| {})?;
+        let ph = crate::design::phased::optimize(&cfg, |_| {})?;
         if methods.phased {
             p.phased_peak_nm = Some(ph.peak_torque_nm);
             p.phased_bend_deg = Some(ph.bend_deg);
             p.least_height_phased_m = limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
         }
         if methods.free {
-            let fr = crate::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})?;
+            let fr = crate::design::free::optimize_from(
+                &cfg,
+                &ph.plan,
+                "phased",
+                cfg.free.nodes,
+                |_| {},
+            )?;
             p.free_peak_nm = Some(fr.peak_torque_nm);
             p.free_bend_deg = Some(fr.bend_deg);
             p.least_height_free_m = limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));

@@ -1,13 +1,13 @@
 //! Physics facts of MODEL.md section 4 checked on the library.
 
 use catflip::Config;
-use catflip::analytic::{analytic_plan, closed_forms, plan, turns_theta, yy_inertia_and_c};
-use catflip::dynamics::{inverse_dynamics, kinetic_energy};
+use catflip::design::analytic::{analytic_plan, closed_forms, plan, turns_theta, yy_inertia_and_c};
+use catflip::design::plan::ShapePlan;
 use catflip::model::Joint;
-use catflip::ode::OdeSettings;
-use catflip::plan::ShapePlan;
-use catflip::simulate::{Controller, dynamic, kinematic};
-use catflip::so3::flip_error;
+use catflip::model::dynamics::{inverse_dynamics, kinetic_energy};
+use catflip::model::so3::flip_error;
+use catflip::verify::ode::OdeSettings;
+use catflip::verify::simulate::{Controller, dynamic, kinematic};
 use std::f64::consts::PI;
 
 fn seed(overrides: &[&str]) -> Config {
@@ -184,7 +184,7 @@ fn dynamic_simulation_of_inverse_dynamics_torque_reproduces_the_plan() {
         };
         let d = dynamic(&cat, &p, &open_loop, &tight()).unwrap();
         let k = kinematic(&cat, &p, &tight()).unwrap();
-        let gap = catflip::so3::wrap((d.flip_deg - k.flip_deg).to_radians());
+        let gap = catflip::model::so3::wrap((d.flip_deg - k.flip_deg).to_radians());
         assert!(
             gap.abs() < 1e-7,
             "{joint:?}: {} vs {}",
@@ -199,7 +199,7 @@ fn dynamic_simulation_of_inverse_dynamics_torque_reproduces_the_plan() {
 #[test]
 fn torque_limit_saturates_and_spoils_the_flip() {
     let cfg = seed(&["limits.max_torque=5"]);
-    let r = catflip::simulate::dynamic_cfg(&cfg, &analytic_plan(&cfg)).unwrap();
+    let r = catflip::verify::simulate::dynamic_cfg(&cfg, &analytic_plan(&cfg)).unwrap();
     assert!(r.peak_torque_nm <= 5.0 + 1e-9);
     assert!(r.max_tracking_error_rad > 1e-2);
 }

@@ -1,10 +1,10 @@
 //! The free-form optimiser: linearisation, SCP machinery, and results.
 
 use catflip::Config;
-use catflip::analytic::analytic_plan;
-use catflip::collocation::Transcription;
-use catflip::free::FreeProblem;
-use catflip::scp::ScpProblem;
+use catflip::design::analytic::analytic_plan;
+use catflip::design::collocation::Transcription;
+use catflip::design::free::FreeProblem;
+use catflip::design::scp::ScpProblem;
 
 fn cfg(name: &str, overrides: &[&str]) -> Config {
     let p = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
@@ -93,7 +93,7 @@ impl ScpProblem for DoubleIntegrator {
             .collect();
         (f, self.tr.defects(z, 0, None))
     }
-    fn linearize(&self, z: &[f64]) -> catflip::scp::Linearization {
+    fn linearize(&self, z: &[f64]) -> catflip::design::scp::Linearization {
         let (terms, _) = self.evaluate(z);
         let t = z[self.tr.duration(0)];
         let mut tj = Vec::new();
@@ -107,7 +107,7 @@ impl ScpProblem for DoubleIntegrator {
         }
         let mut rj = Vec::new();
         let residual = self.tr.defects(z, 0, Some(&mut rj));
-        catflip::scp::Linearization {
+        catflip::design::scp::Linearization {
             terms,
             terms_jac: tj,
             residual,
@@ -116,7 +116,7 @@ impl ScpProblem for DoubleIntegrator {
     }
     fn add_constraints(
         &self,
-        d: &mut catflip::conic::ConicData,
+        d: &mut catflip::design::conic::ConicData,
         z: &[f64],
         var: &dyn Fn(usize) -> usize,
     ) {
@@ -124,7 +124,7 @@ impl ScpProblem for DoubleIntegrator {
         let n = tr.nodes;
         // second coordinate fixed at zero throughout; first from 0 to 1, at rest
         let mut rows = 0;
-        let mut fix = |d: &mut catflip::conic::ConicData, i: usize, value: f64| {
+        let mut fix = |d: &mut catflip::design::conic::ConicData, i: usize, value: f64| {
             d.row(&[(var(i), 1.0)], value - z[i]);
             rows += 1;
         };
@@ -138,7 +138,7 @@ impl ScpProblem for DoubleIntegrator {
         fix(d, tr.q(0, n - 1), 1.0);
         fix(d, tr.v(0, n - 1), 0.0);
         fix(d, tr.duration(0), 1.0);
-        d.cone(catflip::conic::Cone::Zero(rows));
+        d.cone(catflip::design::conic::Cone::Zero(rows));
     }
     fn scales(&self) -> Vec<f64> {
         vec![1.0; self.dim()]
@@ -160,10 +160,16 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
         }
         z[tr.duration(0)] = 1.0;
         let p = DoubleIntegrator { tr };
-        let r = catflip::scp::solve(&p, z, &catflip::scp::ScpSettings::default(), |_| {}).unwrap();
+        let r = catflip::design::scp::solve(
+            &p,
+            z,
+            &catflip::design::scp::ScpSettings::default(),
+            |_| {},
+        )
+        .unwrap();
         assert_eq!(
             r.status,
-            catflip::scp::ScpStatus::Converged,
+            catflip::design::scp::ScpStatus::Converged,
             "{nodes} nodes"
         );
         // first-order-hold force needs one interval to switch: peak 4 / (1 - h/2)^2-ish above 4
@@ -193,7 +199,7 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
 fn accepted_scp_steps_never_increase_the_penalised_objective() {
     let c = cfg("seed", &[]);
     let mut seen = 0;
-    let r = catflip::free::optimize(&c, catflip::free::Seed::Analytic, |it| {
+    let r = catflip::design::free::optimize(&c, catflip::design::free::Seed::Analytic, |it| {
         if it.accepted {
             seen += 1;
             assert!(
@@ -209,16 +215,23 @@ fn accepted_scp_steps_never_increase_the_penalised_objective() {
     })
     .unwrap();
     assert!(seen > 5);
-    assert_eq!(r.status, catflip::scp::ScpStatus::Converged);
+    assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
 }
 
 #[test]
 fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
     let c = cfg("seed", &[]);
-    let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
-    for seed in [catflip::free::Seed::Phased, catflip::free::Seed::Analytic] {
-        let r = catflip::free::optimize(&c, seed, |_| {}).unwrap();
-        assert_eq!(r.status, catflip::scp::ScpStatus::Converged, "{seed:?}");
+    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+    for seed in [
+        catflip::design::free::Seed::Phased,
+        catflip::design::free::Seed::Analytic,
+    ] {
+        let r = catflip::design::free::optimize(&c, seed, |_| {}).unwrap();
+        assert_eq!(
+            r.status,
+            catflip::design::scp::ScpStatus::Converged,
+            "{seed:?}"
+        );
         assert!(
             r.flip_error_rad.abs() < 1e-3 && r.kinematic_flip_error_rad.abs() < 1e-3,
             "{seed:?}"
@@ -240,9 +253,11 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
 fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
     for name in ["seed", "domestic-cat"] {
         let c = cfg(name, &[]);
-        let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
-        let a = catflip::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
-        let b = catflip::free::optimize_from(&c, &phased.plan, "phased", 80, |_| {}).unwrap();
+        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+        let a =
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        let b =
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 80, |_| {}).unwrap();
         let rel = (a.peak_torque_nm - b.peak_torque_nm).abs() / b.peak_torque_nm;
         assert!(
             rel < 0.01,
@@ -258,9 +273,10 @@ fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
 fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
     for name in ["seed", "domestic-cat", "robot-universal"] {
         let c = cfg(name, &[]);
-        let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
         let free =
-            catflip::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {}).unwrap();
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
+                .unwrap();
         assert!(
             free.peak_torque_nm <= phased.peak_torque_nm,
             "{name}: {} > {}",
@@ -274,13 +290,15 @@ fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
 #[test]
 fn bend_limit_holds_in_both_optimisers() {
     let c = cfg("seed", &["limits.max_bend_deg=30"]);
-    let phased = catflip::phased::optimize(&c, |_| {}).unwrap();
+    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
     assert!(phased.bend_deg <= 30.0 + 1e-9, "{}", phased.bend_deg);
-    let free = catflip::free::optimize_from(&c, &phased.plan, "phased", 20, |_| {}).unwrap();
+    let free =
+        catflip::design::free::optimize_from(&c, &phased.plan, "phased", 20, |_| {}).unwrap();
     assert!(free.bend_deg <= 30.0 + 1e-6, "{}", free.bend_deg);
     assert!(free.flip_error_rad.abs() < 1e-3);
     // the limit costs torque against the unconstrained design (optimum bend ~ 42 deg)
-    let open = catflip::free::optimize_from(&cfg("seed", &[]), &phased.plan, "phased", 20, |_| {})
-        .unwrap();
+    let open =
+        catflip::design::free::optimize_from(&cfg("seed", &[]), &phased.plan, "phased", 20, |_| {})
+            .unwrap();
     assert!(free.peak_torque_nm > open.peak_torque_nm);
 }

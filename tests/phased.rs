@@ -1,15 +1,15 @@
 //! The phased optimiser against independent code paths.
 
 use catflip::Config;
-use catflip::analytic::plan as cosine_plan;
-use catflip::analyze::peak_along;
+use catflip::design::analytic::plan as cosine_plan;
+use catflip::design::path::Path;
+use catflip::design::phased::{design_at, optimize, twist_for};
+use catflip::design::plan::ShapePlan;
+use catflip::design::timing::TimingProblem;
 use catflip::error::Error;
 use catflip::model::Joint;
-use catflip::path::Path;
-use catflip::phased::{design_at, optimize, twist_for};
-use catflip::plan::ShapePlan;
-use catflip::simulate::kinematic;
-use catflip::timing::TimingProblem;
+use catflip::verify::analyze::peak_along;
+use catflip::verify::simulate::kinematic;
 
 fn cfg(name: &str, overrides: &[&str]) -> Config {
     let p = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));

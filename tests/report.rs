@@ -140,14 +140,15 @@ fn sweep_agrees_with_single_runs() {
     assert_eq!(points.len(), 2);
     for p in &points {
         let cfg = catflip::Config::load(&cfg_path, &[format!("fall.height={}", p.value)]).unwrap();
-        let (a, _) = catflip::analyze::peak_along(
+        let (a, _) = catflip::verify::analyze::peak_along(
             &cfg,
-            &catflip::analytic::analytic_plan(&cfg),
-            catflip::analyze::dense_samples(&cfg),
+            &catflip::design::analytic::analytic_plan(&cfg),
+            catflip::verify::analyze::dense_samples(&cfg),
         );
-        let ph = catflip::phased::optimize(&cfg, |_| {}).unwrap();
+        let ph = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
         let fr =
-            catflip::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+            catflip::design::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
+                .unwrap();
         assert!((p.analytic_peak_nm.unwrap() - a).abs() <= 1e-12 * a);
         assert!((p.phased_peak_nm.unwrap() - ph.peak_torque_nm).abs() <= 1e-12 * a);
         assert!((p.free_peak_nm.unwrap() - fr.peak_torque_nm).abs() <= 1e-9 * fr.peak_torque_nm);

@@ -1,12 +1,12 @@
 //! `catflip analyze`: the seed's closed forms beside the true dynamics of its
 //! schedule.
 
-use crate::analytic::{ClosedForms, analytic_plan, closed_forms};
 use crate::config::Config;
+use crate::design::analytic::{ClosedForms, analytic_plan, closed_forms};
+use crate::design::path::PhasedPlan;
+use crate::design::plan::{Schedule, ShapePlan};
 use crate::error::Result;
-use crate::path::PhasedPlan;
-use crate::plan::{Schedule, ShapePlan};
-use crate::simulate::{SimReport, dynamic_cfg, kinematic_cfg};
+use crate::verify::simulate::{SimReport, dynamic_cfg, kinematic_cfg};
 use serde::Serialize;
 
 /// Samples per phase of the reported ("dense") peaks: at least 2000 and a

@@ -1,5 +1,5 @@
 //! The free-form optimiser: multi-phase direct collocation of the shape with
-//! successive convexification ([`crate::scp`]) on Clarabel.
+//! successive convexification ([`crate::design::scp`]) on Clarabel.
 //!
 //! Decision variables: `q, dq/ds, d2q/ds2` at `N` nodes in each of the three
 //! phases (normalised time `s`) and the three phase durations
@@ -20,17 +20,17 @@
 //! `dOmega_j` of step `j` moves the final attitude by `R_{j+1} J_r(Omega_j) dOmega_j`
 //! in the world frame.
 
-use crate::collocation::{CollocationPlan, Transcription};
 use crate::config::Config;
-use crate::conic::{Cone, ConicData};
-use crate::dynamics::{linearize_torque, torque_from};
-use crate::error::Result;
-use crate::model::{Cat, ShapeTerms, TorqueNorm};
-use crate::scp::{
+use crate::design::collocation::{CollocationPlan, Transcription};
+use crate::design::conic::{Cone, ConicData};
+use crate::design::scp::{
     Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets, solve,
 };
-use crate::simulate::SimReport;
-use crate::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
+use crate::error::Result;
+use crate::model::dynamics::{linearize_torque, torque_from};
+use crate::model::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
+use crate::model::{Cat, ShapeTerms, TorqueNorm};
+use crate::verify::simulate::SimReport;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
@@ -394,7 +394,7 @@ impl Seed {
 /// Runs the SCP from a seed plan at `nodes` per phase.
 pub fn optimize_from(
     cfg: &Config,
-    seed_plan: &dyn crate::plan::ShapePlan,
+    seed_plan: &dyn crate::design::plan::ShapePlan,
     seed: &str,
     nodes: usize,
     observe: impl FnMut(&ScpIteration),
@@ -425,16 +425,17 @@ pub fn optimize_from(
         tr,
         z: res.z.clone(),
     };
-    let (peak, _) = crate::analyze::peak_along(cfg, &plan, crate::analyze::dense_samples(cfg));
+    let (peak, _) =
+        crate::verify::analyze::peak_along(cfg, &plan, crate::verify::analyze::dense_samples(cfg));
     // a limit that the design breaks fails before any simulation is spent on it
-    crate::phased::check_limit(
+    crate::design::phased::check_limit(
         cfg,
         peak * cfg.available_time().powi(2),
         peak,
         "free-form design",
     )?;
-    let sim = crate::simulate::dynamic_cfg(cfg, &plan)?;
-    let kin = crate::simulate::kinematic_cfg(cfg, &plan)?;
+    let sim = crate::verify::simulate::dynamic_cfg(cfg, &plan)?;
+    let kin = crate::verify::simulate::kinematic_cfg(cfg, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
     for p in 0..3 {
         for k in 0..nodes {
@@ -444,7 +445,7 @@ pub fn optimize_from(
             if b > 1e-3 {
                 let phi = q[1].atan2(q[0]);
                 if let Some(l) = last_phi {
-                    twist += crate::so3::wrap(phi - l);
+                    twist += crate::model::so3::wrap(phi - l);
                 }
                 last_phi = Some(phi);
             }
@@ -485,12 +486,12 @@ pub fn optimize(
 ) -> Result<FreeResult> {
     match seed {
         Seed::Phased => {
-            let ph = crate::phased::optimize(cfg, |_| {})?;
+            let ph = crate::design::phased::optimize(cfg, |_| {})?;
             optimize_from(cfg, &ph.plan, seed.name(), cfg.free.nodes, observe)
         }
         Seed::Analytic => optimize_from(
             cfg,
-            &crate::analytic::analytic_plan(cfg),
+            &crate::design::analytic::analytic_plan(cfg),
             seed.name(),
             cfg.free.nodes,
             observe,

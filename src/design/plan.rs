@@ -1,7 +1,7 @@
 //! Shape trajectories in time (plans) and their sampled form (schedules).
 
-use crate::dynamics::inverse_dynamics;
 use crate::error::{Error, Result};
+use crate::model::dynamics::inverse_dynamics;
 use crate::model::{Cat, TorqueNorm};
 use serde::Serialize;
 

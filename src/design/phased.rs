@@ -2,22 +2,22 @@
 //!
 //! For a bend `b` each phase is a rest-to-rest traversal of a fixed path, so
 //! its least peak in time `T_i` is `p_i(b) / T_i^2` (F3) with `p_i` from the
-//! phase SOCP ([`crate::timing`]). The best split is `T_i ~ sqrt(p_i)` and the
+//! phase SOCP ([`crate::design::timing`]). The best split is `T_i ~ sqrt(p_i)` and the
 //! phased peak is `(sum_i sqrt(p_i))^2 / T^2`. The bend is then searched by a
 //! coarse scan (which includes the one-turn bend of F6 and the config's bend)
 //! and golden-section refinement inside the best bracket: derivative-free, so
 //! it stays correct where the objective has kinks (a phase taking over the peak).
 
-use crate::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
-use crate::analyze::peak_along;
 use crate::config::Config;
-use crate::conic::SolveStatus;
+use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::design::conic::SolveStatus;
+use crate::design::path::{Path, PhasedPlan, Timing};
+use crate::design::timing::{PhaseTiming, TimingProblem};
 use crate::error::{Error, Result};
 use crate::model::{Cat, Joint};
-use crate::ode::OdeSettings;
-use crate::path::{Path, PhasedPlan, Timing};
-use crate::simulate::{SimReport, dynamic_cfg, kinematic};
-use crate::timing::{PhaseTiming, TimingProblem};
+use crate::verify::analyze::peak_along;
+use crate::verify::ode::OdeSettings;
+use crate::verify::simulate::{SimReport, dynamic_cfg, kinematic};
 use serde::Serialize;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -307,7 +307,7 @@ pub fn finish(
     let durations = design.durations(t);
     let socp_peak = design.unit_peak() / (t * t);
     let plan = design.plan(durations);
-    let (peak, _) = peak_along(cfg, &plan, crate::analyze::dense_samples(cfg));
+    let (peak, _) = peak_along(cfg, &plan, crate::verify::analyze::dense_samples(cfg));
     check_limit(cfg, peak * t * t, peak, "phased design")?;
     let split = cfg.analytic.split.map(|f| f * t);
     let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);

@@ -4,8 +4,8 @@
 //! (plotters' `ab_glyph` feature), so no system font library is needed; the
 //! SVGs carry real `<text>` elements.
 
+use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
-use crate::scp::ScpIteration;
 use plotters::prelude::*;
 use std::sync::Once;
 

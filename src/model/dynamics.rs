@@ -6,8 +6,8 @@
 //! Their exact derivatives come from [`ShapeTerms`], so the torque Jacobians
 //! below are exact too.
 
+use crate::model::small::{add3, cross, mat_mul, mat_vec, scale3, transpose};
 use crate::model::{Cat, ShapeTerms};
-use crate::small::{add3, cross, mat_mul, mat_vec, scale3, transpose};
 use num_dual::Dual64;
 
 /// `c[i][j][k] = dM_ij/dq_k - 1/2 dM_jk/dq_i`.
@@ -141,7 +141,7 @@ pub fn angular_momentum(
     let rw = mat_vec(r_a, w_a);
     for i in 0..3 {
         // d/dt R_A = R_A hat(w_A) = hat(R_A w_A) R_A
-        let dr = mat_mul(&crate::small::hat(rw), r_a);
+        let dr = mat_mul(&crate::model::small::hat(rw), r_a);
         for j in 0..3 {
             ra[i][j].eps = dr[i][j];
         }

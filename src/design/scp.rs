@@ -19,7 +19,7 @@
 //! (converged); the penalty grows tenfold when the model stalls while still
 //! infeasible; an iteration limit or a collapsed trust region end the run.
 
-use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::error::{Error, Result};
 use crate::model::TorqueNorm;
 use serde::Serialize;

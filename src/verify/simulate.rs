@@ -8,12 +8,12 @@
 //! renormalised after each step.
 
 use crate::config::Config;
-use crate::dynamics::{angular_momentum, bias, solve2};
+use crate::design::plan::ShapePlan;
 use crate::error::{Error, Result};
+use crate::model::dynamics::{angular_momentum, bias, solve2};
+use crate::model::so3::{flip_and_tilt, from_na, normalize_quat, quat_from, quat_rate, wrap};
 use crate::model::{Cat, ShapeTerms, TorqueNorm};
-use crate::ode::{OdeSettings, OdeStatus, integrate};
-use crate::plan::ShapePlan;
-use crate::so3::{flip_and_tilt, from_na, normalize_quat, quat_from, quat_rate, wrap};
+use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
 
 /// One recorded instant of a simulation.
@@ -86,7 +86,7 @@ fn finish(
     let (flip, tilt) = flip_and_tilt(&quat_from(y_quat));
     Ok(SimReport {
         flip_deg: flip.to_degrees(),
-        flip_error_rad: crate::so3::flip_error(flip),
+        flip_error_rad: crate::model::so3::flip_error(flip),
         tilt_deg: tilt.to_degrees(),
         final_shape_error_rad: 0.0,
         final_rate_error_rad_s: 0.0,

@@ -2,7 +2,7 @@
 //! (MODEL.md section 5), evaluated with the true dynamics elsewhere.
 
 use crate::config::Config;
-use crate::path::{Path, PhasedPlan, Timing};
+use crate::design::path::{Path, PhasedPlan, Timing};
 use serde::Serialize;
 use std::f64::consts::PI;
 

@@ -17,11 +17,11 @@
 //! `beta = beta_k + ds (3 a_k + a_{k+1}) / 4`: the torque is then continuous
 //! and the bound holds between points to second order in `ds`.
 
-use crate::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
-use crate::dynamics::christoffel;
+use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::design::path::{GridTiming, Path};
 use crate::error::{Error, Result};
+use crate::model::dynamics::christoffel;
 use crate::model::{Cat, ShapeTerms, TorqueNorm};
-use crate::path::{GridTiming, Path};
 
 /// Result of one phase: unit-time least peak and the timing that attains it.
 #[derive(Debug, Clone)]

@@ -2,7 +2,7 @@
 //! constant bend, unfold in a plane; and the rest-to-rest timings that run
 //! along them. A phased plan is three (path, timing, duration) triples.
 
-use crate::plan::{Phase, ShapePlan, ShapeState};
+use crate::design::plan::{Phase, ShapePlan, ShapeState};
 use serde::Serialize;
 
 /// A shape path `q(s)`, `s` in `[0, 1]`.

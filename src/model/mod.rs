@@ -15,7 +15,11 @@
 //! Zero angular momentum gives `w_A = -J^-1 K q_dot` with `K = Kt S`, and the
 //! reduced mass matrix is `M = S' Nt S - K' J^-1 K`.
 
-use crate::small::*;
+pub mod dynamics;
+pub mod small;
+pub mod so3;
+
+use crate::model::small::*;
 use nalgebra::{Const, U1};
 use num_dual::{Derivative, Dual2SVec64, DualSVec64};
 use serde::{Deserialize, Serialize};

@@ -17,7 +17,7 @@
 //! the interpolation is the matching cubic in `q`, and the same interpolation
 //! reconstructs the schedule.
 
-use crate::plan::{Phase, ShapePlan, ShapeState};
+use crate::design::plan::{Phase, ShapePlan, ShapeState};
 
 /// Grid and variable layout.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -261,7 +261,7 @@ mod tests {
 
     #[test]
     fn sampling_a_plan_and_reading_it_back_agree_at_the_nodes() {
-        let plan = crate::analytic::plan(1.0, 3.0, [0.3, 0.5, 0.4]);
+        let plan = crate::design::analytic::plan(1.0, 3.0, [0.3, 0.5, 0.4]);
         let tr = Transcription::new(3, 7);
         let z = tr.sample(&plan);
         let cp = CollocationPlan { tr, z };

@@ -1,0 +1,13 @@
+//! Design: the torque schedules. The seed's closed-form schedule, the
+//! certified phased optimum (path-timing SOCPs) and the free-form optimum
+//! (collocation + successive convexification), with the shape plans and
+//! sampled schedules they produce and the conic solver they share.
+pub mod analytic;
+pub mod collocation;
+pub mod conic;
+pub mod free;
+pub mod path;
+pub mod phased;
+pub mod plan;
+pub mod scp;
+pub mod timing;
