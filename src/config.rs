@@ -112,6 +112,9 @@ pub struct SimulateConfig {
     pub pd_damping: f64,
     /// Rows per phase in written schedules (default 200).
     pub samples_per_phase: usize,
+    /// Largest flip error and spine tilt of a simulated design, rad, beyond
+    /// which the design is flagged as missing the flip (default 0.01).
+    pub flip_tolerance: f64,
 }
 
 impl Default for SimulateConfig {
@@ -123,6 +126,7 @@ impl Default for SimulateConfig {
             pd_bandwidth_hz: 10.0,
             pd_damping: 1.0,
             samples_per_phase: 200,
+            flip_tolerance: 0.01,
         }
     }
 }
@@ -327,12 +331,18 @@ impl Config {
             s.pd_damping > 0.0,
             "must be > 0",
         )?;
+        check(
+            "simulate.flip_tolerance",
+            s.flip_tolerance,
+            s.flip_tolerance > 0.0 && s.flip_tolerance <= std::f64::consts::PI,
+            "must be in (0, pi] rad",
+        )?;
         let n = s.samples_per_phase as f64;
         check(
             "simulate.samples_per_phase",
             n,
-            (2.0..=100_000.0).contains(&n),
-            "must be in 2..=100000",
+            (2.0..=30_000.0).contains(&n),
+            "must be in 2..=30000",
         )?;
         let p = &self.phased;
         check(
