@@ -284,10 +284,24 @@ fn print_sim(title: &str, r: &SimReport) {
     row("accepted steps", format!("{}", r.steps));
 }
 
+/// Reads a schedule file, refusing one far larger than any schedule that
+/// [`catflip::verify::simulate::MAX_SCHEDULE_ROWS`] admits before reading it.
+fn read_bounded(p: &Path) -> std::io::Result<String> {
+    let limit = 500 * catflip::verify::simulate::MAX_SCHEDULE_ROWS as u64;
+    let len = std::fs::metadata(p)?.len();
+    if len > limit {
+        return Err(std::io::Error::other(format!(
+            "{len} bytes, more than a schedule of {} rows can have; resample it more coarsely",
+            catflip::verify::simulate::MAX_SCHEDULE_ROWS
+        )));
+    }
+    std::fs::read_to_string(p)
+}
+
 fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     let cfg = load(c)?;
     let text = match schedule {
-        Some(p) => Some(std::fs::read_to_string(p).map_err(|e| {
+        Some(p) => Some(read_bounded(p).map_err(|e| {
             catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
         })?),
         None => None,

@@ -70,10 +70,22 @@ pub struct AnalyticConfig {
     /// Angle between the halves during the twist, degrees (default 45, the seed's pi/4).
     pub theta_deg: f64,
     /// Fractions of the manoeuvre time for fold, twist, unfold (default 0.2, 0.6, 0.2).
+    #[serde(deserialize_with = "three_fractions")]
     pub split: [f64; 3],
     /// Use the seed's transverse inertia `m (r^2 + l^2)/12` (erratum E1) to reproduce
     /// its printed example (default false).
     pub seed_inertia: bool,
+}
+
+/// `analytic.split`: exactly three numbers, no more, no fewer.
+fn three_fractions<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[f64; 3], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "analytic.split needs exactly 3 fractions (fold, twist, unfold), got {}",
+            v.len()
+        ))
+    })
 }
 
 impl Default for AnalyticConfig {
@@ -203,25 +215,66 @@ impl Config {
         Self::from_toml(&text, &path.display().to_string(), overrides)
     }
 
+    /// Parses the user's text, applies `--set` overrides and validates. An
+    /// error in the file points at the file's own line; an error in an
+    /// override names that `--set` argument.
     pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| Error::ConfigParse {
+        let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
             message: e.to_string(),
-        })?;
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
+        // the file alone, parsed from its own text: unknown keys and wrong
+        // types carry the file's line; a missing key may come from an override
+        if let Err(e) = toml::from_str::<Config>(text) {
+            if overrides.is_empty() || !e.message().starts_with("missing field") {
+                return Err(file_err(e));
+            }
+        }
+        // each override alone on a complete config, so that its error names it
+        let template = toml::Table::try_from(Config::template()).expect("the template serialises");
         for arg in overrides {
+            let mut t = template.clone();
+            apply_override(&mut t, arg)?;
+            if let Err(e) = t.try_into::<Config>() {
+                return Err(Error::Override {
+                    arg: arg.clone(),
+                    message: e.message().trim().to_string(),
+                });
+            }
             apply_override(&mut table, arg)?;
         }
-        let merged = toml::to_string(&table).expect("a TOML table serialises");
-        let cfg: Config = toml::from_str(&merged).map_err(|e| Error::ConfigParse {
-            origin: if overrides.is_empty() {
-                origin.into()
-            } else {
-                format!("{origin} (with --set overrides)")
-            },
-            message: e.to_string(),
+        // together: what is left is a key that neither gives
+        let cfg: Config = table.try_into().map_err(|e: toml::de::Error| Error::ConfigParse {
+            origin: format!("{origin} (with --set overrides)"),
+            message: e.message().trim().to_string(),
         })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+
+    /// A complete valid config (the seed's cat), the base on which each
+    /// `--set` is checked alone.
+    fn template() -> Config {
+        Config {
+            name: "template".into(),
+            cat: CatConfig {
+                mass: 1.0,
+                length: 1.0,
+                radius: 0.1,
+                joint: Joint::NoTwist,
+            },
+            fall: FallConfig {
+                height: 10.0,
+                gravity: default_gravity(),
+                margin: 0.0,
+            },
+            analytic: AnalyticConfig::default(),
+            limits: LimitsConfig::default(),
+            simulate: SimulateConfig::default(),
+            phased: PhasedConfig::default(),
+            free: FreeConfig::default(),
+        }
     }
 
     pub fn validate(&self) -> Result<()> {

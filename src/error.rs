@@ -16,7 +16,9 @@ pub enum Error {
     },
     #[error("`--set {arg}`: {message}")]
     Override { arg: String, message: String },
-    /// A bad command-line argument other than `--set`.
+    #[error("`--set-range {arg}`: {message}")]
+    Range { arg: String, message: String },
+    /// A bad command-line argument other than `--set` and `--set-range`.
     #[error("{0}")]
     Usage(String),
     #[error("schedule {file}, line {line}: {message}")]
@@ -56,6 +58,7 @@ impl Error {
                 | Error::ConfigParse { .. }
                 | Error::Invalid { .. }
                 | Error::Override { .. }
+                | Error::Range { .. }
                 | Error::Usage(_)
                 | Error::Schedule { .. }
                 | Error::OutputDir { .. }
