@@ -174,16 +174,26 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// A method's line; `sim` is its dynamic simulation, or why that failed
+/// (then the schedule is kept, flagged, with NaN simulation numbers).
 fn summarize(
     cfg: &Config,
     method: &'static str,
     status: String,
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
-    sim: &SimReport,
+    sim: std::result::Result<&SimReport, &Error>,
     solve_time_s: f64,
 ) -> MethodSummary {
     let (bend, twist, durations) = path_numbers;
+    let failed_sim;
+    let (sim, sim_error) = match sim {
+        Ok(s) => (s, None),
+        Err(e) => {
+            failed_sim = SimReport::failed();
+            (&failed_sim, Some(e.to_string()))
+        }
+    };
     let n = MethodNumbers {
         peak_torque_nm: peak,
         bend_deg: bend,
@@ -200,7 +210,10 @@ fn summarize(
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
     };
-    let reason = flags(cfg, &status, &n);
+    let reason = match (sim_error, flags(cfg, &status, &n)) {
+        (Some(e), _) => Some(e),
+        (None, r) => r,
+    };
     MethodSummary {
         method,
         status,
@@ -272,9 +285,11 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "analytic schedule (seed closed forms, errata corrected)",
     });
     let clock = Instant::now();
-    let analytic = analyze(cfg).and_then(|a| {
-        let sim = dynamic_cfg(cfg, &a.plan)?;
-        Ok((a, sim))
+    // the kinematic check is part of the analysis; a failed dynamic
+    // simulation (e.g. under a saturating torque limit) only flags the schedule
+    let analytic = analyze(cfg).map(|a| {
+        let sim = dynamic_cfg(cfg, &a.plan);
+        (a, sim)
     });
     let a_time = clock.elapsed().as_secs_f64();
     match &analytic {
@@ -290,10 +305,12 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                     a.closed.twist_rad,
                     a.closed.phase_durations_s,
                 ),
-                a_sim,
+                a_sim.as_ref(),
                 a_time,
             ));
-            traces.push(trace(cfg, "analytic", &a.plan, a_sim, 300));
+            let failed_sim = SimReport::failed();
+            let sim = a_sim.as_ref().unwrap_or(&failed_sim);
+            traces.push(trace(cfg, "analytic", &a.plan, sim, 300));
         }
         Err(e) => methods.push(MethodSummary::failed("analytic", e)),
     }
@@ -327,7 +344,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 format!("{:?}", ph.status).to_lowercase(),
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
-                ph_sim,
+                Ok(ph_sim),
                 ph.solve_time_s,
             ));
             traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
@@ -363,7 +380,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 format!("{:?}", fr.status).to_lowercase(),
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
-                &fr.sim,
+                Ok(&fr.sim),
                 fr.solve_time_s,
             ));
             traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));

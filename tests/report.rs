@@ -53,7 +53,7 @@ fn run_writes_a_complete_consistent_report() {
         out.contains("analytic") && out.contains("phased") && out.contains("free"),
         "{out}"
     );
-    let base = dir.path().join("output/seed");
+    let base = dir.path().join("output/seed/run");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
     let methods = summary["methods"].as_array().unwrap();
@@ -178,14 +178,14 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         dir.path(),
     );
     assert!(ok, "{err}");
-    let csv = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass/sweep-cat_mass.csv")).unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 3);
     assert!(rows[0].starts_with("cat.mass,"));
     // with a torque limit, the least drop height of F7 is there
     assert!(
         dir.path()
-            .join("output/seed/sweep-cat_mass-least-height.svg")
+            .join("output/seed/sweep-cat_mass/sweep-cat_mass-least-height.svg")
             .exists()
     );
     let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
@@ -254,7 +254,7 @@ fn exports_parse_and_carry_the_model_masses_and_inertias() {
     assert!(ok, "{err}");
     assert!(
         dir.path()
-            .join("output/robot-universal/robot-universal.mjcf.xml")
+            .join("output/robot-universal/export-mjcf/robot-universal.mjcf.xml")
             .exists()
     );
 }

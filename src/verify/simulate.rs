@@ -50,6 +50,24 @@ pub struct SimReport {
     pub trace: Vec<TracePoint>,
 }
 
+impl SimReport {
+    /// The report of a simulation that failed: every number NaN (null in JSON).
+    pub fn failed() -> SimReport {
+        SimReport {
+            flip_deg: f64::NAN,
+            flip_error_rad: f64::NAN,
+            tilt_deg: f64::NAN,
+            final_shape_error_rad: f64::NAN,
+            final_rate_error_rad_s: f64::NAN,
+            max_tracking_error_rad: f64::NAN,
+            momentum_drift_nms: f64::NAN,
+            peak_torque_nm: f64::NAN,
+            steps: 0,
+            trace: Vec::new(),
+        }
+    }
+}
+
 fn settings(cfg: &Config) -> OdeSettings {
     OdeSettings {
         rtol: cfg.simulate.rtol,
@@ -73,7 +91,18 @@ impl Unwrap {
 }
 
 /// Why a run stopped early, in words that name the cause and the remedy.
-fn failure(status: OdeStatus, trace: &[TracePoint], ode: &OdeSettings) -> Error {
+fn failure(
+    status: OdeStatus,
+    trace: &[TracePoint],
+    ode: &OdeSettings,
+    limit: Option<f64>,
+) -> Error {
+    let cause = match limit {
+        Some(l) => format!(
+            "the schedule's torques do not fit this cat, or limits.max_torque = {l} N m holds the motors below what the schedule needs (check the torque units, N m, the config the schedule was designed for, and the limit)"
+        ),
+        None => "the schedule's torques do not fit this cat (check their units, N m, and the config the schedule was designed for)".to_string(),
+    };
     let last = trace.last();
     let at = last.map(|p| p.t).unwrap_or(0.0);
     let peak = trace
@@ -83,12 +112,12 @@ fn failure(status: OdeStatus, trace: &[TracePoint], ode: &OdeSettings) -> Error 
     let bend = last.map(|p| p.q[0].hypot(p.q[1])).unwrap_or(0.0);
     Error::Simulation(match status {
         OdeStatus::Stopped => format!(
-            "the motion diverged at t = {at:.6} s: the bend reached {:.1} deg, past the {:.0} deg where the halves meet (applied torque up to {peak:.4e} N m); the schedule's torques do not fit this cat (check their units, N m, and the config the schedule was designed for)",
+            "the motion diverged at t = {at:.6} s: the bend reached {:.1} deg, past the {:.0} deg where the halves meet (applied torque up to {peak:.4e} N m); {cause}",
             bend.to_degrees(),
             MAX_BEND.to_degrees()
         ),
         OdeStatus::NonFinite => format!(
-            "the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); the schedule's torques do not fit this cat (check their units, N m, and the config the schedule was designed for)"
+            "the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); {cause}"
         ),
         OdeStatus::StepBudget => format!(
             "the integrator used its {} steps per phase by t = {at:.6} s (applied torque up to {peak:.4e} N m): the motion is too fast or too rough for simulate.rtol = {:e}; a schedule with very many rows or huge torques is the usual cause, and simulate.rtol = 1e-8 may help",
@@ -124,9 +153,10 @@ fn finish(
     steps: usize,
     status: OdeStatus,
     ode: &OdeSettings,
+    limit: Option<f64>,
 ) -> Result<SimReport> {
     if status != OdeStatus::Done {
-        return Err(failure(status, &trace, ode));
+        return Err(failure(status, &trace, ode, limit));
     }
     let (flip, tilt) = flip_and_tilt(&quat_from(y_quat));
     Ok(SimReport {
@@ -188,8 +218,14 @@ impl<'a> Recorder<'a> {
         finite && q[0].hypot(q[1]) < MAX_BEND
     }
 
-    fn finish(self, quat: &[f64], status: OdeStatus, ode: &OdeSettings) -> Result<SimReport> {
-        let mut r = finish(quat, self.trace, self.steps, status, ode)?;
+    fn finish(
+        self,
+        quat: &[f64],
+        status: OdeStatus,
+        ode: &OdeSettings,
+        limit: Option<f64>,
+    ) -> Result<SimReport> {
+        let mut r = finish(quat, self.trace, self.steps, status, ode, limit)?;
         r.momentum_drift_nms = self.drift;
         Ok(r)
     }
@@ -243,7 +279,7 @@ pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<S
             rec.record(t, y, s.q, s.qd, [0.0; 2])
         },
     );
-    let mut r = rec.finish(&y, status, ode)?;
+    let mut r = rec.finish(&y, status, ode, None)?;
     let end = plan.state(plan.duration());
     r.final_shape_error_rad = end.q[0].hypot(end.q[1]);
     r.final_rate_error_rad_s = end.qd[0].hypot(end.qd[1]);
@@ -340,7 +376,7 @@ pub fn dynamic(
             rec.record(t, y, q, qd, tau)
         },
     );
-    let mut r = rec.finish(&y, status, ode)?;
+    let mut r = rec.finish(&y, status, ode, ctrl.limit)?;
     r.peak_torque_nm = peak;
     r.max_tracking_error_rad = track;
     r.final_shape_error_rad = y[4].hypot(y[5]);
