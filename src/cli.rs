@@ -309,7 +309,8 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     let publisher = publisher(c, &cfg, "simulate")?;
     let (source, report) = match (schedule, text) {
         (Some(p), Some(text)) => {
-            let s = catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
+            let s =
+                catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
             (p.display().to_string(), verify(&cfg, &s)?)
         }
         _ => {

@@ -78,7 +78,9 @@ pub struct AnalyticConfig {
 }
 
 /// `analytic.split`: exactly three numbers, no more, no fewer.
-fn three_fractions<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<[f64; 3], D::Error> {
+fn three_fractions<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<[f64; 3], D::Error> {
     let v: Vec<f64> = Vec::deserialize(d)?;
     <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
         serde::de::Error::custom(format!(
@@ -245,10 +247,12 @@ impl Config {
             apply_override(&mut table, arg)?;
         }
         // together: what is left is a key that neither gives
-        let cfg: Config = table.try_into().map_err(|e: toml::de::Error| Error::ConfigParse {
-            origin: format!("{origin} (with --set overrides)"),
-            message: e.message().trim().to_string(),
-        })?;
+        let cfg: Config = table
+            .try_into()
+            .map_err(|e: toml::de::Error| Error::ConfigParse {
+                origin: format!("{origin} (with --set overrides)"),
+                message: e.message().trim().to_string(),
+            })?;
         cfg.validate()?;
         Ok(cfg)
     }

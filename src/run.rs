@@ -368,9 +368,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             (&analytic_seed, "analytic")
         }
     };
-    let free = crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-        progress(Progress::Scp(it))
-    });
+    let free =
+        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+            progress(Progress::Scp(it))
+        });
     match &free {
         Ok(fr) => {
             Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");

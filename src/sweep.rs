@@ -42,7 +42,7 @@ impl std::str::FromStr for SweepSpec {
             .trim()
             .parse()
             .map_err(|_| bad("COUNT must be a whole number"))?;
-        if count < 1 || !from.is_finite() || !to.is_finite() {
+        if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
         }
         if count > MAX_POINTS {
@@ -74,7 +74,7 @@ impl SweepSpec {
             return vec![self.from];
         }
         (0..self.count)
-            .map(|i| self.from + (self.to - self.from) * i as f64 / (self.count - 1) as f64)
+            .map(|i| self.from + (self.to - self.from) * (i as f64 / (self.count - 1) as f64))
             .collect()
     }
 }
@@ -139,9 +139,13 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match &ph {
-                Ok(ph) => {
-                    crate::design::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
-                }
+                Ok(ph) => crate::design::free::optimize_from(
+                    &cfg,
+                    &ph.plan,
+                    "phased",
+                    cfg.free.nodes,
+                    |_| {},
+                ),
                 Err(_) => crate::design::free::optimize_from(
                     &cfg,
                     &analytic_plan(&cfg),
@@ -224,10 +228,10 @@ pub fn sweep(
                         .map_err(|e| e.to_string())
                         .and_then(|c| point(c, values[i], methods).map_err(|e| e.to_string()))
                         .unwrap_or_else(|e| SweepPoint {
-                        value: values[i],
-                        error: Some(e),
-                        ..Default::default()
-                    });
+                            value: values[i],
+                            error: Some(e),
+                            ..Default::default()
+                        });
                     results.lock().unwrap()[i] = Some(p);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
                 }

@@ -73,7 +73,12 @@ fn read_analyze_set(link: &Path) -> Option<f64> {
     let (peak, rows) = csv_peak(&csv);
     let jp = v["peak_torque_nm"].as_f64().unwrap();
     // the three files describe one schedule: same rows, same peak (the JSON samples more densely)
-    assert_eq!(s["rows"].as_array().unwrap().len(), rows, "{}", dir.display());
+    assert_eq!(
+        s["rows"].as_array().unwrap().len(),
+        rows,
+        "{}",
+        dir.display()
+    );
     assert!(
         peak <= jp * (1.0 + 1e-9) && peak > 0.99 * jp,
         "{}: CSV peak {peak} vs analyze.json {jp}: files of different runs",
@@ -138,10 +143,7 @@ fn row12_sigkill_at_random_moments_never_leaves_a_partial_set() {
         );
     }
     // a finished run publishes and removes every leftover of the killed ones
-    let (code, _, err) = run(
-        &["analyze", seed().to_str().unwrap()],
-        dir.path(),
-    );
+    let (code, _, err) = run(&["analyze", seed().to_str().unwrap()], dir.path());
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(read_analyze_set(&link), Some(45.0));
     let target = std::fs::read_link(&link).unwrap();
@@ -204,7 +206,12 @@ fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
     let run_dir = dir.path().join("output/seed/run");
     let before: Vec<(String, String)> = ["phased.csv", "analytic.csv", "free.csv", "summary.json"]
         .iter()
-        .map(|f| (f.to_string(), std::fs::read_to_string(run_dir.join(f)).unwrap()))
+        .map(|f| {
+            (
+                f.to_string(),
+                std::fs::read_to_string(run_dir.join(f)).unwrap(),
+            )
+        })
         .collect();
     // other designs of the same name land in their own sets
     for args in [
@@ -221,7 +228,11 @@ fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
             "{f} changed"
         );
     }
-    assert!(dir.path().join("output/seed/optimize-phased/phased.csv").exists());
+    assert!(
+        dir.path()
+            .join("output/seed/optimize-phased/phased.csv")
+            .exists()
+    );
     assert!(dir.path().join("output/seed/analyze/analytic.csv").exists());
 }
 
@@ -231,7 +242,12 @@ fn row14_unwritable_out_fails_before_computing_with_one_message() {
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
     let (code, out, err) = run(
-        &["run", seed().to_str().unwrap(), "--out", file.to_str().unwrap()],
+        &[
+            "run",
+            seed().to_str().unwrap(),
+            "--out",
+            file.to_str().unwrap(),
+        ],
         dir.path(),
     );
     assert_eq!(code, Some(2), "{err}");
@@ -248,11 +264,19 @@ fn row14_unwritable_out_fails_before_computing_with_one_message() {
     std::fs::set_permissions(&ro, perm).unwrap();
     if std::fs::write(ro.join("probe"), "x").is_err() {
         let (code, _, err) = run(
-            &["run", seed().to_str().unwrap(), "--out", ro.to_str().unwrap()],
+            &[
+                "run",
+                seed().to_str().unwrap(),
+                "--out",
+                ro.to_str().unwrap(),
+            ],
             dir.path(),
         );
         assert_eq!(code, Some(2), "{err}");
-        assert!(!err.contains("[1/4]") && err.matches("error:").count() == 1, "{err}");
+        assert!(
+            !err.contains("[1/4]") && err.matches("error:").count() == 1,
+            "{err}"
+        );
     }
 }
 
@@ -289,7 +313,10 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(p["verdict"], "failed");
     assert!(p["peak_torque_nm"].is_null());
     let reason = p["reason"].as_str().unwrap();
-    assert!(reason.contains("fall.height") && reason.contains("at least"), "{reason}");
+    assert!(
+        reason.contains("fall.height") && reason.contains("at least"),
+        "{reason}"
+    );
     assert_eq!(a["verdict"], "flagged");
     assert!(a["reason"].as_str().unwrap().contains("limits.max_torque"));
     assert_eq!(f["verdict"], "ok", "{f}");
@@ -299,8 +326,7 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert!(peak <= 0.5 * (1.0 + 1e-6), "{peak}");
     assert!(!base.join("phased.csv").exists());
     let summary: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap())
-            .unwrap();
+        serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["methods"], v["methods"]);
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     assert!(html.contains("FAILED: the flip is impossible") && html.contains("FLAGGED"));
@@ -310,11 +336,19 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
 fn an_unconverged_design_is_flagged_in_table_and_exit_status() {
     let dir = tempfile::tempdir().unwrap();
     let (code, out, err) = run(
-        &["run", seed().to_str().unwrap(), "--set", "free.max_iterations=2"],
+        &[
+            "run",
+            seed().to_str().unwrap(),
+            "--set",
+            "free.max_iterations=2",
+        ],
         dir.path(),
     );
     assert_eq!(code, Some(3), "{err}");
-    let free = out.lines().find(|l| l.trim_start().starts_with("free")).unwrap();
+    let free = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("free"))
+        .unwrap();
     assert!(
         free.contains("FLAGGED") && free.contains("iterationlimit"),
         "{out}"
@@ -358,7 +392,12 @@ fn simulate(dir: &Path, schedule: &str, extra: &[&str]) -> (Option<i32>, String,
     let p = dir.join("schedule.csv");
     std::fs::write(&p, schedule).unwrap();
     let c = seed();
-    let mut args = vec!["simulate", c.to_str().unwrap(), "--schedule", p.to_str().unwrap()];
+    let mut args = vec![
+        "simulate",
+        c.to_str().unwrap(),
+        "--schedule",
+        p.to_str().unwrap(),
+    ];
     args.extend(extra);
     run(&args, dir)
 }
@@ -393,7 +432,11 @@ fn row3_a_million_row_resampling_is_refused_at_once_with_the_bound() {
     let dir = tempfile::tempdir().unwrap();
     let csv = analytic_csv(dir.path(), &[]);
     // linear resampling of each phase to 333,334 rows: the same schedule, 1e6 rows
-    let rows: Vec<Vec<&str>> = csv.lines().skip(1).map(|l| l.split(',').collect()).collect();
+    let rows: Vec<Vec<&str>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
     let mut big = format!("{}\n", csv.lines().next().unwrap());
     for phase in ["fold", "twist", "unfold"] {
         let ph: Vec<Vec<f64>> = rows
@@ -443,7 +486,10 @@ fn row13_a_schedule_for_another_fall_is_refused_naming_both_durations() {
     let slow = map_rows(&csv, |x| x[0] *= 100.0);
     let (code, _, err) = simulate(dir.path(), &slow, &[]);
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("142.857") && err.contains("fall.height"), "{err}");
+    assert!(
+        err.contains("142.857") && err.contains("fall.height"),
+        "{err}"
+    );
     assert!(!dir.path().join("output/seed/simulate").exists());
 }
 
@@ -453,7 +499,12 @@ fn row9_split_needs_exactly_three_numbers() {
     let c = seed();
     let c = c.to_str().unwrap();
     let (code, _, err) = run(
-        &["analyze", c, "--set", r#"analytic.split=[0.2,0.6,0.2,99,"x"]"#],
+        &[
+            "analyze",
+            c,
+            "--set",
+            r#"analytic.split=[0.2,0.6,0.2,99,"x"]"#,
+        ],
         dir.path(),
     );
     assert_eq!(code, Some(2), "{err}");
@@ -475,14 +526,21 @@ fn row10_config_errors_point_at_the_users_line_or_the_set_argument() {
     let text = std::fs::read_to_string(seed()).unwrap();
     let line = |needle: &str, t: &str| t.lines().position(|l| l.contains(needle)).unwrap() + 1;
     let cases = [
-        (text.replace("radius = 0.1", "radius = 0.1\nradus = 0.2"), "radus"),
+        (
+            text.replace("radius = 0.1", "radius = 0.1\nradus = 0.2"),
+            "radus",
+        ),
         (text.replace("height = 10.0", "height = \"ten\""), "height"),
     ];
     for (body, key) in cases {
         let want = line(key, &body);
         let bad = dir.path().join("bad.toml");
         std::fs::write(&bad, &body).unwrap();
-        for extra in [vec![], vec!["--set", "cat.mass=2"], vec!["--set", "phased.nodes=30"]] {
+        for extra in [
+            vec![],
+            vec!["--set", "cat.mass=2"],
+            vec!["--set", "phased.nodes=30"],
+        ] {
             let mut args = vec!["analyze", bad.to_str().unwrap()];
             args.extend(extra.iter().copied());
             let (code, _, err) = run(&args, dir.path());
@@ -512,14 +570,31 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
     let c = c.to_str().unwrap();
     // row 1: a billion points is refused before any work
     let (code, _, err) = run(
-        &["sweep", c, "--set-range", "fall.height=1:2:1000000000", "--methods", "analytic"],
+        &[
+            "sweep",
+            c,
+            "--set-range",
+            "fall.height=1:2:1000000000",
+            "--methods",
+            "analytic",
+        ],
         dir.path(),
     );
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("--set-range") && err.contains("10000"), "{err}");
+    assert!(
+        err.contains("--set-range") && err.contains("10000"),
+        "{err}"
+    );
     // row 16
     let (code, _, err) = run(
-        &["sweep", c, "--set-range", "cat.mass=1:2:2", "--threads", "0"],
+        &[
+            "sweep",
+            c,
+            "--set-range",
+            "cat.mass=1:2:2",
+            "--threads",
+            "0",
+        ],
         dir.path(),
     );
     assert_eq!(code, Some(2), "{err}");
@@ -528,7 +603,13 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
     // row 15: bad points are their own failures, the good ones are computed
     let (code, out, err) = run(
         &[
-            "sweep", c, "--set-range", "cat.mass=-1:1:5", "--methods", "analytic", "--json",
+            "sweep",
+            c,
+            "--set-range",
+            "cat.mass=-1:1:5",
+            "--methods",
+            "analytic",
+            "--json",
         ],
         dir.path(),
     );
@@ -550,5 +631,8 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
     // every point invalid (an unknown key) is bad input
     let (code, _, err) = run(&["sweep", c, "--set-range", "cat.masss=1:2:3"], dir.path());
     assert_eq!(code, Some(2), "{err}");
-    assert!(err.contains("--set-range cat.masss") && err.contains("masss"), "{err}");
+    assert!(
+        err.contains("--set-range cat.masss") && err.contains("masss"),
+        "{err}"
+    );
 }

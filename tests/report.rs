@@ -178,7 +178,11 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         dir.path(),
     );
     assert!(ok, "{err}");
-    let csv = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass/sweep-cat_mass.csv")).unwrap();
+    let csv = std::fs::read_to_string(
+        dir.path()
+            .join("output/seed/sweep-cat_mass/sweep-cat_mass.csv"),
+    )
+    .unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 3);
     assert!(rows[0].starts_with("cat.mass,"));

@@ -214,7 +214,12 @@ impl<'a> Recorder<'a> {
             q,
             tau,
         });
-        let finite = quat.iter().chain(&q).chain(&qd).chain(&tau).all(|x| x.is_finite());
+        let finite = quat
+            .iter()
+            .chain(&q)
+            .chain(&qd)
+            .chain(&tau)
+            .all(|x| x.is_finite());
         finite && q[0].hypot(q[1]) < MAX_BEND
     }
 
