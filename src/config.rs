@@ -228,10 +228,10 @@ impl Config {
         let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
         // the file alone, parsed from its own text: unknown keys and wrong
         // types carry the file's line; a missing key may come from an override
-        if let Err(e) = toml::from_str::<Config>(text) {
-            if overrides.is_empty() || !e.message().starts_with("missing field") {
-                return Err(file_err(e));
-            }
+        if let Err(e) = toml::from_str::<Config>(text)
+            && (overrides.is_empty() || !e.message().starts_with("missing field"))
+        {
+            return Err(file_err(e));
         }
         // each override alone on a complete config, so that its error names it
         let template = toml::Table::try_from(Config::template()).expect("the template serialises");

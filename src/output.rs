@@ -89,13 +89,13 @@ impl Publisher {
             created,
             published: false,
         };
-        if let Ok(m) = fs::symlink_metadata(p.link()) {
-            if !m.file_type().is_symlink() {
-                return Err(Error::OutputDir {
-                    path: p.link(),
-                    message: "exists and is not a set published by catflip (a link to a hidden folder); move it away".into(),
-                });
-            }
+        if let Ok(m) = fs::symlink_metadata(p.link())
+            && !m.file_type().is_symlink()
+        {
+            return Err(Error::OutputDir {
+                path: p.link(),
+                message: "exists and is not a set published by catflip (a link to a hidden folder); move it away".into(),
+            });
         }
         fs::create_dir(p.staging()).map_err(|e| oerr(&p.staging(), e))?;
         p.remove_leftovers();

@@ -142,34 +142,26 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
     if !matches!(status, "closed-form" | "solved" | "converged") {
         why.push(format!("solver status {status}"));
     }
-    let tol = cfg.simulate.flip_tolerance;
-    if !(n.flip_error_rad.abs() <= tol) {
+    why.extend(crate::verify::simulate::misses_flip(
+        n.flip_error_rad,
+        n.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    if let Some(lim) = cfg.limits.max_torque
+        && n.peak_torque_nm > lim * (1.0 + 1e-6)
+    {
         why.push(format!(
-            "misses the flip by {:.3e} rad (simulate.flip_tolerance {tol:e})",
-            n.flip_error_rad
+            "needs {:.4} N m, above limits.max_torque = {lim} N m",
+            n.peak_torque_nm
         ));
     }
-    if !(n.tilt_deg.to_radians() <= tol) {
+    if let Some(b) = cfg.limits.max_bend_deg
+        && n.bend_deg > b * (1.0 + 1e-6)
+    {
         why.push(format!(
-            "tilts the spine by {:.3} deg (simulate.flip_tolerance {tol:e} rad)",
-            n.tilt_deg
+            "bends {:.2} deg, above limits.max_bend_deg = {b} deg",
+            n.bend_deg
         ));
-    }
-    if let Some(lim) = cfg.limits.max_torque {
-        if n.peak_torque_nm > lim * (1.0 + 1e-6) {
-            why.push(format!(
-                "needs {:.4} N m, above limits.max_torque = {lim} N m",
-                n.peak_torque_nm
-            ));
-        }
-    }
-    if let Some(b) = cfg.limits.max_bend_deg {
-        if n.bend_deg > b * (1.0 + 1e-6) {
-            why.push(format!(
-                "bends {:.2} deg, above limits.max_bend_deg = {b} deg",
-                n.bend_deg
-            ));
-        }
     }
     (!why.is_empty()).then(|| why.join("; "))
 }

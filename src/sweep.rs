@@ -201,16 +201,16 @@ pub fn sweep(
             })
         })
         .collect();
-    if let Some(Err(first)) = configs.iter().find(|c| c.is_err()) {
-        if configs.iter().all(|c| c.is_err()) {
-            return Err(Error::Range {
-                arg: spec.arg(),
-                message: match first {
-                    Error::Range { message, .. } => format!("every point is invalid; {message}"),
-                    e => e.to_string(),
-                },
-            });
-        }
+    if let Some(Err(first)) = configs.first()
+        && configs.iter().all(|c| c.is_err())
+    {
+        return Err(Error::Range {
+            arg: spec.arg(),
+            message: match first {
+                Error::Range { message, .. } => format!("every point is invalid; {message}"),
+                e => e.to_string(),
+            },
+        });
     }
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);

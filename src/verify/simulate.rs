@@ -134,12 +134,14 @@ const MAX_BEND: f64 = std::f64::consts::PI;
 /// `tol`, rad), if it does; NaN counts as a miss.
 pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
     let mut why = Vec::new();
-    if !(flip_error_rad.abs() <= tol) {
+    // NaN compares false: a failed number is a miss
+    let beyond = |x: f64| x.is_nan() || x.abs() > tol;
+    if beyond(flip_error_rad) {
         why.push(format!(
             "misses the flip by {flip_error_rad:.3e} rad (simulate.flip_tolerance = {tol:e} rad)"
         ));
     }
-    if !(tilt_deg.to_radians().abs() <= tol) {
+    if beyond(tilt_deg.to_radians()) {
         why.push(format!(
             "tilts the spine by {tilt_deg:.3} deg (simulate.flip_tolerance = {tol:e} rad)"
         ));
