@@ -69,13 +69,14 @@ impl BendDesign {
 
 /// Twist of the bend direction that flips the cat by exactly pi.
 ///
-/// `no-twist`: `pi / C` (F1, exact). `universal`: F1 is only approximate (F4),
-/// so the twist is root-found on the integrated attitude; by F2 the timing is
-/// irrelevant and a unit-time cosine plan is used.
+/// `no-twist` with identical halves: `pi / C` (F1, exact). `universal` (F4)
+/// or unequal halves: F1 is only approximate, so the twist is root-found on
+/// the integrated attitude, starting from `pi / C` with the mean half; by F2
+/// the timing is irrelevant and a unit-time cosine plan is used.
 pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
     let guess = PI / c;
-    if cat.joint == Joint::NoTwist {
+    if cat.joint == Joint::NoTwist && cat.is_symmetric() {
         return Ok(guess);
     }
     let ode = OdeSettings {
@@ -101,7 +102,12 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     }
     Err(Error::Unreachable {
         reason: format!(
-            "no twist angle flips the universal-joint cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            "no twist angle flips the {} cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            if cat.is_symmetric() {
+                "universal-joint"
+            } else {
+                "unequal-halves"
+            },
             bend.to_degrees()
         ),
     })
@@ -118,9 +124,10 @@ pub struct BendEvaluation {
 /// Designs the phases at one bend.
 ///
 /// For the `no-twist` joint the unfold is the fold run backwards and rotated
-/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`) and the
-/// torque is invariant under time reversal, so the unfold reuses the fold's
-/// timing reversed (the discrete SOCP has the same symmetry, tested).
+/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`, which
+/// holds for unequal halves too, each being a cylinder about its own axis)
+/// and the torque is invariant under time reversal, so the unfold reuses the
+/// fold's timing reversed (the discrete SOCP has the same symmetry, tested).
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
     let twist = twist_for(cat, bend)?;
     let paths = Path::phased(bend, twist);

@@ -214,7 +214,7 @@ pub struct Controller {
 impl Controller {
     /// Gains from the config: natural frequency `2 pi f` about `M(0) = I_t / 2`.
     pub fn from_config(cfg: &Config) -> Controller {
-        let m0 = cfg.cat().i_t() / 2.0;
+        let m0 = cfg.cat().straight_inertia();
         let wn = 2.0 * std::f64::consts::PI * cfg.simulate.pd_bandwidth_hz;
         let (kp, kd) = if cfg.simulate.pd {
             (m0 * wn * wn, 2.0 * cfg.simulate.pd_damping * m0 * wn)
