@@ -497,6 +497,16 @@ impl Config {
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
     }
 
+    /// The joint's motors as the limits describe them.
+    pub fn motor(&self) -> crate::model::motor::Motor {
+        crate::model::motor::Motor {
+            max_torque: self.limits.max_torque,
+            no_load_speed: self.limits.no_load_speed,
+            max_speed: self.limits.max_speed,
+            norm: self.norm(),
+        }
+    }
+
     /// Largest bend the optimisers may use, rad.
     pub fn max_bend(&self) -> f64 {
         self.limits.max_bend_deg.unwrap_or(175.0).to_radians()

@@ -19,6 +19,7 @@
 
 pub mod body;
 pub mod dynamics;
+pub mod motor;
 pub mod small;
 pub mod so3;
 
