@@ -10,6 +10,7 @@
 
 use crate::config::Config;
 use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::design::bend_search::{Scored, scan_then_golden};
 use crate::design::conic::SolveStatus;
 use crate::design::path::{Path, PhasedPlan, Timing};
 use crate::design::timing::{PhaseTiming, TimingProblem};
@@ -188,7 +189,14 @@ pub struct PhasedResult {
     pub sim: Option<SimReport>,
 }
 
-/// Bend search: scan, then golden section in the best bracket.
+impl Scored for BendDesign {
+    fn score(&self) -> f64 {
+        self.unit_peak()
+    }
+}
+
+/// Bend search: scan (with the one-turn and the config's bend), then golden
+/// section in the best bracket.
 pub fn search_bend(
     cfg: &Config,
     problem: &mut TimingProblem,
@@ -231,45 +239,8 @@ pub fn search_bend(
             xs.push(b);
         }
     }
-    xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    let mut designs = Vec::new();
-    for &x in &xs {
-        designs.push(eval(x, &mut evals)?);
-    }
-    let best = (0..xs.len())
-        .min_by(|&i, &j| {
-            designs[i]
-                .unit_peak()
-                .partial_cmp(&designs[j].unit_peak())
-                .unwrap()
-        })
-        .unwrap();
-    let (mut a, mut b) = (xs[best.saturating_sub(1)], xs[(best + 1).min(xs.len() - 1)]);
-    let mut best_d = designs.swap_remove(best);
-    let g = (5f64.sqrt() - 1.0) / 2.0;
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    let mut x1 = b - g * (b - a);
-    let mut x2 = a + g * (b - a);
-    let mut d1 = eval(x1, &mut evals)?;
-    let mut d2 = eval(x2, &mut evals)?;
-    while b - a > tol {
-        if d1.unit_peak() <= d2.unit_peak() {
-            b = x2;
-            (x2, d2) = (x1, d1);
-            x1 = b - g * (b - a);
-            d1 = eval(x1, &mut evals)?;
-        } else {
-            a = x1;
-            (x1, d1) = (x2, d2);
-            x2 = a + g * (b - a);
-            d2 = eval(x2, &mut evals)?;
-        }
-    }
-    for d in [d1, d2] {
-        if d.unit_peak() < best_d.unit_peak() {
-            best_d = d;
-        }
-    }
+    let best_d = scan_then_golden(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
 }
 
