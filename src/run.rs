@@ -6,6 +6,7 @@ use crate::design::analytic::ClosedForms;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
+use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
 use crate::verify::analyze::analyze;
@@ -81,6 +82,11 @@ pub struct MethodNumbers {
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
+    /// Largest joint speed of the written schedule, rad/s (motor norm).
+    pub max_speed_rad_s: f64,
+    /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
+    /// the envelope, negative violated; absent without limits).
+    pub min_envelope_margin: Option<f64>,
     pub solve_time_s: f64,
     pub schedule_csv: String,
     pub schedule_json: String,
@@ -155,6 +161,13 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
             n.peak_torque_nm
         ));
     }
+    if let Some(m) = n.min_envelope_margin
+        && m < -1e-6
+    {
+        why.push(format!(
+            "leaves the motor envelope (smallest margin {m:.3}; limits.max_torque, limits.no_load_speed, limits.max_speed)"
+        ));
+    }
     if let Some(b) = cfg.limits.max_bend_deg
         && n.bend_deg > b * (1.0 + 1e-6)
     {
@@ -175,6 +188,7 @@ fn summarize(
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: std::result::Result<&SimReport, &Error>,
+    motor: MotorUse,
     solve_time_s: f64,
 ) -> MethodSummary {
     let (bend, twist, durations) = path_numbers;
@@ -198,6 +212,8 @@ fn summarize(
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
+        max_speed_rad_s: motor.max_speed_rad_s,
+        min_envelope_margin: motor.min_margin,
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
@@ -258,6 +274,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let cat = cfg.cat();
     let per = cfg.simulate.samples_per_phase;
     let mut output = Output::default();
+    let motor = cfg.motor();
+    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
     let mut methods = Vec::new();
     let mut traces = Vec::new();
     let stage_end = |progress: &mut dyn FnMut(Progress), clock: Instant, err: Option<&Error>| {
@@ -286,7 +304,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let a_time = clock.elapsed().as_secs_f64();
     match &analytic {
         Ok((a, a_sim)) => {
-            Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "analytic");
+            let a_sched = Schedule::sample(&cat, &a.plan, per);
+            a_sched.add_to(&mut output, "analytic");
             methods.push(summarize(
                 cfg,
                 "analytic",
@@ -298,6 +317,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                     a.closed.phase_durations_s,
                 ),
                 a_sim.as_ref(),
+                usage(&a_sched),
                 a_time,
             ));
             let failed_sim = SimReport::failed();
@@ -325,7 +345,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     });
     match &phased {
         Ok(ph) => {
-            Schedule::sample(&cat, &ph.plan, per).add_to(&mut output, "phased");
+            let ph_sched = Schedule::sample(&cat, &ph.plan, per);
+            ph_sched.add_to(&mut output, "phased");
             let ph_sim = ph
                 .sim
                 .as_ref()
@@ -337,6 +358,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
                 Ok(ph_sim),
+                usage(&ph_sched),
                 ph.solve_time_s,
             ));
             traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
@@ -366,7 +388,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         });
     match &free {
         Ok(fr) => {
-            Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
+            let fr_sched = Schedule::sample(&cat, &fr.plan, per);
+            fr_sched.add_to(&mut output, "free");
             methods.push(summarize(
                 cfg,
                 "free",
@@ -374,6 +397,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
                 Ok(&fr.sim),
+                usage(&fr_sched),
                 fr.solve_time_s,
             ));
             traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
