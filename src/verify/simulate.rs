@@ -110,15 +110,16 @@ fn failure(
         .iter()
         .map(|p| p.tau[0].hypot(p.tau[1]))
         .fold(0.0, f64::max);
-    let bend = last.map(|p| p.q[0].hypot(p.q[1])).unwrap_or(0.0);
     Error::Simulation(match status {
-        OdeStatus::Stopped => format!(
-            "the motion diverged at t = {at:.6} s: the bend reached {:.1} deg, past the {:.0} deg where the halves meet (applied torque up to {peak:.4e} N m); {cause}",
-            bend.to_degrees(),
-            MAX_BEND.to_degrees()
-        ),
-        OdeStatus::NonFinite => format!(
-            "the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); {cause}"
+        OdeStatus::Stopped
+            if last.is_some_and(|p| p.q.iter().chain(&p.tau).all(|x| x.is_finite())) =>
+        {
+            format!(
+                "the motion diverged at t = {at:.6} s: the shape left the schedule by more than a full turn (applied torque up to {peak:.4e} N m); {cause}"
+            )
+        }
+        OdeStatus::NonFinite | OdeStatus::Stopped => format!(
+            "the motion diverged: the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); {cause}"
         ),
         OdeStatus::StepBudget => format!(
             "the integrator used its {} steps per phase by t = {at:.6} s (applied torque up to {peak:.4e} N m): the motion is too fast or too rough for simulate.rtol = {:e}; a schedule with very many rows or huge torques is the usual cause, and simulate.rtol = 1e-8 may help",
@@ -128,8 +129,9 @@ fn failure(
     })
 }
 
-/// Largest bend the simulation follows: at pi the halves lie on each other.
-const MAX_BEND: f64 = std::f64::consts::PI;
+/// Tracking error, rad, beyond which the simulated shape has left the
+/// schedule for good: more than a full turn (a saturated motor lags by less).
+const MAX_TRACKING_ERROR: f64 = 2.0 * std::f64::consts::PI;
 
 /// Why a simulated flip misses its target (flip error or spine tilt beyond
 /// `tol`, rad), if it does; NaN counts as a miss.
@@ -200,7 +202,7 @@ impl<'a> Recorder<'a> {
     }
 
     /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from `q`, `qd`.
-    /// False when the state left the model (non-finite, or bent past pi).
+    /// False when the state is no longer finite (the motion diverged).
     fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) -> bool {
         self.steps += 1;
         let qa = quat_from(quat);
@@ -217,13 +219,11 @@ impl<'a> Recorder<'a> {
             q,
             tau,
         });
-        let finite = quat
-            .iter()
+        quat.iter()
             .chain(&q)
             .chain(&qd)
             .chain(&tau)
-            .all(|x| x.is_finite());
-        finite && q[0].hypot(q[1]) < MAX_BEND
+            .all(|x| x.is_finite())
     }
 
     fn finish(
@@ -368,8 +368,10 @@ pub fn dynamic(
             let (tau, qref) = applied(i, t, y);
             let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
             peak = peak.max(ctrl.motor.norm.of(tau));
-            track = track.max((q[0] - qref[0]).hypot(q[1] - qref[1]));
-            rec.record(t, y, q, qd, tau)
+            let off = (q[0] - qref[0]).hypot(q[1] - qref[1]);
+            track = track.max(off);
+            // a shape a full turn away from the plan has left the schedule
+            rec.record(t, y, q, qd, tau) && off <= MAX_TRACKING_ERROR
         },
     );
     let mut r = rec.finish(&y, status, ode, ctrl.motor.max_torque)?;
