@@ -128,6 +128,13 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
         let ph = crate::design::phased::optimize(&cfg, |_| {});
         match &ph {
             Ok(ph) if methods.phased => {
+                errors.extend(flagged(
+                    "phased",
+                    &format!("{:?}", ph.status),
+                    ph.flip_error_rad,
+                    ph.tilt_deg,
+                    &cfg,
+                ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
                 p.least_height_phased_m =
@@ -156,6 +163,13 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
             };
             match fr {
                 Ok(fr) => {
+                    errors.extend(flagged(
+                        "free",
+                        &format!("{:?}", fr.status),
+                        fr.flip_error_rad,
+                        fr.tilt_deg,
+                        &cfg,
+                    ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m =
@@ -169,6 +183,27 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
         p.error = Some(errors.join("; "));
     }
     Ok(p)
+}
+
+/// A kept design that misses a target (unconverged, flip missed) is named in
+/// the point's `error` column beside its numbers.
+fn flagged(
+    method: &str,
+    status: &str,
+    flip_error: f64,
+    tilt_deg: f64,
+    cfg: &Config,
+) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "Solved" | "Converged") {
+        why.push(format!("solver status {}", status.to_lowercase()));
+    }
+    why.extend(crate::verify::simulate::misses_flip(
+        flip_error,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
 /// Runs a sweep on the config at `path` (with `overrides`), `threads` points at a time.

@@ -636,3 +636,36 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
         "{err}"
     );
 }
+
+#[test]
+fn a_sweep_keeps_every_method_and_flags_an_unconverged_one_per_point() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, out, err) = run(
+        &[
+            "sweep",
+            seed().to_str().unwrap(),
+            "--set-range",
+            "fall.height=5:10:2",
+            "--set",
+            "free.max_iterations=2",
+            "--methods",
+            "phased,free",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(3), "{err}");
+    let pts: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
+    for p in &pts {
+        let e = p["error"].as_str().unwrap();
+        assert!(
+            e.contains("free FLAGGED") && e.contains("iterationlimit"),
+            "{e}"
+        );
+        assert!(!e.contains("phased"), "the phased design converged: {e}");
+        assert!(p["free_peak_nm"].is_f64() && p["phased_peak_nm"].is_f64());
+    }
+    // F3: the same path in half the time squared: peak times 2 from 10 m to 5 m
+    let ph = |i: usize| pts[i]["phased_peak_nm"].as_f64().unwrap();
+    assert!((ph(0) / ph(1) - 2.0).abs() < 1e-4, "{} {}", ph(0), ph(1));
+}
