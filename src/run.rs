@@ -161,8 +161,10 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
             n.peak_torque_nm
         ));
     }
+    // the envelope also holds the speed limits; a torque already named is not repeated
     if let Some(m) = n.min_envelope_margin
         && m < -1e-6
+        && !why.iter().any(|w| w.contains("limits.max_torque"))
     {
         why.push(format!(
             "leaves the motor envelope (smallest margin {m:.3}; limits.max_torque, limits.no_load_speed, limits.max_speed)"
@@ -370,7 +372,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     progress(Progress::Stage {
         index: 3,
         total,
-        name: "free-form optimiser (collocation + SCP, seeded by the phased design)",
+        name: "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
     });
     let clock = Instant::now();
     // seeded by the phased design, or by the analytic plan when that failed

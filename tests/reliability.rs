@@ -125,7 +125,7 @@ fn row12_sigkill_at_random_moments_never_leaves_a_partial_set() {
     for i in 0..16 {
         let theta = if i % 2 == 0 { 45.0 } else { 60.0 };
         let mut child = analyze_cmd(dir.path(), theta).spawn().unwrap();
-        std::thread::sleep(Duration::from_millis(rng.below(250)));
+        std::thread::sleep(Duration::from_millis(rng.below(60)));
         let _ = child.kill(); // SIGKILL
         let status = child.wait().unwrap();
         // the published set, if any, is complete and from one run
