@@ -155,7 +155,7 @@ impl Cols {
     /// `beta` at point `j`: exact for the piecewise-quadratic `beta`.
     fn beta_at(&self, p: usize, j: usize) -> Expr {
         let i = j / 2;
-        if j % 2 == 0 {
+        if j.is_multiple_of(2) {
             vec![(self.beta(p, i), 1.0)]
         } else {
             let ds = self.ds();
@@ -168,7 +168,7 @@ impl Cols {
     }
     fn a_at(&self, p: usize, j: usize) -> Expr {
         let i = j / 2;
-        if j % 2 == 0 {
+        if j.is_multiple_of(2) {
             vec![(self.a(p, i), 1.0)]
         } else {
             vec![(self.a(p, i), 0.5), (self.a(p, i + 1), 0.5)]
