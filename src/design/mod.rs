@@ -8,6 +8,7 @@ pub mod collocation;
 pub mod conic;
 pub mod envelope;
 pub mod free;
+pub mod least_height;
 pub mod objective;
 pub mod path;
 pub mod phased;
