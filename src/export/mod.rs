@@ -53,9 +53,9 @@ pub(crate) fn torque_limit(cfg: &Config) -> Option<f64> {
     cfg.limits.max_torque
 }
 
-/// Numbers in model files: enough digits to round-trip the model.
+/// Numbers in model files: the shortest text that reads back to the same f64.
 pub(crate) fn f(x: f64) -> String {
-    format!("{x:.12}")
+    format!("{x}")
 }
 
 /// Everything `catflip run` writes for the simulators: both models and, per

@@ -5,11 +5,14 @@ use super::{Half, f, halves, torque_limit};
 use crate::config::Config;
 use crate::model::Joint;
 
-/// Mass of the universal joint's massless `cross` link as a fraction of a
-/// half's mass (its inertia scales likewise): simulators refuse or replace a
-/// moving link without mass. 1e-6 changes the seed's and the robot's flip by
-/// under 1e-4 deg (measured by replaying in MuJoCo, see the README).
-pub const CROSS_MASS_FRACTION: f64 = 1e-6;
+/// Mass and inertia of the universal joint's `cross` link (massless in the
+/// model) as fractions of a half's mass and axial inertia: simulators refuse
+/// (MuJoCo) or replace with 1 kg (pyBullet) a moving link without mass. The
+/// effect is linear in the fraction: in MuJoCo on the robot config, 1e-6 of a
+/// half's mass and transverse inertia moved the flip by 2.6e-4 deg, 1e-4 by
+/// 2.6e-2 deg; at 1e-8 of mass and axial inertia the URDF and the cross-less
+/// MJCF flip within 1e-6 deg of each other (examples/replay_mujoco.py prints it).
+pub const CROSS_FRACTION: f64 = 1e-8;
 
 /// Speed limit written for joints when the config has none, rad/s (URDF needs one).
 const NO_SPEED_LIMIT: f64 = 1e3;
@@ -63,13 +66,10 @@ pub fn urdf(cfg: &Config) -> String {
     s.push_str(&link("rear", &rear, 0.0));
     match cfg.cat.joint {
         Joint::Universal => {
-            let (m, it) = (
-                CROSS_MASS_FRACTION * rear.mass,
-                CROSS_MASS_FRACTION * rear.i_t,
-            );
+            let (m, i) = (CROSS_FRACTION * rear.mass, CROSS_FRACTION * rear.i_a);
             s.push_str(&format!(
-                "  <!-- the universal joint's cross: massless in the model; a negligible mass ({CROSS_MASS_FRACTION:e} of a half)\n       because simulators need every moving link massive -->\n  <link name=\"cross\">\n{}  </link>\n",
-                inertial(m, it, it, 0.0)
+                "  <!-- the universal joint's cross: massless in the model; a negligible mass and inertia ({CROSS_FRACTION:e}\n       of a half's mass and axial inertia) because simulators need every moving link massive -->\n  <link name=\"cross\">\n{}  </link>\n",
+                inertial(m, i, i, 0.0)
             ));
             s.push_str(&revolute(
                 "motor1",
@@ -83,12 +83,14 @@ pub fn urdf(cfg: &Config) -> String {
         }
         Joint::NoTwist => {
             s.push_str(&format!(
-                "  <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)). type=\"spherical\" is a\n       pyBullet extension (3 DoF, torque in the front link's frame, see *.pybullet.csv) -->\n  <joint name=\"spine\" type=\"spherical\">\n    <parent link=\"rear\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"0 0 {}\"/>\n  </joint>\n",
+                "  <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)). type=\"spherical\" is a\n       pyBullet extension (3 DoF, torque in the front link's frame, see *.pybullet.csv) -->\n  <joint name=\"spine\" type=\"spherical\">\n    <parent link=\"rear\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"0 0 {}\"/>\n    <axis xyz=\"0 0 1\"/>\n  </joint>\n",
                 f(rear.length / 2.0)
             ));
         }
     }
     s.push_str(&link("front", &front, front.length / 2.0));
+    // MuJoCo reads this (pyBullet ignores it): keep the root link as a body of its own.
+    s.push_str("  <mujoco><compiler fusestatic=\"false\" discardvisual=\"true\"/></mujoco>\n");
     s.push_str("</robot>\n");
     s
 }
