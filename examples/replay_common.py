@@ -28,6 +28,7 @@ def read_controls(path):
     pick = lambda prefix: data[:, [i for i, c in enumerate(cols) if c.startswith(prefix)]]
     limit = None if meta["max_torque_nm"] == "none" else float(meta["max_torque_nm"])
     return {
+        "slope": float(meta.get("motor_slope_nm_s", "0")),
         "dt": float(meta["dt_s"]),
         "steps": int(meta["steps"]),
         "kp": float(meta["pd_kp"]),
@@ -112,17 +113,23 @@ class FlipTracker:
         return self.acc
 
 
-def limit_catflip_torque(tau_v, limit, norm):
-    """catflip's saturation of its two joint torques (src/verify/simulate.rs Controller)."""
+def limit_catflip_torque(tau_v, qd, c):
+    """catflip's motor envelope on its two joint torques at joint speed `qd`
+    (src/model/motor.rs Motor::clip): |tau + k qd| <= T per motor, or the disc
+    of radius T about -k qd for the Euclidean norm."""
+    limit, k = c["limit"], c["slope"]
     if limit is None:
         return tau_v
     tau_v = np.array(tau_v, float)
-    if norm == "per-motor":
-        tau_v[:2] = np.clip(tau_v[:2], -limit, limit)
+    centre = -k * np.asarray(qd[:2], float)
+    e = tau_v[:2] - centre
+    if c["norm"] == "per-motor":
+        e = np.clip(e, -limit, limit)
     else:
-        n = math.hypot(tau_v[0], tau_v[1])
+        n = math.hypot(e[0], e[1])
         if n > limit:
-            tau_v[:2] *= limit / n
+            e *= limit / n
+    tau_v[:2] = centre + e
     return tau_v
 
 

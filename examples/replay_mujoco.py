@@ -45,14 +45,14 @@ def replay(model, c, pd):
             tau_v = jr.T @ ff[k]
             if pd:
                 tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
-            tau_v = limit_catflip_torque(tau_v, c["limit"], c["norm"])
+            tau_v = limit_catflip_torque(tau_v, vd, c)
             data.ctrl[:] = np.linalg.solve(jr.T, tau_v)
         else:
             q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
             tau_v = ff[k].copy()
             if pd:
                 tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
-            tau_v = limit_catflip_torque(tau_v, c["limit"], c["norm"])
+            tau_v = limit_catflip_torque(tau_v, qd, c)
             data.ctrl[:] = tau_v
         peak = max(peak, peak_of(tau_v, c["norm"]))
         mujoco.mj_step(model, data)

@@ -79,7 +79,7 @@ def replay(urdf, c, pd, substeps=1):
                 tau_v = jr.T @ ff[k]
                 if pd:
                     tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
-                tau_v = limit_catflip_torque(tau_v, c["limit"], c["norm"])
+                tau_v = limit_catflip_torque(tau_v, vd, c)
                 u = np.linalg.solve(jr.T, tau_v)
             else:
                 st = p.getJointStates(body, joints, physicsClientId=cid)
@@ -88,7 +88,7 @@ def replay(urdf, c, pd, substeps=1):
                 tau_v = ff[k].copy()
                 if pd:
                     tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
-                tau_v = limit_catflip_torque(tau_v, c["limit"], c["norm"])
+                tau_v = limit_catflip_torque(tau_v, qd, c)
                 u = tau_v
             peak = max(peak, peak_of(tau_v, c["norm"]))
             for _ in range(substeps):

@@ -6,6 +6,7 @@ use crate::design::analytic::ClosedForms;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::Result;
+use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
 use crate::verify::analyze::{analyze, peak_along};
@@ -50,6 +51,11 @@ pub struct MethodSummary {
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
+    /// Largest joint speed of the written schedule, rad/s (motor norm).
+    pub max_speed_rad_s: f64,
+    /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
+    /// the envelope, negative violated; absent without limits).
+    pub min_envelope_margin: Option<f64>,
     pub solve_time_s: f64,
     pub schedule_csv: String,
     pub schedule_json: String,
@@ -85,6 +91,7 @@ fn summarize(
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: &SimReport,
+    motor: MotorUse,
     solve_time_s: f64,
 ) -> MethodSummary {
     let (bend, twist, durations) = path_numbers;
@@ -102,6 +109,8 @@ fn summarize(
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
+        max_speed_rad_s: motor.max_speed_rad_s,
+        min_envelope_margin: motor.min_margin,
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
@@ -155,7 +164,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let a = analyze(cfg)?;
     let a_sim = dynamic_cfg(cfg, &a.plan)?;
     let a_time = clock.elapsed().as_secs_f64();
-    Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "analytic");
+    let motor = cfg.motor();
+    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
+    let a_sched = Schedule::sample(&cat, &a.plan, per);
+    a_sched.add_to(&mut output, "analytic");
     progress(Progress::StageDone { seconds: a_time });
 
     progress(Progress::Stage {
@@ -173,7 +185,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             peak_nm: e.peak_nm,
         });
     })?;
-    Schedule::sample(&cat, &ph.plan, per).add_to(&mut output, "phased");
+    let ph_sched = Schedule::sample(&cat, &ph.plan, per);
+    ph_sched.add_to(&mut output, "phased");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });
@@ -187,7 +200,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let fr = crate::design::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
         progress(Progress::Scp(it))
     })?;
-    Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
+    let fr_sched = Schedule::sample(&cat, &fr.plan, per);
+    fr_sched.add_to(&mut output, "free");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });
@@ -215,6 +229,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 a.closed.phase_durations_s,
             ),
             &a_sim,
+            usage(&a_sched),
             a_time,
         ),
         summarize(
@@ -223,6 +238,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             ph.peak_torque_nm,
             (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
             ph_sim,
+            usage(&ph_sched),
             ph.solve_time_s,
         ),
         summarize(
@@ -231,13 +247,18 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             fr.peak_torque_nm,
             (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
             fr_sim,
+            usage(&fr_sched),
             fr.solve_time_s,
         ),
     ];
     crate::export::add_simulator_files(
         cfg,
         &mut output,
-        &[("analytic", &a.plan), ("phased", &ph.plan), ("free", &fr.plan)],
+        &[
+            ("analytic", &a.plan),
+            ("phased", &ph.plan),
+            ("free", &fr.plan),
+        ],
     );
     let traces = vec![
         trace(cfg, "analytic", &a.plan, &a_sim, 300),

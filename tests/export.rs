@@ -31,7 +31,8 @@ fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
 }
 
 fn num(s: &str) -> f64 {
-    s.parse().unwrap_or_else(|_| panic!("`{s}` is not a number"))
+    s.parse()
+        .unwrap_or_else(|_| panic!("`{s}` is not a number"))
 }
 
 fn close(s: &str, want: f64) -> bool {
@@ -39,7 +40,13 @@ fn close(s: &str, want: f64) -> bool {
 }
 
 /// Header keys and numeric rows of a controls CSV.
-fn read_controls(text: &str) -> (std::collections::HashMap<String, String>, Vec<String>, Vec<Vec<f64>>) {
+fn read_controls(
+    text: &str,
+) -> (
+    std::collections::HashMap<String, String>,
+    Vec<String>,
+    Vec<Vec<f64>>,
+) {
     let mut meta = std::collections::HashMap::new();
     let mut cols = Vec::new();
     let mut rows = Vec::new();
@@ -59,9 +66,24 @@ fn read_controls(text: &str) -> (std::collections::HashMap<String, String>, Vec<
 
 #[test]
 fn models_carry_the_masses_inertias_limits_and_actuators() {
-    for name in ["seed", "robot-universal"] {
-        let cfg = config(name, &[]);
+    let unequal = [
+        "cat.front.mass=0.4",
+        "cat.front.length=0.15",
+        "cat.front.radius=0.02",
+    ];
+    for (name, set) in [
+        ("seed", &[][..]),
+        ("robot-universal", &[][..]),
+        ("robot-universal", &unequal[..]),
+        ("seed", &unequal[..2]),
+    ] {
+        let cfg = config(name, set);
         let cat = cfg.cat();
+        let half = |link: &str| match link {
+            "rear" => cat.rear,
+            "front" => cat.front,
+            other => panic!("unexpected link {other}"),
+        };
         let limit = cfg.limits.max_torque;
 
         let urdf = catflip::export::urdf(&cfg);
@@ -73,21 +95,34 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
                 .descendants()
                 .find(|n| n.has_tag_name("mass"))
                 .unwrap_or_else(|| panic!("{name}: link {lname} has no mass"));
-            let inertia = link.descendants().find(|n| n.has_tag_name("inertia")).unwrap();
+            let inertia = link
+                .descendants()
+                .find(|n| n.has_tag_name("inertia"))
+                .unwrap();
             if lname == "cross" {
                 // massive (simulators need it) but negligible
                 let m = num(mass.attribute("value").unwrap());
-                assert!(m > 0.0 && m < 1e-6 * cat.mass, "{m}");
+                assert!(m > 0.0 && m < 1e-6 * cat.rear.mass, "{m}");
                 let i = num(inertia.attribute("ixx").unwrap());
-                assert!(i > 1e-15 && i < 1e-6 * cat.i_a(), "{i}");
+                assert!(i > 1e-15 && i < 1e-6 * cat.rear.i_a(), "{i}");
             } else {
-                assert!(close(mass.attribute("value").unwrap(), cat.mass));
-                assert!(close(inertia.attribute("ixx").unwrap(), cat.i_t()));
-                assert!(close(inertia.attribute("iyy").unwrap(), cat.i_t()));
-                assert!(close(inertia.attribute("izz").unwrap(), cat.i_a()));
+                let h = half(lname);
+                assert!(close(mass.attribute("value").unwrap(), h.mass));
+                assert!(close(inertia.attribute("ixx").unwrap(), h.i_t()));
+                assert!(close(inertia.attribute("iyy").unwrap(), h.i_t()));
+                assert!(close(inertia.attribute("izz").unwrap(), h.i_a()));
+                let cyl = link
+                    .descendants()
+                    .find(|n| n.has_tag_name("cylinder"))
+                    .unwrap();
+                assert!(close(cyl.attribute("length").unwrap(), h.length));
+                assert!(close(cyl.attribute("radius").unwrap(), h.radius));
             }
         }
-        let joints: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("joint")).collect();
+        let joints: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("joint"))
+            .collect();
         match cat.joint {
             Joint::Universal => {
                 assert_eq!(joints.len(), 2);
@@ -104,25 +139,63 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
 
         let mjcf = catflip::export::mjcf(&cfg);
         let doc = roxmltree::Document::parse(&mjcf).unwrap();
-        let inertials: Vec<_> = doc
+        let bodies: Vec<_> = doc
             .descendants()
-            .filter(|n| n.has_tag_name("inertial"))
+            .filter(|n| n.has_tag_name("body"))
             .collect();
-        assert_eq!(inertials.len(), 2);
-        for n in inertials {
-            assert!(close(n.attribute("mass").unwrap(), cat.mass));
+        assert_eq!(bodies.len(), 2);
+        for b in bodies {
+            let h = half(b.attribute("name").unwrap());
+            let n = b.children().find(|n| n.has_tag_name("inertial")).unwrap();
+            assert!(close(n.attribute("mass").unwrap(), h.mass));
             let d: Vec<&str> = n.attribute("diaginertia").unwrap().split(' ').collect();
-            assert!(close(d[0], cat.i_t()) && close(d[1], cat.i_t()) && close(d[2], cat.i_a()));
+            assert!(close(d[0], h.i_t()) && close(d[1], h.i_t()) && close(d[2], h.i_a()));
+            // centre of mass l/2 along the half's own axis (the rear's at its origin)
+            let z = n
+                .attribute("pos")
+                .unwrap()
+                .split(' ')
+                .nth(2)
+                .map(num)
+                .unwrap();
+            let want = if b.attribute("name") == Some("rear") {
+                0.0
+            } else {
+                h.length / 2.0
+            };
+            assert!((z - want).abs() < 1e-12);
         }
+        // the joint sits at the rear's end face
+        let front = doc
+            .descendants()
+            .find(|n| n.attribute("name") == Some("front"))
+            .unwrap();
+        let jz = front
+            .attribute("pos")
+            .unwrap()
+            .split(' ')
+            .nth(2)
+            .map(num)
+            .unwrap();
+        assert!((jz - cat.rear.length / 2.0).abs() < 1e-12);
         // the model's step is the controls' step
-        let opt = doc.descendants().find(|n| n.has_tag_name("option")).unwrap();
+        let opt = doc
+            .descendants()
+            .find(|n| n.has_tag_name("option"))
+            .unwrap();
         let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
         assert!(close(opt.attribute("timestep").unwrap(), dt));
-        let motors: Vec<_> = doc.descendants().filter(|n| n.has_tag_name("motor")).collect();
+        let motors: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("motor"))
+            .collect();
         match cat.joint {
             // a ball has three degrees of freedom: one motor about each child axis
             Joint::NoTwist => {
-                let gears: Vec<_> = motors.iter().map(|m| m.attribute("gear").unwrap()).collect();
+                let gears: Vec<_> = motors
+                    .iter()
+                    .map(|m| m.attribute("gear").unwrap())
+                    .collect();
                 assert_eq!(gears, ["1 0 0", "0 1 0", "0 0 1"]);
             }
             Joint::Universal => assert_eq!(motors.len(), 2),
@@ -180,7 +253,8 @@ fn held_torques_carry_the_schedules_impulse() {
             .map(|w| 0.5 * (w[0].tau[j] + w[1].tau[j]) * (w[1].t - w[0].t))
             .sum();
         assert!(
-            (held - exact).abs() < 1e-12 * s.rows.iter().map(|r| r.tau[j].abs()).fold(0.0, f64::max),
+            (held - exact).abs()
+                < 1e-12 * s.rows.iter().map(|r| r.tau[j].abs()).fold(0.0, f64::max),
             "motor {j}: {held} vs {exact}"
         );
     }
@@ -217,7 +291,11 @@ fn ball_controls_are_quaternions_and_child_frame_rates() {
             worst = worst.max((fd - mean).abs());
         }
     }
-    let scale = mj.rows.iter().flat_map(|r| r.vel.iter()).fold(0.0f64, |m, x| m.max(x.abs()));
+    let scale = mj
+        .rows
+        .iter()
+        .flat_map(|r| r.vel.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
     assert!(worst < 1e-4 * scale, "{worst} vs {scale}");
     // the ball's twist rate is not zero: the third motor is needed
     assert!(mj.rows.iter().any(|r| r.vel[2].abs() > 1e-3 * scale));
@@ -226,7 +304,15 @@ fn ball_controls_are_quaternions_and_child_frame_rates() {
     let pb = Controls::sample(&cfg, &plan, Simulator::Pybullet);
     let (k, r) = (n / 2, &pb.rows[pb.rows.len() / 2]);
     if (pb.dt - mj.dt).abs() < 1e-15 {
-        assert_eq!(r.pos, [mj.rows[k].pos[1], mj.rows[k].pos[2], mj.rows[k].pos[3], mj.rows[k].pos[0]]);
+        assert_eq!(
+            r.pos,
+            [
+                mj.rows[k].pos[1],
+                mj.rows[k].pos[2],
+                mj.rows[k].pos[3],
+                mj.rows[k].pos[0]
+            ]
+        );
     }
     let norm = r.pos.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!((norm - 1.0).abs() < 1e-14 && r.pos[3] > 0.0);
@@ -244,7 +330,13 @@ fn export_with_a_bad_schedule_fails_and_writes_nothing() {
             dir.path(),
         );
         assert!(!ok, "{sched} should fail");
-        assert!(err.contains("broken.csv") || err.contains("missing.csv"), "{err}");
-        assert!(!dir.path().join("output").exists(), "{sched}: wrote something");
+        assert!(
+            err.contains("broken.csv") || err.contains("missing.csv"),
+            "{err}"
+        );
+        assert!(
+            !dir.path().join("output").exists(),
+            "{sched}: wrote something"
+        );
     }
 }

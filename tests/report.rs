@@ -99,7 +99,10 @@ fn run_writes_a_complete_consistent_report() {
         let flip = m["flip_deg"].as_f64().unwrap();
         assert!((flip + 180.0).abs() < 1e-3, "{name}: flip {flip}");
         for sim in ["mujoco", "pybullet"] {
-            assert!(base.join(format!("{name}.{sim}.csv")).exists(), "{name} {sim}");
+            assert!(
+                base.join(format!("{name}.{sim}.csv")).exists(),
+                "{name} {sim}"
+            );
         }
     }
     assert!(base.join("seed.mjcf.xml").exists() && base.join("seed.urdf").exists());
@@ -202,4 +205,3 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         assert!(!ok && !err.is_empty(), "{bad} should fail");
     }
 }
-

@@ -246,7 +246,8 @@ impl Controls {
     }
 
     /// CSV with a `#` header that states the time step, the hold, the PD gains
-    /// and the torque limit catflip's own simulation uses.
+    /// and the motor envelope catflip's own simulation clips to
+    /// (`|tau + k qd| <= T` per motor or as a disc, `k` = `motor_slope_nm_s`).
     pub fn to_csv(&self, cfg: &Config, method: &str) -> String {
         let ctrl = crate::verify::simulate::Controller::from_config(cfg);
         let n = self.rows.len() - 1;
@@ -257,7 +258,7 @@ impl Controls {
              # to be held for the step (zero-order hold, exact impulse). The last row is the final\n\
              # planned state (torque 0). Units: s, rad, rad/s, N m.\n{joint_note}\
              # dt_s = {dt:.15e}\n# steps = {n}\n# pd_kp = {kp:.15e}\n# pd_kd = {kd:.15e}\n\
-             # max_torque_nm = {lim}\n# peak_norm = {norm}\n{cols}\n",
+             # max_torque_nm = {lim}\n# motor_slope_nm_s = {slope:.15e}\n# peak_norm = {norm}\n{cols}\n",
             sim = self.simulator.name(),
             name = cfg.name,
             joint = self.joint.name(),
@@ -265,16 +266,19 @@ impl Controls {
                 Joint::NoTwist =>
                     "# Ball joint: quaternion of the front half relative to the rear, velocity and torque\n\
                      # in the front half's frame; torque = J_r(v)^-T (tau1, tau2, tau3), tau3 holding the twist.\n",
-                Joint::Universal => "# Hinges motor1 (rear x) and motor2 (rotated y): catflip's q, q_dot, tau.\n",
+                Joint::Universal =>
+                    "# Hinges motor1 (rear x) and motor2 (rotated y): catflip's q, q_dot, tau.\n",
             },
             dt = self.dt,
             kp = ctrl.kp,
             kd = ctrl.kd,
             lim = ctrl
-                .limit
+                .motor
+                .max_torque
                 .map(|l| format!("{l}"))
                 .unwrap_or_else(|| "none".into()),
-            norm = match ctrl.norm {
+            slope = ctrl.motor.slope(),
+            norm = match ctrl.motor.norm {
                 crate::model::TorqueNorm::Euclidean => "euclidean",
                 crate::model::TorqueNorm::PerMotor => "per-motor",
             },
@@ -295,19 +299,33 @@ impl Controls {
 mod tests {
     use super::*;
     use crate::design::plan::Phase;
-    use crate::model::InertiaFormula;
     use crate::model::dynamics::inverse_dynamics;
     use crate::model::small::{add3, cross, mat_mul, mat_vec, scale3, transpose};
+    use crate::model::{Half, InertiaFormula};
     use num_dual::Dual2_64;
 
     fn cat(joint: Joint) -> Cat {
-        Cat {
-            mass: 1.3,
-            length: 0.8,
-            radius: 0.12,
+        Cat::symmetric(
+            Half {
+                mass: 1.3,
+                length: 0.8,
+                radius: 0.12,
+                inertia: InertiaFormula::SolidCylinder,
+            },
             joint,
+        )
+    }
+
+    /// A heavier, shorter, thicker rear half.
+    fn unequal(joint: Joint) -> Cat {
+        let mut c = cat(joint);
+        c.rear = Half {
+            mass: 2.5,
+            length: 0.6,
+            radius: 0.15,
             inertia: InertiaFormula::SolidCylinder,
-        }
+        };
+        c
     }
 
     fn state(q: [f64; 2], qd: [f64; 2], qdd: [f64; 2]) -> ShapeState {
@@ -336,23 +354,24 @@ mod tests {
         let d1 = |x: &[D; 3]| x.map(|v| v.v1);
         let d2 = |x: &[D; 3]| x.map(|v| v.v2);
         let (w, wd) = (re(&wa), d1(&wa));
-        // B's centre of mass sits at d/2 from the common one; world acceleration
-        // of an A-frame point x: w x (w x x) + wd x x + 2 w x x' + x''.
+        // B's centre of mass sits at m_A/(m_A + m_B) d from the common one; world
+        // acceleration of an A-frame point x: w x (w x x) + wd x x + 2 w x x' + x''.
+        let share = cat.rear.mass / cat.mass();
         let (x, xd, xdd) = (
-            scale3(0.5, re(&d)),
-            scale3(0.5, d1(&d)),
-            scale3(0.5, d2(&d)),
+            scale3(share, re(&d)),
+            scale3(share, d1(&d)),
+            scale3(share, d2(&d)),
         );
         let acc = add3(
             add3(cross(w, cross(w, x)), cross(wd, x)),
             add3(scale3(2.0, cross(w, xd)), xdd),
         );
-        let force = scale3(cat.mass, acc);
+        let force = scale3(cat.front.mass, acc);
         let wb = add3(w, re(&wr));
         let wbd = add3(wd, add3(cross(w, re(&wr)), d1(&wr)));
         let r = rel.map(|row| row.map(|v| v.re));
         let ib = mat_mul(
-            &mat_mul(&r, &cat.body_inertia::<f64>()),
+            &mat_mul(&r, &Cat::body_inertia::<f64>(&cat.front)),
             &transpose(&r),
         );
         // I wd + w x I w = torque + (joint - B) x F, joint - B = -s
@@ -363,26 +382,30 @@ mod tests {
 
     #[test]
     fn ball_torque_matches_newton_euler_on_the_front_half() {
-        let c = cat(Joint::NoTwist);
-        for (q, qd, qdd) in [
-            ([0.8, -0.5], [1.5, 2.2], [-3.0, 4.0]),
-            ([0.02, 0.01], [0.3, -0.7], [5.0, 1.0]),
-            ([-1.9, 1.2], [-2.5, 0.4], [0.5, -6.0]),
-        ] {
-            let tau = inverse_dynamics(&c, q, qd, qdd);
-            let lagrange = ball_torque(&c, &state(q, qd, qdd), tau);
-            let newton = joint_torque_on_front(&c, q, qd, qdd);
-            for i in 0..3 {
-                assert!(
-                    (lagrange[i] - newton[i]).abs() < 1e-10 * (1.0 + newton[i].abs()),
-                    "{q:?}: {lagrange:?} vs {newton:?}"
-                );
+        for c in [cat(Joint::NoTwist), unequal(Joint::NoTwist)] {
+            for (q, qd, qdd) in [
+                ([0.8, -0.5], [1.5, 2.2], [-3.0, 4.0]),
+                ([0.02, 0.01], [0.3, -0.7], [5.0, 1.0]),
+                ([-1.9, 1.2], [-2.5, 0.4], [0.5, -6.0]),
+            ] {
+                let tau = inverse_dynamics(&c, q, qd, qdd);
+                let lagrange = ball_torque(&c, &state(q, qd, qdd), tau);
+                let newton = joint_torque_on_front(&c, q, qd, qdd);
+                for i in 0..3 {
+                    assert!(
+                        (lagrange[i] - newton[i]).abs() < 1e-10 * (1.0 + newton[i].abs()),
+                        "{q:?}: {lagrange:?} vs {newton:?}"
+                    );
+                }
             }
         }
-        // Identical halves: the twist needs no holding torque (the swap symmetry of
-        // the halves; with unequal halves it does), yet the ball's third motor
-        // carries a real share of the bend torque through J_r^-T.
+        // Unequal halves need a torque to hold the twist at zero.
         let (q, qd, qdd) = ([0.8, -0.5], [1.5, 2.2], [-3.0, 4.0]);
+        assert!(twist_constraint_torque(&unequal(Joint::NoTwist), q, qd, qdd).abs() > 1e-3);
+        let c = cat(Joint::NoTwist);
+        // Identical halves: the twist needs no holding torque (the swap symmetry of
+        // the halves), yet the ball's third motor carries a real share of the
+        // bend torque through J_r^-T.
         assert!(twist_constraint_torque(&c, q, qd, qdd).abs() < 1e-14);
         let tb = ball_torque(&c, &state(q, qd, qdd), inverse_dynamics(&c, q, qd, qdd));
         assert!(tb[2].abs() > 0.05 * tb[0].hypot(tb[1]), "{tb:?}");
@@ -418,6 +441,7 @@ mod tests {
         // twisting the straightened halves against each other: both axial inertias
         // about their common axis, halved (reduced pair), at the straight cat
         let (m0, _) = c.ball_locked_terms::<f64>([0.0; 3]);
+        // (identical halves: the reduced pair's axial inertia, I_a / 2)
         assert!((m0[2][2] - c.i_a() / 2.0).abs() < 1e-15, "{m0:?}");
         assert!(m3[2][2] > 0.0);
     }

@@ -11,22 +11,46 @@ fn body_parts(h: &Half, z: f64) -> String {
         "      <inertial pos=\"0 0 {z}\" mass=\"{m}\" diaginertia=\"{it} {it} {ia}\"/>\n      <geom type=\"cylinder\" size=\"{r} {hl}\" pos=\"0 0 {z}\" mass=\"0\"/>\n",
         z = f(z),
         m = f(h.mass),
-        it = f(h.i_t),
-        ia = f(h.i_a),
+        it = f(h.i_t()),
+        ia = f(h.i_a()),
         r = f(h.radius),
         hl = f(h.length / 2.0),
     )
+}
+
+/// The motor envelope in words, for the model files' header comments.
+pub(crate) fn motor_note(cfg: &Config) -> String {
+    let m = cfg.motor();
+    let mut s = String::new();
+    if let Some(t) = m.max_torque {
+        s.push_str(&format!("\n     Motor: stall torque {t} N m"));
+        if m.slope() > 0.0 {
+            s.push_str(&format!(
+                ", torque-speed line |tau + {k} w| <= {t} (not expressible here: apply it to the command)",
+                k = m.slope()
+            ));
+        }
+        s.push('.');
+    }
+    if let Some(w) = super::speed_limit(cfg) {
+        s.push_str(&format!("\n     Joint speed limit {w} rad/s."));
+    }
+    s
 }
 
 /// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
 ///
 /// The time step tiles the config's manoeuvre time (at most 0.5 ms), the step
 /// of the `*.mujoco.csv` controls. The torque limit becomes `ctrlrange` and
-/// `forcerange` of every motor.
+/// `forcerange` of every motor (unless a torque-speed line makes it speed
+/// dependent, which MJCF motors cannot say; the header comment then states it).
 pub fn mjcf(cfg: &Config) -> String {
     let [rear, front] = halves(cfg);
     let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
+    // A box on the torque is exact only without a torque-speed line; with one
+    // (|tau + k w| <= T) the replay clips to the envelope itself.
     let limit = torque_limit(cfg)
+        .filter(|_| cfg.motor().slope() == 0.0)
         .map(|l| {
             format!(
                 " ctrllimited=\"true\" ctrlrange=\"{a} {b}\" forcelimited=\"true\" forcerange=\"{a} {b}\"",
@@ -52,7 +76,7 @@ pub fn mjcf(cfg: &Config) -> String {
     format!(
         r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);
      SI units, angles in rad. Time step {dt:.9e} s = the manoeuvre time / an integer, the
-     step of catflip's *.mujoco.csv controls (torque held over each step). -->
+     step of catflip's *.mujoco.csv controls (torque held over each step).{motor_note} -->
 <mujoco model="{name}">
   <option gravity="0 0 -{g}" timestep="{dt:.15e}" integrator="RK4"/>
   <worldbody>
@@ -72,6 +96,7 @@ pub fn mjcf(cfg: &Config) -> String {
         g = f(cfg.fall.gravity),
         height = f(cfg.fall.height),
         joint_z = f(rear.length / 2.0),
+        motor_note = motor_note(cfg),
         rear_parts = body_parts(&rear, 0.0),
         front_parts = body_parts(&front, front.length / 2.0),
     )

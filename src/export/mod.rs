@@ -19,38 +19,25 @@ pub use urdf::urdf;
 
 use crate::config::Config;
 use crate::design::plan::ShapePlan;
+use crate::model::Half;
 use crate::output::Output;
 
-/// One half of the cat as a rigid body: what a model file needs.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Half {
-    /// kg.
-    pub mass: f64,
-    /// m.
-    pub length: f64,
-    /// m.
-    pub radius: f64,
-    /// Transverse and axial inertia about its own centre of mass, kg m^2.
-    pub i_t: f64,
-    pub i_a: f64,
-}
-
-/// The rear (A) and front (B) halves, from the one place that knows them.
+/// The rear (A) and front (B) halves, from the one place that knows them
+/// (each half's mass, length, radius and inertia: [`Half`]).
 pub fn halves(cfg: &Config) -> [Half; 2] {
     let cat = cfg.cat();
-    let half = Half {
-        mass: cat.mass,
-        length: cat.length,
-        radius: cat.radius,
-        i_t: cat.i_t(),
-        i_a: cat.i_a(),
-    };
-    [half, half]
+    [cat.rear, cat.front]
 }
 
-/// Largest joint torque the exports allow, N m (the config's limit).
+/// Largest joint torque the exports allow, N m (the config's stall torque).
 pub(crate) fn torque_limit(cfg: &Config) -> Option<f64> {
     cfg.limits.max_torque
+}
+
+/// Joint speed limit for the model files, rad/s: the config's hard limit, else
+/// the motor's no-load speed (it cannot drive faster), else none.
+pub(crate) fn speed_limit(cfg: &Config) -> Option<f64> {
+    cfg.limits.max_speed.or(cfg.limits.no_load_speed)
 }
 
 /// Numbers in model files: the shortest text that reads back to the same f64.
@@ -67,10 +54,7 @@ pub fn add_simulator_files(cfg: &Config, out: &mut Output, methods: &[(&str, &dy
     for (name, plan) in methods {
         for sim in [controls::Simulator::Mujoco, controls::Simulator::Pybullet] {
             let c = controls::Controls::sample(cfg, *plan, sim);
-            out.add(
-                format!("{name}.{}.csv", sim.name()),
-                c.to_csv(cfg, name),
-            );
+            out.add(format!("{name}.{}.csv", sim.name()), c.to_csv(cfg, name));
         }
     }
 }

@@ -1,8 +1,9 @@
 //! The cat as a URDF for pyBullet (the seed's simulator); the universal one
 //! also loads in MuJoCo.
 
-use super::{Half, f, halves, torque_limit};
+use super::{f, halves, speed_limit, torque_limit};
 use crate::config::Config;
+use crate::model::Half;
 use crate::model::Joint;
 
 /// Mass and inertia of the universal joint's `cross` link (massless in the
@@ -16,6 +17,8 @@ pub const CROSS_FRACTION: f64 = 1e-8;
 
 /// Speed limit written for joints when the config has none, rad/s (URDF needs one).
 const NO_SPEED_LIMIT: f64 = 1e3;
+/// Effort written when the config has no torque limit, N m.
+const NO_TORQUE_LIMIT: f64 = 1e3;
 
 fn inertial(m: f64, it: f64, ia: f64, z: f64) -> String {
     format!(
@@ -36,37 +39,48 @@ fn link(name: &str, h: &Half, z: f64) -> String {
     );
     format!(
         "  <link name=\"{name}\">\n{}    <visual>{geometry}</visual>\n    <collision>{geometry}</collision>\n  </link>\n",
-        inertial(h.mass, h.i_t, h.i_a, z)
+        inertial(h.mass, h.i_t(), h.i_a(), z)
     )
 }
 
-fn revolute(name: &str, parent: &str, child: &str, z: f64, axis: &str, effort: f64) -> String {
+fn revolute(
+    name: &str,
+    parent: &str,
+    child: &str,
+    z: f64,
+    axis: &str,
+    (effort, speed): (f64, f64),
+) -> String {
     format!(
         "  <joint name=\"{name}\" type=\"revolute\">\n    <parent link=\"{parent}\"/>\n    <child link=\"{child}\"/>\n    <origin xyz=\"0 0 {z}\"/>\n    <axis xyz=\"{axis}\"/>\n    <limit lower=\"{lo}\" upper=\"{hi}\" effort=\"{effort}\" velocity=\"{v}\"/>\n  </joint>\n",
         z = f(z),
         lo = f(-std::f64::consts::PI),
         hi = f(std::f64::consts::PI),
         effort = f(effort),
-        v = f(NO_SPEED_LIMIT),
+        v = f(speed),
     )
 }
 
 /// URDF text of the cat of `cfg`.
 pub fn urdf(cfg: &Config) -> String {
     let [rear, front] = halves(cfg);
-    let effort = torque_limit(cfg).unwrap_or(1e3);
+    let limits = (
+        torque_limit(cfg).unwrap_or(NO_TORQUE_LIMIT),
+        speed_limit(cfg).unwrap_or(NO_SPEED_LIMIT),
+    );
     let mut s = format!(
-        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}). -->\n<robot name=\"{name}\">\n",
+        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}), velocity = its speed limit (else 1000).{note} -->\n<robot name=\"{name}\">\n",
         name = cfg.name,
         joint = cfg.cat.joint.name(),
         lim = torque_limit(cfg)
             .map(|l| format!("{l} N m"))
             .unwrap_or_else(|| "none: 1000 N m written".into()),
+        note = super::mjcf::motor_note(cfg),
     );
     s.push_str(&link("rear", &rear, 0.0));
     match cfg.cat.joint {
         Joint::Universal => {
-            let (m, i) = (CROSS_FRACTION * rear.mass, CROSS_FRACTION * rear.i_a);
+            let (m, i) = (CROSS_FRACTION * rear.mass, CROSS_FRACTION * rear.i_a());
             s.push_str(&format!(
                 "  <!-- the universal joint's cross: massless in the model; a negligible mass and inertia ({CROSS_FRACTION:e}\n       of a half's mass and axial inertia) because simulators need every moving link massive -->\n  <link name=\"cross\">\n{}  </link>\n",
                 inertial(m, i, i, 0.0)
@@ -77,9 +91,9 @@ pub fn urdf(cfg: &Config) -> String {
                 "cross",
                 rear.length / 2.0,
                 "1 0 0",
-                effort,
+                limits,
             ));
-            s.push_str(&revolute("motor2", "cross", "front", 0.0, "0 1 0", effort));
+            s.push_str(&revolute("motor2", "cross", "front", 0.0, "0 1 0", limits));
         }
         Joint::NoTwist => {
             s.push_str(&format!(

@@ -165,7 +165,11 @@ mod tests {
             assert!((f - a).abs() < 1e-2, "{f} {a}");
             last = f;
         }
-        assert!((last.to_degrees() + 181.146).abs() < 0.01, "{}", last.to_degrees());
+        assert!(
+            (last.to_degrees() + 181.146).abs() < 0.01,
+            "{}",
+            last.to_degrees()
+        );
         // the wrapped value alone would read +178.85 deg
         let (w, _) = flip_and_tilt(&UnitQuaternion::from_axis_angle(&Vector3::z_axis(), end));
         assert!(w > 0.0);
