@@ -64,12 +64,15 @@ fn revolute(
 /// URDF text of the cat of `cfg`.
 pub fn urdf(cfg: &Config) -> String {
     let [rear, front] = halves(cfg);
+    // URDF's effort is one bound on |tau|: the stall torque, or with a
+    // torque-speed line the most the envelope allows (braking at the speed limit).
+    let speed = speed_limit(cfg).unwrap_or(NO_SPEED_LIMIT);
     let limits = (
-        torque_limit(cfg).unwrap_or(NO_TORQUE_LIMIT),
-        speed_limit(cfg).unwrap_or(NO_SPEED_LIMIT),
+        torque_limit(cfg).map_or(NO_TORQUE_LIMIT, |t| t + cfg.motor().slope() * speed),
+        speed,
     );
     let mut s = format!(
-        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}), velocity = its speed limit (else 1000).{note} -->\n<robot name=\"{name}\">\n",
+        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}; with a torque-speed line, the most\n     it allows, when braking at the speed limit), velocity = its speed limit (else 1000).{note} -->\n<robot name=\"{name}\">\n",
         name = cfg.name,
         joint = cfg.cat.joint.name(),
         lim = torque_limit(cfg)
