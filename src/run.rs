@@ -251,6 +251,15 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             fr.solve_time_s,
         ),
     ];
+    crate::export::add_simulator_files(
+        cfg,
+        &mut output,
+        &[
+            ("analytic", &a.plan),
+            ("phased", &ph.plan),
+            ("free", &fr.plan),
+        ],
+    );
     let traces = vec![
         trace(cfg, "analytic", &a.plan, &a_sim, 300),
         trace(cfg, "phased", &ph.plan, ph_sim, 300),
