@@ -22,6 +22,8 @@ pub struct Config {
     #[serde(default)]
     pub limits: LimitsConfig,
     #[serde(default)]
+    pub design: DesignConfig,
+    #[serde(default)]
     pub simulate: SimulateConfig,
     #[serde(default)]
     pub phased: PhasedConfig,
@@ -114,6 +116,15 @@ impl Default for AnalyticConfig {
             seed_inertia: false,
         }
     }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct DesignConfig {
+    /// What the optimisers minimise: `peak-torque` (default), `time` (the
+    /// shortest manoeuvre inside the motor envelope, hence the least drop
+    /// height) or `energy` (`integral |tau|^2 dt` inside the envelope).
+    pub objective: crate::design::objective::Objective,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -282,26 +293,11 @@ impl Config {
     /// A complete valid config (the seed's cat), the base on which each
     /// `--set` is checked alone.
     fn template() -> Config {
-        Config {
-            name: "template".into(),
-            cat: CatConfig {
-                mass: 1.0,
-                length: 1.0,
-                radius: 0.1,
-                joint: Joint::NoTwist,
-                front: None,
-            },
-            fall: FallConfig {
-                height: 10.0,
-                gravity: default_gravity(),
-                margin: 0.0,
-            },
-            analytic: AnalyticConfig::default(),
-            limits: LimitsConfig::default(),
-            simulate: SimulateConfig::default(),
-            phased: PhasedConfig::default(),
-            free: FreeConfig::default(),
-        }
+        // parsed rather than built, so that sections added later come with their defaults
+        toml::from_str(
+            "name = \"template\"\n[cat]\nmass = 1.0\nlength = 1.0\nradius = 0.1\n[fall]\nheight = 10.0\n",
+        )
+        .expect("the template config parses")
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -563,6 +559,15 @@ impl Config {
         self.limits
             .norm
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
+    }
+
+    /// Whether the design needs the motor-envelope program (a speed limit, a
+    /// torque-speed line or an objective other than the peak torque) rather
+    /// than the unit-time peak program with F3 scaling.
+    pub fn uses_envelope(&self) -> bool {
+        self.design.objective != crate::design::objective::Objective::PeakTorque
+            || self.limits.max_speed.is_some()
+            || self.limits.no_load_speed.is_some()
     }
 
     /// The joint's motors as the limits describe them.

@@ -422,6 +422,18 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "report (figures, summary)",
     });
     let clock = Instant::now();
+    // the simulator models and each kept method's controls for them
+    let mut plans: Vec<(&str, &dyn ShapePlan)> = Vec::new();
+    if let Ok((a, _)) = &analytic {
+        plans.push(("analytic", &a.plan));
+    }
+    if let Ok(ph) = &phased {
+        plans.push(("phased", &ph.plan));
+    }
+    if let Ok(fr) = &free {
+        plans.push(("free", &fr.plan));
+    }
+    crate::export::add_simulator_files(cfg, &mut output, &plans);
     let norm_name = match cfg.norm() {
         crate::model::TorqueNorm::Euclidean => "Euclidean",
         crate::model::TorqueNorm::PerMotor => "per motor",
