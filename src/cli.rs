@@ -747,7 +747,18 @@ fn cmd_sweep(
             .unwrap_or(1)
     });
     let quiet = c.json;
-    let key = spec.key.replace('.', "_");
+    // a file-name-safe key (an unknown key is refused below, but names the staging first)
+    let key: String = spec
+        .key
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     let points = catflip::sweep::sweep(&c.config, &c.set, &spec, m, threads, |done, total| {
         if !quiet {
