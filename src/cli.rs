@@ -130,6 +130,9 @@ pub enum Status {
     Ok,
     /// Results were written, but some are flagged or failed (exit 3).
     Partial,
+    /// The motors cannot flip the cat from the configured height; the least
+    /// height and its schedule were written (exit 4).
+    Impossible,
 }
 
 fn status_of(partial: bool) -> Status {
@@ -650,10 +653,15 @@ fn cmd_run(c: &Common) -> Result<Status> {
     let dir = publisher.link();
     let r = catflip::run::run(&cfg, progress_display(c.json))?;
     let partial = r.is_partial();
+    let status = if r.is_impossible() {
+        Status::Impossible
+    } else {
+        status_of(partial)
+    };
     let written = publisher.publish(r.output)?;
     if c.json {
         println!("{}", serde_json::to_string_pretty(&r.summary)?);
-        return Ok(status_of(partial));
+        return Ok(status);
     }
     let s = &r.summary;
     println!();
@@ -696,17 +704,22 @@ fn cmd_run(c: &Common) -> Result<Status> {
         s.scp_iterations,
         s.nodes
     );
+    if let Some(a) = &s.answer {
+        println!("  {}", a.sentence());
+    }
     println!(
         "  report: {} ({} files)",
         dir.join("index.html").display(),
         written.len()
     );
-    if partial {
+    if status == Status::Impossible {
+        eprintln!("the flip is not possible from this height: exit status 4");
+    } else if partial {
         eprintln!(
             "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3"
         );
     }
-    Ok(status_of(partial))
+    Ok(status)
 }
 
 fn cmd_sweep(

@@ -3,6 +3,7 @@
 
 use crate::config::Config;
 use crate::design::analytic::ClosedForms;
+use crate::design::least_height::HeightAnswer;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
@@ -124,6 +125,9 @@ pub struct RunSummary {
     pub nodes: usize,
     pub analytic: ClosedForms,
     pub figures: Vec<String>,
+    /// With motor limits: can the motors flip the cat from `fall.height`, and
+    /// the least drop height at which they can (absent without limits).
+    pub answer: Option<HeightAnswer>,
 }
 
 /// A finished run: its summary and the files to write.
@@ -138,6 +142,11 @@ impl RunResult {
     /// True when some method is flagged or failed.
     pub fn is_partial(&self) -> bool {
         self.summary.outcome != "ok"
+    }
+
+    /// True when the motors cannot flip the cat from the configured height.
+    pub fn is_impossible(&self) -> bool {
+        self.summary.answer.as_ref().is_some_and(|a| !a.possible)
     }
 }
 
@@ -272,7 +281,8 @@ pub fn trace(
 /// others: its status and reason go into the summary, table and report. Only
 /// when every method fails is the run an error.
 pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult> {
-    let total = 4;
+    let limited = cfg.motor().is_limited();
+    let total = if limited { 5 } else { 4 };
     let cat = cfg.cat();
     let per = cfg.simulate.samples_per_phase;
     let mut output = Output::default();
@@ -280,6 +290,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
     let mut methods = Vec::new();
     let mut traces = Vec::new();
+    let mut notes_early: Vec<String> = Vec::new();
     let stage_end = |progress: &mut dyn FnMut(Progress), clock: Instant, err: Option<&Error>| {
         let seconds = clock.elapsed().as_secs_f64();
         match err {
@@ -330,21 +341,56 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     }
     stage_end(&mut progress, clock, analytic.as_ref().err());
 
+    // the robot question first: when the motors cannot flip the cat in
+    // this fall, no design at this height is attempted
+    let mut answer = None;
+    if limited {
+        progress(Progress::Stage {
+            index: 2,
+            total,
+            name: "least drop height (shortest manoeuvre inside the motor envelope)",
+        });
+        let clock = Instant::now();
+        let a = crate::design::least_height::answer(cfg);
+        stage_end(&mut progress, clock, a.as_ref().err());
+        match a {
+            Ok(Some(a)) => {
+                Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "least-height");
+                answer = Some(a);
+            }
+            Ok(None) => {}
+            Err(e) => notes_early.push(format!("The least drop height could not be found: {e}")),
+        }
+    }
+    let impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
+        format!(
+            "not possible from {} m with these motors; the least drop height is {:.3} m (least-height.csv)",
+            a.height_m, a.least_height_m
+        )
+    });
+    let skipped = |reason: &String| Error::Unreachable {
+        reason: reason.clone(),
+    };
+    let stage = |i: usize| if limited { i + 1 } else { i };
+
     progress(Progress::Stage {
-        index: 2,
+        index: stage(2),
         total,
         name: "phased optimiser (path-timing SOCPs, bend search)",
     });
     let clock = Instant::now();
     let mut evaluations = 0;
-    let phased = crate::design::phased::optimize(cfg, |e| {
-        evaluations += 1;
-        progress(Progress::Bend {
-            evaluations,
-            bend_deg: e.bend_deg,
-            peak_nm: e.peak_nm,
-        });
-    });
+    let phased = match &impossible {
+        Some(r) => Err(skipped(r)),
+        None => crate::design::phased::optimize(cfg, |e| {
+            evaluations += 1;
+            progress(Progress::Bend {
+                evaluations,
+                bend_deg: e.bend_deg,
+                peak_nm: e.peak_nm,
+            });
+        }),
+    };
     match &phased {
         Ok(ph) => {
             let ph_sched = Schedule::sample(&cat, &ph.plan, per);
@@ -370,7 +416,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     stage_end(&mut progress, clock, phased.as_ref().err());
 
     progress(Progress::Stage {
-        index: 3,
+        index: stage(3),
         total,
         name: "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
     });
@@ -384,10 +430,14 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             (&analytic_seed, "analytic")
         }
     };
-    let free =
-        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-            progress(Progress::Scp(it))
-        });
+    let free = match &impossible {
+        Some(r) => Err(skipped(r)),
+        None => {
+            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+                progress(Progress::Scp(it))
+            })
+        }
+    };
     match &free {
         Ok(fr) => {
             let fr_sched = Schedule::sample(&cat, &fr.plan, per);
@@ -417,7 +467,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     }
 
     progress(Progress::Stage {
-        index: 4,
+        index: stage(4),
         total,
         name: "report (figures, summary)",
     });
@@ -451,7 +501,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     if !iterations.is_empty() {
         figures.push(("convergence.svg", report::convergence(&iterations)));
     }
-    let mut notes = Vec::new();
+    let mut notes = notes_early;
     let figures: Vec<(&str, String)> = figures
         .into_iter()
         .filter_map(|(name, svg)| match svg {
@@ -485,6 +535,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         nodes,
         analytic: crate::design::analytic::closed_forms(cfg),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
+        answer,
     };
     let header = TABLE_HEADER;
     let rows: Vec<Vec<String>> = summary.methods.iter().map(table_row).collect();
@@ -502,7 +553,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             summary.nodes
         ),
     );
-    notes.insert(1, "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking).".into());
+    notes.insert(1, "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking, torque clipped to the motor envelope).".into());
+    if let Some(a) = &summary.answer {
+        notes.insert(0, a.sentence());
+    }
     if summary.outcome != "ok" {
         notes.insert(
             0,
