@@ -364,7 +364,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     }
     let impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
         format!(
-            "not possible from {} m with these motors; the least drop height is {:.3} m (least-height.csv)",
+            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {:.3} m (least-height.csv)",
             a.height_m, a.least_height_m
         )
     });
@@ -430,14 +430,12 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             (&analytic_seed, "analytic")
         }
     };
-    let free = match &impossible {
-        Some(r) => Err(skipped(r)),
-        None => {
-            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-                progress(Progress::Scp(it))
-            })
-        }
-    };
+    // always tried: the phased least height is an upper bound, and a
+    // free-form design may fit where no phased one does
+    let free =
+        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+            progress(Progress::Scp(it))
+        });
     match &free {
         Ok(fr) => {
             let fr_sched = Schedule::sample(&cat, &fr.plan, per);
@@ -458,6 +456,15 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     }
     stage_end(&mut progress, clock, free.as_ref().err());
 
+    if let Some(a) = answer.as_mut().filter(|a| !a.possible)
+        && let Some(m) = methods
+            .iter()
+            .find(|m| m.method == "free" && m.verdict == Verdict::Ok)
+    {
+        // a verified free-form schedule inside the envelope settles it
+        a.possible = true;
+        a.method = m.method;
+    }
     if methods.iter().all(|m| m.verdict == Verdict::Failed) {
         let reasons: Vec<String> = methods
             .iter()

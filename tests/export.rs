@@ -76,7 +76,10 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
         ("robot-universal", &[][..]),
         ("robot-universal", &unequal[..]),
         ("seed", &unequal[..2]),
-        ("seed", &["limits.max_torque=2.5", "cat.joint=universal"][..]),
+        (
+            "seed",
+            &["limits.max_torque=2.5", "cat.joint=universal"][..],
+        ),
     ] {
         let cfg = config(name, set);
         let cat = cfg.cat();

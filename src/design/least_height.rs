@@ -17,11 +17,13 @@ pub struct HeightAnswer {
     pub possible: bool,
     /// The configured drop height, m.
     pub height_m: f64,
-    /// The least drop height at which the motors can flip the cat, m.
+    /// The least drop height found for the motors, m: the phased `time`
+    /// design's (an upper bound on the true least height).
     pub least_height_m: f64,
     /// The shortest manoeuvre inside the motor envelope, s.
     pub least_time_s: f64,
-    /// Which design found it.
+    /// Which design settles the answer (`phased` for the least height; `free`
+    /// when a verified free-form schedule fits although no phased one does).
     pub method: &'static str,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
@@ -53,15 +55,20 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
 impl HeightAnswer {
     /// One plain sentence for the terminal and the report.
     pub fn sentence(&self) -> String {
-        if self.possible {
+        if self.possible && self.least_height_m > self.height_m {
             format!(
-                "The flip is possible from {} m: the motors need at least {:.3} m ({:.4} s of manoeuvre, {}).",
-                self.height_m, self.least_height_m, self.least_time_s, self.method
+                "The flip is possible from {} m: the {} design fits the motors, although the phased least-height design needs {:.3} m.",
+                self.height_m, self.method, self.least_height_m
+            )
+        } else if self.possible {
+            format!(
+                "The flip is possible from {} m: the motors need at most {:.3} m ({:.4} s of manoeuvre, phased time-optimal schedule in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s
             )
         } else {
             format!(
-                "The flip is NOT possible from {} m with these motors: drop it from at least {:.3} m ({:.4} s of manoeuvre, {} time-optimal schedule in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s, self.method
+                "The flip is NOT possible from {} m with these motors: from {:.3} m it is ({:.4} s of manoeuvre, the phased time-optimal schedule in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s
             )
         }
     }
