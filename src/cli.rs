@@ -355,10 +355,10 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 return Ok(());
             };
             println!(
-                "catflip optimize --mode phased: {} ({} joint), status {:?}",
+                "catflip optimize --mode phased: {} ({} joint), status {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                r.status
+                catflip::run::json_name(&r.status)
             );
             row(
                 "peak torque",
@@ -426,10 +426,10 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 return Ok(());
             };
             println!(
-                "catflip optimize --mode free: {} ({} joint), status {:?}, seed {}",
+                "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                r.status,
+                catflip::run::json_name(&r.status),
                 r.seed
             );
             row(
@@ -521,8 +521,10 @@ fn cmd_run(c: &Common) -> Result<()> {
     let s = &r.summary;
     println!();
     println!(
-        "catflip run: {} ({} joint, peak norm {:?})",
-        s.name, s.joint, s.peak_norm
+        "catflip run: {} ({} joint, peak norm {})",
+        s.name,
+        s.joint,
+        catflip::run::json_name(&s.peak_norm)
     );
     let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
@@ -546,6 +548,11 @@ fn cmd_run(c: &Common) -> Result<()> {
     line(header.iter().map(|h| h.to_string()).collect());
     for row in rows {
         line(row);
+    }
+    for m in &s.methods {
+        for w in catflip::run::warnings(m, s.max_torque_nm) {
+            println!("  warning: {w}");
+        }
     }
     println!(
         "  free-form / phased peak {:.3}, phased / analytic {:.3}; {} SCP iterations at {} nodes per phase",

@@ -461,6 +461,41 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
     Ok(())
 }
 
+/// Unit of each numeric config key, for axis labels (`fall.height (m)`).
+pub const UNITS: [(&str, &str); 23] = [
+    ("cat.mass", "kg"),
+    ("cat.length", "m"),
+    ("cat.radius", "m"),
+    ("fall.height", "m"),
+    ("fall.gravity", "m/s^2"),
+    ("fall.margin", "s"),
+    ("analytic.theta_deg", "deg"),
+    ("limits.max_torque", "N m"),
+    ("limits.max_bend_deg", "deg"),
+    ("simulate.rtol", "relative"),
+    ("simulate.atol", "absolute"),
+    ("simulate.pd_bandwidth_hz", "Hz"),
+    ("simulate.pd_damping", "damping ratio"),
+    ("simulate.samples_per_phase", "rows per phase"),
+    ("phased.nodes", "intervals per phase"),
+    ("phased.bend_min_deg", "deg"),
+    ("phased.bend_max_deg", "deg"),
+    ("phased.scan_points", "count"),
+    ("phased.bend_tol_deg", "deg"),
+    ("free.nodes", "nodes per phase"),
+    ("free.max_iterations", "count"),
+    ("free.tolerance", "relative"),
+    ("free.attitude_tolerance", "rad"),
+];
+
+/// A config key with its unit, e.g. `fall.height (m)`.
+pub fn key_label(key: &str) -> String {
+    match UNITS.iter().find(|(k, _)| *k == key) {
+        Some((_, u)) => format!("{key} ({u})"),
+        None => key.to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -508,5 +543,41 @@ gravity = 9.8
                 .to_string();
             assert!(e.contains(needle), "`{e}` should mention `{needle}`");
         }
+    }
+
+    /// Every numeric key of the config has a unit, and the table names no
+    /// key the config lacks (sweep axes are labelled from it).
+    #[test]
+    fn every_numeric_key_has_a_unit() {
+        let c = Config::from_toml(
+            SEED,
+            "t",
+            &[
+                "limits.max_torque=1".into(),
+                "limits.max_bend_deg=90".into(),
+            ],
+        )
+        .unwrap();
+        let tree = toml::Table::try_from(&c).unwrap();
+        let mut numeric = Vec::new();
+        for (section, v) in &tree {
+            if let toml::Value::Table(t) = v {
+                for (k, x) in t {
+                    if x.is_integer() || x.is_float() {
+                        numeric.push(format!("{section}.{k}"));
+                    }
+                }
+            }
+        }
+        for k in &numeric {
+            assert_ne!(key_label(k), *k, "{k} has no unit in UNITS");
+        }
+        for (k, _) in UNITS {
+            assert!(
+                numeric.iter().any(|n| n == k),
+                "UNITS names {k}, not a numeric key"
+            );
+        }
+        assert_eq!(key_label("fall.height"), "fall.height (m)");
     }
 }

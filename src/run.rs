@@ -51,6 +51,11 @@ pub struct MethodSummary {
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
     pub solve_time_s: f64,
+    /// What to look at before using this schedule: `over-limit` (the schedule
+    /// needs more than `limits.max_torque`), `not-converged` (the optimiser
+    /// stopped early), `flip-missed` (the simulated flip or tilt is off by
+    /// more than [`FLIP_TOLERANCE_RAD`]). Empty when all is well.
+    pub flags: Vec<String>,
     pub schedule_csv: String,
     pub schedule_json: String,
 }
@@ -103,6 +108,7 @@ fn summarize(
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
         solve_time_s,
+        flags: Vec::new(),
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
     }
@@ -204,7 +210,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .expect("phased result carries its simulation");
     let fr_sim = &fr.sim;
     let (a_peak, _) = peak_along(cfg, &a.plan, crate::verify::analyze::dense_samples(cfg));
-    let methods = vec![
+    let mut methods = vec![
         summarize(
             "analytic",
             "closed-form".into(),
@@ -219,7 +225,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         ),
         summarize(
             "phased",
-            format!("{:?}", ph.status).to_lowercase(),
+            json_name(&ph.status),
             ph.peak_torque_nm,
             (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
             ph_sim,
@@ -227,25 +233,33 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         ),
         summarize(
             "free",
-            format!("{:?}", fr.status).to_lowercase(),
+            json_name(&fr.status),
             fr.peak_torque_nm,
             (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
             fr_sim,
             fr.solve_time_s,
         ),
     ];
+    let converged = [
+        true,
+        ph.status == crate::design::conic::SolveStatus::Solved,
+        fr.status == crate::design::scp::ScpStatus::Converged,
+    ];
+    for (m, ok) in methods.iter_mut().zip(converged) {
+        m.flags = flags(m, ok, cfg.limits.max_torque);
+    }
     let traces = vec![
         trace(cfg, "analytic", &a.plan, &a_sim, 300),
         trace(cfg, "phased", &ph.plan, ph_sim, 300),
         trace(cfg, "free", &fr.plan, fr_sim, 300),
     ];
-    let norm_name = match cfg.norm() {
-        crate::model::TorqueNorm::Euclidean => "Euclidean",
-        crate::model::TorqueNorm::PerMotor => "per motor",
-    };
+    let norm_name = json_name(&cfg.norm());
     let figures = vec![
         ("angles.svg", report::angles(&traces)?),
-        ("torque.svg", report::torque(&traces, norm_name)?),
+        (
+            "torque.svg",
+            report::torque(&traces, &norm_name, cfg.limits.max_torque)?,
+        ),
         ("flip.svg", report::flip(&traces)?),
         ("shape_path.svg", report::shape_path(&traces)?),
         ("convergence.svg", report::convergence(&fr.iterations)?),
@@ -279,6 +293,35 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking).".into(),
     ];
     let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
+    let sims = [&a_sim, ph_sim, fr_sim];
+    let scene = report::animation::Scene {
+        length: cat.length,
+        radius: cat.radius,
+        joint: summary.joint,
+        norm: norm_name.clone(),
+        max_torque_nm: cfg.limits.max_torque,
+        tracks: summary
+            .methods
+            .iter()
+            .zip(sims)
+            .map(|(m, sim)| {
+                let status = table_row(m)[1].clone();
+                report::animation::track(
+                    &cat,
+                    cfg.norm(),
+                    m.method,
+                    &status,
+                    sim,
+                    report::animation::FRAMES,
+                )
+            })
+            .collect(),
+    };
+    let warnings: Vec<String> = summary
+        .methods
+        .iter()
+        .flat_map(|m| warnings(m, cfg.limits.max_torque))
+        .collect();
     output.add(
         "index.html",
         report::index_html(
@@ -286,6 +329,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             &header,
             &rows,
             &notes,
+            &warnings,
+            &report::animation::section(&scene),
             &figure_names,
         ),
     );
@@ -320,17 +365,85 @@ pub const TABLE_HEADER: [&str; 9] = [
     "solve s",
 ];
 
+/// A simulated flip or tilt farther than this from a clean half turn is a
+/// miss, rad (0.57 deg: well above the designs' integration and tracking
+/// errors, well below what a landing notices).
+pub const FLIP_TOLERANCE_RAD: f64 = 1e-2;
+
+/// The name serde gives a unit enum value (`per-motor`, `iteration-limit`),
+/// so the terminal says what the JSON says.
+pub fn json_name<T: Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
+}
+
+/// The flags of a method (see [`MethodSummary::flags`]).
+pub fn flags(m: &MethodSummary, converged: bool, limit: Option<f64>) -> Vec<String> {
+    let mut f = Vec::new();
+    if limit.is_some_and(|l| m.peak_torque_nm > l * (1.0 + 1e-9)) {
+        f.push("over-limit".to_string());
+    }
+    if !converged {
+        f.push("not-converged".to_string());
+    }
+    if m.flip_error_rad.abs() > FLIP_TOLERANCE_RAD
+        || m.tilt_deg.to_radians().abs() > FLIP_TOLERANCE_RAD
+    {
+        f.push("flip-missed".to_string());
+    }
+    f
+}
+
+/// One sentence per flag of a method, for the report and the terminal.
+pub fn warnings(m: &MethodSummary, limit: Option<f64>) -> Vec<String> {
+    m.flags
+        .iter()
+        .map(|f| match f.as_str() {
+            "over-limit" => format!(
+                "{}: the schedule needs {:.4} N m, over the {} N m torque limit; the simulation saturates at the limit.",
+                m.method,
+                m.peak_torque_nm,
+                limit.unwrap_or(f64::NAN)
+            ),
+            "not-converged" => format!(
+                "{}: the optimiser stopped without converging (status {}); the schedule is its last iterate.",
+                m.method, m.status
+            ),
+            _ => format!(
+                "{}: the simulated motion misses the half turn: flip {:.3} deg (error {:.3e} rad), tilt {:.3} deg.",
+                m.method, m.flip_deg, m.flip_error_rad, m.tilt_deg
+            ),
+        })
+        .collect()
+}
+
+/// A small number in the table: `0` for exact zero, else 3 significant digits.
+fn small(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
 /// One line of the comparison table.
 pub fn table_row(m: &MethodSummary) -> Vec<String> {
     let d = m.phase_durations_s;
+    let status = if m.flags.is_empty() {
+        m.status.clone()
+    } else {
+        format!("{} [{}]", m.status, m.flags.join(", "))
+    };
     vec![
         m.method.to_string(),
-        m.status.clone(),
+        status,
         format!("{:.5}", m.peak_torque_nm),
         format!("{:.2}", m.bend_deg),
         format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
-        format!("{:.2e}", m.flip_error_rad),
-        format!("{:.2e}", m.tilt_deg),
+        small(m.flip_error_rad),
+        small(m.tilt_deg),
         format!("{:.5}", m.sim_peak_torque_nm),
         format!("{:.3}", m.solve_time_s),
     ]
