@@ -120,6 +120,7 @@ fn run_writes_a_complete_consistent_report() {
             "{name}: {texts:?}"
         );
     }
+    assert!(html.contains("<script type=\"application/json\" id=\"scene\">"));
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     assert!(
         torque.contains(&format!("peak {:.4} N m", peaks[2])),
@@ -190,6 +191,22 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
     );
     let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
     assert!(h > 10.0, "{h}");
+    // the x axis carries the key's unit; peaks spanning more than a factor
+    // 20 (the seed's schedule against the optimum) go on a log axis
+    let svg = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass.svg")).unwrap();
+    assert!(svg.contains("cat.mass (kg)"));
+    let peaks: Vec<f64> = rows[1..]
+        .iter()
+        .flat_map(|r| {
+            r.split(',')
+                .skip(1)
+                .take(2)
+                .map(|x| x.parse::<f64>().unwrap())
+        })
+        .collect();
+    let spread =
+        peaks.iter().cloned().fold(0.0, f64::max) / peaks.iter().cloned().fold(f64::MAX, f64::min);
+    assert_eq!(svg.contains("log scale"), spread > 20.0, "spread {spread}");
     for bad in ["cat.mass=1:2", "cat.masss=1:2:3", "cat.mass=-1:2:3"] {
         let (ok, _, err) = run(&["sweep", c, "--set-range", bad], dir.path());
         assert!(!ok && !err.is_empty(), "{bad} should fail");
@@ -257,4 +274,114 @@ fn exports_parse_and_carry_the_model_masses_and_inertias() {
             .join("output/robot-universal/robot-universal.mjcf.xml")
             .exists()
     );
+}
+
+/// A run that goes wrong on purpose: a torque limit the seed's schedule
+/// exceeds and a free-form optimiser cut off after 3 iterations. Each
+/// problem is flagged where a user looks: JSON, terminal, page, figure.
+#[test]
+fn run_flags_an_exceeded_limit_and_an_unconverged_optimiser() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let (ok, out, err) = run(
+        &[
+            "run",
+            cfg.to_str().unwrap(),
+            "--set",
+            "limits.max_torque=5",
+            "--set",
+            "free.max_iterations=3",
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    let base = dir.path().join("output/seed");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    for m in summary["methods"].as_array().unwrap() {
+        let name = m["method"].as_str().unwrap();
+        let flags: Vec<&str> = m["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f.as_str().unwrap())
+            .collect();
+        let over = m["peak_torque_nm"].as_f64().unwrap() > 5.0;
+        assert_eq!(flags.contains(&"over-limit"), over, "{name}: {flags:?}");
+        let stopped = ["iteration-limit", "stalled"].contains(&m["status"].as_str().unwrap());
+        assert_eq!(
+            flags.contains(&"not-converged"),
+            stopped,
+            "{name}: {flags:?}"
+        );
+        let missed = m["flip_error_rad"].as_f64().unwrap().abs() > 1e-2
+            || m["tilt_deg"].as_f64().unwrap().to_radians() > 1e-2;
+        assert_eq!(flags.contains(&"flip-missed"), missed, "{name}: {flags:?}");
+        for f in &flags {
+            // the table's status cell and the terminal carry every flag
+            assert!(html.contains(f) && out.contains(f), "{name}: {f} not shown");
+        }
+    }
+    let a = &summary["methods"][0];
+    assert!(
+        a["flags"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f == "over-limit")
+    );
+    assert_eq!(summary["methods"][2]["status"], "iteration-limit");
+    assert!(out.contains("warning: free:") && html.contains("class=\"warn\""));
+    // the terminal says what the JSON says, not Rust's Debug names
+    assert!(out.contains("iteration-limit") && !out.contains("IterationLimit"));
+    assert!(out.contains("peak norm euclidean"), "{out}");
+    let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
+    assert!(torque.contains("torque limit 5 N m") && torque.contains("OVER LIMIT"));
+}
+
+/// The animation frames: spread over the whole simulation, body B built from
+/// body A and the shape. Oracles: the angle between the two spines is the
+/// bend `|q|` (no-twist joint: `q` is a rotation about an axis normal to A's
+/// spine), and at the end the straight cat's halves share one attitude.
+#[test]
+fn animation_frames_follow_the_simulation() {
+    use catflip::report::animation::{FRAMES, track};
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+    let cfg = catflip::Config::load(&configs().join("seed.toml"), &[]).unwrap();
+    let cat = cfg.cat();
+    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let sim = catflip::verify::simulate::dynamic_cfg(&cfg, &plan).unwrap();
+    let tr = track(&cat, cfg.norm(), "analytic", "closed-form", &sim, FRAMES);
+    let f = &tr.frames;
+    assert!(f.len() > FRAMES / 2 && f.len() <= FRAMES, "{}", f.len());
+    assert_eq!(f[0].t, sim.trace[0].t);
+    assert_eq!(f.last().unwrap().t, sim.trace.last().unwrap().t);
+    assert!(f.windows(2).all(|w| w[1].t > w[0].t));
+    let uq = |q: [f64; 4]| UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+    let mut largest = 0.0f64;
+    for fr in f {
+        let (a, b) = (uq(fr.a), uq(fr.b));
+        let spines = (a * Vector3::z())
+            .dot(&(b * Vector3::z()))
+            .clamp(-1.0, 1.0)
+            .acos();
+        assert!(
+            (spines.to_degrees() - fr.bend_deg).abs() < 1e-6,
+            "t {}: spines {} deg, bend {} deg",
+            fr.t,
+            spines.to_degrees(),
+            fr.bend_deg
+        );
+        largest = largest.max(fr.bend_deg);
+    }
+    assert!(
+        (largest - 135.0).abs() < 1.0,
+        "the seed bends 135 deg: {largest}"
+    );
+    let end = f.last().unwrap();
+    assert!(uq(end.a).angle_to(&uq(end.b)) < 1e-6);
+    // the embedded flip is the simulation's, whatever its sign convention
+    let last = sim.trace.last().unwrap();
+    assert_eq!(end.flip_deg, last.flip.to_degrees());
 }
