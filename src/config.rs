@@ -6,7 +6,7 @@
 //! they go through the same checks.
 
 use crate::error::{Error, Result};
-use crate::model::{Cat, InertiaFormula, Joint, TorqueNorm};
+use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -41,6 +41,22 @@ pub struct CatConfig {
     /// `no-twist` (default) or `universal`.
     #[serde(default = "default_joint")]
     pub joint: Joint,
+    /// `[cat.front]`: the front half where it differs from the rear (default: none,
+    /// both halves as above).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub front: Option<FrontConfig>,
+}
+
+/// Front-half overrides; a missing key keeps the `[cat]` value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FrontConfig {
+    /// kg.
+    pub mass: Option<f64>,
+    /// m.
+    pub length: Option<f64>,
+    /// m.
+    pub radius: Option<f64>,
 }
 
 fn default_joint() -> Joint {
@@ -95,6 +111,12 @@ pub struct LimitsConfig {
     pub max_bend_deg: Option<f64>,
     /// Peak norm: `euclidean` or `per-motor` (default: euclidean for no-twist, per-motor for universal).
     pub norm: Option<TorqueNorm>,
+    /// rad/s, no-load speed of the motors' linear torque-speed line (default: none).
+    /// With `max_torque = T` and `k = T / no_load_speed` the motor gives
+    /// `-T - k w <= tau <= T - k w` at joint speed `w` (docs/model.md, "Motors").
+    pub no_load_speed: Option<f64>,
+    /// rad/s, hard joint speed limit (default: none).
+    pub max_speed: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -253,6 +275,27 @@ impl Config {
             c.radius > 0.0 && c.radius < c.length,
             "must be > 0 m and less than cat.length",
         )?;
+        if let Some(fr) = &c.front {
+            let front = self.cat().front;
+            check(
+                "cat.front.mass",
+                front.mass,
+                fr.mass.is_none_or(|m| m > 0.0),
+                "must be > 0 kg (mass of the front half)",
+            )?;
+            check(
+                "cat.front.length",
+                front.length,
+                fr.length.is_none_or(|l| l > 0.0),
+                "must be > 0 m (length of the front half)",
+            )?;
+            check(
+                "cat.front.radius",
+                front.radius,
+                front.radius > 0.0 && front.radius < front.length,
+                "must be > 0 m and less than the front half's length",
+            )?;
+        }
         let f = &self.fall;
         check("fall.height", f.height, f.height > 0.0, "must be > 0 m")?;
         check(
@@ -293,6 +336,24 @@ impl Config {
         )?;
         if let Some(t) = self.limits.max_torque {
             check("limits.max_torque", t, t > 0.0, "must be > 0 N m")?;
+        }
+        if let Some(w) = self.limits.no_load_speed {
+            check(
+                "limits.no_load_speed",
+                w,
+                w > 0.0,
+                "must be > 0 rad/s (the speed at which the motor's torque falls to 0)",
+            )?;
+            if self.limits.max_torque.is_none() {
+                return Err(Error::Invalid {
+                    key: "limits.no_load_speed".into(),
+                    value: format!("{w}"),
+                    expected: "needs limits.max_torque too: the torque-speed line runs from max_torque at rest to 0 at no_load_speed".into(),
+                });
+            }
+        }
+        if let Some(w) = self.limits.max_speed {
+            check("limits.max_speed", w, w > 0.0, "must be > 0 rad/s")?;
         }
         if let Some(b) = self.limits.max_bend_deg {
             check(
@@ -395,16 +456,28 @@ impl Config {
 
     /// The cat with the inertia formula the config asks for.
     pub fn cat(&self) -> Cat {
-        Cat {
-            mass: self.cat.mass,
-            length: self.cat.length,
-            radius: self.cat.radius,
-            joint: self.cat.joint,
+        let c = &self.cat;
+        let rear = Half {
+            mass: c.mass,
+            length: c.length,
+            radius: c.radius,
             inertia: if self.analytic.seed_inertia {
                 InertiaFormula::Seed
             } else {
                 InertiaFormula::SolidCylinder
             },
+        };
+        let fr = c.front.clone().unwrap_or_default();
+        let front = Half {
+            mass: fr.mass.unwrap_or(c.mass),
+            length: fr.length.unwrap_or(c.length),
+            radius: fr.radius.unwrap_or(c.radius),
+            ..rear
+        };
+        Cat {
+            rear,
+            front,
+            joint: c.joint,
         }
     }
 
@@ -422,6 +495,16 @@ impl Config {
         self.limits
             .norm
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
+    }
+
+    /// The joint's motors as the limits describe them.
+    pub fn motor(&self) -> crate::model::motor::Motor {
+        crate::model::motor::Motor {
+            max_torque: self.limits.max_torque,
+            no_load_speed: self.limits.no_load_speed,
+            max_speed: self.limits.max_speed,
+            norm: self.norm(),
+        }
     }
 
     /// Largest bend the optimisers may use, rad.

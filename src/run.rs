@@ -6,6 +6,7 @@ use crate::design::analytic::ClosedForms;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::Result;
+use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
 use crate::verify::analyze::{analyze, peak_along};
@@ -50,6 +51,11 @@ pub struct MethodSummary {
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
+    /// Largest joint speed of the written schedule, rad/s (motor norm).
+    pub max_speed_rad_s: f64,
+    /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
+    /// the envelope, negative violated; absent without limits).
+    pub min_envelope_margin: Option<f64>,
     pub solve_time_s: f64,
     /// What to look at before using this schedule: `over-limit` (the schedule
     /// needs more than `limits.max_torque`), `not-converged` (the optimiser
@@ -90,6 +96,7 @@ fn summarize(
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: &SimReport,
+    motor: MotorUse,
     solve_time_s: f64,
 ) -> MethodSummary {
     let (bend, twist, durations) = path_numbers;
@@ -107,6 +114,8 @@ fn summarize(
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
+        max_speed_rad_s: motor.max_speed_rad_s,
+        min_envelope_margin: motor.min_margin,
         solve_time_s,
         flags: Vec::new(),
         schedule_csv: format!("{method}.csv"),
@@ -161,7 +170,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let a = analyze(cfg)?;
     let a_sim = dynamic_cfg(cfg, &a.plan)?;
     let a_time = clock.elapsed().as_secs_f64();
-    Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "analytic");
+    let motor = cfg.motor();
+    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
+    let a_sched = Schedule::sample(&cat, &a.plan, per);
+    a_sched.add_to(&mut output, "analytic");
     progress(Progress::StageDone { seconds: a_time });
 
     progress(Progress::Stage {
@@ -179,7 +191,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             peak_nm: e.peak_nm,
         });
     })?;
-    Schedule::sample(&cat, &ph.plan, per).add_to(&mut output, "phased");
+    let ph_sched = Schedule::sample(&cat, &ph.plan, per);
+    ph_sched.add_to(&mut output, "phased");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });
@@ -193,7 +206,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let fr = crate::design::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
         progress(Progress::Scp(it))
     })?;
-    Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
+    let fr_sched = Schedule::sample(&cat, &fr.plan, per);
+    fr_sched.add_to(&mut output, "free");
     progress(Progress::StageDone {
         seconds: clock.elapsed().as_secs_f64(),
     });
@@ -221,6 +235,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 a.closed.phase_durations_s,
             ),
             &a_sim,
+            usage(&a_sched),
             a_time,
         ),
         summarize(
@@ -229,6 +244,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             ph.peak_torque_nm,
             (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
             ph_sim,
+            usage(&ph_sched),
             ph.solve_time_s,
         ),
         summarize(
@@ -237,6 +253,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             fr.peak_torque_nm,
             (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
             fr_sim,
+            usage(&fr_sched),
             fr.solve_time_s,
         ),
     ];

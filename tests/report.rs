@@ -229,7 +229,7 @@ fn exports_parse_and_carry_the_model_masses_and_inertias() {
         assert!(
             masses
                 .iter()
-                .all(|m| close(m.attribute("value").unwrap(), cat.mass))
+                .all(|m| close(m.attribute("value").unwrap(), cat.rear.mass))
         );
         for i in doc.descendants().filter(|n| n.has_tag_name("inertia")) {
             assert!(
@@ -260,7 +260,7 @@ fn exports_parse_and_carry_the_model_masses_and_inertias() {
             .collect();
         assert_eq!(inertials.len(), 2);
         for n in inertials {
-            assert!(close(n.attribute("mass").unwrap(), cat.mass));
+            assert!(close(n.attribute("mass").unwrap(), cat.rear.mass));
             let d: Vec<&str> = n.attribute("diaginertia").unwrap().split(' ').collect();
             assert!(close(d[0], cat.i_t()) && close(d[1], cat.i_t()) && close(d[2], cat.i_a()));
         }

@@ -3,6 +3,7 @@
 //! (collocation + successive convexification), with the shape plans and
 //! sampled schedules they produce and the conic solver they share.
 pub mod analytic;
+pub mod bend_search;
 pub mod collocation;
 pub mod conic;
 pub mod free;

@@ -10,6 +10,7 @@
 
 use crate::config::Config;
 use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::design::bend_search::{Scored, scan_then_golden};
 use crate::design::conic::SolveStatus;
 use crate::design::path::{Path, PhasedPlan, Timing};
 use crate::design::timing::{PhaseTiming, TimingProblem};
@@ -69,13 +70,14 @@ impl BendDesign {
 
 /// Twist of the bend direction that flips the cat by exactly pi.
 ///
-/// `no-twist`: `pi / C` (F1, exact). `universal`: F1 is only approximate (F4),
-/// so the twist is root-found on the integrated attitude; by F2 the timing is
-/// irrelevant and a unit-time cosine plan is used.
+/// `no-twist` with identical halves: `pi / C` (F1, exact). `universal` (F4)
+/// or unequal halves: F1 is only approximate, so the twist is root-found on
+/// the integrated attitude, starting from `pi / C` with the mean half; by F2
+/// the timing is irrelevant and a unit-time cosine plan is used.
 pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
     let guess = PI / c;
-    if cat.joint == Joint::NoTwist {
+    if cat.joint == Joint::NoTwist && cat.is_symmetric() {
         return Ok(guess);
     }
     let ode = OdeSettings {
@@ -101,7 +103,12 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     }
     Err(Error::Unreachable {
         reason: format!(
-            "no twist angle flips the universal-joint cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            "no twist angle flips the {} cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            if cat.is_symmetric() {
+                "universal-joint"
+            } else {
+                "unequal-halves"
+            },
             bend.to_degrees()
         ),
     })
@@ -118,9 +125,10 @@ pub struct BendEvaluation {
 /// Designs the phases at one bend.
 ///
 /// For the `no-twist` joint the unfold is the fold run backwards and rotated
-/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`) and the
-/// torque is invariant under time reversal, so the unfold reuses the fold's
-/// timing reversed (the discrete SOCP has the same symmetry, tested).
+/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`, which
+/// holds for unequal halves too, each being a cylinder about its own axis)
+/// and the torque is invariant under time reversal, so the unfold reuses the
+/// fold's timing reversed (the discrete SOCP has the same symmetry, tested).
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
     let twist = twist_for(cat, bend)?;
     let paths = Path::phased(bend, twist);
@@ -181,7 +189,14 @@ pub struct PhasedResult {
     pub sim: Option<SimReport>,
 }
 
-/// Bend search: scan, then golden section in the best bracket.
+impl Scored for BendDesign {
+    fn score(&self) -> f64 {
+        self.unit_peak()
+    }
+}
+
+/// Bend search: scan (with the one-turn and the config's bend), then golden
+/// section in the best bracket.
 pub fn search_bend(
     cfg: &Config,
     problem: &mut TimingProblem,
@@ -224,45 +239,8 @@ pub fn search_bend(
             xs.push(b);
         }
     }
-    xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    let mut designs = Vec::new();
-    for &x in &xs {
-        designs.push(eval(x, &mut evals)?);
-    }
-    let best = (0..xs.len())
-        .min_by(|&i, &j| {
-            designs[i]
-                .unit_peak()
-                .partial_cmp(&designs[j].unit_peak())
-                .unwrap()
-        })
-        .unwrap();
-    let (mut a, mut b) = (xs[best.saturating_sub(1)], xs[(best + 1).min(xs.len() - 1)]);
-    let mut best_d = designs.swap_remove(best);
-    let g = (5f64.sqrt() - 1.0) / 2.0;
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    let mut x1 = b - g * (b - a);
-    let mut x2 = a + g * (b - a);
-    let mut d1 = eval(x1, &mut evals)?;
-    let mut d2 = eval(x2, &mut evals)?;
-    while b - a > tol {
-        if d1.unit_peak() <= d2.unit_peak() {
-            b = x2;
-            (x2, d2) = (x1, d1);
-            x1 = b - g * (b - a);
-            d1 = eval(x1, &mut evals)?;
-        } else {
-            a = x1;
-            (x1, d1) = (x2, d2);
-            x2 = a + g * (b - a);
-            d2 = eval(x2, &mut evals)?;
-        }
-    }
-    for d in [d1, d2] {
-        if d.unit_peak() < best_d.unit_peak() {
-            best_d = d;
-        }
-    }
+    let best_d = scan_then_golden(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
 }
 

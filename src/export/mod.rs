@@ -19,9 +19,9 @@ fn f(x: f64) -> String {
 /// URDF text of the cat of `cfg`.
 pub fn urdf(cfg: &Config) -> String {
     let cat = cfg.cat();
-    let (m, l, r, it, ia) = (cat.mass, cat.length, cat.radius, cat.i_t(), cat.i_a());
-    let h = l / 2.0;
-    let link = |name: &str, z: f64| {
+    let h = cat.rear.half_length();
+    let link = |name: &str, z: f64, half: &crate::model::Half| {
+        let (m, l, r, it, ia) = (half.mass, half.length, half.radius, half.i_t(), half.i_a());
         format!(
             r#"  <link name="{name}">
     <inertial>
@@ -47,7 +47,7 @@ pub fn urdf(cfg: &Config) -> String {
         cat.joint.name(),
         cfg.name
     );
-    s.push_str(&link("rear", 0.0));
+    s.push_str(&link("rear", 0.0, &cat.rear));
     match cat.joint {
         Joint::Universal => {
             s.push_str("  <link name=\"cross\"/>\n");
@@ -68,7 +68,7 @@ pub fn urdf(cfg: &Config) -> String {
             ));
         }
     }
-    s.push_str(&link("front", h));
+    s.push_str(&link("front", cat.front.half_length(), &cat.front));
     s.push_str("</robot>\n");
     s
 }
@@ -76,8 +76,7 @@ pub fn urdf(cfg: &Config) -> String {
 /// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
 pub fn mjcf(cfg: &Config) -> String {
     let cat = cfg.cat();
-    let (m, l, r, it, ia) = (cat.mass, cat.length, cat.radius, cat.i_t(), cat.i_a());
-    let h = l / 2.0;
+    let (a, b) = (&cat.rear, &cat.front);
     let joints = match cat.joint {
         Joint::Universal => "        <joint name=\"motor1\" type=\"hinge\" axis=\"1 0 0\"/>\n        <joint name=\"motor2\" type=\"hinge\" axis=\"0 1 0\"/>\n".to_string(),
         Joint::NoTwist => "        <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)) -->\n        <joint name=\"spine\" type=\"ball\"/>\n".to_string(),
@@ -98,11 +97,11 @@ pub fn mjcf(cfg: &Config) -> String {
     <!-- spine (the rear half's z axis) horizontal along world x; rotate about it to set the initial roll -->
     <body name="rear" pos="0 0 {height}" euler="0 90 0">
       <freejoint name="fall"/>
-      <inertial pos="0 0 0" mass="{m}" diaginertia="{it} {it} {ia}"/>
-      <geom type="cylinder" size="{r} {h}" mass="0"/>
-      <body name="front" pos="0 0 {h}">
-{joints}        <inertial pos="0 0 {h}" mass="{m}" diaginertia="{it} {it} {ia}"/>
-        <geom type="cylinder" size="{r} {h}" pos="0 0 {h}" mass="0"/>
+      <inertial pos="0 0 0" mass="{ma}" diaginertia="{ita} {ita} {iaa}"/>
+      <geom type="cylinder" size="{ra} {ha}" mass="0"/>
+      <body name="front" pos="0 0 {ha}">
+{joints}        <inertial pos="0 0 {hb}" mass="{mb}" diaginertia="{itb} {itb} {iab}"/>
+        <geom type="cylinder" size="{rb} {hb}" pos="0 0 {hb}" mass="0"/>
       </body>
     </body>
   </worldbody>
@@ -114,10 +113,15 @@ pub fn mjcf(cfg: &Config) -> String {
         joint = cat.joint.name(),
         g = f(cfg.fall.gravity),
         height = f(cfg.fall.height),
-        m = f(m),
-        it = f(it),
-        ia = f(ia),
-        r = f(r),
-        h = f(h),
+        ma = f(a.mass),
+        ita = f(a.i_t()),
+        iaa = f(a.i_a()),
+        ra = f(a.radius),
+        ha = f(a.half_length()),
+        mb = f(b.mass),
+        itb = f(b.i_t()),
+        iab = f(b.i_a()),
+        rb = f(b.radius),
+        hb = f(b.half_length()),
     )
 }

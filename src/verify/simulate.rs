@@ -11,8 +11,9 @@ use crate::config::Config;
 use crate::design::plan::ShapePlan;
 use crate::error::{Error, Result};
 use crate::model::dynamics::{angular_momentum, bias, solve2};
+use crate::model::motor::Motor;
 use crate::model::so3::{flip_and_tilt, from_na, normalize_quat, quat_from, quat_rate, wrap};
-use crate::model::{Cat, ShapeTerms, TorqueNorm};
+use crate::model::{Cat, ShapeTerms};
 use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
 
@@ -206,19 +207,19 @@ pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<S
     Ok(r)
 }
 
-/// PD tracking and saturation of a position-controlled motor.
+/// PD tracking of the plan, and the motor model: the commanded torque is
+/// clipped to the motor envelope at the current joint speed.
 #[derive(Debug, Clone, Copy)]
 pub struct Controller {
     pub kp: f64,
     pub kd: f64,
-    pub limit: Option<f64>,
-    pub norm: TorqueNorm,
+    pub motor: Motor,
 }
 
 impl Controller {
     /// Gains from the config: natural frequency `2 pi f` about `M(0) = I_t / 2`.
     pub fn from_config(cfg: &Config) -> Controller {
-        let m0 = cfg.cat().i_t() / 2.0;
+        let m0 = cfg.cat().straight_inertia();
         let wn = 2.0 * std::f64::consts::PI * cfg.simulate.pd_bandwidth_hz;
         let (kp, kd) = if cfg.simulate.pd {
             (m0 * wn * wn, 2.0 * cfg.simulate.pd_damping * m0 * wn)
@@ -228,8 +229,7 @@ impl Controller {
         Controller {
             kp,
             kd,
-            limit: cfg.limits.max_torque,
-            norm: cfg.norm(),
+            motor: cfg.motor(),
         }
     }
 
@@ -245,18 +245,7 @@ impl Controller {
         for j in 0..2 {
             tau[j] = ff[j] + self.kp * (q_ref[j] - q[j]) + self.kd * (qd_ref[j] - qd[j]);
         }
-        if let Some(lim) = self.limit {
-            match self.norm {
-                TorqueNorm::PerMotor => tau = tau.map(|x| x.clamp(-lim, lim)),
-                TorqueNorm::Euclidean => {
-                    let n = tau[0].hypot(tau[1]);
-                    if n > lim {
-                        tau = tau.map(|x| x * lim / n);
-                    }
-                }
-            }
-        }
-        tau
+        self.motor.clip(tau, qd)
     }
 }
 
@@ -291,7 +280,7 @@ pub fn dynamic(
         |i, t, y| {
             let (tau, qref) = applied(i, t, y);
             let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
-            peak = peak.max(ctrl.norm.of(tau));
+            peak = peak.max(ctrl.motor.norm.of(tau));
             track = track.max((q[0] - qref[0]).hypot(q[1] - qref[1]));
             rec.record(t, y, q, qd, tau);
         },
