@@ -545,16 +545,21 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 23] = [
+pub const UNITS: [(&str, &str); 28] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
+    ("cat.front.mass", "kg"),
+    ("cat.front.length", "m"),
+    ("cat.front.radius", "m"),
     ("fall.height", "m"),
     ("fall.gravity", "m/s^2"),
     ("fall.margin", "s"),
     ("analytic.theta_deg", "deg"),
     ("limits.max_torque", "N m"),
     ("limits.max_bend_deg", "deg"),
+    ("limits.no_load_speed", "rad/s"),
+    ("limits.max_speed", "rad/s"),
     ("simulate.rtol", "relative"),
     ("simulate.atol", "absolute"),
     ("simulate.pd_bandwidth_hz", "Hz"),
@@ -632,26 +637,32 @@ gravity = 9.8
     /// key the config lacks (sweep axes are labelled from it).
     #[test]
     fn every_numeric_key_has_a_unit() {
-        let c = Config::from_toml(
-            SEED,
-            "t",
-            &[
-                "limits.max_torque=1".into(),
-                "limits.max_bend_deg=90".into(),
-            ],
-        )
-        .unwrap();
-        let tree = toml::Table::try_from(&c).unwrap();
-        let mut numeric = Vec::new();
-        for (section, v) in &tree {
-            if let toml::Value::Table(t) = v {
-                for (k, x) in t {
-                    if x.is_integer() || x.is_float() {
-                        numeric.push(format!("{section}.{k}"));
-                    }
+        let optional = [
+            "limits.max_torque=1",
+            "limits.max_bend_deg=90",
+            "limits.no_load_speed=10",
+            "limits.max_speed=20",
+            "cat.front.mass=2",
+            "cat.front.length=1",
+            "cat.front.radius=0.1",
+        ];
+        let c = Config::from_toml(SEED, "t", &optional.map(String::from)).unwrap();
+        fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {
+            for (k, x) in t {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                match x {
+                    toml::Value::Table(inner) => walk(&key, inner, out),
+                    x if x.is_integer() || x.is_float() => out.push(key),
+                    _ => {}
                 }
             }
         }
+        let mut numeric = Vec::new();
+        walk("", &toml::Table::try_from(&c).unwrap(), &mut numeric);
         for k in &numeric {
             assert_ne!(key_label(k), *k, "{k} has no unit in UNITS");
         }

@@ -312,8 +312,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
     let sims = [&a_sim, ph_sim, fr_sim];
     let scene = report::animation::Scene {
-        length: cat.length,
-        radius: cat.radius,
+        rear: cat.rear,
+        front: cat.front,
         joint: summary.joint,
         norm: norm_name.clone(),
         max_torque_nm: cfg.limits.max_torque,

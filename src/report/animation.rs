@@ -6,6 +6,7 @@
 //! verified motion does. The world frame is body A's initial frame; the view
 //! follows the common centre of mass (the fall itself is only a readout).
 
+use crate::model::body::Half;
 use crate::model::so3::to_na;
 use crate::model::{Cat, TorqueNorm};
 use crate::verify::simulate::SimReport;
@@ -42,9 +43,9 @@ pub struct Track {
 /// Everything the player needs.
 #[derive(Debug, Clone, Serialize)]
 pub struct Scene {
-    /// Each half: length and radius, m (drawn at true size).
-    pub length: f64,
-    pub radius: f64,
+    /// The rear half A and the front half B (drawn at true size).
+    pub rear: Half,
+    pub front: Half,
     pub joint: &'static str,
     pub norm: String,
     pub max_torque_nm: Option<f64>,

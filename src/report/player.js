@@ -4,7 +4,8 @@
 (function () {
   'use strict';
   const scene = JSON.parse(document.getElementById('scene').textContent);
-  const L = scene.length, R = scene.radius;
+  const halves = { A: scene.rear, B: scene.front };
+  const L = (scene.rear.length + scene.front.length) / 2; // sets the view's scale
   const tracks = scene.tracks;
   const tEnd = Math.max(...tracks.map(tr => tr.frames[tr.frames.length - 1].t));
   const COLORS = { A: [214, 120, 40], B: [60, 110, 190] };
@@ -42,7 +43,7 @@
   // --- geometry: a cylinder along body z, centred on its centre of mass ----
   const SEG = 28;
   function cylinder(q, centre, body) {
-    const faces = [], ring = [];
+    const faces = [], ring = [], R = halves[body].radius, L = halves[body].length;
     const at = (x, y, z) => add(centre, rot(q, [x, y, z]));
     for (let i = 0; i < SEG; i++) {
       const a = 2 * Math.PI * (i + 0.5) / SEG;
@@ -63,10 +64,12 @@
     return { faces, legs };
   }
 
-  // Both halves, placed so that the common centre of mass stays at the origin.
+  // Both halves, placed so that the common centre of mass stays at the origin:
+  // d runs from A's centre through the joint to B's centre.
   function pose(s) {
-    const d = add(rot(s.a, [0, 0, L / 2]), rot(s.b, [0, 0, L / 2]));
-    return [cylinder(s.a, scale(d, -0.5), 'A'), cylinder(s.b, scale(d, 0.5), 'B')];
+    const { A, B } = halves, m = A.mass + B.mass;
+    const d = add(rot(s.a, [0, 0, A.length / 2]), rot(s.b, [0, 0, B.length / 2]));
+    return [cylinder(s.a, scale(d, -B.mass / m), 'A'), cylinder(s.b, scale(d, A.mass / m), 'B')];
   }
 
   // --- camera: world x is up on screen at rest, the spine (z) runs right ---
@@ -90,8 +93,10 @@
     const s0 = proj([0, 0, -1.6 * L]), s1 = proj([0, 0, 1.6 * L]);
     ctx.beginPath(); ctx.moveTo(s0[0], s0[1]); ctx.lineTo(s1[0], s1[1]); ctx.stroke();
     ctx.setLineDash([]);
-    const g0 = proj([0.9 * L, 0, -1.5 * L]), g1 = proj([0.5 * L, 0, -1.5 * L]);
-    arrow(ctx, g0, g1); ctx.fillStyle = '#555'; ctx.font = '12px sans-serif'; ctx.fillText('down', g0[0] + 6, g0[1]);
+    // gravity (world -x) as an arrow from a fixed corner, turning with the camera
+    const g = camera([-1, 0, 0]), gl = Math.hypot(g[0], g[1]) || 1;
+    const g0 = [40, 40], g1 = [40 + 28 * g[0] / gl, 40 - 28 * g[1] / gl];
+    arrow(ctx, g0, g1); ctx.fillStyle = '#555'; ctx.font = '12px sans-serif'; ctx.fillText('down', 8, 16);
     const light = [-0.4, 0.6, 0.7];
     const items = [];
     for (const b of bodies) {
@@ -176,7 +181,9 @@
     });
     v.canvas.addEventListener('pointerup', () => { drag = null; });
   }
-  setTime(0);
+  // #t=0.7 opens the page at that instant (for links and screenshots)
+  const at = /t=([0-9.]+)/.exec(location.hash);
+  setTime(at ? +at[1] : 0);
 
   // --- #selftest: render two instants, play briefly, report into the DOM ---
   if (location.hash === '#selftest') {
