@@ -114,7 +114,8 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = 0.05 * (hi - lo).max(1e-9);
+    // a flat series still gets room above and below
+    let pad = 0.05 * (hi - lo).max(0.2 * hi.abs().max(lo.abs())).max(1e-9);
     (lo - pad, hi + pad)
 }
 
@@ -213,8 +214,9 @@ impl<C, DB: DrawingBackend> Drawable<DB> for Mark<C> {
     }
 }
 
-/// Draws a line in `st` with `MARKS` markers spread along it, shifted by
-/// `shift` (0..1 of a marker gap) so that coinciding lines show all markers.
+/// Draws a line in `st` with markers: `MARKS` spread along a dense curve,
+/// shifted by `shift` (0..1 of a marker gap) so that coinciding lines show
+/// all their markers, or one on each point of a short series.
 fn line<'a, 'b, CT>(
     c: &mut ChartContext<'a, SVGBackend<'b>, CT>,
     pts: &[(f64, f64)],
@@ -234,12 +236,17 @@ where
             .map(|_| ()),
     }
     .map_err(perr)?;
-    if pts.len() > 1 {
+    // a few points (a sweep's samples) are each marked; a dense curve gets MARKS
+    let marks: Vec<(f64, f64)> = if pts.len() <= 4 * MARKS {
+        pts.to_vec()
+    } else {
         let gap = (pts.len() - 1) as f64 / MARKS as f64;
-        let marks = (0..MARKS).map(|k| pts[((k as f64 + 0.25 + 0.5 * shift) * gap) as usize]);
-        c.draw_series(marks.map(|p| marker(p, st.marker, st.color)))
-            .map_err(perr)?;
-    }
+        (0..MARKS)
+            .map(|k| pts[((k as f64 + 0.25 + 0.5 * shift) * gap) as usize])
+            .collect()
+    };
+    c.draw_series(marks.into_iter().map(|p| marker(p, st.marker, st.color)))
+        .map_err(perr)?;
     Ok(())
 }
 
@@ -702,7 +709,7 @@ pub fn index_html(
     h.push_str(&esc(title));
     h.push_str(concat!(
         "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}",
-        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}",
+        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right;white-space:nowrap}",
         "th{background:#eee}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}",
         ".warn{border-left:4px solid #b00;padding:2px 8px;background:#fee}",
         "#views{display:flex;flex-wrap:wrap;gap:12px}.view h3{margin:4px 0}",
