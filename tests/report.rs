@@ -113,6 +113,32 @@ fn run_writes_a_complete_consistent_report() {
             .map(|n| n.text().unwrap_or("").to_string())
             .collect();
         assert!(texts.len() > 5, "{name} has too little text");
+        // legends sit beside the plot: every label naming a method lies right
+        // of every point of every drawn curve (polylines of many points)
+        let curve_right = doc
+            .descendants()
+            .filter(|n| n.tag_name().name() == "polyline")
+            .filter_map(|n| n.attribute("points"))
+            .map(|p| p.split_whitespace().collect::<Vec<_>>())
+            .filter(|p| p.len() > 10)
+            .flat_map(|p| {
+                p.into_iter()
+                    .map(|xy| xy.split(',').next().unwrap().parse::<f64>().unwrap())
+            })
+            .fold(0.0, f64::max);
+        for t in doc.descendants().filter(|n| n.tag_name().name() == "text") {
+            let label = t.text().unwrap_or("").trim();
+            if ["analytic", "phased", "free"]
+                .iter()
+                .any(|m| label.starts_with(m))
+            {
+                let x: f64 = t.attribute("x").unwrap().parse().unwrap();
+                assert!(
+                    x > curve_right,
+                    "{name}: legend `{label}` at x {x} within the curves (to {curve_right})"
+                );
+            }
+        }
         assert!(
             texts.iter().any(|t| t.contains("time (s)")
                 || t.contains("iteration")
