@@ -52,9 +52,14 @@ pub struct Scene {
     pub tracks: Vec<Track>,
 }
 
+/// Quaternion components to 1e-7 (far below a pixel), which halves the page.
+fn short(q: [f64; 4]) -> [f64; 4] {
+    q.map(|x| (x * 1e7).round() / 1e7)
+}
+
 fn quat(r: &Rotation3<f64>) -> [f64; 4] {
     let q = UnitQuaternion::from_rotation_matrix(r);
-    [q.w, q.i, q.j, q.k]
+    short([q.w, q.i, q.j, q.k])
 }
 
 /// Picks about `count` trace points evenly spread in time (the simulation's
@@ -92,7 +97,7 @@ pub fn track(
             let rel = Rotation3::from_matrix_unchecked(to_na(&cat.rel_rotation(p.q)));
             Frame {
                 t: p.t,
-                a: p.attitude,
+                a: short(p.attitude),
                 b: quat(&(ra * rel)),
                 flip_deg: p.flip.to_degrees(),
                 bend_deg: p.q[0].hypot(p.q[1]).to_degrees(),
@@ -114,28 +119,12 @@ fn script_json(scene: &Scene) -> String {
         .replace("</", "<\\/")
 }
 
-/// The animation section of `index.html`: canvases, controls, readouts and
-/// the inline player. Open the page with `#selftest` and the player checks
-/// itself and writes the result into `<pre id="selftest">`.
+/// The animation section of `index.html` (`player.html` with the scene and
+/// `player.js` filled in): canvases, controls, readouts and the inline
+/// player. Open the page with `#selftest` and the player checks itself and
+/// writes the result into `<pre id="selftest">`.
 pub fn section(scene: &Scene) -> String {
-    format!(
-        "<section id=\"animation\">\n<h2>The flip, animated</h2>\n\
-<p>Forward simulation of each schedule: both halves at true size, in the frame of the common \
-centre of mass. Drag a view to turn the camera. The stubs mark the belly (the cat starts upside \
-down, belly up); the dashed line is the initial spine.</p>\n\
-<div class=\"controls\"><button id=\"play\" type=\"button\">play</button>\n\
-<label>time <input id=\"time\" type=\"range\" min=\"0\" max=\"1000\" value=\"0\"></label>\n\
-<span id=\"clock\">t = 0.000 s</span>\n\
-<label>speed <select id=\"speed\"><option value=\"0.05\">0.05x</option><option value=\"0.1\">0.1x</option>\
-<option value=\"0.25\" selected>0.25x</option><option value=\"0.5\">0.5x</option><option value=\"1\">1x (real time)</option></select></label>\n\
-<button id=\"reset-view\" type=\"button\">reset view</button></div>\n\
-<div id=\"views\"></div>\n\
-<pre id=\"selftest\" hidden></pre>\n<pre id=\"errors\"></pre>\n\
-<script>window.catflipErrors = []; window.addEventListener('error', e => {{ catflipErrors.push(String(e.message)); \
-document.getElementById('errors').textContent = 'script error: ' + catflipErrors.join('; '); }});</script>\n\
-<script type=\"application/json\" id=\"scene\">{}</script>\n\
-<script>\n{}</script>\n</section>\n",
-        script_json(scene),
-        include_str!("player.js")
-    )
+    include_str!("player.html")
+        .replace("{{SCENE}}", &script_json(scene))
+        .replace("{{PLAYER}}", include_str!("player.js"))
 }
