@@ -63,12 +63,16 @@ enum Command {
         #[arg(long)]
         threads: Option<usize>,
     },
-    /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model.
+    /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
         #[arg(value_enum)]
         format: ExportFormat,
         #[command(flatten)]
         common: Common,
+        /// Schedule CSV (as written by catflip) to write as `<stem>.mujoco.csv` (mjcf)
+        /// or `<stem>.pybullet.csv` (urdf) at the simulator's time step.
+        #[arg(long)]
+        schedule: Option<PathBuf>,
     },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
@@ -123,7 +127,11 @@ pub fn run() -> Result<()> {
             methods,
             threads,
         } => cmd_sweep(&common, &range, &methods, threads),
-        Command::Export { format, common } => cmd_export(&common, format),
+        Command::Export {
+            format,
+            common,
+            schedule,
+        } => cmd_export(&common, format, schedule.as_deref()),
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -644,17 +652,38 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
     Ok(())
 }
 
-fn cmd_export(c: &Common, format: ExportFormat) -> Result<()> {
+fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Result<()> {
+    use catflip::export::controls::{Controls, Simulator};
     let cfg = load(c)?;
-    let (name, text) = match format {
-        ExportFormat::Urdf => (format!("{}.urdf", cfg.name), catflip::export::urdf(&cfg)),
+    let (name, text, sim) = match format {
+        ExportFormat::Urdf => (
+            format!("{}.urdf", cfg.name),
+            catflip::export::urdf(&cfg),
+            Simulator::Pybullet,
+        ),
         ExportFormat::Mjcf => (
             format!("{}.mjcf.xml", cfg.name),
             catflip::export::mjcf(&cfg),
+            Simulator::Mujoco,
         ),
     };
     let mut out = Output::default();
     out.add(name, text);
+    if let Some(p) = schedule {
+        let text = std::fs::read_to_string(p)
+            .with_context(|| format!("cannot read schedule {}", p.display()))?;
+        let s = Schedule::from_csv(&text, &p.display().to_string())?;
+        let stem = p
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("schedule")
+            .to_string();
+        let controls = Controls::sample(&cfg, &s, sim);
+        out.add(
+            format!("{stem}.{}.csv", sim.name()),
+            controls.to_csv(&cfg, &stem),
+        );
+    }
     for w in out.commit(&out_dir(c, &cfg))? {
         println!("wrote {}", w.display());
     }

@@ -22,6 +22,8 @@ pub struct Config {
     #[serde(default)]
     pub limits: LimitsConfig,
     #[serde(default)]
+    pub design: DesignConfig,
+    #[serde(default)]
     pub simulate: SimulateConfig,
     #[serde(default)]
     pub phased: PhasedConfig,
@@ -100,6 +102,15 @@ impl Default for AnalyticConfig {
             seed_inertia: false,
         }
     }
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
+pub struct DesignConfig {
+    /// What the optimisers minimise: `peak-torque` (default), `time` (the
+    /// shortest manoeuvre inside the motor envelope, hence the least drop
+    /// height) or `energy` (`integral |tau|^2 dt` inside the envelope).
+    pub objective: crate::design::objective::Objective,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
@@ -495,6 +506,15 @@ impl Config {
         self.limits
             .norm
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
+    }
+
+    /// Whether the design needs the motor-envelope program (a speed limit, a
+    /// torque-speed line or an objective other than the peak torque) rather
+    /// than the unit-time peak program with F3 scaling.
+    pub fn uses_envelope(&self) -> bool {
+        self.design.objective != crate::design::objective::Objective::PeakTorque
+            || self.limits.max_speed.is_some()
+            || self.limits.no_load_speed.is_some()
     }
 
     /// The joint's motors as the limits describe them.

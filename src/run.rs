@@ -265,6 +265,15 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     for (m, ok) in methods.iter_mut().zip(converged) {
         m.flags = flags(m, ok, cfg.limits.max_torque);
     }
+    crate::export::add_simulator_files(
+        cfg,
+        &mut output,
+        &[
+            ("analytic", &a.plan),
+            ("phased", &ph.plan),
+            ("free", &fr.plan),
+        ],
+    );
     let traces = vec![
         trace(cfg, "analytic", &a.plan, &a_sim, 300),
         trace(cfg, "phased", &ph.plan, ph_sim, 300),

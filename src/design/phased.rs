@@ -12,6 +12,7 @@ use crate::config::Config;
 use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
 use crate::design::bend_search::{Scored, scan_then_golden};
 use crate::design::conic::SolveStatus;
+use crate::design::objective::Objective;
 use crate::design::path::{Path, PhasedPlan, Timing};
 use crate::design::timing::{PhaseTiming, TimingProblem};
 use crate::error::{Error, Result};
@@ -118,6 +119,9 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct BendEvaluation {
     pub bend_deg: f64,
+    /// The objective at this bend, in its unit (`design.objective`; infinite
+    /// where no timing fits the motor envelope).
+    pub value: f64,
     pub unit_peak: f64,
     pub peak_nm: f64,
 }
@@ -153,6 +157,12 @@ pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<Be
 pub struct PhasedResult {
     pub mode: &'static str,
     pub status: SolveStatus,
+    pub objective: Objective,
+    /// The objective's value for the written schedule, in [`Objective::unit`]
+    /// (peak torque N m, manoeuvre time s, or `integral |tau|^2 dt` N^2 m^2 s).
+    pub objective_value: f64,
+    /// Manoeuvre time of the schedule, s.
+    pub manoeuvre_time_s: f64,
     /// Peak joint torque of the written schedule (inverse dynamics, sampled
     /// densely), N m: what the motors must give.
     pub peak_torque_nm: f64,
@@ -189,6 +199,41 @@ pub struct PhasedResult {
     pub sim: Option<SimReport>,
 }
 
+/// The coarse bend scan over `[lo, hi]` rad: `phased.scan_points` even
+/// points plus the one-turn bend (F6) and the config's bend where inside.
+pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
+    let cat = cfg.cat();
+    let n = cfg.phased.scan_points;
+    let mut xs: Vec<f64> = (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect();
+    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
+    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
+    for b in [one_turn, seed_bend] {
+        if b > lo && b < hi {
+            xs.push(b);
+        }
+    }
+    xs
+}
+
+/// The bend range the config allows, rad.
+pub fn bend_range(cfg: &Config) -> Result<(f64, f64)> {
+    let lo = cfg.phased.bend_min_deg.to_radians();
+    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
+    if hi <= lo {
+        return Err(Error::Invalid {
+            key: "limits.max_bend_deg".into(),
+            value: format!("{}", cfg.max_bend().to_degrees()),
+            expected: format!(
+                "must exceed phased.bend_min_deg = {}",
+                cfg.phased.bend_min_deg
+            ),
+        });
+    }
+    Ok((lo, hi))
+}
+
 impl Scored for BendDesign {
     fn score(&self) -> f64 {
         self.unit_peak()
@@ -204,23 +249,13 @@ pub fn search_bend(
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
     let cat = cfg.cat();
     let t = cfg.available_time();
-    let lo = cfg.phased.bend_min_deg.to_radians();
-    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
-    if hi <= lo {
-        return Err(Error::Invalid {
-            key: "limits.max_bend_deg".into(),
-            value: format!("{}", cfg.max_bend().to_degrees()),
-            expected: format!(
-                "must exceed phased.bend_min_deg = {}",
-                cfg.phased.bend_min_deg
-            ),
-        });
-    }
+    let (lo, hi) = bend_range(cfg)?;
     let mut evals = Vec::new();
     let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
         let d = design_at(&cat, problem, b)?;
         let e = BendEvaluation {
             bend_deg: b.to_degrees(),
+            value: d.unit_peak() / (t * t),
             unit_peak: d.unit_peak(),
             peak_nm: d.unit_peak() / (t * t),
         };
@@ -228,17 +263,7 @@ pub fn search_bend(
         evals.push(e);
         Ok(d)
     };
-    let n = cfg.phased.scan_points;
-    let mut xs: Vec<f64> = (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect();
-    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
-    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
-    for b in [one_turn, seed_bend] {
-        if b > lo && b < hi {
-            xs.push(b);
-        }
-    }
+    let xs = bend_scan(cfg, lo, hi);
     let tol = cfg.phased.bend_tol_deg.to_radians();
     let best_d = scan_then_golden(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
@@ -267,6 +292,9 @@ pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Resul
 
 /// The phased optimiser: bend search, optimal split, reconstruction, verification.
 pub fn optimize(cfg: &Config, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    if cfg.uses_envelope() {
+        return crate::design::envelope::optimize(cfg, observe);
+    }
     let start = Instant::now();
     let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
     let (design, evals) = search_bend(cfg, &mut problem, observe)?;
@@ -299,6 +327,9 @@ pub fn finish(
     Ok(PhasedResult {
         mode: "phased",
         status,
+        objective: Objective::PeakTorque,
+        objective_value: peak,
+        manoeuvre_time_s: t,
         peak_torque_nm: peak,
         socp_peak_torque_nm: socp_peak,
         unit_peak_nm_s2: peak * t * t,

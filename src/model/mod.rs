@@ -134,15 +134,7 @@ impl Cat {
     /// Rotation of B relative to A, in A's frame.
     pub fn rel_rotation<T: Real>(&self, q: [T; 2]) -> M3<T> {
         match self.joint {
-            Joint::NoTwist => {
-                let v = [q[0], q[1], T::zero()];
-                let (a, b, _) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
-                let h = hat(v);
-                mat_add(
-                    &mat_add(&eye3(), &mat_scale(a, &h)),
-                    &mat_scale(b, &mat_mul(&h, &h)),
-                )
-            }
+            Joint::NoTwist => exp_so3([q[0], q[1], T::zero()]),
             Joint::Universal => mat_mul(&rot_x(q[0]), &rot_y(q[1])),
         }
     }
@@ -151,18 +143,8 @@ impl Cat {
     pub fn rel_rate_jacobian<T: Real>(&self, q: [T; 2]) -> [V3<T>; 2] {
         match self.joint {
             Joint::NoTwist => {
-                // Left Jacobian of SO(3): R_dot R' = hat(J_l(v) v_dot).
-                let v = [q[0], q[1], T::zero()];
-                let (_, b, c) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
-                let h = hat(v);
-                let jl = mat_add(
-                    &mat_add(&eye3(), &mat_scale(b, &h)),
-                    &mat_scale(c, &mat_mul(&h, &h)),
-                );
-                [
-                    [jl[0][0], jl[1][0], jl[2][0]],
-                    [jl[0][1], jl[1][1], jl[2][1]],
-                ]
+                let jl = left_jacobian_columns([q[0], q[1], T::zero()]);
+                [jl[0], jl[1]]
             }
             Joint::Universal => {
                 let z = T::zero();
@@ -190,14 +172,29 @@ impl Cat {
 
     /// Reduced mass matrix `M(q)` and connection `A(q) = J^-1 K` (body rate `w_A = -A q_dot`).
     pub fn locked_terms<T: Real>(&self, q: [T; 2]) -> ([[T; 2]; 2], [V3<T>; 2]) {
-        let rel = self.rel_rotation(q);
-        let sj = self.rel_rate_jacobian(q);
-        let (s, d) = self.offsets(&rel);
+        self.locked_terms_of(&self.rel_rotation(q), self.rel_rate_jacobian(q))
+    }
+
+    /// [`Cat::locked_terms`] of the no-twist cat with its twist freed: `v` is the
+    /// full rotation vector of B relative to A (a ball joint), so `M` is 3 x 3.
+    /// At `v3 = 0` its upper-left 2 x 2 block is the no-twist `M`; its third row
+    /// gives the torque that holds the twist at zero.
+    pub fn ball_locked_terms<T: Real>(&self, v: [T; 3]) -> ([[T; 3]; 3], [V3<T>; 3]) {
+        self.locked_terms_of(&exp_so3(v), left_jacobian_columns(v))
+    }
+
+    /// Locked terms for any joint with relative rotation `rel` and rate columns `sj`.
+    fn locked_terms_of<T: Real, const N: usize>(
+        &self,
+        rel: &M3<T>,
+        sj: [V3<T>; N],
+    ) -> ([[T; N]; N], [V3<T>; N]) {
+        let (s, d) = self.offsets(rel);
         let mu = c::<T>(self.reduced_mass());
         let ic = Self::body_inertia::<T>(&self.rear);
         let ib = mat_mul(
-            &mat_mul(&rel, &Self::body_inertia::<T>(&self.front)),
-            &transpose(&rel),
+            &mat_mul(rel, &Self::body_inertia::<T>(&self.front)),
+            &transpose(rel),
         );
         let gram = |a: V3<T>, b: V3<T>| {
             // hat(a)' hat(b) = (a.b) I - b a'
@@ -213,11 +210,11 @@ impl Cat {
         let j = mat_add(&mat_add(&ic, &ib), &mat_scale(mu, &gram(d, d)));
         let kt = mat_add(&ib, &mat_scale(mu, &gram(d, s)));
         let nt = mat_add(&ib, &mat_scale(mu, &gram(s, s)));
-        let k = [mat_vec(&kt, sj[0]), mat_vec(&kt, sj[1])];
-        let a = [solve3(&j, k[0]), solve3(&j, k[1])];
-        let mut m = [[T::zero(); 2]; 2];
-        for r in 0..2 {
-            for cidx in 0..2 {
+        let k: [V3<T>; N] = std::array::from_fn(|i| mat_vec(&kt, sj[i]));
+        let a: [V3<T>; N] = std::array::from_fn(|i| solve3(&j, k[i]));
+        let mut m = [[T::zero(); N]; N];
+        for r in 0..N {
+            for cidx in 0..N {
                 m[r][cidx] = dot(sj[r], mat_vec(&nt, sj[cidx])) - dot(k[r], a[cidx]);
             }
         }
@@ -233,6 +230,27 @@ impl Cat {
             -(a[0][2] * qd[0] + a[1][2] * qd[1]),
         ]
     }
+}
+
+/// `exp(hat(v))` (Rodrigues).
+fn exp_so3<T: Real>(v: V3<T>) -> M3<T> {
+    let (a, b, _) = rodrigues_coefficients(dot(v, v));
+    let h = hat(v);
+    mat_add(
+        &mat_add(&eye3(), &mat_scale(a, &h)),
+        &mat_scale(b, &mat_mul(&h, &h)),
+    )
+}
+
+/// Columns of the left Jacobian of SO(3): `R_dot R' = hat(J_l(v) v_dot)`.
+fn left_jacobian_columns<T: Real>(v: V3<T>) -> [V3<T>; 3] {
+    let (_, b, c) = rodrigues_coefficients(dot(v, v));
+    let h = hat(v);
+    let jl = mat_add(
+        &mat_add(&eye3(), &mat_scale(b, &h)),
+        &mat_scale(c, &mat_mul(&h, &h)),
+    );
+    [0, 1, 2].map(|k| [jl[0][k], jl[1][k], jl[2][k]])
 }
 
 fn rot_x<T: Real>(a: T) -> M3<T> {

@@ -12,7 +12,7 @@ use crate::design::plan::ShapePlan;
 use crate::error::{Error, Result};
 use crate::model::dynamics::{angular_momentum, bias, solve2};
 use crate::model::motor::Motor;
-use crate::model::so3::{flip_and_tilt, from_na, normalize_quat, quat_from, quat_rate, wrap};
+use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate};
 use crate::model::{Cat, ShapeTerms};
 use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
@@ -34,7 +34,8 @@ pub struct TracePoint {
 /// What a simulation reports.
 #[derive(Debug, Clone, Serialize)]
 pub struct SimReport {
-    /// Final rotation about the initial spine, `(-pi, pi]`, degrees.
+    /// Final rotation about the initial spine, unwrapped along the run
+    /// ([`FlipTracker`], the one convention of tables, JSON, figures), degrees.
     pub flip_deg: f64,
     /// `pi - |flip|`, rad.
     pub flip_error_rad: f64,
@@ -62,22 +63,9 @@ fn settings(cfg: &Config) -> OdeSettings {
     }
 }
 
-/// Tracks the unwrapped flip angle along a run.
-struct Unwrap {
-    last: f64,
-    acc: f64,
-}
-
-impl Unwrap {
-    fn push(&mut self, a: f64) -> f64 {
-        self.acc += wrap(a - self.last);
-        self.last = a;
-        self.acc
-    }
-}
-
 fn finish(
-    y_quat: &[f64],
+    flip: f64,
+    tilt: f64,
     trace: Vec<TracePoint>,
     steps: usize,
     status: OdeStatus,
@@ -87,7 +75,6 @@ fn finish(
             "the integrator stopped early ({status:?}); loosen simulate.rtol / simulate.atol or check the schedule"
         )));
     }
-    let (flip, tilt) = flip_and_tilt(&quat_from(y_quat));
     Ok(SimReport {
         flip_deg: flip.to_degrees(),
         flip_error_rad: crate::model::so3::flip_error(flip),
@@ -106,7 +93,7 @@ fn finish(
 struct Recorder<'a> {
     cat: &'a Cat,
     trace: Vec<TracePoint>,
-    unwrap: Unwrap,
+    flip: FlipTracker,
     steps: usize,
     drift: f64,
 }
@@ -116,10 +103,7 @@ impl<'a> Recorder<'a> {
         Self {
             cat,
             trace: Vec::new(),
-            unwrap: Unwrap {
-                last: 0.0,
-                acc: 0.0,
-            },
+            flip: FlipTracker::default(),
             steps: 0,
             drift: 0.0,
         }
@@ -129,7 +113,7 @@ impl<'a> Recorder<'a> {
     fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) {
         self.steps += 1;
         let qa = quat_from(quat);
-        let (f, tilt) = flip_and_tilt(&qa);
+        let (flip, tilt) = self.flip.push(&qa);
         let ra = from_na(qa.to_rotation_matrix().matrix());
         let l = angular_momentum(self.cat, &ra, self.cat.body_rate(q, qd), q, qd);
         self.drift = self
@@ -137,7 +121,7 @@ impl<'a> Recorder<'a> {
             .max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
         self.trace.push(TracePoint {
             t,
-            flip: self.unwrap.push(f),
+            flip,
             tilt,
             q,
             tau,
@@ -145,8 +129,9 @@ impl<'a> Recorder<'a> {
         });
     }
 
-    fn finish(self, quat: &[f64], status: OdeStatus) -> Result<SimReport> {
-        let mut r = finish(quat, self.trace, self.steps, status)?;
+    fn finish(mut self, quat: &[f64], status: OdeStatus) -> Result<SimReport> {
+        let (flip, tilt) = self.flip.push(&quat_from(quat));
+        let mut r = finish(flip, tilt, self.trace, self.steps, status)?;
         r.momentum_drift_nms = self.drift;
         Ok(r)
     }
