@@ -117,9 +117,9 @@
     items.sort((u, v) => u.depth - v.depth).forEach(it => it.draw());
     view.drawnLegs = bodies.flatMap(b => b.legs.map(([, q]) => proj(q).slice(0, 2)));
     const lim = scene.max_torque_nm;
-    const over = lim != null && s.tau > lim * (1 + 1e-9);
+    const over = lim != null && s.tau >= lim * (1 - 1e-6); // the simulation clips at the limit
     view.readout.innerHTML = `t = ${t.toFixed(3)} s<br>flip ${s.flip.toFixed(1)} deg<br>bend ${s.bend.toFixed(1)} deg<br>` +
-      `torque ${s.tau.toPrecision(4)} N m (${scene.norm})` + (lim != null ? ` / limit ${lim}` : '') + (over ? ' <b>at or over the limit</b>' : '');
+      `torque ${s.tau.toPrecision(4)} N m (${scene.norm})` + (lim != null ? ` / limit ${lim}` : '') + (over ? ' <b>at the limit</b>' : '');
     return s;
   }
 
