@@ -107,11 +107,11 @@
         const depth = pts.reduce((acc, p) => acc + p[2], 0) / pts.length;
         const lum = 0.35 + 0.65 * Math.max(0, n[0] * light[0] + n[1] * light[1] + n[2] * light[2]);
         const c = COLORS[fc.body].map(v => Math.round(v * lum * (fc.dark ? 0.55 : 1)));
-        items.push({ depth, draw: () => { ctx.fillStyle = ctx.strokeStyle = `rgb(${c})`; ctx.lineWidth = 1; ctx.beginPath(); pts.forEach((p, i) => i ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])); ctx.closePath(); ctx.fill(); ctx.stroke(); } });
+        items.push({ depth, draw: () => polygon(ctx, pts, `rgb(${c})`) });
       }
       for (const [p, q] of b.legs) {
         const a = proj(p), e = proj(q);
-        items.push({ depth: (a[2] + e[2]) / 2, draw: () => { ctx.strokeStyle = '#222'; ctx.lineWidth = 4; ctx.lineCap = 'round'; ctx.beginPath(); ctx.moveTo(a[0], a[1]); ctx.lineTo(e[0], e[1]); ctx.stroke(); } });
+        items.push({ depth: (a[2] + e[2]) / 2, draw: () => segment(ctx, a, e) });
       }
     }
     items.sort((u, v) => u.depth - v.depth).forEach(it => it.draw());
@@ -121,6 +121,28 @@
     view.readout.innerHTML = `t = ${t.toFixed(3)} s<br>flip ${s.flip.toFixed(1)} deg<br>bend ${s.bend.toFixed(1)} deg<br>` +
       `torque ${s.tau.toPrecision(4)} N m (${scene.norm})` + (lim != null ? ` / limit ${lim}` : '') + (over ? ' <b>at the limit</b>' : '');
     return s;
+  }
+
+  // A face, filled and outlined in its own colour (no seams between faces).
+  function polygon(ctx, pts, color) {
+    ctx.fillStyle = ctx.strokeStyle = color;
+    ctx.lineWidth = 1;
+    ctx.beginPath();
+    pts.forEach((p, i) => (i ? ctx.lineTo(p[0], p[1]) : ctx.moveTo(p[0], p[1])));
+    ctx.closePath();
+    ctx.fill();
+    ctx.stroke();
+  }
+
+  // A belly stub.
+  function segment(ctx, a, e) {
+    ctx.strokeStyle = '#222';
+    ctx.lineWidth = 4;
+    ctx.lineCap = 'round';
+    ctx.beginPath();
+    ctx.moveTo(a[0], a[1]);
+    ctx.lineTo(e[0], e[1]);
+    ctx.stroke();
   }
 
   function arrow(ctx, a, b) {
