@@ -144,7 +144,7 @@ def parse_args(engine, default_tol):
         description=f"Replay catflip's exported schedules in {engine}, feed-forward only and "
         "feed-forward + PD, and compare with catflip's summary.json."
     )
-    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed")
+    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run")
     p.add_argument("--methods", default=None,
                    help="comma-separated methods (default: all in summary.json)")
     p.add_argument("--tol-deg", type=float, default=default_tol,

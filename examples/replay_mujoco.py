@@ -2,9 +2,9 @@
 """Replay catflip's schedules in MuJoCo, unedited.
 
     catflip run configs/seed.toml
-    python examples/replay_mujoco.py output/seed
+    python examples/replay_mujoco.py output/seed/run
 
-Loads output/<name>/<name>.mjcf.xml and each output/<name>/<method>.mujoco.csv
+Loads output/<name>/run/<name>.mjcf.xml and each output/<name>/run/<method>.mujoco.csv
 as catflip wrote them, steps MuJoCo at the model's time step (the CSV's), and
 holds each row's torque over its step: once feed-forward only, once
 feed-forward plus catflip's PD (gains and torque limit from the CSV header).

@@ -2,11 +2,11 @@
 """Replay catflip's schedules in pyBullet, unedited.
 
     catflip run configs/seed.toml
-    python examples/replay_pybullet.py output/seed
+    python examples/replay_pybullet.py output/seed/run
 
-Loads output/<name>/<name>.urdf with URDF_USE_INERTIA_FROM_FILE (without it
+Loads output/<name>/run/<name>.urdf with URDF_USE_INERTIA_FROM_FILE (without it
 pyBullet recomputes the inertias from the collision cylinders) and each
-output/<name>/<method>.pybullet.csv as catflip wrote them; sets the links'
+output/<name>/run/<method>.pybullet.csv as catflip wrote them; sets the links'
 damping to zero (pyBullet's default is 0.04), steps at the CSV's time step
 and holds each row's torque over its step: once feed-forward only, once
 feed-forward plus catflip's PD. Prints flip, tilt, final shape error and peak

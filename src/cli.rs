@@ -1,9 +1,9 @@
 //! Argument parsing into a checked configuration, and the terminal tables.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use catflip::Config;
 use catflip::design::plan::Schedule;
-use catflip::output::Output;
+use catflip::output::{Output, Publisher};
 use catflip::verify::analyze::{analytic_schedule, analyze, verify};
 use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
@@ -117,7 +117,37 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
     c.out.join(&cfg.name)
 }
 
-pub fn run() -> Result<()> {
+/// Starts the command's output set `<out>/<name>/<set>` before any work, so
+/// that an unwritable `--out` fails at once.
+fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
+    Ok(Publisher::begin(&out_dir(c, cfg), set)?)
+}
+
+/// How a command that finished ended: the exit status tells them apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Every result meets its targets (exit 0).
+    Ok,
+    /// Results were written, but some are flagged or failed (exit 3).
+    Partial,
+    /// The motors cannot flip the cat from the configured height; the least
+    /// height and its schedule were written (exit 4).
+    Impossible,
+}
+
+fn status_of(partial: bool) -> Status {
+    if partial { Status::Partial } else { Status::Ok }
+}
+
+/// Prints a flagged verdict on stderr and says whether there was one.
+fn flag(what: &str, reason: Option<String>) -> bool {
+    if let Some(r) = &reason {
+        eprintln!("warning: {what} is FLAGGED: {r}");
+    }
+    reason.is_some()
+}
+
+pub fn run() -> Result<Status> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(c) => cmd_run(&c),
@@ -147,18 +177,31 @@ fn row(label: &str, value: String) {
     println!("  {label:<34} {value}");
 }
 
-fn cmd_analyze(c: &Common) -> Result<()> {
+fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
+    let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let json = serde_json::to_string_pretty(&a)?;
+    let reason = catflip::verify::simulate::misses_flip(
+        a.flip_error_rad,
+        a.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    );
+    let mut v = serde_json::to_value(&a)?;
+    v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    if let Some(r) = &reason {
+        v["reason"] = r.clone().into();
+    }
+    let json = serde_json::to_string_pretty(&v)?;
     let mut out = Output::default();
     sched.add_to(&mut out, "analytic");
     out.add("analyze.json", json.clone());
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    // the analysis is what was asked: a miss is flagged in it, not a partial result
+    flag("the seed's schedule", reason);
     if c.json {
         println!("{json}");
-        return Ok(());
+        return Ok(Status::Ok);
     }
     let cf = &a.closed;
     println!("catflip analyze: {} ({} joint)", a.name, a.joint);
@@ -221,7 +264,7 @@ fn cmd_analyze(c: &Common) -> Result<()> {
     for w in written {
         row("wrote", w.display().to_string());
     }
-    Ok(())
+    Ok(Status::Ok)
 }
 
 fn print_sim(title: &str, r: &SimReport) {
@@ -253,16 +296,36 @@ fn print_sim(title: &str, r: &SimReport) {
     row("accepted steps", format!("{}", r.steps));
 }
 
-fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
+/// Reads a schedule file, refusing one far larger than any schedule that
+/// [`catflip::verify::simulate::MAX_SCHEDULE_ROWS`] admits before reading it.
+fn read_bounded(p: &Path) -> std::io::Result<String> {
+    let limit = 500 * catflip::verify::simulate::MAX_SCHEDULE_ROWS as u64;
+    let len = std::fs::metadata(p)?.len();
+    if len > limit {
+        return Err(std::io::Error::other(format!(
+            "{len} bytes, more than a schedule of {} rows can have; resample it more coarsely",
+            catflip::verify::simulate::MAX_SCHEDULE_ROWS
+        )));
+    }
+    std::fs::read_to_string(p)
+}
+
+fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     let cfg = load(c)?;
-    let (source, report) = match schedule {
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .with_context(|| format!("cannot read schedule {}", p.display()))?;
-            let s = Schedule::from_csv(&text, &p.display().to_string())?;
+    let text = match schedule {
+        Some(p) => Some(read_bounded(p).map_err(|e| {
+            catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
+        })?),
+        None => None,
+    };
+    let publisher = publisher(c, &cfg, "simulate")?;
+    let (source, report) = match (schedule, text) {
+        (Some(p), Some(text)) => {
+            let s =
+                catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
             (p.display().to_string(), verify(&cfg, &s)?)
         }
-        None => {
+        _ => {
             let plan = catflip::design::analytic::analytic_plan(&cfg);
             ("analytic schedule".to_string(), verify(&cfg, &plan)?)
         }
@@ -274,12 +337,22 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
             p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
         ));
     }
+    let reason = catflip::verify::simulate::misses_flip(
+        report.flip_error_rad,
+        report.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    );
     let mut out = Output::default();
     out.add("simulation.csv", trace);
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    let partial = flag("the simulated schedule", reason.clone());
     if c.json {
         let mut v = serde_json::to_value(&report)?;
         v["source"] = serde_json::Value::String(source);
+        v["verdict"] = (if partial { "flagged" } else { "ok" }).into();
+        if let Some(r) = reason {
+            v["reason"] = r.into();
+        }
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         print_sim(
@@ -293,22 +366,30 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
             row("wrote", w.display().to_string());
         }
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
 /// Writes `<stem>.csv` and `<stem>.json`; prints the JSON and returns `None` with `--json`.
 fn write_design(
     c: &Common,
     cfg: &Config,
+    publisher: Publisher,
     stem: &str,
     plan: &dyn catflip::design::plan::ShapePlan,
-    json: String,
+    json: serde_json::Value,
+    reason: Option<String>,
 ) -> Result<Option<Vec<PathBuf>>> {
+    let mut json = json;
+    json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    if let Some(r) = reason {
+        json["reason"] = r.into();
+    }
+    let json = serde_json::to_string_pretty(&json)?;
     let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
     let mut out = Output::default();
     sched.add_to(&mut out, stem);
     out.add(format!("{stem}.json"), json.clone());
-    let written = out.commit(&out_dir(c, cfg))?;
+    let written = publisher.publish(out)?;
     if c.json {
         println!("{json}");
         return Ok(None);
@@ -340,8 +421,28 @@ fn design_rows(
     }
 }
 
-fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<()> {
+/// Why an optimiser's verified design is flagged: unconverged, or the flip missed.
+fn design_flags(cfg: &Config, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "solved" | "converged") {
+        why.push(format!("solver status {status}"));
+    }
+    why.extend(catflip::verify::simulate::misses_flip(
+        flip_error_rad,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
+    let set = match mode {
+        Mode::Phased => "optimize-phased",
+        Mode::Free => "optimize-free",
+    };
+    let publisher = publisher(c, &cfg, set)?;
+    let partial;
     match mode {
         Mode::Phased => {
             let r = catflip::design::phased::optimize(&cfg, |e| {
@@ -352,15 +453,24 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
+            let reason = design_flags(
+                &cfg,
+                &catflip::run::json_name(&r.status),
+                r.flip_error_rad,
+                r.tilt_deg,
+            );
+            partial = flag("the phased design", reason.clone());
             let Some(written) = write_design(
                 c,
                 &cfg,
+                publisher,
                 "phased",
                 &r.plan,
-                serde_json::to_string_pretty(&r)?,
+                serde_json::to_value(&r)?,
+                reason,
             )?
             else {
-                return Ok(());
+                return Ok(status_of(partial));
             };
             println!(
                 "catflip optimize --mode phased: {} ({} joint), status {}",
@@ -428,10 +538,24 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
-            let Some(written) =
-                write_design(c, &cfg, "free", &r.plan, serde_json::to_string_pretty(&r)?)?
+            let reason = design_flags(
+                &cfg,
+                &catflip::run::json_name(&r.status),
+                r.flip_error_rad,
+                r.tilt_deg,
+            );
+            partial = flag("the free-form design", reason.clone());
+            let Some(written) = write_design(
+                c,
+                &cfg,
+                publisher,
+                "free",
+                &r.plan,
+                serde_json::to_value(&r)?,
+                reason,
+            )?
             else {
-                return Ok(());
+                return Ok(status_of(partial));
             };
             println!(
                 "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
@@ -468,7 +592,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             );
         }
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
 /// Stage lines on stderr; live iteration counters when stderr is a terminal.
@@ -494,6 +618,12 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
                 }
                 let _ = writeln!(e, " done in {seconds:.2} s");
             }
+            Progress::StageFailed { seconds, reason } => {
+                if live {
+                    let _ = write!(e, "\r\x1b[2K");
+                }
+                let _ = writeln!(e, " FAILED after {seconds:.2} s: {reason}");
+            }
             Progress::Bend {
                 evaluations,
                 bend_deg,
@@ -517,14 +647,21 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
     }
 }
 
-fn cmd_run(c: &Common) -> Result<()> {
+fn cmd_run(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
+    let publisher = publisher(c, &cfg, "run")?;
+    let dir = publisher.link();
     let r = catflip::run::run(&cfg, progress_display(c.json))?;
-    let dir = out_dir(c, &cfg);
-    let written = r.output.commit(&dir)?;
+    let partial = r.is_partial();
+    let status = if r.is_impossible() {
+        Status::Impossible
+    } else {
+        status_of(partial)
+    };
+    let written = publisher.publish(r.output)?;
     if c.json {
         println!("{}", serde_json::to_string_pretty(&r.summary)?);
-        return Ok(());
+        return Ok(status);
     }
     let s = &r.summary;
     println!();
@@ -536,7 +673,8 @@ fn cmd_run(c: &Common) -> Result<()> {
     );
     let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
-    let widths: Vec<usize> = (0..header.len())
+    // the last column (verdict) is left as is: it holds the reasons
+    let widths: Vec<usize> = (0..header.len() - 1)
         .map(|j| {
             rows.iter()
                 .map(|r| r[j].len())
@@ -549,7 +687,10 @@ fn cmd_run(c: &Common) -> Result<()> {
         let parts: Vec<String> = cells
             .iter()
             .enumerate()
-            .map(|(j, c)| format!("{c:>w$}", w = widths[j]))
+            .map(|(j, c)| match widths.get(j) {
+                Some(w) => format!("{c:>w$}"),
+                None => c.to_string(),
+            })
             .collect();
         println!("  {}", parts.join("  "));
     };
@@ -557,26 +698,46 @@ fn cmd_run(c: &Common) -> Result<()> {
     for row in rows {
         line(row);
     }
-    for m in &s.methods {
-        for w in catflip::run::warnings(m, s.max_torque_nm) {
-            println!("  warning: {w}");
-        }
-    }
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     println!(
-        "  free-form / phased peak {:.3}, phased / analytic {:.3}; {} SCP iterations at {} nodes per phase",
-        s.free_over_phased, s.phased_over_analytic, s.scp_iterations, s.nodes
+        "  free-form / phased peak {}, phased / analytic {}; {} SCP iterations at {} nodes per phase",
+        show(s.free_over_phased),
+        show(s.phased_over_analytic),
+        s.scp_iterations,
+        s.nodes
     );
+    if let Some(a) = &s.answer {
+        println!("  {}", a.sentence());
+    }
     println!(
         "  report: {} ({} files)",
         dir.join("index.html").display(),
         written.len()
     );
-    Ok(())
+    if status == Status::Impossible {
+        eprintln!("the flip is not possible from this height: exit status 4");
+    } else if partial {
+        eprintln!(
+            "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3"
+        );
+    }
+    Ok(status)
 }
 
-fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>) -> Result<()> {
+fn cmd_sweep(
+    c: &Common,
+    range: &str,
+    methods: &[String],
+    threads: Option<usize>,
+) -> Result<Status> {
     let cfg = load(c)?;
     let spec: catflip::sweep::SweepSpec = range.parse()?;
+    if threads == Some(0) {
+        return Err(catflip::Error::Usage(
+            "--threads 0: at least one point must be computed at a time; give --threads 1 or more, or leave it out for one per core".into(),
+        )
+        .into());
+    }
     let mut m = catflip::sweep::Methods {
         analytic: false,
         phased: false,
@@ -587,9 +748,12 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
             "analytic" => m.analytic = true,
             "phased" => m.phased = true,
             "free" => m.free = true,
-            other => anyhow::bail!(
-                "unknown method `{other}` in --methods; use analytic, phased and/or free"
-            ),
+            other => {
+                return Err(catflip::Error::Usage(format!(
+                    "unknown method `{other}` in --methods; use analytic, phased and/or free"
+                ))
+                .into());
+            }
         }
     }
     let threads = threads.unwrap_or_else(|| {
@@ -598,6 +762,19 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
             .unwrap_or(1)
     });
     let quiet = c.json;
+    // a file-name-safe key (an unknown key is refused below, but names the staging first)
+    let key: String = spec
+        .key
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     let points = catflip::sweep::sweep(&c.config, &c.set, &spec, m, threads, |done, total| {
         if !quiet {
             eprint!("\r  sweep {}: {done}/{total} points", spec.key);
@@ -606,7 +783,7 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
     if !quiet {
         eprintln!();
     }
-    let key = spec.key.replace('.', "_");
+    let partial = points.iter().any(|p| p.error.is_some());
     let mut out = Output::default();
     out.add(
         format!("sweep-{key}.csv"),
@@ -615,10 +792,17 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
     for (name, svg) in catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)? {
         out.add(name, svg);
     }
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    if partial {
+        eprintln!(
+            "warning: partial result: {} of {} points have errors (see the error column); exit status 3",
+            points.iter().filter(|p| p.error.is_some()).count(),
+            points.len()
+        );
+    }
     if c.json {
         println!("{}", serde_json::to_string_pretty(&points)?);
-        return Ok(());
+        return Ok(status_of(partial));
     }
     println!(
         "catflip sweep: {} over {} ({} points, {threads} at a time)",
@@ -649,13 +833,24 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
     for w in written {
         row("wrote", w.display().to_string());
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
-fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Result<()> {
+fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Result<Status> {
     use catflip::export::controls::{Controls, Simulator};
     let cfg = load(c)?;
-    let (name, text, sim) = match format {
+    let set = match format {
+        ExportFormat::Urdf => "export-urdf",
+        ExportFormat::Mjcf => "export-mjcf",
+    };
+    let text = match schedule {
+        Some(p) => Some(read_bounded(p).map_err(|e| {
+            catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
+        })?),
+        None => None,
+    };
+    let publisher = publisher(c, &cfg, set)?;
+    let (name, text_model, sim) = match format {
         ExportFormat::Urdf => (
             format!("{}.urdf", cfg.name),
             catflip::export::urdf(&cfg),
@@ -668,11 +863,9 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
         ),
     };
     let mut out = Output::default();
-    out.add(name, text);
-    if let Some(p) = schedule {
-        let text = std::fs::read_to_string(p)
-            .with_context(|| format!("cannot read schedule {}", p.display()))?;
-        let s = Schedule::from_csv(&text, &p.display().to_string())?;
+    out.add(name, text_model);
+    if let (Some(p), Some(text)) = (schedule, text) {
+        let s = catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
         let stem = p
             .file_stem()
             .and_then(|s| s.to_str())
@@ -684,8 +877,8 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
             controls.to_csv(&cfg, &stem),
         );
     }
-    for w in out.commit(&out_dir(c, &cfg))? {
+    for w in publisher.publish(out)? {
         println!("wrote {}", w.display());
     }
-    Ok(())
+    Ok(Status::Ok)
 }

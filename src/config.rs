@@ -88,10 +88,24 @@ pub struct AnalyticConfig {
     /// Angle between the halves during the twist, degrees (default 45, the seed's pi/4).
     pub theta_deg: f64,
     /// Fractions of the manoeuvre time for fold, twist, unfold (default 0.2, 0.6, 0.2).
+    #[serde(deserialize_with = "three_fractions")]
     pub split: [f64; 3],
     /// Use the seed's transverse inertia `m (r^2 + l^2)/12` (erratum E1) to reproduce
     /// its printed example (default false).
     pub seed_inertia: bool,
+}
+
+/// `analytic.split`: exactly three numbers, no more, no fewer.
+fn three_fractions<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<[f64; 3], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "analytic.split needs exactly 3 fractions (fold, twist, unfold), got {}",
+            v.len()
+        ))
+    })
 }
 
 impl Default for AnalyticConfig {
@@ -145,6 +159,9 @@ pub struct SimulateConfig {
     pub pd_damping: f64,
     /// Rows per phase in written schedules (default 200).
     pub samples_per_phase: usize,
+    /// Largest flip error and spine tilt of a simulated design, rad, beyond
+    /// which the design is flagged as missing the flip (default 0.01).
+    pub flip_tolerance: f64,
 }
 
 impl Default for SimulateConfig {
@@ -156,6 +173,7 @@ impl Default for SimulateConfig {
             pd_bandwidth_hz: 10.0,
             pd_damping: 1.0,
             samples_per_phase: 200,
+            flip_tolerance: 0.01,
         }
     }
 }
@@ -232,25 +250,54 @@ impl Config {
         Self::from_toml(&text, &path.display().to_string(), overrides)
     }
 
+    /// Parses the user's text, applies `--set` overrides and validates. An
+    /// error in the file points at the file's own line; an error in an
+    /// override names that `--set` argument.
     pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| Error::ConfigParse {
+        let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
             message: e.to_string(),
-        })?;
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
+        // the file alone, parsed from its own text: unknown keys and wrong
+        // types carry the file's line; a missing key may come from an override
+        if let Err(e) = toml::from_str::<Config>(text)
+            && (overrides.is_empty() || !e.message().starts_with("missing field"))
+        {
+            return Err(file_err(e));
+        }
+        // each override alone on a complete config, so that its error names it
+        let template = toml::Table::try_from(Config::template()).expect("the template serialises");
         for arg in overrides {
+            let mut t = template.clone();
+            apply_override(&mut t, arg)?;
+            if let Err(e) = t.try_into::<Config>() {
+                return Err(Error::Override {
+                    arg: arg.clone(),
+                    message: e.message().trim().to_string(),
+                });
+            }
             apply_override(&mut table, arg)?;
         }
-        let merged = toml::to_string(&table).expect("a TOML table serialises");
-        let cfg: Config = toml::from_str(&merged).map_err(|e| Error::ConfigParse {
-            origin: if overrides.is_empty() {
-                origin.into()
-            } else {
-                format!("{origin} (with --set overrides)")
-            },
-            message: e.to_string(),
-        })?;
+        // together: what is left is a key that neither gives
+        let cfg: Config = table
+            .try_into()
+            .map_err(|e: toml::de::Error| Error::ConfigParse {
+                origin: format!("{origin} (with --set overrides)"),
+                message: e.message().trim().to_string(),
+            })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+
+    /// A complete valid config (the seed's cat), the base on which each
+    /// `--set` is checked alone.
+    fn template() -> Config {
+        // parsed rather than built, so that sections added later come with their defaults
+        toml::from_str(
+            "name = \"template\"\n[cat]\nmass = 1.0\nlength = 1.0\nradius = 0.1\n[fall]\nheight = 10.0\n",
+        )
+        .expect("the template config parses")
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -399,12 +446,18 @@ impl Config {
             s.pd_damping > 0.0,
             "must be > 0",
         )?;
+        check(
+            "simulate.flip_tolerance",
+            s.flip_tolerance,
+            s.flip_tolerance > 0.0 && s.flip_tolerance <= std::f64::consts::PI,
+            "must be in (0, pi] rad",
+        )?;
         let n = s.samples_per_phase as f64;
         check(
             "simulate.samples_per_phase",
             n,
-            (2.0..=100_000.0).contains(&n),
-            "must be in 2..=100000",
+            (2.0..=30_000.0).contains(&n),
+            "must be in 2..=30000",
         )?;
         let p = &self.phased;
         check(
@@ -565,7 +618,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 28] = [
+pub const UNITS: [(&str, &str); 29] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -585,6 +638,7 @@ pub const UNITS: [(&str, &str); 28] = [
     ("simulate.pd_bandwidth_hz", "Hz"),
     ("simulate.pd_damping", "damping ratio"),
     ("simulate.samples_per_phase", "rows per phase"),
+    ("simulate.flip_tolerance", "rad"),
     ("phased.nodes", "intervals per phase"),
     ("phased.bend_min_deg", "deg"),
     ("phased.bend_max_deg", "deg"),

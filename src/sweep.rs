@@ -23,7 +23,7 @@ pub struct SweepSpec {
 impl std::str::FromStr for SweepSpec {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        let bad = |m: &str| Error::Override {
+        let bad = |m: &str| Error::Range {
             arg: s.into(),
             message: format!("{m}; expected KEY=FROM:TO:COUNT, e.g. fall.height=0.5:10:40"),
         };
@@ -42,8 +42,13 @@ impl std::str::FromStr for SweepSpec {
             .trim()
             .parse()
             .map_err(|_| bad("COUNT must be a whole number"))?;
-        if count < 1 || !from.is_finite() || !to.is_finite() {
+        if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
+        }
+        if count > MAX_POINTS {
+            return Err(bad(&format!(
+                "COUNT {count} is more than the {MAX_POINTS} points a sweep may have; split the range into several sweeps"
+            )));
         }
         Ok(SweepSpec {
             key: key.trim().into(),
@@ -54,13 +59,22 @@ impl std::str::FromStr for SweepSpec {
     }
 }
 
+/// Most points a sweep may have: each point runs whole optimisations, so
+/// more would take days; the bound also keeps the result table in memory.
+pub const MAX_POINTS: usize = 10_000;
+
 impl SweepSpec {
+    /// The argument as the user would write it, for messages.
+    pub fn arg(&self) -> String {
+        format!("{}={}:{}:{}", self.key, self.from, self.to, self.count)
+    }
+
     pub fn values(&self) -> Vec<f64> {
         if self.count == 1 {
             return vec![self.from];
         }
         (0..self.count)
-            .map(|i| self.from + (self.to - self.from) * i as f64 / (self.count - 1) as f64)
+            .map(|i| self.from + (self.to - self.from) * (i as f64 / (self.count - 1) as f64))
             .collect()
     }
 }
@@ -107,27 +121,89 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
             .0,
         );
     }
+    // a method that fails leaves its columns empty and its reason in `error`;
+    // the other methods' numbers are kept
+    let mut errors = Vec::new();
     if methods.phased || methods.free {
-        let ph = crate::design::phased::optimize(&cfg, |_| {})?;
-        if methods.phased {
-            p.phased_peak_nm = Some(ph.peak_torque_nm);
-            p.phased_bend_deg = Some(ph.bend_deg);
-            p.least_height_phased_m = limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
+        let ph = crate::design::phased::optimize(&cfg, |_| {});
+        match &ph {
+            Ok(ph) if methods.phased => {
+                errors.extend(flagged(
+                    "phased",
+                    &format!("{:?}", ph.status),
+                    ph.flip_error_rad,
+                    ph.tilt_deg,
+                    &cfg,
+                ));
+                p.phased_peak_nm = Some(ph.peak_torque_nm);
+                p.phased_bend_deg = Some(ph.bend_deg);
+                p.least_height_phased_m =
+                    limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
+            }
+            Err(e) if methods.phased => errors.push(format!("phased: {e}")),
+            _ => {}
         }
         if methods.free {
-            let fr = crate::design::free::optimize_from(
-                &cfg,
-                &ph.plan,
-                "phased",
-                cfg.free.nodes,
-                |_| {},
-            )?;
-            p.free_peak_nm = Some(fr.peak_torque_nm);
-            p.free_bend_deg = Some(fr.bend_deg);
-            p.least_height_free_m = limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+            // seeded by the phased design, or by the analytic plan when that failed
+            let fr = match &ph {
+                Ok(ph) => crate::design::free::optimize_from(
+                    &cfg,
+                    &ph.plan,
+                    "phased",
+                    cfg.free.nodes,
+                    |_| {},
+                ),
+                Err(_) => crate::design::free::optimize_from(
+                    &cfg,
+                    &analytic_plan(&cfg),
+                    "analytic",
+                    cfg.free.nodes,
+                    |_| {},
+                ),
+            };
+            match fr {
+                Ok(fr) => {
+                    errors.extend(flagged(
+                        "free",
+                        &format!("{:?}", fr.status),
+                        fr.flip_error_rad,
+                        fr.tilt_deg,
+                        &cfg,
+                    ));
+                    p.free_peak_nm = Some(fr.peak_torque_nm);
+                    p.free_bend_deg = Some(fr.bend_deg);
+                    p.least_height_free_m =
+                        limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+                }
+                Err(e) => errors.push(format!("free: {e}")),
+            }
         }
     }
+    if !errors.is_empty() {
+        p.error = Some(errors.join("; "));
+    }
     Ok(p)
+}
+
+/// A kept design that misses a target (unconverged, flip missed) is named in
+/// the point's `error` column beside its numbers.
+fn flagged(
+    method: &str,
+    status: &str,
+    flip_error: f64,
+    tilt_deg: f64,
+    cfg: &Config,
+) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "Solved" | "Converged") {
+        why.push(format!("solver status {}", status.to_lowercase()));
+    }
+    why.extend(crate::verify::simulate::misses_flip(
+        flip_error,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
 /// Runs a sweep on the config at `path` (with `overrides`), `threads` points at a time.
@@ -145,10 +221,31 @@ pub fn sweep(
         ov.push(format!("{}={}", spec.key, v));
         Config::load(path, &ov)
     };
-    // a bad key or an out-of-range end fails before any work
-    let mut configs = Vec::with_capacity(values.len());
-    for &v in &values {
-        configs.push(load(v)?);
+    // a point whose config is invalid is that point's failure; when every
+    // point is invalid (e.g. an unknown key) the sweep fails before any work
+    let configs: Vec<Result<Config>> = values
+        .iter()
+        .map(|&v| {
+            load(v).map_err(|e| Error::Range {
+                arg: spec.arg(),
+                message: match e {
+                    // the override is internal: name the point, not a `--set`
+                    Error::Override { message, .. } => format!("at {} = {v}: {message}", spec.key),
+                    e => format!("at {} = {v}: {e}", spec.key),
+                },
+            })
+        })
+        .collect();
+    if let Some(Err(first)) = configs.first()
+        && configs.iter().all(|c| c.is_err())
+    {
+        return Err(Error::Range {
+            arg: spec.arg(),
+            message: match first {
+                Error::Range { message, .. } => format!("every point is invalid; {message}"),
+                e => e.to_string(),
+            },
+        });
     }
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
@@ -161,11 +258,15 @@ pub fn sweep(
                     if i >= values.len() {
                         break;
                     }
-                    let p = point(&configs[i], values[i], methods).unwrap_or_else(|e| SweepPoint {
-                        value: values[i],
-                        error: Some(e.to_string()),
-                        ..Default::default()
-                    });
+                    let p = configs[i]
+                        .as_ref()
+                        .map_err(|e| e.to_string())
+                        .and_then(|c| point(c, values[i], methods).map_err(|e| e.to_string()))
+                        .unwrap_or_else(|e| SweepPoint {
+                            value: values[i],
+                            error: Some(e),
+                            ..Default::default()
+                        });
                     results.lock().unwrap()[i] = Some(p);
                     progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
                 }

@@ -25,7 +25,7 @@ fn report_page_renders_runs_and_animates_in_chromium() {
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let base = dir.path().join("output/seed");
+    let base = dir.path().join("output/seed/run");
     let profile = tempfile::tempdir().unwrap();
     let url = format!("file://{}#selftest", base.join("index.html").display());
     let out = Command::new("chromium")

@@ -76,6 +76,10 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
         ("robot-universal", &[][..]),
         ("robot-universal", &unequal[..]),
         ("seed", &unequal[..2]),
+        (
+            "seed",
+            &["limits.max_torque=2.5", "cat.joint=universal"][..],
+        ),
     ] {
         let cfg = config(name, set);
         let cat = cfg.cat();
@@ -85,6 +89,11 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
             other => panic!("unexpected link {other}"),
         };
         let limit = cfg.limits.max_torque;
+        // URDF effort: the stall torque, or with a torque-speed line the most
+        // the envelope allows (braking at the speed limit)
+        let speed = cfg.limits.max_speed.or(cfg.limits.no_load_speed);
+        let effort = limit.map(|t| t + cfg.motor().slope() * speed.unwrap_or(0.0));
+        let torque_line = cfg.limits.no_load_speed.is_some();
 
         let urdf = catflip::export::urdf(&cfg);
         assert!(urdf.contains("URDF_USE_INERTIA_FROM_FILE"));
@@ -129,7 +138,7 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
                 for j in &joints {
                     assert_eq!(j.attribute("type"), Some("revolute"));
                     let lim = j.children().find(|n| n.has_tag_name("limit")).unwrap();
-                    assert!(close(lim.attribute("effort").unwrap(), limit.unwrap()));
+                    assert!(close(lim.attribute("effort").unwrap(), effort.unwrap()));
                 }
             }
             Joint::NoTwist => {
@@ -200,7 +209,13 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
             }
             Joint::Universal => assert_eq!(motors.len(), 2),
         }
-        for m in &motors {
+        if torque_line {
+            // MJCF motors cannot say a torque-speed line: no clipping range,
+            // the header says so and the replays clip to the envelope
+            assert!(motors.iter().all(|m| m.attribute("ctrlrange").is_none()));
+            assert!(mjcf.contains("no_load_speed") || mjcf.contains("torque-speed"));
+        }
+        for m in motors.iter().filter(|_| !torque_line) {
             match limit {
                 Some(l) => {
                     let r: Vec<&str> = m.attribute("ctrlrange").unwrap().split(' ').collect();
@@ -223,8 +238,10 @@ fn held_torques_carry_the_schedules_impulse() {
     let c = cfg_path.to_str().unwrap();
     let (ok, _, err) = run(&["analyze", c], dir.path());
     assert!(ok, "{err}");
-    let base = dir.path().join("output/robot-universal");
-    let sched = base.join("analytic.csv");
+    let sched = dir
+        .path()
+        .join("output/robot-universal/analyze/analytic.csv");
+    let base = dir.path().join("output/robot-universal/export-mjcf");
     let (ok, out, err) = run(
         &["export", "mjcf", c, "--schedule", sched.to_str().unwrap()],
         dir.path(),

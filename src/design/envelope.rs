@@ -89,6 +89,9 @@ pub struct EnvelopeDesign {
     pub status: SolveStatus,
     /// Tangent updates of the torque-speed line.
     pub iterations: usize,
+    /// `s_dot^2` at every point of each phase, 1/s^2 (a tangent point for
+    /// another program on the same paths).
+    point_betas: Option<[Vec<f64>; 3]>,
 }
 
 impl Scored for EnvelopeDesign {
@@ -411,6 +414,33 @@ impl EnvelopeProblem {
         twist: f64,
         shrink: f64,
     ) -> Result<EnvelopeDesign> {
+        let first = self.solve_from(cat, bend, twist, shrink, None)?;
+        if first.timings.is_some() || self.budget.is_none() || self.motor.slope() == 0.0 {
+            return Ok(first);
+        }
+        // The first tangent (at the no-load speed) can be too conservative
+        // for a tight budget: start from the shortest manoeuvre instead,
+        // which fits any budget at least as long as itself.
+        let mut timed = EnvelopeProblem::new(self.k, self.motor, Objective::Time, None);
+        let fastest = timed.solve_from(cat, bend, twist, shrink, None)?;
+        match fastest.point_betas {
+            Some(b) if fastest.value <= self.budget.unwrap_or(0.0) => {
+                self.solve_from(cat, bend, twist, shrink, Some(b))
+            }
+            _ => Ok(first),
+        }
+    }
+
+    /// [`Self::solve`] from a given first tangent point (`s_dot^2` at every
+    /// point, 1/s^2), or from the no-load speed.
+    fn solve_from(
+        &mut self,
+        cat: &Cat,
+        bend: f64,
+        twist: f64,
+        shrink: f64,
+        start: Option<[Vec<f64>; 3]>,
+    ) -> Result<EnvelopeDesign> {
         let paths = Path::phased(bend, twist);
         let cols = Cols::new(self.k, self.objective);
         let m0 = cat.straight_inertia();
@@ -456,15 +486,18 @@ impl EnvelopeProblem {
         // speed: beyond it a motor can only brake, so this is where the line
         // matters, and the first program is already conservative
         let no_load = lim.torque.unwrap_or(0.0) / lim.slope.max(1e-300);
-        let mut beta0: [Vec<f64>; 3] = data.each_ref().map(|pts| {
-            pts.iter()
-                .map(|pd| {
-                    (no_load / self.motor.norm.of(pd.dq).max(1e-9))
-                        .powi(2)
-                        .min(1e12)
-                })
-                .collect()
-        });
+        let mut beta0: [Vec<f64>; 3] = match start {
+            Some(b) => b.map(|v| v.iter().map(|x| x * ts * ts).collect()),
+            None => data.each_ref().map(|pts| {
+                pts.iter()
+                    .map(|pd| {
+                        (no_load / self.motor.norm.of(pd.dq).max(1e-9))
+                            .powi(2)
+                            .min(1e12)
+                    })
+                    .collect()
+            }),
+        };
         let mut out: Option<(SolveStatus, Vec<f64>, f64)> = None;
         let mut iterations = 0;
         for it in 0..40 {
@@ -481,6 +514,7 @@ impl EnvelopeProblem {
                         value: f64::INFINITY,
                         status,
                         iterations,
+                        point_betas: None,
                     });
                 }
                 break;
@@ -508,6 +542,12 @@ impl EnvelopeProblem {
             Objective::Time => durations.iter().sum(),
             Objective::Energy => obj * nu * nu * ts,
         };
+        let point_betas = [0, 1, 2].map(|p| {
+            point_betas(&cols, &x, p)
+                .iter()
+                .map(|b| b / (ts * ts))
+                .collect()
+        });
         Ok(EnvelopeDesign {
             bend,
             twist,
@@ -516,6 +556,7 @@ impl EnvelopeProblem {
             value,
             status,
             iterations,
+            point_betas: Some(point_betas),
         })
     }
 }
@@ -627,26 +668,34 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
         budget,
     );
     let mut problem = EnvelopeProblem::new(cfg.phased.nodes, cfg.motor(), objective, budget);
-    let best = search(
-        &cat,
-        &mut coarse,
-        bend_scan(cfg, lo, hi),
-        cfg.phased.bend_tol_deg.to_radians(),
-        |d| {
-            let e = BendEvaluation {
-                bend_deg: d.bend.to_degrees(),
-                value: d.value,
-                unit_peak: f64::NAN,
-                peak_nm: if objective == Objective::PeakTorque {
-                    d.value
-                } else {
-                    f64::NAN
-                },
-            };
-            observe(&e);
-            evals.push(e);
-        },
-    )?;
+    let mut record = |d: &EnvelopeDesign| {
+        let e = BendEvaluation {
+            bend_deg: d.bend.to_degrees(),
+            value: d.value,
+            unit_peak: f64::NAN,
+            peak_nm: if objective == Objective::PeakTorque {
+                d.value
+            } else {
+                f64::NAN
+            },
+        };
+        observe(&e);
+        evals.push(e);
+    };
+    let scan = bend_scan(cfg, lo, hi);
+    let spacing = (hi - lo) / (scan.len().max(2) - 1) as f64;
+    let tol = cfg.phased.bend_tol_deg.to_radians();
+    let mut best = search(&cat, &mut coarse, scan, tol, &mut record)?;
+    if !best.value.is_finite() && budget.is_some() {
+        // a budget close to the least time leaves a narrow band of feasible
+        // bends that the scan can miss: look around the time-optimal bend
+        let mut timed = EnvelopeProblem::new(coarse.k, cfg.motor(), Objective::Time, None);
+        let fastest = search(&cat, &mut timed, bend_scan(cfg, lo, hi), tol, |_| {})?;
+        let around: Vec<f64> = (-3..=3)
+            .map(|i| (fastest.bend + spacing * i as f64 / 6.0).clamp(lo, hi))
+            .collect();
+        best = search(&cat, &mut coarse, around, tol, &mut record)?;
+    }
     let found = if best.value.is_finite() {
         verified_design(cfg, &mut problem, best.bend)?
     } else {

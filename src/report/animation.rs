@@ -35,7 +35,7 @@ pub struct Frame {
 #[derive(Debug, Clone, Serialize)]
 pub struct Track {
     pub name: String,
-    /// The method's status line of the summary table (flags included).
+    /// The method's status and verdict from the summary table (set by the run).
     pub status: String,
     pub frames: Vec<Frame>,
 }
@@ -64,14 +64,7 @@ fn quat(r: &Rotation3<f64>) -> [f64; 4] {
 
 /// Picks about `count` trace points evenly spread in time (the simulation's
 /// adaptive steps are uneven) and adds body B's attitude `R_A R_rel(q)`.
-pub fn track(
-    cat: &Cat,
-    norm: TorqueNorm,
-    name: &str,
-    status: &str,
-    sim: &SimReport,
-    count: usize,
-) -> Track {
+pub fn track(cat: &Cat, norm: TorqueNorm, name: &str, sim: &SimReport, count: usize) -> Track {
     let tr = &sim.trace;
     let mut picked: Vec<usize> = Vec::new();
     if let (Some(first), Some(last)) = (tr.first(), tr.last()) {
@@ -107,7 +100,7 @@ pub fn track(
         .collect();
     Track {
         name: name.into(),
-        status: status.into(),
+        status: String::new(),
         frames,
     }
 }
