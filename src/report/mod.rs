@@ -385,21 +385,22 @@ pub fn angles(methods: &[MethodTrace]) -> Result<String> {
 }
 
 /// Joint torque (peak norm) against time, each method's peak marked. The
-/// seed's schedule (the first method) has its own panel: its peak is often
+/// seed's schedule (`analytic`) has its own panel: its peak is often
 /// an order of magnitude above the optimised ones and would flatten them.
 /// With a torque limit the limit is drawn (or named, when off the panel's scale).
 pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> Result<String> {
     svg((1000, 760), |root| {
         let tmax = range(methods.iter().flat_map(|m| m.t.iter().copied())).1;
-        let split = 1.min(methods.len() - 1);
+        let (seed, optimised): (Vec<&MethodTrace>, Vec<&MethodTrace>) =
+            methods.iter().partition(|m| m.name == "analytic");
         let groups = [
-            (
-                "Joint torque: the seed's analytic schedule",
-                &methods[..split],
-            ),
-            ("Joint torque: optimised schedules", &methods[split..]),
+            ("Joint torque: the seed's analytic schedule", seed),
+            ("Joint torque: optimised schedules", optimised),
         ];
-        for (panel, (title, shown)) in root.split_evenly((2, 1)).iter().zip(groups) {
+        // a run where a method failed may leave one group empty: no panel for it
+        let groups: Vec<_> = groups.into_iter().filter(|g| !g.1.is_empty()).collect();
+        let panels = root.split_evenly((groups.len().max(1), 1));
+        for (panel, (title, shown)) in panels.iter().zip(groups) {
             let (plot, side) = with_legend(panel);
             let data_max = shown.iter().map(|m| peak(&m.tau)).fold(0.0, f64::max);
             // the limit joins the scale unless it would squash the curves
@@ -415,7 +416,7 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> R
                 false,
             )?;
             let mut keys = Vec::new();
-            for m in shown {
+            for &m in &shown {
                 let i = methods.iter().position(|x| x.name == m.name).unwrap_or(0);
                 let st = style_of(&m.name, i);
                 let pts: Vec<_> = m.t.iter().zip(&m.tau).map(|(t, v)| (*t, *v)).collect();
