@@ -455,7 +455,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             })?;
             let reason = design_flags(
                 &cfg,
-                &format!("{:?}", r.status).to_lowercase(),
+                &catflip::run::json_name(&r.status),
                 r.flip_error_rad,
                 r.tilt_deg,
             );
@@ -473,10 +473,10 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 return Ok(status_of(partial));
             };
             println!(
-                "catflip optimize --mode phased: {} ({} joint), status {:?}",
+                "catflip optimize --mode phased: {} ({} joint), status {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                r.status
+                catflip::run::json_name(&r.status)
             );
             row(
                 "peak torque",
@@ -540,7 +540,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             })?;
             let reason = design_flags(
                 &cfg,
-                &format!("{:?}", r.status).to_lowercase(),
+                &catflip::run::json_name(&r.status),
                 r.flip_error_rad,
                 r.tilt_deg,
             );
@@ -558,10 +558,10 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 return Ok(status_of(partial));
             };
             println!(
-                "catflip optimize --mode free: {} ({} joint), status {:?}, seed {}",
+                "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                r.status,
+                catflip::run::json_name(&r.status),
                 r.seed
             );
             row(
@@ -666,8 +666,10 @@ fn cmd_run(c: &Common) -> Result<Status> {
     let s = &r.summary;
     println!();
     println!(
-        "catflip run: {} ({} joint, peak norm {:?})",
-        s.name, s.joint, s.peak_norm
+        "catflip run: {} ({} joint, peak norm {})",
+        s.name,
+        s.joint,
+        catflip::run::json_name(&s.peak_norm)
     );
     let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();

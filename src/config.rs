@@ -617,6 +617,47 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
     Ok(())
 }
 
+/// Unit of each numeric config key, for axis labels (`fall.height (m)`).
+pub const UNITS: [(&str, &str); 29] = [
+    ("cat.mass", "kg"),
+    ("cat.length", "m"),
+    ("cat.radius", "m"),
+    ("cat.front.mass", "kg"),
+    ("cat.front.length", "m"),
+    ("cat.front.radius", "m"),
+    ("fall.height", "m"),
+    ("fall.gravity", "m/s^2"),
+    ("fall.margin", "s"),
+    ("analytic.theta_deg", "deg"),
+    ("limits.max_torque", "N m"),
+    ("limits.max_bend_deg", "deg"),
+    ("limits.no_load_speed", "rad/s"),
+    ("limits.max_speed", "rad/s"),
+    ("simulate.rtol", "relative"),
+    ("simulate.atol", "absolute"),
+    ("simulate.pd_bandwidth_hz", "Hz"),
+    ("simulate.pd_damping", "damping ratio"),
+    ("simulate.samples_per_phase", "rows per phase"),
+    ("simulate.flip_tolerance", "rad"),
+    ("phased.nodes", "intervals per phase"),
+    ("phased.bend_min_deg", "deg"),
+    ("phased.bend_max_deg", "deg"),
+    ("phased.scan_points", "count"),
+    ("phased.bend_tol_deg", "deg"),
+    ("free.nodes", "nodes per phase"),
+    ("free.max_iterations", "count"),
+    ("free.tolerance", "relative"),
+    ("free.attitude_tolerance", "rad"),
+];
+
+/// A config key with its unit, e.g. `fall.height (m)`.
+pub fn key_label(key: &str) -> String {
+    match UNITS.iter().find(|(k, _)| *k == key) {
+        Some((_, u)) => format!("{key} ({u})"),
+        None => key.to_string(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -664,5 +705,47 @@ gravity = 9.8
                 .to_string();
             assert!(e.contains(needle), "`{e}` should mention `{needle}`");
         }
+    }
+
+    /// Every numeric key of the config has a unit, and the table names no
+    /// key the config lacks (sweep axes are labelled from it).
+    #[test]
+    fn every_numeric_key_has_a_unit() {
+        let optional = [
+            "limits.max_torque=1",
+            "limits.max_bend_deg=90",
+            "limits.no_load_speed=10",
+            "limits.max_speed=20",
+            "cat.front.mass=2",
+            "cat.front.length=1",
+            "cat.front.radius=0.1",
+        ];
+        let c = Config::from_toml(SEED, "t", &optional.map(String::from)).unwrap();
+        fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {
+            for (k, x) in t {
+                let key = if prefix.is_empty() {
+                    k.clone()
+                } else {
+                    format!("{prefix}.{k}")
+                };
+                match x {
+                    toml::Value::Table(inner) => walk(&key, inner, out),
+                    x if x.is_integer() || x.is_float() => out.push(key),
+                    _ => {}
+                }
+            }
+        }
+        let mut numeric = Vec::new();
+        walk("", &toml::Table::try_from(&c).unwrap(), &mut numeric);
+        for k in &numeric {
+            assert_ne!(key_label(k), *k, "{k} has no unit in UNITS");
+        }
+        for (k, _) in UNITS {
+            assert!(
+                numeric.iter().any(|n| n == k),
+                "UNITS names {k}, not a numeric key"
+            );
+        }
+        assert_eq!(key_label("fall.height"), "fall.height (m)");
     }
 }

@@ -290,6 +290,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
     let mut methods = Vec::new();
     let mut traces = Vec::new();
+    let mut tracks = Vec::new();
+    let track = |name: &str, sim: &SimReport| {
+        report::animation::track(&cat, cfg.norm(), name, sim, report::animation::FRAMES)
+    };
     let mut notes_early: Vec<String> = Vec::new();
     let stage_end = |progress: &mut dyn FnMut(Progress), clock: Instant, err: Option<&Error>| {
         let seconds = clock.elapsed().as_secs_f64();
@@ -336,6 +340,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             let failed_sim = SimReport::failed();
             let sim = a_sim.as_ref().unwrap_or(&failed_sim);
             traces.push(trace(cfg, "analytic", &a.plan, sim, 300));
+            tracks.push(track("analytic", sim));
         }
         Err(e) => methods.push(MethodSummary::failed("analytic", e)),
     }
@@ -402,7 +407,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             methods.push(summarize(
                 cfg,
                 "phased",
-                format!("{:?}", ph.status).to_lowercase(),
+                json_name(&ph.status),
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
                 Ok(ph_sim),
@@ -410,6 +415,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 ph.solve_time_s,
             ));
             traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
+            tracks.push(track("phased", ph_sim));
         }
         Err(e) => methods.push(MethodSummary::failed("phased", e)),
     }
@@ -443,7 +449,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             methods.push(summarize(
                 cfg,
                 "free",
-                format!("{:?}", fr.status).to_lowercase(),
+                json_name(&fr.status),
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
                 Ok(&fr.sim),
@@ -451,6 +457,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 fr.solve_time_s,
             ));
             traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
+            tracks.push(track("free", &fr.sim));
         }
         Err(e) => methods.push(MethodSummary::failed("free", e)),
     }
@@ -491,17 +498,17 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         plans.push(("free", &fr.plan));
     }
     crate::export::add_simulator_files(cfg, &mut output, &plans);
-    let norm_name = match cfg.norm() {
-        crate::model::TorqueNorm::Euclidean => "Euclidean",
-        crate::model::TorqueNorm::PerMotor => "per motor",
-    };
+    let norm_name = json_name(&cfg.norm());
     let iterations = free
         .as_ref()
         .map(|fr| fr.iterations.clone())
         .unwrap_or_default();
     let mut figures = vec![
         ("angles.svg", report::angles(&traces)),
-        ("torque.svg", report::torque(&traces, norm_name)),
+        (
+            "torque.svg",
+            report::torque(&traces, &norm_name, cfg.limits.max_torque),
+        ),
         ("flip.svg", report::flip(&traces)),
         ("shape_path.svg", report::shape_path(&traces)),
     ];
@@ -571,6 +578,27 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         );
     }
     let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
+    // the animation: each simulated method, with its table status and verdict
+    for t in &mut tracks {
+        if let Some(m) = summary.methods.iter().find(|m| m.method == t.name) {
+            let row = table_row(m);
+            t.status = format!("{}; {}", row[1], row[row.len() - 1]);
+        }
+    }
+    tracks.retain(|t| t.frames.len() > 1);
+    let scene = report::animation::Scene {
+        rear: cat.rear,
+        front: cat.front,
+        joint: summary.joint,
+        norm: norm_name.clone(),
+        max_torque_nm: cfg.limits.max_torque,
+        tracks,
+    };
+    let warnings: Vec<String> = summary
+        .methods
+        .iter()
+        .filter_map(|m| Some(format!("{}: {}", m.method, m.reason.as_ref()?)))
+        .collect();
     output.add(
         "index.html",
         report::index_html(
@@ -578,6 +606,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             &header,
             &rows,
             &notes,
+            &warnings,
+            &report::animation::section(&scene),
             &figure_names,
         ),
     );
@@ -611,6 +641,24 @@ pub const TABLE_HEADER: [&str; 10] = [
     "verdict",
 ];
 
+/// The name serde gives a unit enum value (`per-motor`, `iteration-limit`),
+/// so the terminal says what the JSON says.
+pub fn json_name<T: Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
+    }
+}
+
+/// A small number in the table: `0` for exact zero, else 3 significant digits.
+fn small(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
 /// One line of the comparison table; a failed method shows `-` for its numbers.
 pub fn table_row(m: &MethodSummary) -> Vec<String> {
     let verdict = match (m.verdict, &m.reason) {
@@ -626,8 +674,8 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.5}", n.peak_torque_nm),
                 format!("{:.2}", n.bend_deg),
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
-                format!("{:.2e}", n.flip_error_rad),
-                format!("{:.2e}", n.tilt_deg),
+                small(n.flip_error_rad),
+                small(n.tilt_deg),
                 format!("{:.5}", n.sim_peak_torque_nm),
                 format!("{:.3}", n.solve_time_s),
             ]);

@@ -337,11 +337,12 @@ pub fn figures(
             series.push((name.to_string(), ys));
         }
     }
+    let xdesc = crate::config::key_label(key);
     let mut figs = vec![(
         format!("sweep-{file_key}.svg"),
         crate::report::lines(
             &format!("Peak joint torque against {key}"),
-            key,
+            &xdesc,
             "peak torque (N m)",
             &x,
             &series,
@@ -365,7 +366,7 @@ pub fn figures(
             format!("sweep-{file_key}-least-height.svg"),
             crate::report::lines(
                 &format!("Least drop height for {l} N m against {key}"),
-                key,
+                &xdesc,
                 "least drop height (m)",
                 &x,
                 &hs,

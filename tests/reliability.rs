@@ -350,7 +350,7 @@ fn an_unconverged_design_is_flagged_in_table_and_exit_status() {
         .find(|l| l.trim_start().starts_with("free"))
         .unwrap();
     assert!(
-        free.contains("FLAGGED") && free.contains("iterationlimit"),
+        free.contains("FLAGGED") && free.contains("iteration-limit"),
         "{out}"
     );
     assert!(err.contains("partial"), "{err}");

@@ -123,6 +123,32 @@ fn run_writes_a_complete_consistent_report() {
             .map(|n| n.text().unwrap_or("").to_string())
             .collect();
         assert!(texts.len() > 5, "{name} has too little text");
+        // legends sit beside the plot: every label naming a method lies right
+        // of every point of every drawn curve (polylines of many points)
+        let curve_right = doc
+            .descendants()
+            .filter(|n| n.tag_name().name() == "polyline")
+            .filter_map(|n| n.attribute("points"))
+            .map(|p| p.split_whitespace().collect::<Vec<_>>())
+            .filter(|p| p.len() > 10)
+            .flat_map(|p| {
+                p.into_iter()
+                    .map(|xy| xy.split(',').next().unwrap().parse::<f64>().unwrap())
+            })
+            .fold(0.0, f64::max);
+        for t in doc.descendants().filter(|n| n.tag_name().name() == "text") {
+            let label = t.text().unwrap_or("").trim();
+            if ["analytic", "phased", "free"]
+                .iter()
+                .any(|m| label.starts_with(m))
+            {
+                let x: f64 = t.attribute("x").unwrap().parse().unwrap();
+                assert!(
+                    x > curve_right,
+                    "{name}: legend `{label}` at x {x} within the curves (to {curve_right})"
+                );
+            }
+        }
         assert!(
             texts.iter().any(|t| t.contains("time (s)")
                 || t.contains("iteration")
@@ -130,6 +156,7 @@ fn run_writes_a_complete_consistent_report() {
             "{name}: {texts:?}"
         );
     }
+    assert!(html.contains("<script type=\"application/json\" id=\"scene\">"));
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     assert!(
         torque.contains(&format!("peak {:.4} N m", peaks[2])),
@@ -204,8 +231,124 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
     );
     let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
     assert!(h > 10.0, "{h}");
+    // the x axis carries the key's unit; peaks spanning more than a factor
+    // 20 (the seed's schedule against the optimum) go on a log axis
+    let svg = std::fs::read_to_string(
+        dir.path()
+            .join("output/seed/sweep-cat_mass/sweep-cat_mass.svg"),
+    )
+    .unwrap();
+    assert!(svg.contains("cat.mass (kg)"));
+    let peaks: Vec<f64> = rows[1..]
+        .iter()
+        .flat_map(|r| {
+            r.split(',')
+                .skip(1)
+                .take(2)
+                .map(|x| x.parse::<f64>().unwrap())
+        })
+        .collect();
+    let spread =
+        peaks.iter().cloned().fold(0.0, f64::max) / peaks.iter().cloned().fold(f64::MAX, f64::min);
+    assert_eq!(svg.contains("log scale"), spread > 20.0, "spread {spread}");
     for bad in ["cat.mass=1:2", "cat.masss=1:2:3", "cat.mass=-1:2:3"] {
         let (ok, _, err) = run(&["sweep", c, "--set-range", bad], dir.path());
         assert!(!ok && !err.is_empty(), "{bad} should fail");
     }
+}
+
+/// A run that goes wrong on purpose: a torque limit the seed's schedule
+/// exceeds and a free-form optimiser cut off after 3 iterations. Each
+/// problem is shown where a user looks: table, page, figure, terminal names.
+#[test]
+fn run_shows_an_exceeded_limit_and_an_unconverged_optimiser() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let (_, out, err) = run(
+        &[
+            "run",
+            cfg.to_str().unwrap(),
+            "--set",
+            "limits.max_torque=5",
+            "--set",
+            "free.max_iterations=3",
+        ],
+        dir.path(),
+    );
+    let base = dir.path().join("output/seed/run");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(base.join("summary.json"))
+            .unwrap_or_else(|e| panic!("{e}: {err}")),
+    )
+    .unwrap();
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    let methods = summary["methods"].as_array().unwrap();
+    // the seed's schedule needs more than 5 N m; the free-form run stopped early
+    assert!(methods[0]["peak_torque_nm"].as_f64().unwrap() > 5.0);
+    assert_eq!(methods[2]["status"], "iteration-limit");
+    for m in &methods[..] {
+        let name = m["method"].as_str().unwrap();
+        if m["verdict"] == "flagged" {
+            // the reason is a red note on the page and sits in the table
+            let reason = m["reason"].as_str().unwrap();
+            let note = format!("<p class=\"warn\">{name}: ");
+            assert!(html.contains(&note), "{name}: no note for {reason}");
+            assert!(
+                out.contains(&format!("FLAGGED: {}", reason)),
+                "{name}: {out}"
+            );
+        }
+    }
+    assert_eq!(methods[0]["verdict"], "flagged");
+    assert_eq!(methods[2]["verdict"], "flagged");
+    // the terminal says what the JSON says, not Rust's Debug names
+    assert!(out.contains("iteration-limit") && !out.contains("IterationLimit"));
+    assert!(out.contains("peak norm euclidean"), "{out}");
+    let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
+    assert!(torque.contains("torque limit 5 N m") && torque.contains("OVER LIMIT"));
+}
+
+/// The animation frames: spread over the whole simulation, body B built from
+/// body A and the shape. Oracles: the angle between the two spines is the
+/// bend `|q|` (no-twist joint: `q` is a rotation about an axis normal to A's
+/// spine), and at the end the straight cat's halves share one attitude.
+#[test]
+fn animation_frames_follow_the_simulation() {
+    use catflip::report::animation::{FRAMES, track};
+    use nalgebra::{Quaternion, UnitQuaternion, Vector3};
+    let cfg = catflip::Config::load(&configs().join("seed.toml"), &[]).unwrap();
+    let cat = cfg.cat();
+    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let sim = catflip::verify::simulate::dynamic_cfg(&cfg, &plan).unwrap();
+    let tr = track(&cat, cfg.norm(), "analytic", &sim, FRAMES);
+    let f = &tr.frames;
+    assert!(f.len() > FRAMES / 2 && f.len() <= FRAMES, "{}", f.len());
+    assert_eq!(f[0].t, sim.trace[0].t);
+    assert_eq!(f.last().unwrap().t, sim.trace.last().unwrap().t);
+    assert!(f.windows(2).all(|w| w[1].t > w[0].t));
+    let uq = |q: [f64; 4]| UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+    let mut largest = 0.0f64;
+    for fr in f {
+        let (a, b) = (uq(fr.a), uq(fr.b));
+        let (za, zb) = (a * Vector3::z(), b * Vector3::z());
+        let spines = za.cross(&zb).norm().atan2(za.dot(&zb));
+        // the page stores quaternions to 1e-7
+        assert!(
+            (spines.to_degrees() - fr.bend_deg).abs() < 1e-4,
+            "t {}: spines {} deg, bend {} deg",
+            fr.t,
+            spines.to_degrees(),
+            fr.bend_deg
+        );
+        largest = largest.max(fr.bend_deg);
+    }
+    assert!(
+        (largest - 135.0).abs() < 1.0,
+        "the seed bends 135 deg: {largest}"
+    );
+    let end = f.last().unwrap();
+    assert!(uq(end.a).angle_to(&uq(end.b)) < 1e-6);
+    // the embedded flip is the simulation's, whatever its sign convention
+    let last = sim.trace.last().unwrap();
+    assert_eq!(end.flip_deg, last.flip.to_degrees());
 }

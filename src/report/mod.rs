@@ -2,11 +2,18 @@
 //!
 //! Text is laid out with DejaVu Sans bundled through the `dejavu` crate
 //! (plotters' `ab_glyph` feature), so no system font library is needed; the
-//! SVGs carry real `<text>` elements.
+//! SVGs carry real `<text>` elements. Every series has a colour, a dash
+//! pattern and a marker ([`Style`]), so a grey print still tells them apart;
+//! legends sit in a column beside the plot, never over the data.
+
+pub mod animation;
 
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
+use plotters::coord::Shift;
+use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
+use plotters_backend::DrawingErrorKind;
 use std::sync::Once;
 
 /// One method's curves.
@@ -18,22 +25,73 @@ pub struct MethodTrace {
     /// Joint torque in the peak norm, N m.
     pub tau: Vec<f64>,
     pub phase_bounds: Vec<f64>,
-    /// Attitude about the initial spine from the kinematic simulation.
+    /// Attitude about the initial spine from the forward simulation.
     pub flip_t: Vec<f64>,
     pub flip_deg: Vec<f64>,
 }
 
-const FONT: &str = "sans-serif";
-const COLORS: [RGBColor; 4] = [
-    RGBColor(0x88, 0x88, 0x88),
-    RGBColor(0x1f, 0x77, 0xb4),
-    RGBColor(0xd6, 0x27, 0x28),
-    RGBColor(0x2c, 0xa0, 0x2c),
+/// A point marker, drawn every few samples along a line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Marker {
+    Square,
+    Circle,
+    Triangle,
+    Cross,
+}
+
+/// How one series is drawn: colour, dash pattern (`None` is solid) and marker.
+#[derive(Debug, Clone, Copy)]
+pub struct Style {
+    pub color: RGBColor,
+    pub dash: Option<(u32, u32)>,
+    pub marker: Marker,
+}
+
+const STYLES: [Style; 4] = [
+    Style {
+        color: RGBColor(0x55, 0x55, 0x55),
+        dash: Some((10, 5)),
+        marker: Marker::Square,
+    },
+    Style {
+        color: RGBColor(0x1f, 0x77, 0xb4),
+        dash: None,
+        marker: Marker::Circle,
+    },
+    Style {
+        color: RGBColor(0xd6, 0x27, 0x28),
+        dash: Some((3, 3)),
+        marker: Marker::Triangle,
+    },
+    Style {
+        color: RGBColor(0x2c, 0xa0, 0x2c),
+        dash: Some((12, 3)),
+        marker: Marker::Cross,
+    },
 ];
 
-fn color(i: usize) -> RGBColor {
-    COLORS[i % COLORS.len()]
+/// The `i`-th series style.
+pub fn style(i: usize) -> Style {
+    STYLES[i % STYLES.len()]
 }
+
+/// A method keeps its style across all figures; other series count from `i`.
+pub fn style_of(name: &str, i: usize) -> Style {
+    match name {
+        "analytic" => STYLES[0],
+        "phased" => STYLES[1],
+        "free" => STYLES[2],
+        _ => style(i),
+    }
+}
+
+const FONT: &str = "sans-serif";
+/// Width of the legend column right of each plot, px.
+const LEGEND_W: u32 = 260;
+/// Markers along a line (enough to tell the lines apart, few enough not to clutter).
+const MARKS: usize = 9;
+
+type Area<'b> = DrawingArea<SVGBackend<'b>, Shift>;
 
 fn font() {
     static ONCE: Once = Once::new();
@@ -56,8 +114,22 @@ fn range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     if !lo.is_finite() {
         return (0.0, 1.0);
     }
-    let pad = 0.05 * (hi - lo).max(1e-9);
+    // a flat series still gets room above and below
+    let pad = 0.05 * (hi - lo).max(0.2 * hi.abs().max(lo.abs())).max(1e-9);
     (lo - pad, hi + pad)
+}
+
+fn peak(v: &[f64]) -> f64 {
+    v.iter().cloned().fold(0.0, f64::max)
+}
+
+/// Tick labels for whole numbers (iteration counts): "5", never "5.0" or "2.5".
+fn whole(v: &f64) -> String {
+    if (v - v.round()).abs() < 1e-9 {
+        format!("{}", v.round() as i64)
+    } else {
+        String::new()
+    }
 }
 
 type Chart<'a, 'b> = ChartContext<
@@ -66,59 +138,208 @@ type Chart<'a, 'b> = ChartContext<
     Cartesian2d<plotters::coord::types::RangedCoordf64, plotters::coord::types::RangedCoordf64>,
 >;
 
+/// A linear chart; `whole_x` labels the x axis with whole numbers only.
 fn chart<'a, 'b>(
-    area: &'a DrawingArea<SVGBackend<'b>, plotters::coord::Shift>,
+    area: &'a Area<'b>,
     title: &str,
     x: (f64, f64),
     y: (f64, f64),
-    xdesc: &str,
-    ydesc: &str,
+    desc: (&str, &str),
+    whole_x: bool,
 ) -> Result<Chart<'a, 'b>> {
     let mut c = ChartBuilder::on(area)
         .caption(title, (FONT, 20))
         .margin(12)
         .x_label_area_size(42)
-        .y_label_area_size(64)
+        .y_label_area_size(70)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(perr)?;
-    c.configure_mesh()
-        .x_desc(xdesc)
-        .y_desc(ydesc)
+    let plain = |v: &f64| format!("{v}");
+    let xf: &dyn Fn(&f64) -> String = if whole_x { &whole } else { &plain };
+    let mut mesh = c.configure_mesh();
+    mesh.x_desc(desc.0)
+        .y_desc(desc.1)
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 15))
-        .light_line_style(WHITE.mix(0.0))
-        .draw()
-        .map_err(perr)?;
+        .light_line_style(WHITE.mix(0.0));
+    if whole_x {
+        mesh.x_label_formatter(xf);
+    }
+    mesh.draw().map_err(perr)?;
     Ok(c)
 }
 
-fn legend<'a, 'b: 'a>(c: &mut Chart<'a, 'b>) -> Result<()> {
-    c.configure_series_labels()
-        .label_font((FONT, 13))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .position(SeriesLabelPosition::UpperRight)
-        .draw()
-        .map_err(perr)
+/// A marker at `at` (data or pixel coordinates), a fixed size in pixels.
+struct Mark<C> {
+    at: C,
+    kind: Marker,
+    color: RGBColor,
 }
 
-fn phase_marks(c: &mut Chart, m: &MethodTrace, col: RGBColor, y: (f64, f64)) -> Result<()> {
-    for &b in &m.phase_bounds[1..m.phase_bounds.len() - 1] {
-        c.draw_series(DashedLineSeries::new(
-            vec![(b, y.0), (b, y.1)],
-            4,
-            4,
-            col.mix(0.6).stroke_width(1),
-        ))
+fn marker<C>(at: C, kind: Marker, color: RGBColor) -> Mark<C> {
+    Mark { at, kind, color }
+}
+
+impl<'a, C> PointCollection<'a, C> for &'a Mark<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.at)
+    }
+}
+
+impl<C, DB: DrawingBackend> Drawable<DB> for Mark<C> {
+    fn draw<I: Iterator<Item = (i32, i32)>>(
+        &self,
+        mut pos: I,
+        backend: &mut DB,
+        _: (u32, u32),
+    ) -> std::result::Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some((x, y)) = pos.next() else {
+            return Ok(());
+        };
+        let fill = self.color.filled();
+        match self.kind {
+            Marker::Square => backend.draw_rect((x - 4, y - 4), (x + 4, y + 4), &fill, true),
+            Marker::Circle => backend.draw_circle((x, y), 4, &fill, true),
+            Marker::Triangle => {
+                backend.fill_polygon([(x, y - 6), (x - 5, y + 4), (x + 5, y + 4)], &fill)
+            }
+            Marker::Cross => {
+                let s = self.color.stroke_width(2);
+                backend.draw_line((x - 4, y - 4), (x + 4, y + 4), &s)?;
+                backend.draw_line((x - 4, y + 4), (x + 4, y - 4), &s)
+            }
+        }
+    }
+}
+
+/// Draws a line in `st` with markers: `MARKS` spread along a dense curve,
+/// shifted by `shift` (0..1 of a marker gap) so that coinciding lines show
+/// all their markers, or one on each point of a short series.
+fn line<'a, 'b, CT>(
+    c: &mut ChartContext<'a, SVGBackend<'b>, CT>,
+    pts: &[(f64, f64)],
+    st: Style,
+    shift: f64,
+) -> Result<()>
+where
+    CT: CoordTranslate<From = (f64, f64)>,
+{
+    let stroke = st.color.stroke_width(2);
+    match st.dash {
+        None => c
+            .draw_series(LineSeries::new(pts.iter().copied(), stroke))
+            .map(|_| ()),
+        Some((on, off)) => c
+            .draw_series(DashedLineSeries::new(pts.iter().copied(), on, off, stroke))
+            .map(|_| ()),
+    }
+    .map_err(perr)?;
+    // a few points (a sweep's samples) are each marked; a dense curve gets MARKS
+    let marks: Vec<(f64, f64)> = if pts.len() <= 4 * MARKS {
+        pts.to_vec()
+    } else {
+        let gap = (pts.len() - 1) as f64 / MARKS as f64;
+        (0..MARKS)
+            .map(|k| pts[((k as f64 + 0.25 + 0.5 * shift) * gap) as usize])
+            .collect()
+    };
+    c.draw_series(marks.into_iter().map(|p| marker(p, st.marker, st.color)))
         .map_err(perr)?;
+    Ok(())
+}
+
+/// What a legend row shows beside its label.
+enum Key {
+    Line(Style),
+    /// A marker alone (e.g. rejected SCP steps).
+    Mark(Style),
+    /// Phase boundaries: thin dotted black, each topped with the method's marker.
+    Boundary,
+    /// A reference level (torque limit, +-180 deg): solid black, thin.
+    Level,
+    /// The open circle around each curve's peak.
+    Peak,
+}
+
+/// The legend column beside a plot.
+fn legend(area: &Area, rows: &[(String, Key)]) -> Result<()> {
+    let text = TextStyle::from((FONT, 13).into_font()).color(&BLACK);
+    let mut y = 48;
+    for (label, key) in rows {
+        let (x0, x1) = (4, 40);
+        match key {
+            Key::Line(st) | Key::Mark(st) => {
+                if let Key::Line(_) = key {
+                    let stroke = st.color.stroke_width(2);
+                    let path = vec![(x0, y), (x1, y)];
+                    match st.dash {
+                        None => area.draw(&PathElement::new(path, stroke)),
+                        Some((on, off)) => {
+                            area.draw(&DashedPathElement::new(path, on, off, stroke))
+                        }
+                    }
+                    .map_err(perr)?;
+                }
+                area.draw(&marker((22, y), st.marker, st.color))
+                    .map_err(perr)?;
+            }
+            Key::Boundary => {
+                area.draw(&DashedPathElement::new(
+                    vec![(22, y - 9), (22, y + 9)],
+                    2,
+                    3,
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(perr)?;
+            }
+            Key::Peak => {
+                area.draw(&Circle::new((22, y), 7, BLACK.stroke_width(2)))
+                    .map_err(perr)?;
+            }
+            Key::Level => {
+                area.draw(&PathElement::new(
+                    vec![(x0, y), (x1, y)],
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(perr)?;
+            }
+        }
+        area.draw_text(label, &text, (48, y - 7)).map_err(perr)?;
+        y += 22;
     }
     Ok(())
 }
 
-fn svg(
-    size: (u32, u32),
-    draw: impl FnOnce(&DrawingArea<SVGBackend, plotters::coord::Shift>) -> Result<()>,
-) -> Result<String> {
+/// Splits off the legend column.
+fn with_legend<'b>(area: &Area<'b>) -> (Area<'b>, Area<'b>) {
+    let w = area.dim_in_pixel().0;
+    area.split_horizontally(w.saturating_sub(LEGEND_W))
+}
+
+/// Dotted vertical lines at the inner phase boundaries, one style for all
+/// methods, each topped with the method's marker.
+fn phase_marks(c: &mut Chart, m: &MethodTrace, st: Style, y: (f64, f64)) -> Result<()> {
+    for &b in &m.phase_bounds[1..m.phase_bounds.len() - 1] {
+        c.draw_series(DashedLineSeries::new(
+            vec![(b, y.0), (b, y.1)],
+            2,
+            3,
+            BLACK.stroke_width(1),
+        ))
+        .map_err(perr)?;
+        c.draw_series(std::iter::once(marker((b, y.1), st.marker, st.color)))
+            .map_err(perr)?;
+    }
+    Ok(())
+}
+
+fn boundary_key() -> (String, Key) {
+    ("phase boundary (marker: method)".into(), Key::Boundary)
+}
+
+fn svg(size: (u32, u32), draw: impl FnOnce(&Area) -> Result<()>) -> Result<String> {
     font();
     let mut s = String::new();
     {
@@ -130,111 +351,116 @@ fn svg(
     Ok(s)
 }
 
-/// Joint angles against time, phase boundaries dashed.
+/// Joint angles against time, phase boundaries dotted.
 pub fn angles(methods: &[MethodTrace]) -> Result<String> {
-    svg((900, 700), |root| {
+    svg((1000, 700), |root| {
         let tmax = range(methods.iter().flat_map(|m| m.t.iter().copied())).1;
-        let panels = root.split_evenly((2, 1));
-        for (j, area) in panels.iter().enumerate() {
+        for (j, panel) in root.split_evenly((2, 1)).iter().enumerate() {
+            let (plot, side) = with_legend(panel);
             let y = range(
                 methods
                     .iter()
                     .flat_map(|m| m.q.iter().map(move |q| q[j].to_degrees())),
             );
             let title = format!("Joint angle q{} against time", j + 1);
-            let mut c = chart(
-                area,
-                &title,
-                (0.0, tmax),
-                y,
-                "time (s)",
-                &format!("q{} (deg)", j + 1),
-            )?;
+            let ydesc = format!("q{} (deg)", j + 1);
+            let mut c = chart(&plot, &title, (0.0, tmax), y, ("time (s)", &ydesc), false)?;
+            let mut keys = Vec::new();
             for (i, m) in methods.iter().enumerate() {
-                let col = color(i);
-                c.draw_series(LineSeries::new(
-                    m.t.iter().zip(&m.q).map(|(t, q)| (*t, q[j].to_degrees())),
-                    col.stroke_width(2),
-                ))
-                .map_err(perr)?
-                .label(m.name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                });
-                phase_marks(&mut c, m, col, y)?;
+                let st = style_of(&m.name, i);
+                let pts: Vec<_> =
+                    m.t.iter()
+                        .zip(&m.q)
+                        .map(|(t, q)| (*t, q[j].to_degrees()))
+                        .collect();
+                line(&mut c, &pts, st, i as f64 / methods.len() as f64)?;
+                phase_marks(&mut c, m, st, y)?;
+                keys.push((m.name.clone(), Key::Line(st)));
             }
-            legend(&mut c)?;
+            keys.push(boundary_key());
+            legend(&side, &keys)?;
         }
         Ok(())
     })
 }
 
-/// Joint torque (peak norm) against time, each method's peak marked: all
-/// methods on top, and below without the first (the seed's schedule), whose
-/// peak is often an order of magnitude larger.
-pub fn torque(methods: &[MethodTrace], norm_name: &str) -> Result<String> {
-    svg((900, 760), |root| {
-        let panels = root.split_evenly((2, 1));
+/// Joint torque (peak norm) against time, each method's peak marked. The
+/// seed's schedule (`analytic`) has its own panel: its peak is often
+/// an order of magnitude above the optimised ones and would flatten them.
+/// With a torque limit the limit is drawn (or named, when off the panel's scale).
+pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> Result<String> {
+    svg((1000, 760), |root| {
         let tmax = range(methods.iter().flat_map(|m| m.t.iter().copied())).1;
-        for (panel, (title, skip)) in [
-            ("Joint torque against time", 0),
-            ("Joint torque: optimised schedules", 1),
-        ]
-        .into_iter()
-        .enumerate()
-        {
-            let shown = &methods[skip.min(methods.len() - 1)..];
-            let ymax = range(shown.iter().flat_map(|m| m.tau.iter().copied())).1 * 1.1;
-            let ydesc = format!("|tau| {norm_name} (N m)");
+        let (seed, optimised): (Vec<&MethodTrace>, Vec<&MethodTrace>) =
+            methods.iter().partition(|m| m.name == "analytic");
+        let groups = [
+            ("Joint torque: the seed's analytic schedule", seed),
+            ("Joint torque: optimised schedules", optimised),
+        ];
+        // a run where a method failed may leave one group empty: no panel for it
+        let groups: Vec<_> = groups.into_iter().filter(|g| !g.1.is_empty()).collect();
+        let panels = root.split_evenly((groups.len().max(1), 1));
+        for (panel, (title, shown)) in panels.iter().zip(groups) {
+            let (plot, side) = with_legend(panel);
+            let data_max = shown.iter().map(|m| peak(&m.tau)).fold(0.0, f64::max);
+            // the limit joins the scale unless it would squash the curves
+            let lim_on_scale = limit.filter(|l| *l <= 2.0 * data_max);
+            let ymax = data_max.max(lim_on_scale.unwrap_or(0.0)) * 1.12;
+            let ydesc = format!("|tau|, {norm_name} (N m)");
             let mut c = chart(
-                &panels[panel],
+                &plot,
                 title,
                 (0.0, tmax),
                 (0.0, ymax),
-                "time (s)",
-                &ydesc,
+                ("time (s)", &ydesc),
+                false,
             )?;
-            for (i, m) in methods.iter().enumerate().skip(skip) {
-                let col = color(i);
-                c.draw_series(LineSeries::new(
-                    m.t.iter().zip(&m.tau).map(|(t, v)| (*t, *v)),
-                    col.stroke_width(2),
-                ))
-                .map_err(perr)?
-                .label(format!(
-                    "{} (peak {:.4} N m)",
-                    m.name,
-                    m.tau.iter().cloned().fold(0.0, f64::max)
-                ))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                });
-                if let Some((k, v)) = m
-                    .tau
-                    .iter()
-                    .enumerate()
-                    .max_by(|a, b| a.1.partial_cmp(b.1).unwrap())
-                {
-                    c.draw_series(std::iter::once(Circle::new((m.t[k], *v), 5, col.filled())))
-                        .map_err(perr)?;
+            let mut keys = Vec::new();
+            for &m in &shown {
+                let i = methods.iter().position(|x| x.name == m.name).unwrap_or(0);
+                let st = style_of(&m.name, i);
+                let pts: Vec<_> = m.t.iter().zip(&m.tau).map(|(t, v)| (*t, *v)).collect();
+                line(&mut c, &pts, st, i as f64 / methods.len() as f64)?;
+                let p = peak(&m.tau);
+                if let Some(k) = m.tau.iter().position(|v| *v == p) {
+                    c.draw_series(std::iter::once(Circle::new(
+                        (m.t[k], p),
+                        7,
+                        st.color.stroke_width(2),
+                    )))
+                    .map_err(perr)?;
                 }
-                phase_marks(&mut c, m, col, (0.0, ymax))?;
+                phase_marks(&mut c, m, st, (0.0, ymax))?;
+                let over = match limit {
+                    Some(l) if p > l * (1.0 + 1e-9) => ", OVER LIMIT",
+                    _ => "",
+                };
+                keys.push((format!("{} (peak {p:.4} N m{over})", m.name), Key::Line(st)));
             }
-            c.configure_series_labels()
-                .label_font((FONT, 13))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .position(SeriesLabelPosition::LowerRight)
-                .draw()
-                .map_err(perr)?;
+            keys.push(("peak of each curve".into(), Key::Peak));
+            keys.push(boundary_key());
+            match (limit, lim_on_scale) {
+                (Some(l), Some(_)) => {
+                    c.draw_series(LineSeries::new(
+                        vec![(0.0, l), (tmax, l)],
+                        BLACK.stroke_width(1),
+                    ))
+                    .map_err(perr)?;
+                    keys.push((format!("torque limit {l} N m"), Key::Level));
+                }
+                (Some(l), None) => keys.push((format!("torque limit {l} N m (above)"), Key::Level)),
+                _ => {}
+            }
+            legend(&side, &keys)?;
         }
         Ok(())
     })
 }
 
-/// Rotation about the initial spine against time (kinematic simulation).
+/// Rotation about the initial spine against time (forward simulation).
 pub fn flip(methods: &[MethodTrace]) -> Result<String> {
-    svg((900, 520), |root| {
+    svg((1000, 520), |root| {
+        let (plot, side) = with_legend(root);
         let tmax = range(methods.iter().flat_map(|m| m.flip_t.iter().copied())).1;
         let y = range(
             methods
@@ -243,90 +469,108 @@ pub fn flip(methods: &[MethodTrace]) -> Result<String> {
                 .chain([0.0, 180.0, -180.0]),
         );
         let mut c = chart(
-            root,
+            &plot,
             "Flip: rotation about the initial spine",
             (0.0, tmax),
             y,
-            "time (s)",
-            "flip (deg)",
+            ("time (s)", "flip (deg)"),
+            false,
         )?;
         for target in [-180.0, 180.0] {
-            c.draw_series(DashedLineSeries::new(
+            c.draw_series(LineSeries::new(
                 vec![(0.0, target), (tmax, target)],
-                6,
-                4,
-                BLACK.mix(0.4).stroke_width(1),
+                BLACK.stroke_width(1),
             ))
             .map_err(perr)?;
         }
+        let mut keys = Vec::new();
         for (i, m) in methods.iter().enumerate() {
-            let col = color(i);
-            c.draw_series(LineSeries::new(
-                m.flip_t.iter().zip(&m.flip_deg).map(|(t, f)| (*t, *f)),
-                col.stroke_width(2),
-            ))
-            .map_err(perr)?
-            .label(m.name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            let st = style_of(&m.name, i);
+            let pts: Vec<_> = m
+                .flip_t
+                .iter()
+                .zip(&m.flip_deg)
+                .map(|(t, f)| (*t, *f))
+                .collect();
+            line(&mut c, &pts, st, i as f64 / methods.len() as f64)?;
+            keys.push((m.name.clone(), Key::Line(st)));
         }
-        legend(&mut c)
+        keys.push(("+-180 deg: a half turn".into(), Key::Level));
+        legend(&side, &keys)
     })
 }
 
 /// The shape path in the (q1, q2) plane.
 pub fn shape_path(methods: &[MethodTrace]) -> Result<String> {
-    svg((700, 700), |root| {
+    svg((700 + LEGEND_W, 700), |root| {
+        let (plot, side) = with_legend(root);
         let r = methods
             .iter()
             .flat_map(|m| m.q.iter().map(|q| q[0].hypot(q[1]).to_degrees()))
             .fold(1.0, f64::max)
             * 1.1;
-        let mut c = chart(root, "Shape path", (-r, r), (-r, r), "q1 (deg)", "q2 (deg)")?;
+        let mut c = chart(
+            &plot,
+            "Shape path",
+            (-r, r),
+            (-r, r),
+            ("q1 (deg)", "q2 (deg)"),
+            false,
+        )?;
+        let mut keys = Vec::new();
         for (i, m) in methods.iter().enumerate() {
-            let col = color(i);
-            c.draw_series(LineSeries::new(
-                m.q.iter().map(|q| (q[0].to_degrees(), q[1].to_degrees())),
-                col.stroke_width(2),
-            ))
-            .map_err(perr)?
-            .label(m.name.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            let st = style_of(&m.name, i);
+            let pts: Vec<_> =
+                m.q.iter()
+                    .map(|q| (q[0].to_degrees(), q[1].to_degrees()))
+                    .collect();
+            line(&mut c, &pts, st, i as f64 / methods.len() as f64)?;
+            keys.push((m.name.clone(), Key::Line(st)));
         }
-        legend(&mut c)
+        legend(&side, &keys)
     })
 }
 
 /// SCP convergence: peak and infeasibility per iteration.
 pub fn convergence(iters: &[ScpIteration]) -> Result<String> {
-    svg((900, 700), |root| {
+    svg((1000, 700), |root| {
         let n = iters.len().max(2) as f64;
         let panels = root.split_evenly((2, 1));
+        let (plot, side) = with_legend(&panels[0]);
         let y = range(iters.iter().map(|i| i.peak));
         let mut c = chart(
-            &panels[0],
+            &plot,
             "Free-form SCP: peak torque per iteration",
             (0.0, n),
             y,
-            "iteration",
-            "peak (N m)",
+            ("iteration", "peak (N m)"),
+            true,
         )?;
-        c.draw_series(LineSeries::new(
-            iters.iter().map(|i| (i.iteration as f64, i.peak)),
-            color(3).stroke_width(2),
-        ))
-        .map_err(perr)?
-        .label("peak at the iterate")
-        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color(3).stroke_width(2)));
+        let st = style(1);
+        let pts: Vec<_> = iters.iter().map(|i| (i.iteration as f64, i.peak)).collect();
+        line(&mut c, &pts, st, 0.0)?;
+        let rejected = style(2);
         c.draw_series(
             iters
                 .iter()
                 .filter(|i| !i.accepted)
-                .map(|i| Cross::new((i.iteration as f64, i.peak), 4, RED)),
+                .map(|i| marker((i.iteration as f64, i.peak), Marker::Cross, rejected.color)),
         )
-        .map_err(perr)?
-        .label("rejected step")
-        .legend(|(x, y)| Cross::new((x + 10, y), 4, RED));
-        legend(&mut c)?;
+        .map_err(perr)?;
+        legend(
+            &side,
+            &[
+                ("peak at the iterate".into(), Key::Line(st)),
+                (
+                    "rejected step".into(),
+                    Key::Mark(Style {
+                        marker: Marker::Cross,
+                        ..rejected
+                    }),
+                ),
+            ],
+        )?;
+        let (plot, side) = with_legend(&panels[1]);
         let lg = |v: f64| v.max(1e-16).log10();
         let y = range(
             iters
@@ -335,36 +579,39 @@ pub fn convergence(iters: &[ScpIteration]) -> Result<String> {
                 .chain(iters.iter().map(|i| lg(i.radius))),
         );
         let mut c = chart(
-            &panels[1],
+            &plot,
             "Constraint violation and trust radius",
             (0.0, n),
             y,
-            "iteration",
-            "log10",
+            ("iteration", "log10 of max |r| (rad) or of radius"),
+            true,
         )?;
-        for (k, (name, f)) in [("max |r| (rad)", 0usize), ("trust radius", 1)]
-            .into_iter()
-            .enumerate()
+        let mut keys = Vec::new();
+        for (k, name) in [
+            "max |r|, constraint violation (rad)",
+            "trust radius (scaled)",
+        ]
+        .into_iter()
+        .enumerate()
         {
-            let col = color(k + 1);
-            c.draw_series(LineSeries::new(
-                iters.iter().map(|i| {
-                    (
-                        i.iteration as f64,
-                        lg(if f == 0 { i.infeasibility } else { i.radius }),
-                    )
-                }),
-                col.stroke_width(2),
-            ))
-            .map_err(perr)?
-            .label(name)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+            let st = style(k + 1);
+            let pts: Vec<_> = iters
+                .iter()
+                .map(|i| {
+                    let v = if k == 0 { i.infeasibility } else { i.radius };
+                    (i.iteration as f64, lg(v))
+                })
+                .collect();
+            line(&mut c, &pts, st, k as f64 / 2.0)?;
+            keys.push((name.to_string(), Key::Line(st)));
         }
-        legend(&mut c)
+        legend(&side, &keys)
     })
 }
 
-/// A line plot of several named series against one variable.
+/// A plot of several named series against one variable. When every value
+/// is positive and they span more than a factor 20, the y axis is
+/// logarithmic, so that a large series does not flatten the small ones.
 pub fn lines(
     title: &str,
     xdesc: &str,
@@ -372,34 +619,72 @@ pub fn lines(
     x: &[f64],
     series: &[(String, Vec<f64>)],
 ) -> Result<String> {
-    svg((900, 560), |root| {
+    svg((1000, 560), |root| {
+        let (plot, side) = with_legend(root);
         let xr = range(x.iter().copied());
-        let yr = range(series.iter().flat_map(|s| s.1.iter().copied()));
-        let mut c = chart(root, title, xr, (yr.0.min(0.0), yr.1), xdesc, ydesc)?;
-        for (i, (name, ys)) in series.iter().enumerate() {
-            // the methods keep their colours across all figures
-            let col = match name.as_str() {
-                "analytic" => color(0),
-                "phased" => color(1),
-                "free" => color(2),
-                _ => color(i + 1),
-            };
-            let pts: Vec<(f64, f64)> = x
+        let finite = || {
+            series
                 .iter()
-                .zip(ys)
-                .filter(|(_, y)| y.is_finite())
-                .map(|(a, b)| (*a, *b))
-                .collect();
-            c.draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
-                .map_err(perr)?
-                .label(name.clone())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
-                });
-            c.draw_series(pts.into_iter().map(|p| Circle::new(p, 3, col.filled())))
+                .flat_map(|s| s.1.iter().copied())
+                .filter(|v| v.is_finite())
+        };
+        let (lo, hi) = finite().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), v| {
+            (a.min(v), b.max(v))
+        });
+        let log = lo > 0.0 && hi / lo > 20.0;
+        let curves: Vec<(Style, Vec<(f64, f64)>)> = series
+            .iter()
+            .enumerate()
+            .map(|(i, (name, ys))| {
+                let pts = x
+                    .iter()
+                    .zip(ys)
+                    .filter(|(_, y)| y.is_finite())
+                    .map(|(a, b)| (*a, *b))
+                    .collect();
+                (style_of(name, i + 1), pts)
+            })
+            .collect();
+        let keys: Vec<(String, Key)> = series
+            .iter()
+            .zip(&curves)
+            .map(|((name, _), (st, _))| (name.clone(), Key::Line(*st)))
+            .collect();
+        if log {
+            let mut c = ChartBuilder::on(&plot)
+                .caption(title, (FONT, 20))
+                .margin(12)
+                .x_label_area_size(42)
+                .y_label_area_size(70)
+                .build_cartesian_2d(xr.0..xr.1, (lo / 1.3..hi * 1.3).log_scale())
                 .map_err(perr)?;
+            let ydesc = format!("{ydesc}, log scale");
+            c.configure_mesh()
+                .x_desc(xdesc)
+                .y_desc(ydesc)
+                .label_style((FONT, 13))
+                .axis_desc_style((FONT, 15))
+                .light_line_style(WHITE.mix(0.0))
+                .draw()
+                .map_err(perr)?;
+            for (k, (st, pts)) in curves.iter().enumerate() {
+                line(&mut c, pts, *st, k as f64 / curves.len() as f64)?;
+            }
+        } else {
+            let yr = range(finite());
+            let mut c = chart(
+                &plot,
+                title,
+                xr,
+                (yr.0.min(0.0), yr.1),
+                (xdesc, ydesc),
+                false,
+            )?;
+            for (k, (st, pts)) in curves.iter().enumerate() {
+                line(&mut c, pts, *st, k as f64 / curves.len() as f64)?;
+            }
         }
-        legend(&mut c)
+        legend(&side, &keys)
     })
 }
 
@@ -410,18 +695,30 @@ pub fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The report page: a summary table and the figures.
+/// The report page: a summary table, warnings, the animation and the figures.
 pub fn index_html(
     title: &str,
     header: &[&str],
     rows: &[Vec<String>],
     notes: &[String],
+    warnings: &[String],
+    animation: &str,
     figures: &[&str],
 ) -> String {
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>");
     h.push_str(&esc(title));
-    h.push_str("</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1000px}table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right}th{background:#eee}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}</style></head><body>\n");
+    h.push_str(concat!(
+        "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}",
+        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right;white-space:nowrap}",
+        "th{background:#eee}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}",
+        ".warn{border-left:4px solid #b00;padding:2px 8px;background:#fee}",
+        "#views{display:flex;flex-wrap:wrap;gap:12px}.view h3{margin:4px 0}",
+        ".view canvas{border:1px solid #bbb;cursor:grab;touch-action:none}",
+        ".readout{font-family:monospace;font-size:13px}.status{font-size:13px;color:#444}",
+        ".controls{display:flex;gap:14px;align-items:center;margin:8px 0}#time{width:320px}",
+        "#errors{color:#b00}</style></head><body>\n"
+    ));
     h.push_str(&format!("<h1>{}</h1>\n<table>\n<tr>", esc(title)));
     for c in header {
         h.push_str(&format!("<th>{}</th>", esc(c)));
@@ -435,9 +732,13 @@ pub fn index_html(
         h.push_str("</tr>\n");
     }
     h.push_str("</table>\n");
+    for w in warnings {
+        h.push_str(&format!("<p class=\"warn\">{}</p>\n", esc(w)));
+    }
     for n in notes {
         h.push_str(&format!("<p>{}</p>\n", esc(n)));
     }
+    h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<div><img src=\"{f}\" alt=\"{f}\"></div>\n"));
     }

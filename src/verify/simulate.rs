@@ -26,6 +26,9 @@ pub struct TracePoint {
     pub tilt: f64,
     pub q: [f64; 2],
     pub tau: [f64; 2],
+    /// Body A's attitude quaternion `[w, x, y, z]` (A frame to world); body
+    /// B's is `R_A R_rel(q)`. The report animates both halves from it.
+    pub attitude: [f64; 4],
 }
 
 /// What a simulation reports.
@@ -202,6 +205,7 @@ impl<'a> Recorder<'a> {
             tilt,
             q,
             tau,
+            attitude: [qa.w, qa.i, qa.j, qa.k],
         });
         quat.iter()
             .chain(&q)

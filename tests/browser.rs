@@ -1,0 +1,88 @@
+//! The report page in a real headless Chromium: it renders, its script runs
+//! without errors, and the animation advances. Ignored by default because it
+//! needs `chromium`; `.ci/run` installs it and runs `cargo test --release -- --ignored`.
+
+use std::path::Path;
+use std::process::Command;
+
+/// The text of `<pre id="ID">...</pre>` in a dumped DOM.
+fn pre<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
+    let open = format!("<pre id=\"{id}\"");
+    let start = dom.find(&open)?;
+    let body = start + dom[start..].find('>')? + 1;
+    let end = body + dom[body..].find("</pre>")?;
+    Some(&dom[body..end])
+}
+
+#[test]
+#[ignore = "needs chromium (.ci/run installs it)"]
+fn report_page_renders_runs_and_animates_in_chromium() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml");
+    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+        .args(["run", cfg.to_str().unwrap()])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let base = dir.path().join("output/seed/run");
+    let profile = tempfile::tempdir().unwrap();
+    let url = format!("file://{}#selftest", base.join("index.html").display());
+    let out = Command::new("chromium")
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-background-networking",
+            "--no-first-run",
+            &format!("--user-data-dir={}", profile.path().display()),
+            "--virtual-time-budget=5000",
+            "--dump-dom",
+            &url,
+        ])
+        .output()
+        .expect("chromium runs (install it: apt-get install chromium)");
+    let dom = String::from_utf8_lossy(&out.stdout);
+    // the page rendered and the player built one view per method
+    assert!(dom.contains("<h1>catflip report: seed</h1>"), "{dom}");
+    assert_eq!(dom.matches("<canvas").count(), 3, "one canvas per method");
+    // no script error reached window.onerror
+    assert_eq!(pre(&dom, "errors"), Some(""), "script errors");
+    let st: serde_json::Value = serde_json::from_str(
+        &pre(&dom, "selftest")
+            .expect("the self-check wrote its result")
+            .replace("&quot;", "\""),
+    )
+    .unwrap();
+    assert_eq!(st["errors"].as_array().unwrap().len(), 0, "{st}");
+    assert_eq!(st["tracks"], 3);
+    // the drawn attitude changes between t = 0 and half-way (every method)
+    for px in st["leg_move_px"].as_array().unwrap() {
+        assert!(
+            px.as_f64().unwrap() > 10.0,
+            "a belly stub moved only {px} px"
+        );
+    }
+    // and pressing play moves the clock on
+    assert!(st["played_to_s"].as_f64().unwrap() > 0.0, "{st}");
+    // The page's own quaternion maths against the simulation's flip: body A's
+    // belly (+x) ends at world x = cos(flip) for a straight, untilted cat.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
+    for (m, bx) in summary["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(st["belly_x_end"].as_array().unwrap())
+    {
+        let flip = m["flip_deg"].as_f64().unwrap().to_radians();
+        let bx = bx.as_f64().unwrap();
+        assert!(
+            (bx - flip.cos()).abs() < 1e-6,
+            "{}: {bx} vs cos(flip) {}",
+            m["method"],
+            flip.cos()
+        );
+        assert!(bx < -0.999, "{}: the belly ends down", m["method"]);
+    }
+}
