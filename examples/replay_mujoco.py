@@ -111,7 +111,9 @@ def main():
     summary = load_summary(out)
     name = summary["name"]
     model = mujoco.MjModel.from_xml_path(str(out / f"{name}.mjcf.xml"))
-    methods = args.methods.split(",") if args.methods else [m["method"] for m in summary["methods"]]
+    # every method that produced a schedule (a failed one has none)
+    methods = args.methods.split(",") if args.methods else [
+        m["method"] for m in summary["methods"] if m.get("verdict") != "failed"]
     results, fails, controls = [], [], []
     for method in methods:
         c = read_controls(out / f"{method}.mujoco.csv")

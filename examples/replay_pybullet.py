@@ -121,7 +121,9 @@ def main():
     out = pathlib.Path(args.output)
     summary = load_summary(out)
     urdf = out / f"{summary['name']}.urdf"
-    methods = args.methods.split(",") if args.methods else [m["method"] for m in summary["methods"]]
+    # every method that produced a schedule (a failed one has none)
+    methods = args.methods.split(",") if args.methods else [
+        m["method"] for m in summary["methods"] if m.get("verdict") != "failed"]
     results = []
     for method in methods:
         c = read_controls(out / f"{method}.pybullet.csv")
