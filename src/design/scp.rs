@@ -15,9 +15,11 @@
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
 //! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
 //! halves when `rho < 0.1` and doubles when `rho > 0.5`.
-//! Stop: predicted decrease below `tolerance * phi` with `max |r| <= feasibility`
-//! (converged); the penalty grows tenfold when the model stalls while still
-//! infeasible; an iteration limit or a collapsed trust region end the run.
+//! Stop: criticality (the predicted decrease at unit radius relative to
+//! `phi`, see [`ScpIteration::criticality`]) below `tolerance` with
+//! `max |r| <= feasibility` (converged); the penalty grows tenfold when the
+//! model stalls while still infeasible; an iteration limit or a collapsed
+//! trust region (stalled) end the run.
 
 use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::error::{Error, Result};
@@ -67,7 +69,8 @@ pub trait ScpProblem {
 pub struct ScpSettings {
     /// Iteration limit (default 150).
     pub max_iterations: usize,
-    /// Converged when the predicted decrease is below this fraction of the merit (default 1e-4).
+    /// Converged when the criticality (predicted decrease at unit trust radius
+    /// relative to the merit) is below this (default 1e-4).
     pub tolerance: f64,
     /// Largest `|r|` accepted as feasible (default 1e-6).
     pub feasibility: f64,
@@ -108,7 +111,33 @@ pub struct ScpIteration {
     pub accepted: bool,
     /// Merit after the iteration (equal to `merit` when rejected).
     pub merit_after: f64,
+    /// Largest scaled component of the trial step `|dz_i| / scale_i`.
+    pub step: f64,
     pub solve_ms: f64,
+}
+
+impl ScpIteration {
+    /// First-order criticality: the model decrease at unit trust radius,
+    /// relative to the merit, bounded above by `predicted / min(radius, 1)`
+    /// (the model's optimal value is convex in the radius, so the predicted
+    /// decrease is concave in it). Unlike the raw predicted decrease it does
+    /// not vanish merely because the trust region has shrunk.
+    pub fn criticality(&self) -> f64 {
+        self.predicted.max(0.0) / self.merit.abs().max(1e-300) / self.radius.min(1.0)
+    }
+
+    /// The record with its peak-valued fields (merit, peak, decreases,
+    /// weight) multiplied by `unit`: problems solved in scaled units report
+    /// physical ones.
+    pub fn in_units(mut self, unit: f64) -> Self {
+        self.merit *= unit;
+        self.peak *= unit;
+        self.weight *= unit;
+        self.predicted *= unit;
+        self.actual *= unit;
+        self.merit_after *= unit;
+        self
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -120,6 +149,24 @@ pub enum ScpStatus {
     Stalled,
 }
 
+/// Why the user may trust the end point: the numbers the stopping rule
+/// looked at, at the last iteration.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Certificate {
+    /// Largest scaled component of the last step taken (`|dz_i| / scale_i`).
+    pub step: f64,
+    /// Largest equality-constraint violation `max |r(z)|` at the end point.
+    pub constraint_violation: f64,
+    /// The method's optimality measure, [`ScpIteration::criticality`] of the
+    /// last iteration (zero exactly at a KKT point of the penalised problem;
+    /// converged below `tolerance`).
+    pub criticality: f64,
+    /// Trust-region radius at the end (scaled units).
+    pub radius: f64,
+    /// Penalty weight at the end, relative to the objective's scale.
+    pub weight: f64,
+}
+
 #[derive(Debug, Clone)]
 pub struct ScpResult {
     pub z: Vec<f64>,
@@ -127,6 +174,7 @@ pub struct ScpResult {
     pub peak: f64,
     pub infeasibility: f64,
     pub iterations: Vec<ScpIteration>,
+    pub certificate: Certificate,
 }
 
 fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
@@ -155,6 +203,7 @@ fn subproblem(
     scales: &[f64],
     radius: f64,
     w: f64,
+    phi: f64,
 ) -> ConicData {
     let n = p.dim();
     let m = lin.residual.len();
@@ -224,7 +273,10 @@ fn subproblem(
     }
     let mut rows = 2 * m + 2 * n;
     if let Some(lim) = p.peak_limit() {
-        d.row(&[(t, 1.0)], lim);
+        // dz = 0 is feasible with model value phi(z), so t <= phi(z) at the
+        // subproblem's optimum: a bound above 10 phi never binds, and a huge
+        // one (1e12) would only wreck the interior-point scaling
+        d.row(&[(t, 1.0)], lim.min(10.0 * phi));
         rows += 1;
     }
     d.cone(Cone::Nonneg(rows));
@@ -280,7 +332,7 @@ fn iterate(
 ) -> Result<(ScpIteration, Vec<f64>)> {
     let (phi, peak, inf) = merit(p, z, w);
     let lin = p.linearize(z);
-    let data = subproblem(p, z, &lin, scales, radius, w);
+    let data = subproblem(p, z, &lin, scales, radius, w, phi);
     let clock = Instant::now();
     let (st, x, _) = solve_reusing(&mut solvers.subproblem, &data)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
@@ -319,6 +371,11 @@ fn iterate(
             }
         }
     }
+    let step = trial
+        .iter()
+        .zip(z)
+        .zip(scales)
+        .fold(0.0f64, |m, ((a, b), s)| m.max((a - b).abs() / s));
     let actual = phi - phi_t;
     let rho = if predicted > 0.0 {
         actual / predicted
@@ -338,6 +395,7 @@ fn iterate(
         rho,
         accepted,
         merit_after: if accepted { phi_t } else { phi },
+        step,
         solve_ms,
     };
     Ok((rec, trial))
@@ -372,7 +430,7 @@ pub fn solve(
             radius = (radius * 2.0).min(1e3);
         }
         let (_, _, inf_now) = merit(p, &z, w);
-        if rec.predicted <= settings.tolerance * rec.merit.abs().max(1e-300) {
+        if rec.criticality() <= settings.tolerance {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
                 break;
@@ -381,20 +439,25 @@ pub fn solve(
             w *= 10.0;
         }
         if radius < 1e-10 {
-            status = if inf_now <= settings.feasibility {
-                ScpStatus::Converged
-            } else {
-                ScpStatus::Stalled
-            };
+            status = ScpStatus::Stalled;
             break;
         }
     }
     let (_, peak, infeasibility) = merit(p, &z, w);
+    let last = iterations.last().copied();
+    let certificate = Certificate {
+        step: last.map_or(0.0, |l| l.step),
+        constraint_violation: infeasibility,
+        criticality: last.map_or(0.0, |l| l.criticality()),
+        radius,
+        weight: w / peak0.max(1e-12),
+    };
     Ok(ScpResult {
         z,
         status,
         peak,
         infeasibility,
         iterations,
+        certificate,
     })
 }
