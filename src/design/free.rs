@@ -263,7 +263,146 @@ impl FreeProblem {
     }
 }
 
+/// `d tau_i / d(q, q^, q^^)` as one row of six.
+fn torque_gradients(cat: &Cat, x: &[f64; 6], terms: Option<&ShapeTerms>) -> [[f64; 6]; 2] {
+    let q = [x[0], x[1]];
+    let owned;
+    let t = match terms {
+        Some(t) => t,
+        None => {
+            owned = ShapeTerms::second(cat, q);
+            &owned
+        }
+    };
+    let l = linearize_torque(t, [x[2], x[3]], [x[4], x[5]]);
+    [0, 1].map(|i| {
+        [
+            l.d_q[i][0],
+            l.d_q[i][1],
+            l.d_qd[i][0],
+            l.d_qd[i][1],
+            l.d_qdd[i][0],
+            l.d_qdd[i][1],
+        ]
+    })
+}
+
+/// `sum_i y_i Hess tau_i` in `(q, q^, q^^)`: central differences of the
+/// exact gradients (the rate and acceleration blocks are polynomial, so
+/// exact up to rounding), symmetrised.
+fn weighted_torque_hessian(cat: &Cat, x: [f64; 6], y: [f64; 2]) -> [[f64; 6]; 6] {
+    let mut g = [[0.0; 6]; 6];
+    let base = ShapeTerms::second(cat, [x[0], x[1]]);
+    for m in 0..6 {
+        let h = 1e-5 * (1.0 + x[m].abs());
+        let (mut xp, mut xm) = (x, x);
+        xp[m] += h;
+        xm[m] -= h;
+        // the shape terms depend on q only
+        let reuse = if m < 2 { None } else { Some(&base) };
+        let (gp, gm) = (
+            torque_gradients(cat, &xp, reuse),
+            torque_gradients(cat, &xm, reuse),
+        );
+        for c in 0..6 {
+            g[m][c] = (0..2)
+                .map(|i| y[i] * (gp[i][c] - gm[i][c]) / (2.0 * h))
+                .sum();
+        }
+    }
+    for a in 0..6 {
+        for b in a + 1..6 {
+            let v = 0.5 * (g[a][b] + g[b][a]);
+            g[a][b] = v;
+            g[b][a] = v;
+        }
+    }
+    g
+}
+
+/// The nearest positive semidefinite matrix (negative eigenvalues clipped).
+fn psd_part(h: nalgebra::SMatrix<f64, 9, 9>) -> nalgebra::SMatrix<f64, 9, 9> {
+    let e = nalgebra::SymmetricEigen::new(h);
+    let d = e.eigenvalues.map(|x| x.max(0.0));
+    e.eigenvectors * nalgebra::SMatrix::<f64, 9, 9>::from_diagonal(&d) * e.eigenvectors.transpose()
+}
+
 impl ScpProblem for FreeProblem {
+    /// Curvature of the peak terms, interval by interval: each check point's
+    /// `y . tau / (I_t T_p^2)` is a function of its interval's eight node
+    /// values and the phase duration; the 9x9 Hessian of the interval's sum
+    /// is clipped to its PSD part (the attitude's curvature is left to the
+    /// driver's second-order correction).
+    fn hessian(&self, z: &[f64], y: &[f64]) -> Triplets {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        let it = self.cat.i_t();
+        let mut out = Vec::with_capacity(3 * (n - 1) * 45);
+        let mut row = 0;
+        for p in 0..3 {
+            let t = z[tr.duration(p)];
+            let (s2, s3, s4) = (
+                1.0 / (t * t * it),
+                -2.0 / (t * t * t * it),
+                6.0 / (t.powi(4) * it),
+            );
+            let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
+            for (k, q, v, a, coef) in self.check_points(z, p) {
+                let w = [y[row], y[row + 1]];
+                row += 2;
+                if w == [0.0, 0.0] {
+                    continue;
+                }
+                let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
+                let g6 = weighted_torque_hessian(&self.cat, x, w);
+                let gr = torque_gradients(&self.cat, &x, None);
+                let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
+                // C: local inputs (kind, component) from the interval's 8 values (component, idx)
+                let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
+                for kind in 0..3 {
+                    for l in 0..2 {
+                        for idx in 0..4 {
+                            c[(2 * kind + l, 4 * l + idx)] = coef[kind][idx];
+                        }
+                    }
+                }
+                let g = nalgebra::SMatrix::<f64, 6, 6>::from_fn(|i, j| g6[i][j]);
+                let hx = c.transpose() * g * c * s2;
+                let grad6 =
+                    nalgebra::SVector::<f64, 6>::from_fn(|i, _| w[0] * gr[0][i] + w[1] * gr[1][i]);
+                let gx = c.transpose() * grad6 * s3;
+                let b = &mut blocks[k];
+                for i in 0..8 {
+                    for j in 0..8 {
+                        b[(i, j)] += hx[(i, j)];
+                    }
+                    b[(i, 8)] += gx[i];
+                    b[(8, i)] += gx[i];
+                }
+                b[(8, 8)] += (w[0] * tau[0] + w[1] * tau[1]) * s4;
+            }
+            for (k, b) in blocks.into_iter().enumerate() {
+                let b = psd_part(b);
+                let mut cols = [0usize; 9];
+                for l in 0..2 {
+                    let ic = tr.interval_columns(p, k, l);
+                    for idx in 0..4 {
+                        cols[4 * l + idx] = ic[idx];
+                    }
+                }
+                cols[8] = tr.duration(p);
+                for i in 0..9 {
+                    for j in 0..9 {
+                        if cols[i] <= cols[j] {
+                            out.push((cols[i], cols[j], b[(i, j)]));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
     fn dim(&self) -> usize {
         self.tr.dim()
     }

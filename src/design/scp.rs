@@ -62,6 +62,14 @@ pub trait ScpProblem {
     fn peak_limit(&self) -> Option<f64> {
         None
     }
+    /// Second-order information: a positive semidefinite approximation of
+    /// `sum_r y_r Hess f_r(z)` (`y` one multiplier per flattened term), as
+    /// upper-triangle triplets with a pattern that does not depend on `z` or
+    /// `y`. The default (none) makes the method sequential linear
+    /// programming; with it, the subproblem is an SQP step.
+    fn hessian(&self, _z: &[f64], _y: &[f64]) -> Triplets {
+        Vec::new()
+    }
 }
 
 /// Driver settings; defaults in each field's doc.
@@ -204,7 +212,8 @@ fn subproblem(
     radius: f64,
     w: f64,
     phi: f64,
-) -> ConicData {
+    y: &[f64],
+) -> (ConicData, TermRows) {
     let n = p.dim();
     let m = lin.residual.len();
     let (t, np, nm) = (n, n + 1, n + 1 + m);
@@ -220,6 +229,8 @@ fn subproblem(
         p_diag[i] = 1e-9 / (scales[i] * scales[i]);
     }
     d.p_diag = Some(p_diag);
+    d.p_upper = p.hessian(z, y);
+    let mut term_rows: TermRows = vec![Vec::new(); lin.terms.len()];
     // linearised equalities with virtual control: r + J dz - nu+ + nu- = 0
     let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
     for &(r, c, v) in &lin.residual_jac {
@@ -246,7 +257,8 @@ fn subproblem(
                 for j in 0..dim {
                     let r = k * dim + j;
                     let row: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
-                    d.row(&row, lin.terms[r]);
+                    // s = f + J dz: the Lagrangian holds -z_row f
+                    term_rows[r].push((d.row(&row, lin.terms[r]), -1.0));
                 }
                 d.cone(Cone::Soc(dim + 1));
             }
@@ -255,10 +267,10 @@ fn subproblem(
             for r in 0..lin.terms.len() {
                 let mut up = jac[r].clone();
                 up.push((t, -1.0));
-                d.row(&up, -lin.terms[r]);
+                term_rows[r].push((d.row(&up, -lin.terms[r]), 1.0));
                 let mut down: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
                 down.push((t, -1.0));
-                d.row(&down, lin.terms[r]);
+                term_rows[r].push((d.row(&down, lin.terms[r]), -1.0));
             }
             d.cone(Cone::Nonneg(2 * lin.terms.len()));
         }
@@ -280,8 +292,12 @@ fn subproblem(
         rows += 1;
     }
     d.cone(Cone::Nonneg(rows));
-    d
+    (d, term_rows)
 }
+
+/// For each flattened term, the subproblem rows it appears in and the sign
+/// with which the row's dual multiplies the term in the Lagrangian.
+type TermRows = Vec<Vec<(usize, f64)>>;
 
 /// Second-order correction at the trial point `z+ = z + dz`: the least
 /// scaled-norm `dc` with `J dc = (r + J dz) - r(z+)` (back onto the model's
@@ -329,12 +345,14 @@ fn iterate(
     iteration: usize,
     scales: &[f64],
     solvers: &mut Solvers,
+    y: &mut Vec<f64>,
 ) -> Result<(ScpIteration, Vec<f64>)> {
     let (phi, peak, inf) = merit(p, z, w);
     let lin = p.linearize(z);
-    let data = subproblem(p, z, &lin, scales, radius, w, phi);
+    y.resize(lin.terms.len(), 0.0);
+    let (data, term_rows) = subproblem(p, z, &lin, scales, radius, w, phi, y);
     let clock = Instant::now();
-    let (st, x, _) = solve_reusing(&mut solvers.subproblem, &data)?;
+    let (st, x, obj) = solve_reusing(&mut solvers.subproblem, &data)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
     if !st.ok() {
         if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
@@ -350,8 +368,15 @@ fn iterate(
         });
     }
     let (n, m) = (p.dim(), lin.residual.len());
-    let model = x[n] + w * x[n + 1..n + 1 + 2 * m].iter().sum::<f64>();
-    let predicted = phi - model;
+    // the peak terms' multipliers, for the next subproblem's curvature
+    if let Some(sv) = &solvers.subproblem {
+        let dual = sv.duals();
+        for (yr, rows) in y.iter_mut().zip(&term_rows) {
+            *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+        }
+    }
+    // model value: t + w |nu|_1 + 1/2 dz' P dz (the solver's objective)
+    let predicted = phi - obj;
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let (mut phi_t, _, _) = merit(p, &trial, w);
     if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
@@ -417,8 +442,9 @@ pub fn solve(
     let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
+    let mut y = Vec::new();
     for it in 0..settings.max_iterations {
-        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers)?;
+        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut y)?;
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
