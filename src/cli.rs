@@ -62,6 +62,11 @@ enum Command {
         /// Points computed at once (default: the machine's cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// K/N: compute only the K-th of N disjoint slices of the grid (for a
+        /// batch scheduler's job array); the shards' CSVs concatenate into the
+        /// whole sweep's.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
     },
     /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model.
     Export {
@@ -122,7 +127,8 @@ pub fn run() -> Result<()> {
             range,
             methods,
             threads,
-        } => cmd_sweep(&common, &range, &methods, threads),
+            shard,
+        } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref()),
         Command::Export { format, common } => cmd_export(&common, format),
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
@@ -559,9 +565,19 @@ fn cmd_run(c: &Common) -> Result<()> {
     Ok(())
 }
 
-fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>) -> Result<()> {
+fn cmd_sweep(
+    c: &Common,
+    range: &str,
+    methods: &[String],
+    threads: Option<usize>,
+    shard: Option<&str>,
+) -> Result<()> {
     let cfg = load(c)?;
     let spec: catflip::sweep::SweepSpec = range.parse()?;
+    let shard = match shard {
+        Some(s) => s.parse()?,
+        None => catflip::sweep::Shard::ALL,
+    };
     let mut m = catflip::sweep::Methods {
         analytic: false,
         phased: false,
@@ -583,15 +599,37 @@ fn cmd_sweep(c: &Common, range: &str, methods: &[String], threads: Option<usize>
             .unwrap_or(1)
     });
     let quiet = c.json;
-    let points = catflip::sweep::sweep(&c.config, &c.set, &spec, m, threads, |done, total| {
-        if !quiet {
-            eprint!("\r  sweep {}: {done}/{total} points", spec.key);
-        }
-    })?;
-    if !quiet {
+    // a live bar on a terminal, plain lines otherwise
+    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let clock = std::time::Instant::now();
+    let points = catflip::sweep::sweep_shard(
+        &c.config,
+        &c.set,
+        &spec,
+        m,
+        threads,
+        shard,
+        |done, total| {
+            if quiet {
+                return;
+            }
+            let line = catflip::sweep::progress_line(
+                &spec.key,
+                done,
+                total,
+                clock.elapsed().as_secs_f64(),
+            );
+            if live {
+                eprint!("\r  {line}");
+            } else {
+                eprintln!("  {line}");
+            }
+        },
+    )?;
+    if !quiet && live {
         eprintln!();
     }
-    let key = spec.key.replace('.', "_");
+    let key = format!("{}{}", spec.key.replace('.', "_"), shard.suffix());
     let mut out = Output::default();
     out.add(
         format!("sweep-{key}.csv"),

@@ -24,7 +24,8 @@ use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
 use crate::design::conic::{Cone, ConicData};
 use crate::design::scp::{
-    Certificate, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets, solve,
+    Certificate, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets,
+    WarmStart, solve_warm,
 };
 use crate::error::Result;
 use crate::model::dynamics::{linearize_torque, torque_from};
@@ -103,6 +104,11 @@ impl FreeProblem {
             max_torque: cfg.limits.max_torque.map(|l| l / torque_unit),
             scales,
         }
+    }
+
+    /// Number of flattened peak terms (two per check point).
+    pub fn terms_len(&self) -> usize {
+        3 * 2 * (2 * self.tr.nodes - 1)
     }
 
     /// Physical `z` (durations in s) to the problem's units.
@@ -572,9 +578,12 @@ pub struct FreeResult {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mesh_check: Option<MeshCheck>,
     pub iterations: Vec<ScpIteration>,
-    /// The solution in the problem's units (a warm start for a neighbour).
+    /// The solution in the problem's units and the SCP's end state (a warm
+    /// start for a neighbour).
     #[serde(skip)]
     pub z_scaled: Vec<f64>,
+    #[serde(skip)]
+    pub warm: WarmStart,
     #[serde(skip)]
     pub plan: CollocationPlan,
     /// The dynamic simulation the reported flip, tilt and peak come from.
@@ -607,7 +616,7 @@ pub fn optimize_from(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let tr = Transcription::new(3, nodes);
-    optimize_start(cfg, &tr.sample(seed_plan), seed, nodes, observe)
+    optimize_start(cfg, &tr.sample(seed_plan), None, seed, nodes, observe)
 }
 
 /// An SCP solution before verification.
@@ -627,6 +636,7 @@ struct Solved {
 fn design(
     cfg: &Config,
     z0: &[f64],
+    warm: Option<&WarmStart>,
     nodes: usize,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Solved> {
@@ -648,7 +658,10 @@ fn design(
         ..Default::default()
     };
     let unit = problem.torque_unit;
-    let mut res = solve(&problem, z0, &settings, |it| observe(&it.in_units(unit)))?;
+    let warm = warm.filter(|w| w.multipliers.len() == problem.terms_len());
+    let mut res = solve_warm(&problem, z0, warm, &settings, |it| {
+        observe(&it.in_units(unit))
+    })?;
     for it in res.iterations.iter_mut() {
         *it = it.in_units(unit);
     }
@@ -674,6 +687,7 @@ fn design(
 pub fn optimize_start(
     cfg: &Config,
     z0: &[f64],
+    warm: Option<&WarmStart>,
     seed: &str,
     nodes: usize,
     observe: impl FnMut(&ScpIteration),
@@ -684,7 +698,7 @@ pub fn optimize_start(
         z_scaled,
         plan,
         attitude_error: att,
-    } = design(cfg, z0, nodes, observe)?;
+    } = design(cfg, z0, warm, nodes, observe)?;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
     let (peak, _) =
@@ -737,10 +751,39 @@ pub fn optimize_start(
         certificate: res.certificate,
         mesh_check: None,
         z_scaled,
+        warm: res.warm.clone(),
         iterations: res.iterations,
         plan,
         sim,
     })
+}
+
+/// Continuation: the free-form design for `cfg` started from a neighbouring
+/// design `prev` (another point of a sweep). The start is `prev`'s solution
+/// in dimensionless units, so a change of drop height, margin or gravity
+/// (F3) starts exactly at the optimum, and a change of the cat or limits
+/// starts next to it.
+pub fn continue_from(
+    cfg: &Config,
+    prev: &FreeResult,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    let nodes = cfg.free.nodes;
+    let tr = Transcription::new(3, nodes);
+    let mut z0 = if prev.nodes == nodes {
+        prev.z_scaled.clone()
+    } else {
+        let mut z = tr.sample(&prev.plan);
+        let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        for p in 0..3 {
+            z[tr.duration(p)] /= total;
+        }
+        z
+    };
+    for p in 0..3 {
+        z0[tr.duration(p)] *= cfg.available_time();
+    }
+    optimize_start(cfg, &z0, Some(&prev.warm), "continuation", nodes, observe)
 }
 
 /// Turns of the bend direction the mesh resolves: eight nodes per turn.
@@ -803,7 +846,7 @@ pub struct MeshCheck {
 pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = Transcription::new(3, nodes).sample(&r.plan);
-    let fine = design(cfg, &z0, nodes, |_| {})?;
+    let fine = design(cfg, &z0, None, nodes, |_| {})?;
     let (peak, _) = crate::verify::analyze::peak_along(
         cfg,
         &fine.plan,
@@ -824,6 +867,7 @@ pub fn optimize(
     seed: Seed,
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
+    check_resolvable(cfg, cfg.free.nodes)?;
     let mut r = match seed {
         Seed::Phased => {
             let ph = crate::design::phased::optimize(cfg, |_| {})?;

@@ -16,8 +16,10 @@
 //! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
 //! halves when `rho < 0.1` and doubles when `rho > 0.5`.
 //! Stop: criticality (the predicted decrease at unit radius relative to
-//! `phi`, see [`ScpIteration::criticality`]) below `tolerance` with
-//! `max |r| <= feasibility` (converged); the penalty grows tenfold when the
+//! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
+//! that fell by less than `tolerance` (relative) over the last `window`
+//! iterations, with `max |r| <= feasibility` (converged; the certificate
+//! names the rule); the penalty grows tenfold when the
 //! model stalls while still infeasible; an iteration limit or a collapsed
 //! trust region (stalled) end the run.
 
@@ -84,6 +86,9 @@ pub struct ScpSettings {
     pub feasibility: f64,
     /// Initial trust radius in scaled units (default 0.5).
     pub initial_radius: f64,
+    /// Iterations over which the merit must fall by `tolerance` (relative)
+    /// to keep going (default 10).
+    pub window: usize,
     /// Penalty weight relative to the initial peak (default 2): the exact L1
     /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
     /// model more curved and the steps shorter. It grows tenfold when needed.
@@ -97,6 +102,7 @@ impl Default for ScpSettings {
             tolerance: 1e-4,
             feasibility: 1e-6,
             initial_radius: 0.5,
+            window: 10,
             weight: 2.0,
         }
     }
@@ -173,6 +179,22 @@ pub struct Certificate {
     pub radius: f64,
     /// Penalty weight at the end, relative to the objective's scale.
     pub weight: f64,
+    /// Which test ended a converged run.
+    pub rule: StopRule,
+}
+
+/// The test that declared convergence (both need `max |r| <= feasibility`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StopRule {
+    /// Not converged.
+    #[default]
+    None,
+    /// Criticality below `tolerance`: a first-order point of the model.
+    Criticality,
+    /// The merit fell by less than `tolerance` (relative) over the last
+    /// `window` iterations: no further progress at this tolerance.
+    Progress,
 }
 
 #[derive(Debug, Clone)]
@@ -183,6 +205,7 @@ pub struct ScpResult {
     pub infeasibility: f64,
     pub iterations: Vec<ScpIteration>,
     pub certificate: Certificate,
+    pub warm: WarmStart,
 }
 
 fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
@@ -432,17 +455,41 @@ pub fn solve(
     p: &dyn ScpProblem,
     z0: Vec<f64>,
     settings: &ScpSettings,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<ScpResult> {
+    solve_warm(p, z0, None, settings, observe)
+}
+
+/// What a finished solve hands to a neighbouring problem (continuation):
+/// its peak-term multipliers (the curvature of the first subproblem) and its
+/// final trust radius.
+#[derive(Debug, Clone, Default)]
+pub struct WarmStart {
+    pub multipliers: Vec<f64>,
+    pub radius: f64,
+}
+
+/// [`solve`] with the multipliers and radius of a neighbouring solve.
+pub fn solve_warm(
+    p: &dyn ScpProblem,
+    z0: Vec<f64>,
+    warm: Option<&WarmStart>,
+    settings: &ScpSettings,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<ScpResult> {
     let scales = p.scales();
     let mut z = z0;
     let (_, peak0, _) = merit(p, &z, 0.0);
     let mut w = settings.weight * peak0.max(1e-12);
-    let mut radius = settings.initial_radius;
+    let mut radius = warm.map_or(settings.initial_radius, |w| {
+        w.radius.clamp(1e-3, settings.initial_radius)
+    });
     let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
-    let mut y = Vec::new();
+    let mut y = warm.map_or_else(Vec::new, |w| w.multipliers.clone());
+    let mut window = Vec::new();
+    let mut rule = StopRule::None;
     for it in 0..settings.max_iterations {
         let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut y)?;
         observe(&rec);
@@ -455,14 +502,26 @@ pub fn solve(
         } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
-        let (_, _, inf_now) = merit(p, &z, w);
-        if rec.criticality() <= settings.tolerance {
+        let (phi_now, _, inf_now) = merit(p, &z, w);
+        window.push(phi_now);
+        let critical = rec.criticality() <= settings.tolerance;
+        // the merit moved by less than `tolerance` (relative) over the window
+        let slow = window.len() > settings.window
+            && window[window.len() - 1 - settings.window] - phi_now
+                <= settings.tolerance * phi_now.abs();
+        if critical || slow {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
+                rule = if critical {
+                    StopRule::Criticality
+                } else {
+                    StopRule::Progress
+                };
                 break;
             }
             // stuck infeasible: the penalty is too weak
             w *= 10.0;
+            window.clear();
         }
         if radius < 1e-10 {
             status = ScpStatus::Stalled;
@@ -477,6 +536,7 @@ pub fn solve(
         criticality: last.map_or(0.0, |l| l.criticality()),
         radius,
         weight: w / peak0.max(1e-12),
+        rule,
     };
     Ok(ScpResult {
         z,
@@ -485,5 +545,9 @@ pub fn solve(
         infeasibility,
         iterations,
         certificate,
+        warm: WarmStart {
+            multipliers: y,
+            radius,
+        },
     })
 }
