@@ -38,7 +38,10 @@ fn shards_partition_the_grid_into_whole_contiguous_chunks() {
     for bad in ["0/3", "4/3", "3", "a/b", "1/0"] {
         assert!(bad.parse::<Shard>().is_err(), "{bad}");
     }
-    assert_eq!("2/5".parse::<Shard>().unwrap(), Shard { index: 2, count: 5 });
+    assert_eq!(
+        "2/5".parse::<Shard>().unwrap(),
+        Shard { index: 2, count: 5 }
+    );
 }
 
 #[test]
@@ -46,7 +49,10 @@ fn progress_line_estimates_the_time_left_from_the_mean_time_per_point() {
     // 10 of 40 points in 20 s: 2 s a point, 30 points left
     let l = progress_line("fall.height", 10, 40, 20.0);
     assert!(l.contains("10/40") && l.contains("ETA 60 s"), "{l}");
-    assert!(l.contains(&format!("[{}{}]", "#".repeat(6), ".".repeat(18))), "{l}");
+    assert!(
+        l.contains(&format!("[{}{}]", "#".repeat(6), ".".repeat(18))),
+        "{l}"
+    );
     assert!(progress_line("k", 0, 3, 0.0).contains("ETA -"));
 }
 

@@ -786,8 +786,8 @@ pub fn continue_from(
     optimize_start(cfg, &z0, Some(&prev.warm), "continuation", nodes, observe)
 }
 
-/// Turns of the bend direction the mesh resolves: eight nodes per turn.
-const NODES_PER_TURN: f64 = 8.0;
+/// Turns of the bend direction the mesh resolves: sixteen nodes per turn.
+const NODES_PER_TURN: f64 = 16.0;
 
 /// Twist coefficient `C` of F1 at bend `b` (no-twist joint; for the
 /// universal joint an estimate, F4).
@@ -883,4 +883,66 @@ pub fn optimize(
     }?;
     r.mesh_check = Some(mesh_check(cfg, &r)?);
     Ok(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn torque_hessian_matches_second_differences_of_the_inverse_dynamics() {
+        for joint in [crate::model::Joint::NoTwist, crate::model::Joint::Universal] {
+            let cat = Cat {
+                mass: 1.0,
+                length: 1.0,
+                radius: 0.1,
+                joint,
+                inertia: crate::model::InertiaFormula::SolidCylinder,
+            };
+            let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
+            let y = [0.8, -1.3];
+            let g = weighted_torque_hessian(&cat, x, y);
+            let f = |x: [f64; 6]| {
+                let t = inverse_dynamics_at(&cat, x);
+                y[0] * t[0] + y[1] * t[1]
+            };
+            let h = 1e-4;
+            for i in 0..6 {
+                for j in 0..6 {
+                    let at = |si: f64, sj: f64| {
+                        let mut z = x;
+                        z[i] += si * h;
+                        z[j] += sj * h;
+                        f(z)
+                    };
+                    let fd = (at(1.0, 1.0) - at(1.0, -1.0) - at(-1.0, 1.0) + at(-1.0, -1.0))
+                        / (4.0 * h * h);
+                    assert!(
+                        (fd - g[i][j]).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "{joint:?} ({i}, {j}): {fd} vs {}",
+                        g[i][j]
+                    );
+                }
+            }
+        }
+    }
+
+    fn inverse_dynamics_at(cat: &Cat, x: [f64; 6]) -> [f64; 2] {
+        crate::model::dynamics::inverse_dynamics(cat, [x[0], x[1]], [x[2], x[3]], [x[4], x[5]])
+    }
+
+    #[test]
+    fn psd_part_clips_negative_curvature_only() {
+        let a = nalgebra::SMatrix::<f64, 9, 9>::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0);
+        let sym = a + a.transpose();
+        let p = psd_part(sym);
+        let e = nalgebra::SymmetricEigen::new(p).eigenvalues;
+        assert!(e.iter().all(|&v| v > -1e-12));
+        // a PSD matrix is its own PSD part
+        let q = a * a.transpose();
+        assert!((psd_part(q) - q).norm() < 1e-10 * q.norm());
+        // and the clipped part is PSD with sym - p negative semidefinite
+        let n = nalgebra::SymmetricEigen::new(sym - p).eigenvalues;
+        assert!(n.iter().all(|&v| v < 1e-12));
+    }
 }
