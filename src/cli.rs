@@ -1,9 +1,9 @@
 //! Argument parsing into a checked configuration, and the terminal tables.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use catflip::Config;
 use catflip::design::plan::Schedule;
-use catflip::output::Output;
+use catflip::output::{Output, Publisher};
 use catflip::verify::analyze::{analytic_schedule, analyze, verify};
 use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
@@ -68,12 +68,16 @@ enum Command {
         #[arg(long, value_name = "K/N")]
         shard: Option<String>,
     },
-    /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model.
+    /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
         #[arg(value_enum)]
         format: ExportFormat,
         #[command(flatten)]
         common: Common,
+        /// Schedule CSV (as written by catflip) to write as `<stem>.mujoco.csv` (mjcf)
+        /// or `<stem>.pybullet.csv` (urdf) at the simulator's time step.
+        #[arg(long)]
+        schedule: Option<PathBuf>,
     },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
@@ -118,7 +122,34 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
     c.out.join(&cfg.name)
 }
 
-pub fn run() -> Result<()> {
+/// Starts the command's output set `<out>/<name>/<set>` before any work, so
+/// that an unwritable `--out` fails at once.
+fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
+    Ok(Publisher::begin(&out_dir(c, cfg), set)?)
+}
+
+/// How a command that finished ended: the exit status tells them apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Every result meets its targets (exit 0).
+    Ok,
+    /// Results were written, but some are flagged or failed (exit 3).
+    Partial,
+}
+
+fn status_of(partial: bool) -> Status {
+    if partial { Status::Partial } else { Status::Ok }
+}
+
+/// Prints a flagged verdict on stderr and says whether there was one.
+fn flag(what: &str, reason: Option<String>) -> bool {
+    if let Some(r) = &reason {
+        eprintln!("warning: {what} is FLAGGED: {r}");
+    }
+    reason.is_some()
+}
+
+pub fn run() -> Result<Status> {
     let cli = Cli::parse();
     match cli.command {
         Command::Run(c) => cmd_run(&c),
@@ -129,7 +160,11 @@ pub fn run() -> Result<()> {
             threads,
             shard,
         } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref()),
-        Command::Export { format, common } => cmd_export(&common, format),
+        Command::Export {
+            format,
+            common,
+            schedule,
+        } => cmd_export(&common, format, schedule.as_deref()),
         Command::Analyze(c) => cmd_analyze(&c),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -145,18 +180,31 @@ fn row(label: &str, value: String) {
     println!("  {label:<34} {value}");
 }
 
-fn cmd_analyze(c: &Common) -> Result<()> {
+fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
+    let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let json = serde_json::to_string_pretty(&a)?;
+    let reason = catflip::verify::simulate::misses_flip(
+        a.flip_error_rad,
+        a.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    );
+    let mut v = serde_json::to_value(&a)?;
+    v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    if let Some(r) = &reason {
+        v["reason"] = r.clone().into();
+    }
+    let json = serde_json::to_string_pretty(&v)?;
     let mut out = Output::default();
     sched.add_to(&mut out, "analytic");
     out.add("analyze.json", json.clone());
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    // the analysis is what was asked: a miss is flagged in it, not a partial result
+    flag("the seed's schedule", reason);
     if c.json {
         println!("{json}");
-        return Ok(());
+        return Ok(Status::Ok);
     }
     let cf = &a.closed;
     println!("catflip analyze: {} ({} joint)", a.name, a.joint);
@@ -219,7 +267,7 @@ fn cmd_analyze(c: &Common) -> Result<()> {
     for w in written {
         row("wrote", w.display().to_string());
     }
-    Ok(())
+    Ok(Status::Ok)
 }
 
 fn print_sim(title: &str, r: &SimReport) {
@@ -251,16 +299,36 @@ fn print_sim(title: &str, r: &SimReport) {
     row("accepted steps", format!("{}", r.steps));
 }
 
-fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
+/// Reads a schedule file, refusing one far larger than any schedule that
+/// [`catflip::verify::simulate::MAX_SCHEDULE_ROWS`] admits before reading it.
+fn read_bounded(p: &Path) -> std::io::Result<String> {
+    let limit = 500 * catflip::verify::simulate::MAX_SCHEDULE_ROWS as u64;
+    let len = std::fs::metadata(p)?.len();
+    if len > limit {
+        return Err(std::io::Error::other(format!(
+            "{len} bytes, more than a schedule of {} rows can have; resample it more coarsely",
+            catflip::verify::simulate::MAX_SCHEDULE_ROWS
+        )));
+    }
+    std::fs::read_to_string(p)
+}
+
+fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     let cfg = load(c)?;
-    let (source, report) = match schedule {
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .with_context(|| format!("cannot read schedule {}", p.display()))?;
-            let s = Schedule::from_csv(&text, &p.display().to_string())?;
+    let text = match schedule {
+        Some(p) => Some(read_bounded(p).map_err(|e| {
+            catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
+        })?),
+        None => None,
+    };
+    let publisher = publisher(c, &cfg, "simulate")?;
+    let (source, report) = match (schedule, text) {
+        (Some(p), Some(text)) => {
+            let s =
+                catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
             (p.display().to_string(), verify(&cfg, &s)?)
         }
-        None => {
+        _ => {
             let plan = catflip::design::analytic::analytic_plan(&cfg);
             ("analytic schedule".to_string(), verify(&cfg, &plan)?)
         }
@@ -272,12 +340,22 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
             p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
         ));
     }
+    let reason = catflip::verify::simulate::misses_flip(
+        report.flip_error_rad,
+        report.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    );
     let mut out = Output::default();
     out.add("simulation.csv", trace);
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    let partial = flag("the simulated schedule", reason.clone());
     if c.json {
         let mut v = serde_json::to_value(&report)?;
         v["source"] = serde_json::Value::String(source);
+        v["verdict"] = (if partial { "flagged" } else { "ok" }).into();
+        if let Some(r) = reason {
+            v["reason"] = r.into();
+        }
         println!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         print_sim(
@@ -291,22 +369,30 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<()> {
             row("wrote", w.display().to_string());
         }
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
 /// Writes `<stem>.csv` and `<stem>.json`; prints the JSON and returns `None` with `--json`.
 fn write_design(
     c: &Common,
     cfg: &Config,
+    publisher: Publisher,
     stem: &str,
     plan: &dyn catflip::design::plan::ShapePlan,
-    json: String,
+    json: serde_json::Value,
+    reason: Option<String>,
 ) -> Result<Option<Vec<PathBuf>>> {
+    let mut json = json;
+    json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    if let Some(r) = reason {
+        json["reason"] = r.into();
+    }
+    let json = serde_json::to_string_pretty(&json)?;
     let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
     let mut out = Output::default();
     sched.add_to(&mut out, stem);
     out.add(format!("{stem}.json"), json.clone());
-    let written = out.commit(&out_dir(c, cfg))?;
+    let written = publisher.publish(out)?;
     if c.json {
         println!("{json}");
         return Ok(None);
@@ -338,8 +424,28 @@ fn design_rows(
     }
 }
 
-fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<()> {
+/// Why an optimiser's verified design is flagged: unconverged, or the flip missed.
+fn design_flags(cfg: &Config, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "solved" | "converged") {
+        why.push(format!("solver status {status}"));
+    }
+    why.extend(catflip::verify::simulate::misses_flip(
+        flip_error_rad,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
+    let set = match mode {
+        Mode::Phased => "optimize-phased",
+        Mode::Free => "optimize-free",
+    };
+    let publisher = publisher(c, &cfg, set)?;
+    let partial;
     match mode {
         Mode::Phased => {
             let r = catflip::design::phased::optimize(&cfg, |e| {
@@ -350,15 +456,24 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
+            let reason = design_flags(
+                &cfg,
+                &format!("{:?}", r.status).to_lowercase(),
+                r.flip_error_rad,
+                r.tilt_deg,
+            );
+            partial = flag("the phased design", reason.clone());
             let Some(written) = write_design(
                 c,
                 &cfg,
+                publisher,
                 "phased",
                 &r.plan,
-                serde_json::to_string_pretty(&r)?,
+                serde_json::to_value(&r)?,
+                reason,
             )?
             else {
-                return Ok(());
+                return Ok(status_of(partial));
             };
             println!(
                 "catflip optimize --mode phased: {} ({} joint), status {:?}",
@@ -426,10 +541,24 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                     );
                 }
             })?;
-            let Some(written) =
-                write_design(c, &cfg, "free", &r.plan, serde_json::to_string_pretty(&r)?)?
+            let reason = design_flags(
+                &cfg,
+                &format!("{:?}", r.status).to_lowercase(),
+                r.flip_error_rad,
+                r.tilt_deg,
+            );
+            partial = flag("the free-form design", reason.clone());
+            let Some(written) = write_design(
+                c,
+                &cfg,
+                publisher,
+                "free",
+                &r.plan,
+                serde_json::to_value(&r)?,
+                reason,
+            )?
             else {
-                return Ok(());
+                return Ok(status_of(partial));
             };
             println!(
                 "catflip optimize --mode free: {} ({} joint), status {:?}, seed {}",
@@ -466,7 +595,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             );
         }
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
 /// Stage lines on stderr; live iteration counters when stderr is a terminal.
@@ -492,6 +621,12 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
                 }
                 let _ = writeln!(e, " done in {seconds:.2} s");
             }
+            Progress::StageFailed { seconds, reason } => {
+                if live {
+                    let _ = write!(e, "\r\x1b[2K");
+                }
+                let _ = writeln!(e, " FAILED after {seconds:.2} s: {reason}");
+            }
             Progress::Bend {
                 evaluations,
                 bend_deg,
@@ -515,14 +650,16 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
     }
 }
 
-fn cmd_run(c: &Common) -> Result<()> {
+fn cmd_run(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
+    let publisher = publisher(c, &cfg, "run")?;
+    let dir = publisher.link();
     let r = catflip::run::run(&cfg, progress_display(c.json))?;
-    let dir = out_dir(c, &cfg);
-    let written = r.output.commit(&dir)?;
+    let partial = r.is_partial();
+    let written = publisher.publish(r.output)?;
     if c.json {
         println!("{}", serde_json::to_string_pretty(&r.summary)?);
-        return Ok(());
+        return Ok(status_of(partial));
     }
     let s = &r.summary;
     println!();
@@ -532,7 +669,8 @@ fn cmd_run(c: &Common) -> Result<()> {
     );
     let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
-    let widths: Vec<usize> = (0..header.len())
+    // the last column (verdict) is left as is: it holds the reasons
+    let widths: Vec<usize> = (0..header.len() - 1)
         .map(|j| {
             rows.iter()
                 .map(|r| r[j].len())
@@ -545,7 +683,10 @@ fn cmd_run(c: &Common) -> Result<()> {
         let parts: Vec<String> = cells
             .iter()
             .enumerate()
-            .map(|(j, c)| format!("{c:>w$}", w = widths[j]))
+            .map(|(j, c)| match widths.get(j) {
+                Some(w) => format!("{c:>w$}"),
+                None => c.to_string(),
+            })
             .collect();
         println!("  {}", parts.join("  "));
     };
@@ -553,16 +694,25 @@ fn cmd_run(c: &Common) -> Result<()> {
     for row in rows {
         line(row);
     }
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     println!(
-        "  free-form / phased peak {:.3}, phased / analytic {:.3}; {} SCP iterations at {} nodes per phase",
-        s.free_over_phased, s.phased_over_analytic, s.scp_iterations, s.nodes
+        "  free-form / phased peak {}, phased / analytic {}; {} SCP iterations at {} nodes per phase",
+        show(s.free_over_phased),
+        show(s.phased_over_analytic),
+        s.scp_iterations,
+        s.nodes
     );
     println!(
         "  report: {} ({} files)",
         dir.join("index.html").display(),
         written.len()
     );
-    Ok(())
+    if partial {
+        eprintln!(
+            "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3"
+        );
+    }
+    Ok(status_of(partial))
 }
 
 fn cmd_sweep(
@@ -571,9 +721,15 @@ fn cmd_sweep(
     methods: &[String],
     threads: Option<usize>,
     shard: Option<&str>,
-) -> Result<()> {
+) -> Result<Status> {
     let cfg = load(c)?;
     let spec: catflip::sweep::SweepSpec = range.parse()?;
+    if threads == Some(0) {
+        return Err(catflip::Error::Usage(
+            "--threads 0: at least one point must be computed at a time; give --threads 1 or more, or leave it out for one per core".into(),
+        )
+        .into());
+    }
     let shard = match shard {
         Some(s) => s.parse()?,
         None => catflip::sweep::Shard::ALL,
@@ -588,9 +744,12 @@ fn cmd_sweep(
             "analytic" => m.analytic = true,
             "phased" => m.phased = true,
             "free" => m.free = true,
-            other => anyhow::bail!(
-                "unknown method `{other}` in --methods; use analytic, phased and/or free"
-            ),
+            other => {
+                return Err(catflip::Error::Usage(format!(
+                    "unknown method `{other}` in --methods; use analytic, phased and/or free"
+                ))
+                .into());
+            }
         }
     }
     let threads = threads.unwrap_or_else(|| {
@@ -599,6 +758,20 @@ fn cmd_sweep(
             .unwrap_or(1)
     });
     let quiet = c.json;
+    // a file-name-safe key (an unknown key is refused below, but names the staging first)
+    let key: String = spec
+        .key
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let key = format!("{key}{}", shard.suffix());
+    let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     // a live bar on a terminal, plain lines otherwise
     let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let clock = std::time::Instant::now();
@@ -629,7 +802,7 @@ fn cmd_sweep(
     if !quiet && live {
         eprintln!();
     }
-    let key = format!("{}{}", spec.key.replace('.', "_"), shard.suffix());
+    let partial = points.iter().any(|p| p.error.is_some());
     let mut out = Output::default();
     out.add(
         format!("sweep-{key}.csv"),
@@ -638,10 +811,17 @@ fn cmd_sweep(
     for (name, svg) in catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)? {
         out.add(name, svg);
     }
-    let written = out.commit(&out_dir(c, &cfg))?;
+    let written = publisher.publish(out)?;
+    if partial {
+        eprintln!(
+            "warning: partial result: {} of {} points have errors (see the error column); exit status 3",
+            points.iter().filter(|p| p.error.is_some()).count(),
+            points.len()
+        );
+    }
     if c.json {
         println!("{}", serde_json::to_string_pretty(&points)?);
-        return Ok(());
+        return Ok(status_of(partial));
     }
     println!(
         "catflip sweep: {} over {} ({} points, {threads} at a time)",
@@ -672,22 +852,52 @@ fn cmd_sweep(
     for w in written {
         row("wrote", w.display().to_string());
     }
-    Ok(())
+    Ok(status_of(partial))
 }
 
-fn cmd_export(c: &Common, format: ExportFormat) -> Result<()> {
+fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Result<Status> {
+    use catflip::export::controls::{Controls, Simulator};
     let cfg = load(c)?;
-    let (name, text) = match format {
-        ExportFormat::Urdf => (format!("{}.urdf", cfg.name), catflip::export::urdf(&cfg)),
+    let set = match format {
+        ExportFormat::Urdf => "export-urdf",
+        ExportFormat::Mjcf => "export-mjcf",
+    };
+    let text = match schedule {
+        Some(p) => Some(read_bounded(p).map_err(|e| {
+            catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
+        })?),
+        None => None,
+    };
+    let publisher = publisher(c, &cfg, set)?;
+    let (name, text_model, sim) = match format {
+        ExportFormat::Urdf => (
+            format!("{}.urdf", cfg.name),
+            catflip::export::urdf(&cfg),
+            Simulator::Pybullet,
+        ),
         ExportFormat::Mjcf => (
             format!("{}.mjcf.xml", cfg.name),
             catflip::export::mjcf(&cfg),
+            Simulator::Mujoco,
         ),
     };
     let mut out = Output::default();
-    out.add(name, text);
-    for w in out.commit(&out_dir(c, &cfg))? {
+    out.add(name, text_model);
+    if let (Some(p), Some(text)) = (schedule, text) {
+        let s = catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
+        let stem = p
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("schedule")
+            .to_string();
+        let controls = Controls::sample(&cfg, &s, sim);
+        out.add(
+            format!("{stem}.{}.csv", sim.name()),
+            controls.to_csv(&cfg, &stem),
+        );
+    }
+    for w in publisher.publish(out)? {
         println!("wrote {}", w.display());
     }
-    Ok(())
+    Ok(Status::Ok)
 }

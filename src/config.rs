@@ -6,7 +6,7 @@
 //! they go through the same checks.
 
 use crate::error::{Error, Result};
-use crate::model::{Cat, InertiaFormula, Joint, TorqueNorm};
+use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -21,6 +21,8 @@ pub struct Config {
     pub analytic: AnalyticConfig,
     #[serde(default)]
     pub limits: LimitsConfig,
+    #[serde(default)]
+    pub design: DesignConfig,
     #[serde(default)]
     pub simulate: SimulateConfig,
     #[serde(default)]
@@ -41,6 +43,22 @@ pub struct CatConfig {
     /// `no-twist` (default) or `universal`.
     #[serde(default = "default_joint")]
     pub joint: Joint,
+    /// `[cat.front]`: the front half where it differs from the rear (default: none,
+    /// both halves as above).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub front: Option<FrontConfig>,
+}
+
+/// Front-half overrides; a missing key keeps the `[cat]` value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct FrontConfig {
+    /// kg.
+    pub mass: Option<f64>,
+    /// m.
+    pub length: Option<f64>,
+    /// m.
+    pub radius: Option<f64>,
 }
 
 fn default_joint() -> Joint {
@@ -70,10 +88,24 @@ pub struct AnalyticConfig {
     /// Angle between the halves during the twist, degrees (default 45, the seed's pi/4).
     pub theta_deg: f64,
     /// Fractions of the manoeuvre time for fold, twist, unfold (default 0.2, 0.6, 0.2).
+    #[serde(deserialize_with = "three_fractions")]
     pub split: [f64; 3],
     /// Use the seed's transverse inertia `m (r^2 + l^2)/12` (erratum E1) to reproduce
     /// its printed example (default false).
     pub seed_inertia: bool,
+}
+
+/// `analytic.split`: exactly three numbers, no more, no fewer.
+fn three_fractions<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> std::result::Result<[f64; 3], D::Error> {
+    let v: Vec<f64> = Vec::deserialize(d)?;
+    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
+        serde::de::Error::custom(format!(
+            "analytic.split needs exactly 3 fractions (fold, twist, unfold), got {}",
+            v.len()
+        ))
+    })
 }
 
 impl Default for AnalyticConfig {
@@ -88,6 +120,15 @@ impl Default for AnalyticConfig {
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
+pub struct DesignConfig {
+    /// What the optimisers minimise: `peak-torque` (default), `time` (the
+    /// shortest manoeuvre inside the motor envelope, hence the least drop
+    /// height) or `energy` (`integral |tau|^2 dt` inside the envelope).
+    pub objective: crate::design::objective::Objective,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields, default)]
 pub struct LimitsConfig {
     /// N m, largest joint torque the motors can give (default: none).
     pub max_torque: Option<f64>,
@@ -95,6 +136,12 @@ pub struct LimitsConfig {
     pub max_bend_deg: Option<f64>,
     /// Peak norm: `euclidean` or `per-motor` (default: euclidean for no-twist, per-motor for universal).
     pub norm: Option<TorqueNorm>,
+    /// rad/s, no-load speed of the motors' linear torque-speed line (default: none).
+    /// With `max_torque = T` and `k = T / no_load_speed` the motor gives
+    /// `-T - k w <= tau <= T - k w` at joint speed `w` (docs/model.md, "Motors").
+    pub no_load_speed: Option<f64>,
+    /// rad/s, hard joint speed limit (default: none).
+    pub max_speed: Option<f64>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -112,6 +159,9 @@ pub struct SimulateConfig {
     pub pd_damping: f64,
     /// Rows per phase in written schedules (default 200).
     pub samples_per_phase: usize,
+    /// Largest flip error and spine tilt of a simulated design, rad, beyond
+    /// which the design is flagged as missing the flip (default 0.01).
+    pub flip_tolerance: f64,
 }
 
 impl Default for SimulateConfig {
@@ -123,6 +173,7 @@ impl Default for SimulateConfig {
             pd_bandwidth_hz: 10.0,
             pd_damping: 1.0,
             samples_per_phase: 200,
+            flip_tolerance: 0.01,
         }
     }
 }
@@ -199,25 +250,54 @@ impl Config {
         Self::from_toml(&text, &path.display().to_string(), overrides)
     }
 
+    /// Parses the user's text, applies `--set` overrides and validates. An
+    /// error in the file points at the file's own line; an error in an
+    /// override names that `--set` argument.
     pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| Error::ConfigParse {
+        let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
             message: e.to_string(),
-        })?;
+        };
+        let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
+        // the file alone, parsed from its own text: unknown keys and wrong
+        // types carry the file's line; a missing key may come from an override
+        if let Err(e) = toml::from_str::<Config>(text)
+            && (overrides.is_empty() || !e.message().starts_with("missing field"))
+        {
+            return Err(file_err(e));
+        }
+        // each override alone on a complete config, so that its error names it
+        let template = toml::Table::try_from(Config::template()).expect("the template serialises");
         for arg in overrides {
+            let mut t = template.clone();
+            apply_override(&mut t, arg)?;
+            if let Err(e) = t.try_into::<Config>() {
+                return Err(Error::Override {
+                    arg: arg.clone(),
+                    message: e.message().trim().to_string(),
+                });
+            }
             apply_override(&mut table, arg)?;
         }
-        let merged = toml::to_string(&table).expect("a TOML table serialises");
-        let cfg: Config = toml::from_str(&merged).map_err(|e| Error::ConfigParse {
-            origin: if overrides.is_empty() {
-                origin.into()
-            } else {
-                format!("{origin} (with --set overrides)")
-            },
-            message: e.to_string(),
-        })?;
+        // together: what is left is a key that neither gives
+        let cfg: Config = table
+            .try_into()
+            .map_err(|e: toml::de::Error| Error::ConfigParse {
+                origin: format!("{origin} (with --set overrides)"),
+                message: e.message().trim().to_string(),
+            })?;
         cfg.validate()?;
         Ok(cfg)
+    }
+
+    /// A complete valid config (the seed's cat), the base on which each
+    /// `--set` is checked alone.
+    fn template() -> Config {
+        // parsed rather than built, so that sections added later come with their defaults
+        toml::from_str(
+            "name = \"template\"\n[cat]\nmass = 1.0\nlength = 1.0\nradius = 0.1\n[fall]\nheight = 10.0\n",
+        )
+        .expect("the template config parses")
     }
 
     pub fn validate(&self) -> Result<()> {
@@ -253,6 +333,27 @@ impl Config {
             c.radius > 0.0 && c.radius < c.length,
             "must be > 0 m and less than cat.length",
         )?;
+        if let Some(fr) = &c.front {
+            let front = self.cat().front;
+            check(
+                "cat.front.mass",
+                front.mass,
+                fr.mass.is_none_or(|m| m > 0.0),
+                "must be > 0 kg (mass of the front half)",
+            )?;
+            check(
+                "cat.front.length",
+                front.length,
+                fr.length.is_none_or(|l| l > 0.0),
+                "must be > 0 m (length of the front half)",
+            )?;
+            check(
+                "cat.front.radius",
+                front.radius,
+                front.radius > 0.0 && front.radius < front.length,
+                "must be > 0 m and less than the front half's length",
+            )?;
+        }
         let f = &self.fall;
         check("fall.height", f.height, f.height > 0.0, "must be > 0 m")?;
         check(
@@ -294,6 +395,24 @@ impl Config {
         if let Some(t) = self.limits.max_torque {
             check("limits.max_torque", t, t > 0.0, "must be > 0 N m")?;
         }
+        if let Some(w) = self.limits.no_load_speed {
+            check(
+                "limits.no_load_speed",
+                w,
+                w > 0.0,
+                "must be > 0 rad/s (the speed at which the motor's torque falls to 0)",
+            )?;
+            if self.limits.max_torque.is_none() {
+                return Err(Error::Invalid {
+                    key: "limits.no_load_speed".into(),
+                    value: format!("{w}"),
+                    expected: "needs limits.max_torque too: the torque-speed line runs from max_torque at rest to 0 at no_load_speed".into(),
+                });
+            }
+        }
+        if let Some(w) = self.limits.max_speed {
+            check("limits.max_speed", w, w > 0.0, "must be > 0 rad/s")?;
+        }
         if let Some(b) = self.limits.max_bend_deg {
             check(
                 "limits.max_bend_deg",
@@ -327,12 +446,18 @@ impl Config {
             s.pd_damping > 0.0,
             "must be > 0",
         )?;
+        check(
+            "simulate.flip_tolerance",
+            s.flip_tolerance,
+            s.flip_tolerance > 0.0 && s.flip_tolerance <= std::f64::consts::PI,
+            "must be in (0, pi] rad",
+        )?;
         let n = s.samples_per_phase as f64;
         check(
             "simulate.samples_per_phase",
             n,
-            (2.0..=100_000.0).contains(&n),
-            "must be in 2..=100000",
+            (2.0..=30_000.0).contains(&n),
+            "must be in 2..=30000",
         )?;
         let p = &self.phased;
         check(
@@ -395,16 +520,28 @@ impl Config {
 
     /// The cat with the inertia formula the config asks for.
     pub fn cat(&self) -> Cat {
-        Cat {
-            mass: self.cat.mass,
-            length: self.cat.length,
-            radius: self.cat.radius,
-            joint: self.cat.joint,
+        let c = &self.cat;
+        let rear = Half {
+            mass: c.mass,
+            length: c.length,
+            radius: c.radius,
             inertia: if self.analytic.seed_inertia {
                 InertiaFormula::Seed
             } else {
                 InertiaFormula::SolidCylinder
             },
+        };
+        let fr = c.front.clone().unwrap_or_default();
+        let front = Half {
+            mass: fr.mass.unwrap_or(c.mass),
+            length: fr.length.unwrap_or(c.length),
+            radius: fr.radius.unwrap_or(c.radius),
+            ..rear
+        };
+        Cat {
+            rear,
+            front,
+            joint: c.joint,
         }
     }
 
@@ -422,6 +559,25 @@ impl Config {
         self.limits
             .norm
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
+    }
+
+    /// Whether the design needs the motor-envelope program (a speed limit, a
+    /// torque-speed line or an objective other than the peak torque) rather
+    /// than the unit-time peak program with F3 scaling.
+    pub fn uses_envelope(&self) -> bool {
+        self.design.objective != crate::design::objective::Objective::PeakTorque
+            || self.limits.max_speed.is_some()
+            || self.limits.no_load_speed.is_some()
+    }
+
+    /// The joint's motors as the limits describe them.
+    pub fn motor(&self) -> crate::model::motor::Motor {
+        crate::model::motor::Motor {
+            max_torque: self.limits.max_torque,
+            no_load_speed: self.limits.no_load_speed,
+            max_speed: self.limits.max_speed,
+            norm: self.norm(),
+        }
     }
 
     /// Largest bend the optimisers may use, rad.

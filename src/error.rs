@@ -16,6 +16,11 @@ pub enum Error {
     },
     #[error("`--set {arg}`: {message}")]
     Override { arg: String, message: String },
+    #[error("`--set-range {arg}`: {message}")]
+    Range { arg: String, message: String },
+    /// A bad command-line argument other than `--set` and `--set-range`.
+    #[error("{0}")]
+    Usage(String),
     #[error("schedule {file}, line {line}: {message}")]
     Schedule {
         file: String,
@@ -30,15 +35,35 @@ pub enum Error {
     },
     #[error("the flip is impossible: {reason}")]
     Unreachable { reason: String },
+    #[error("every method failed: {0}")]
+    AllFailed(String),
     #[error("simulation failed: {0}")]
     Simulation(String),
     #[error("drawing a figure failed: {0}")]
     Report(String),
-    #[error("cannot write {path}: {source}")]
-    Write {
-        path: PathBuf,
-        source: std::io::Error,
-    },
+    /// The output folder cannot take the results (checked before computing).
+    #[error("cannot write to {path}: {message}; choose another --out")]
+    OutputDir { path: PathBuf, message: String },
+    #[error("cannot write {path}: {message}")]
+    Write { path: PathBuf, message: String },
+}
+
+impl Error {
+    /// True when the user's input is at fault (config, arguments, files given,
+    /// output folder) rather than a computation: the CLI exits with 2.
+    pub fn is_bad_input(&self) -> bool {
+        matches!(
+            self,
+            Error::ConfigRead { .. }
+                | Error::ConfigParse { .. }
+                | Error::Invalid { .. }
+                | Error::Override { .. }
+                | Error::Range { .. }
+                | Error::Usage(_)
+                | Error::Schedule { .. }
+                | Error::OutputDir { .. }
+        )
+    }
 }
 
 pub type Result<T> = std::result::Result<T, Error>;

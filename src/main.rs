@@ -1,12 +1,20 @@
 //! The `catflip` command line: a thin layer over the library.
+//!
+//! Exit status: 0 every result meets its targets; 1 the computation failed;
+//! 2 bad input (config, arguments, files, output folder), nothing computed or
+//! written; 3 partial: results written, but some are flagged or failed.
 mod cli;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {
-        Ok(()) => std::process::ExitCode::SUCCESS,
+        Ok(cli::Status::Ok) => std::process::ExitCode::SUCCESS,
+        Ok(cli::Status::Partial) => std::process::ExitCode::from(3),
         Err(e) => {
             eprintln!("error: {e:#}");
-            std::process::ExitCode::from(2)
+            let bad_input = e
+                .downcast_ref::<catflip::Error>()
+                .is_some_and(|e| e.is_bad_input());
+            std::process::ExitCode::from(if bad_input { 2 } else { 1 })
         }
     }
 }

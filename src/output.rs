@@ -1,10 +1,22 @@
-//! All-or-nothing output: every file of a run is staged in memory, written
-//! to a temporary sibling and renamed into place only when all were written.
+//! All-or-nothing output that holds under SIGKILL and concurrent writers.
+//!
+//! Each command publishes one *set* of files, `<dir>/<set>` (e.g.
+//! `output/seed/run`). The set is a symbolic link to a hidden folder
+//! `<dir>/.<set>.<id>` that was written completely before the link was
+//! switched to it with `rename(2)`, which replaces a link atomically: a reader
+//! sees the old set or the new one, never a mix. Commands have separate sets,
+//! so `optimize` never overwrites the files `run` described in its summary.
+//!
+//! While a process stages, it holds an advisory lock on `<dir>/.<set>.<id>.lock`;
+//! the lock dies with the process (also under SIGKILL), so the next command
+//! knows a staging folder without a held lock is a leftover and removes it.
+//! Hidden names are never taken for results.
 
 use crate::error::{Error, Result};
+use std::fs::{self, File, OpenOptions};
 use std::path::{Path, PathBuf};
 
-/// Files to write into one folder.
+/// Files to write into one set, kept in memory until published.
 #[derive(Debug, Default)]
 pub struct Output {
     files: Vec<(String, Vec<u8>)>,
@@ -15,31 +27,270 @@ impl Output {
         self.files.push((name.into(), contents.into()));
     }
 
-    /// Writes every file into `dir` (created if missing); returns their paths.
-    pub fn commit(self, dir: &Path) -> Result<Vec<PathBuf>> {
-        let werr = |path: &Path, source| Error::Write {
+    /// Names of the files added so far.
+    pub fn names(&self) -> impl Iterator<Item = &str> {
+        self.files.iter().map(|f| f.0.as_str())
+    }
+
+    /// Stages and publishes in one go as the set `set_path` (`<dir>/<set>`).
+    /// Commands that compute for long should call [`Publisher::begin`] first,
+    /// so that an unwritable folder is reported before the work.
+    pub fn commit(self, set_path: &Path) -> Result<Vec<PathBuf>> {
+        let (dir, set) = split_set(set_path)?;
+        Publisher::begin(&dir, &set)?.publish(self)
+    }
+}
+
+fn split_set(set_path: &Path) -> Result<(PathBuf, String)> {
+    let set = set_path
+        .file_name()
+        .and_then(|s| s.to_str())
+        .ok_or_else(|| Error::OutputDir {
+            path: set_path.to_path_buf(),
+            message: "not a folder name".into(),
+        })?;
+    let dir = set_path.parent().unwrap_or(Path::new("."));
+    Ok((dir.to_path_buf(), set.to_string()))
+}
+
+/// A set being staged: created by [`Publisher::begin`] (which checks the folder
+/// is writable), finished by [`Publisher::publish`]. Dropped unpublished, it
+/// removes its staging folder and any folders it created.
+#[derive(Debug)]
+pub struct Publisher {
+    dir: PathBuf,
+    set: String,
+    id: String,
+    /// Held for the whole staging; released when dropped.
+    _lock: File,
+    /// Folders `begin` created, innermost last.
+    created: Vec<PathBuf>,
+    published: bool,
+}
+
+impl Publisher {
+    /// Prepares the set `<dir>/<set>`: creates `dir` if needed, checks it takes
+    /// files, removes leftovers of killed commands and opens a private staging folder.
+    pub fn begin(dir: &Path, set: &str) -> Result<Publisher> {
+        let oerr = |path: &Path, e: std::io::Error| Error::OutputDir {
             path: path.to_path_buf(),
-            source,
+            message: e.to_string(),
         };
-        std::fs::create_dir_all(dir).map_err(|e| werr(dir, e))?;
-        let mut staged = Vec::new();
-        for (name, bytes) in &self.files {
-            let fin = dir.join(name);
-            let tmp = dir.join(format!(".{name}.tmp{}", std::process::id()));
-            if let Err(e) = std::fs::write(&tmp, bytes) {
-                for (t, _) in &staged {
-                    let _ = std::fs::remove_file(t);
+        let created = create_dirs(dir).map_err(|(p, e)| oerr(&p, e))?;
+        let (lock, id) = new_lock(dir, set).map_err(|e| {
+            remove_created(&created);
+            oerr(dir, e)
+        })?;
+        let p = Publisher {
+            dir: dir.to_path_buf(),
+            set: set.to_string(),
+            id,
+            _lock: lock,
+            created,
+            published: false,
+        };
+        if let Ok(m) = fs::symlink_metadata(p.link())
+            && !m.file_type().is_symlink()
+        {
+            return Err(Error::OutputDir {
+                path: p.link(),
+                message: "exists and is not a set published by catflip (a link to a hidden folder); move it away".into(),
+            });
+        }
+        fs::create_dir(p.staging()).map_err(|e| oerr(&p.staging(), e))?;
+        p.remove_leftovers();
+        Ok(p)
+    }
+
+    /// The published path `<dir>/<set>`.
+    pub fn link(&self) -> PathBuf {
+        self.dir.join(&self.set)
+    }
+
+    fn staging(&self) -> PathBuf {
+        self.dir.join(format!(".{}.{}", self.set, self.id))
+    }
+
+    /// Writes every file into the staging folder, then switches the link to it.
+    /// Returns the files' published paths.
+    pub fn publish(mut self, out: Output) -> Result<Vec<PathBuf>> {
+        let staging = self.staging();
+        for (name, bytes) in &out.files {
+            let path = staging.join(name);
+            fs::write(&path, bytes).map_err(|e| Error::Write {
+                path: self.link().join(name),
+                message: e.to_string(),
+            })?;
+        }
+        let tmp_link = self.dir.join(format!(".{}.{}.link", self.set, self.id));
+        let _ = fs::remove_file(&tmp_link);
+        let werr = |e: std::io::Error| Error::Write {
+            path: self.link(),
+            message: e.to_string(),
+        };
+        symlink(Path::new(&format!(".{}.{}", self.set, self.id)), &tmp_link).map_err(werr)?;
+        fs::rename(&tmp_link, self.link()).map_err(|e| {
+            let _ = fs::remove_file(&tmp_link);
+            werr(e)
+        })?;
+        self.published = true;
+        // the link is switched before the lock goes: a set without a lock file
+        // is either the link's target or superseded
+        let _ = fs::remove_file(self.lock_path(&self.id));
+        self.remove_leftovers();
+        Ok(out.files.iter().map(|(n, _)| self.link().join(n)).collect())
+    }
+
+    fn lock_path(&self, id: &str) -> PathBuf {
+        self.dir.join(format!(".{}.{id}.lock", self.set))
+    }
+
+    /// Removes staging folders of dead processes and superseded sets.
+    fn remove_leftovers(&self) {
+        let prefix = format!(".{}.", self.set);
+        let Ok(entries) = fs::read_dir(&self.dir) else {
+            return;
+        };
+        let mut ids: Vec<String> = entries
+            .filter_map(|e| e.ok()?.file_name().into_string().ok())
+            .filter_map(|n| {
+                let rest = n.strip_prefix(&prefix)?;
+                let id = rest
+                    .strip_suffix(".lock")
+                    .or_else(|| rest.strip_suffix(".link"))
+                    .unwrap_or(rest);
+                Some(id.to_string())
+            })
+            .filter(|id| *id != self.id && is_id(id))
+            .collect();
+        ids.sort();
+        ids.dedup();
+        for id in ids {
+            let lock = self.lock_path(&id);
+            let _held;
+            if lock.exists() {
+                let Ok(f) = OpenOptions::new().write(true).open(&lock) else {
+                    continue;
+                };
+                if f.try_lock().is_err() {
+                    continue; // a live command is staging
                 }
-                let _ = std::fs::remove_file(&tmp);
-                return Err(werr(&fin, e));
+                _held = f;
             }
-            staged.push((tmp, fin));
+            let name = format!(".{}.{id}", self.set);
+            let _ = fs::remove_file(self.dir.join(format!("{name}.link")));
+            let target = fs::read_link(self.link()).ok();
+            if target.as_deref() != Some(Path::new(&name)) {
+                let _ = fs::remove_dir_all(self.dir.join(&name));
+            }
+            let _ = fs::remove_file(&lock);
         }
-        let mut done = Vec::new();
-        for (tmp, fin) in staged {
-            std::fs::rename(&tmp, &fin).map_err(|e| werr(&fin, e))?;
-            done.push(fin);
+    }
+}
+
+impl Drop for Publisher {
+    fn drop(&mut self) {
+        if !self.published {
+            let _ = fs::remove_dir_all(self.staging());
+            let _ = fs::remove_file(self.lock_path(&self.id));
+            remove_created(&self.created);
         }
-        Ok(done)
+    }
+}
+
+/// Staging ids: `<pid>-<nanoseconds>-<counter>`.
+fn is_id(s: &str) -> bool {
+    !s.is_empty() && s.chars().all(|c| c.is_ascii_digit() || c == '-')
+}
+
+/// Creates and locks a fresh `<dir>/.<set>.<id>.lock`; returns it and the id.
+fn new_lock(dir: &Path, set: &str) -> std::io::Result<(File, String)> {
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static COUNTER: AtomicU64 = AtomicU64::new(0);
+    loop {
+        let nanos = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
+        let id = format!(
+            "{}-{nanos}-{}",
+            std::process::id(),
+            COUNTER.fetch_add(1, Ordering::Relaxed)
+        );
+        let path = dir.join(format!(".{set}.{id}.lock"));
+        let f = match OpenOptions::new().write(true).create_new(true).open(&path) {
+            Ok(f) => f,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+        };
+        f.lock()?;
+        // another command may have taken the file for a leftover between
+        // create and lock, and removed it: then start again with a new id
+        if same_file(&f, &path) {
+            return Ok((f, id));
+        }
+    }
+}
+
+#[cfg(unix)]
+fn same_file(f: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (f.metadata(), fs::metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_f: &File, path: &Path) -> bool {
+    path.exists()
+}
+
+#[cfg(unix)]
+fn symlink(target: &Path, link: &Path) -> std::io::Result<()> {
+    std::os::unix::fs::symlink(target, link)
+}
+
+#[cfg(windows)]
+fn symlink(target: &Path, link: &Path) -> std::io::Result<()> {
+    std::os::windows::fs::symlink_dir(target, link)
+}
+
+/// `create_dir_all` that returns the folders it created, outermost first.
+fn create_dirs(dir: &Path) -> std::result::Result<Vec<PathBuf>, (PathBuf, std::io::Error)> {
+    let mut missing = Vec::new();
+    let mut cur = Some(dir);
+    while let Some(d) = cur {
+        if d.as_os_str().is_empty() || d.exists() {
+            break;
+        }
+        missing.push(d.to_path_buf());
+        cur = d.parent();
+    }
+    missing.reverse();
+    let mut created = Vec::new();
+    for d in missing {
+        match fs::create_dir(&d) {
+            Ok(()) => created.push(d),
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists && d.is_dir() => {}
+            Err(e) => {
+                remove_created(&created);
+                return Err((d, e));
+            }
+        }
+    }
+    if !dir.is_dir() {
+        return Err((
+            dir.to_path_buf(),
+            std::io::Error::other("exists and is not a folder"),
+        ));
+    }
+    Ok(created)
+}
+
+/// Removes folders this command created, innermost first, if they are empty.
+fn remove_created(created: &[PathBuf]) {
+    for d in created.iter().rev() {
+        let _ = fs::remove_dir(d);
     }
 }

@@ -5,10 +5,11 @@ use crate::config::Config;
 use crate::design::analytic::ClosedForms;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
-use crate::error::Result;
+use crate::error::{Error, Result};
+use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
-use crate::verify::analyze::{analyze, peak_along};
+use crate::verify::analyze::analyze;
 use crate::verify::simulate::{SimReport, dynamic_cfg};
 use serde::Serialize;
 use std::time::Instant;
@@ -24,6 +25,11 @@ pub enum Progress<'a> {
     StageDone {
         seconds: f64,
     },
+    /// The stage's method failed; the run goes on with the others.
+    StageFailed {
+        seconds: f64,
+        reason: &'a str,
+    },
     Bend {
         evaluations: usize,
         bend_deg: f64,
@@ -32,11 +38,37 @@ pub enum Progress<'a> {
     Scp(&'a ScpIteration),
 }
 
+/// How a method ended, as the summary, the table and the exit status see it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// A result that meets its targets.
+    Ok,
+    /// A result that misses a target (unconverged, flip missed, limit broken):
+    /// kept and reported, with the reason.
+    Flagged,
+    /// No result: the method stopped with an error, given as the reason.
+    Failed,
+}
+
 /// One method's line of the summary.
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodSummary {
     pub method: &'static str,
+    /// Solver status (`closed-form`, `solved`, `converged`, ...), or `failed`.
     pub status: String,
+    pub verdict: Verdict,
+    /// Why the method is flagged or failed (absent when ok).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// The numbers, absent when the method failed.
+    #[serde(flatten)]
+    pub result: Option<MethodNumbers>,
+}
+
+/// The numbers of a method that produced a schedule.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodNumbers {
     /// Peak joint torque of the schedule (inverse dynamics, dense), N m.
     pub peak_torque_nm: f64,
     pub bend_deg: f64,
@@ -50,9 +82,30 @@ pub struct MethodSummary {
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
+    /// Largest joint speed of the written schedule, rad/s (motor norm).
+    pub max_speed_rad_s: f64,
+    /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
+    /// the envelope, negative violated; absent without limits).
+    pub min_envelope_margin: Option<f64>,
     pub solve_time_s: f64,
     pub schedule_csv: String,
     pub schedule_json: String,
+}
+
+impl MethodSummary {
+    fn failed(method: &'static str, e: &crate::Error) -> MethodSummary {
+        MethodSummary {
+            method,
+            status: "failed".into(),
+            verdict: Verdict::Failed,
+            reason: Some(e.to_string()),
+            result: None,
+        }
+    }
+
+    pub fn peak(&self) -> Option<f64> {
+        self.result.as_ref().map(|r| r.peak_torque_nm)
+    }
 }
 
 #[derive(Debug, Clone, Serialize)]
@@ -61,10 +114,12 @@ pub struct RunSummary {
     pub joint: &'static str,
     pub peak_norm: crate::model::TorqueNorm,
     pub max_torque_nm: Option<f64>,
+    /// `ok` when every method is ok, `partial` when some are flagged or failed.
+    pub outcome: &'static str,
     pub methods: Vec<MethodSummary>,
-    /// Peak ratios between methods.
-    pub phased_over_analytic: f64,
-    pub free_over_phased: f64,
+    /// Peak ratios between methods (absent when either failed).
+    pub phased_over_analytic: Option<f64>,
+    pub free_over_phased: Option<f64>,
     pub scp_iterations: usize,
     pub nodes: usize,
     pub analytic: ClosedForms,
@@ -79,18 +134,75 @@ pub struct RunResult {
     pub iterations: Vec<ScpIteration>,
 }
 
+impl RunResult {
+    /// True when some method is flagged or failed.
+    pub fn is_partial(&self) -> bool {
+        self.summary.outcome != "ok"
+    }
+}
+
+/// Why a verified design misses its targets, if it does: solver status,
+/// flip and tilt beyond `simulate.flip_tolerance`, limits broken.
+fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
+    let mut why = Vec::new();
+    if !matches!(status, "closed-form" | "solved" | "converged") {
+        why.push(format!("solver status {status}"));
+    }
+    why.extend(crate::verify::simulate::misses_flip(
+        n.flip_error_rad,
+        n.tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    if let Some(lim) = cfg.limits.max_torque
+        && n.peak_torque_nm > lim * (1.0 + 1e-6)
+    {
+        why.push(format!(
+            "needs {:.4} N m, above limits.max_torque = {lim} N m",
+            n.peak_torque_nm
+        ));
+    }
+    // the envelope also holds the speed limits; a torque already named is not repeated
+    if let Some(m) = n.min_envelope_margin
+        && m < -1e-6
+        && !why.iter().any(|w| w.contains("limits.max_torque"))
+    {
+        why.push(format!(
+            "leaves the motor envelope (smallest margin {m:.3}; limits.max_torque, limits.no_load_speed, limits.max_speed)"
+        ));
+    }
+    if let Some(b) = cfg.limits.max_bend_deg
+        && n.bend_deg > b * (1.0 + 1e-6)
+    {
+        why.push(format!(
+            "bends {:.2} deg, above limits.max_bend_deg = {b} deg",
+            n.bend_deg
+        ));
+    }
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// A method's line; `sim` is its dynamic simulation, or why that failed
+/// (then the schedule is kept, flagged, with NaN simulation numbers).
 fn summarize(
+    cfg: &Config,
     method: &'static str,
     status: String,
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
-    sim: &SimReport,
+    sim: std::result::Result<&SimReport, &Error>,
+    motor: MotorUse,
     solve_time_s: f64,
 ) -> MethodSummary {
     let (bend, twist, durations) = path_numbers;
-    MethodSummary {
-        method,
-        status,
+    let failed_sim;
+    let (sim, sim_error) = match sim {
+        Ok(s) => (s, None),
+        Err(e) => {
+            failed_sim = SimReport::failed();
+            (&failed_sim, Some(e.to_string()))
+        }
+    };
+    let n = MethodNumbers {
         peak_torque_nm: peak,
         bend_deg: bend,
         theta_deg: 180.0 - bend,
@@ -102,9 +214,26 @@ fn summarize(
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
+        max_speed_rad_s: motor.max_speed_rad_s,
+        min_envelope_margin: motor.min_margin,
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
+    };
+    let reason = match (sim_error, flags(cfg, &status, &n)) {
+        (Some(e), _) => Some(e),
+        (None, r) => r,
+    };
+    MethodSummary {
+        method,
+        status,
+        verdict: if reason.is_some() {
+            Verdict::Flagged
+        } else {
+            Verdict::Ok
+        },
+        reason,
+        result: Some(n),
     }
 }
 
@@ -139,12 +268,28 @@ pub fn trace(
     }
 }
 
-/// Runs everything for one config.
+/// Runs everything for one config. A method that fails does not stop the
+/// others: its status and reason go into the summary, table and report. Only
+/// when every method fails is the run an error.
 pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult> {
     let total = 4;
     let cat = cfg.cat();
     let per = cfg.simulate.samples_per_phase;
     let mut output = Output::default();
+    let motor = cfg.motor();
+    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
+    let mut methods = Vec::new();
+    let mut traces = Vec::new();
+    let stage_end = |progress: &mut dyn FnMut(Progress), clock: Instant, err: Option<&Error>| {
+        let seconds = clock.elapsed().as_secs_f64();
+        match err {
+            None => progress(Progress::StageDone { seconds }),
+            Some(e) => progress(Progress::StageFailed {
+                seconds,
+                reason: &e.to_string(),
+            }),
+        }
+    };
 
     progress(Progress::Stage {
         index: 1,
@@ -152,11 +297,38 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "analytic schedule (seed closed forms, errata corrected)",
     });
     let clock = Instant::now();
-    let a = analyze(cfg)?;
-    let a_sim = dynamic_cfg(cfg, &a.plan)?;
+    // the kinematic check is part of the analysis; a failed dynamic
+    // simulation (e.g. under a saturating torque limit) only flags the schedule
+    let analytic = analyze(cfg).map(|a| {
+        let sim = dynamic_cfg(cfg, &a.plan);
+        (a, sim)
+    });
     let a_time = clock.elapsed().as_secs_f64();
-    Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "analytic");
-    progress(Progress::StageDone { seconds: a_time });
+    match &analytic {
+        Ok((a, a_sim)) => {
+            let a_sched = Schedule::sample(&cat, &a.plan, per);
+            a_sched.add_to(&mut output, "analytic");
+            methods.push(summarize(
+                cfg,
+                "analytic",
+                "closed-form".into(),
+                a.peak_torque_nm,
+                (
+                    a.closed.bend_deg,
+                    a.closed.twist_rad,
+                    a.closed.phase_durations_s,
+                ),
+                a_sim.as_ref(),
+                usage(&a_sched),
+                a_time,
+            ));
+            let failed_sim = SimReport::failed();
+            let sim = a_sim.as_ref().unwrap_or(&failed_sim);
+            traces.push(trace(cfg, "analytic", &a.plan, sim, 300));
+        }
+        Err(e) => methods.push(MethodSummary::failed("analytic", e)),
+    }
+    stage_end(&mut progress, clock, analytic.as_ref().err());
 
     progress(Progress::Stage {
         index: 2,
@@ -165,32 +337,84 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     });
     let clock = Instant::now();
     let mut evaluations = 0;
-    let ph = crate::design::phased::optimize(cfg, |e| {
+    let phased = crate::design::phased::optimize(cfg, |e| {
         evaluations += 1;
         progress(Progress::Bend {
             evaluations,
             bend_deg: e.bend_deg,
             peak_nm: e.peak_nm,
         });
-    })?;
-    Schedule::sample(&cat, &ph.plan, per).add_to(&mut output, "phased");
-    progress(Progress::StageDone {
-        seconds: clock.elapsed().as_secs_f64(),
     });
+    match &phased {
+        Ok(ph) => {
+            let ph_sched = Schedule::sample(&cat, &ph.plan, per);
+            ph_sched.add_to(&mut output, "phased");
+            let ph_sim = ph
+                .sim
+                .as_ref()
+                .expect("phased result carries its simulation");
+            methods.push(summarize(
+                cfg,
+                "phased",
+                format!("{:?}", ph.status).to_lowercase(),
+                ph.peak_torque_nm,
+                (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
+                Ok(ph_sim),
+                usage(&ph_sched),
+                ph.solve_time_s,
+            ));
+            traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
+        }
+        Err(e) => methods.push(MethodSummary::failed("phased", e)),
+    }
+    stage_end(&mut progress, clock, phased.as_ref().err());
 
     progress(Progress::Stage {
         index: 3,
         total,
-        name: "free-form optimiser (collocation + SCP, seeded by the phased design)",
+        name: "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
     });
     let clock = Instant::now();
-    let fr = crate::design::free::optimize_from(cfg, &ph.plan, "phased", cfg.free.nodes, |it| {
-        progress(Progress::Scp(it))
-    })?;
-    Schedule::sample(&cat, &fr.plan, per).add_to(&mut output, "free");
-    progress(Progress::StageDone {
-        seconds: clock.elapsed().as_secs_f64(),
-    });
+    // seeded by the phased design, or by the analytic plan when that failed
+    let analytic_seed;
+    let (seed_plan, seed_name): (&dyn ShapePlan, &str) = match &phased {
+        Ok(ph) => (&ph.plan, "phased"),
+        Err(_) => {
+            analytic_seed = crate::design::analytic::analytic_plan(cfg);
+            (&analytic_seed, "analytic")
+        }
+    };
+    let free =
+        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+            progress(Progress::Scp(it))
+        });
+    match &free {
+        Ok(fr) => {
+            let fr_sched = Schedule::sample(&cat, &fr.plan, per);
+            fr_sched.add_to(&mut output, "free");
+            methods.push(summarize(
+                cfg,
+                "free",
+                format!("{:?}", fr.status).to_lowercase(),
+                fr.peak_torque_nm,
+                (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
+                Ok(&fr.sim),
+                usage(&fr_sched),
+                fr.solve_time_s,
+            ));
+            traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
+        }
+        Err(e) => methods.push(MethodSummary::failed("free", e)),
+    }
+    stage_end(&mut progress, clock, free.as_ref().err());
+
+    if methods.iter().all(|m| m.verdict == Verdict::Failed) {
+        let reasons: Vec<String> = methods
+            .iter()
+            .map(|m| format!("{}: {}", m.method, m.reason.as_deref().unwrap_or("")))
+            .collect();
+        return Err(Error::AllFailed(reasons.join("; ")));
+    }
 
     progress(Progress::Stage {
         index: 4,
@@ -198,86 +422,93 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "report (figures, summary)",
     });
     let clock = Instant::now();
-    let ph_sim = ph
-        .sim
-        .as_ref()
-        .expect("phased result carries its simulation");
-    let fr_sim = &fr.sim;
-    let (a_peak, _) = peak_along(cfg, &a.plan, crate::verify::analyze::dense_samples(cfg));
-    let methods = vec![
-        summarize(
-            "analytic",
-            "closed-form".into(),
-            a_peak,
-            (
-                a.closed.bend_deg,
-                a.closed.twist_rad,
-                a.closed.phase_durations_s,
-            ),
-            &a_sim,
-            a_time,
-        ),
-        summarize(
-            "phased",
-            format!("{:?}", ph.status).to_lowercase(),
-            ph.peak_torque_nm,
-            (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
-            ph_sim,
-            ph.solve_time_s,
-        ),
-        summarize(
-            "free",
-            format!("{:?}", fr.status).to_lowercase(),
-            fr.peak_torque_nm,
-            (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
-            fr_sim,
-            fr.solve_time_s,
-        ),
-    ];
-    let traces = vec![
-        trace(cfg, "analytic", &a.plan, &a_sim, 300),
-        trace(cfg, "phased", &ph.plan, ph_sim, 300),
-        trace(cfg, "free", &fr.plan, fr_sim, 300),
-    ];
+    // the simulator models and each kept method's controls for them
+    let mut plans: Vec<(&str, &dyn ShapePlan)> = Vec::new();
+    if let Ok((a, _)) = &analytic {
+        plans.push(("analytic", &a.plan));
+    }
+    if let Ok(ph) = &phased {
+        plans.push(("phased", &ph.plan));
+    }
+    if let Ok(fr) = &free {
+        plans.push(("free", &fr.plan));
+    }
+    crate::export::add_simulator_files(cfg, &mut output, &plans);
     let norm_name = match cfg.norm() {
         crate::model::TorqueNorm::Euclidean => "Euclidean",
         crate::model::TorqueNorm::PerMotor => "per motor",
     };
-    let figures = vec![
-        ("angles.svg", report::angles(&traces)?),
-        ("torque.svg", report::torque(&traces, norm_name)?),
-        ("flip.svg", report::flip(&traces)?),
-        ("shape_path.svg", report::shape_path(&traces)?),
-        ("convergence.svg", report::convergence(&fr.iterations)?),
+    let iterations = free
+        .as_ref()
+        .map(|fr| fr.iterations.clone())
+        .unwrap_or_default();
+    let mut figures = vec![
+        ("angles.svg", report::angles(&traces)),
+        ("torque.svg", report::torque(&traces, norm_name)),
+        ("flip.svg", report::flip(&traces)),
+        ("shape_path.svg", report::shape_path(&traces)),
     ];
+    if !iterations.is_empty() {
+        figures.push(("convergence.svg", report::convergence(&iterations)));
+    }
+    let mut notes = Vec::new();
+    let figures: Vec<(&str, String)> = figures
+        .into_iter()
+        .filter_map(|(name, svg)| match svg {
+            Ok(svg) => Some((name, svg)),
+            Err(e) => {
+                notes.push(format!("Figure {name} is missing: {e}"));
+                None
+            }
+        })
+        .collect();
+    let peak = |name: &str| methods.iter().find(|m| m.method == name)?.peak();
+    let ratio = |a: &str, b: &str| Some(peak(a)? / peak(b)?);
+    let (scp_iterations, nodes) = free
+        .as_ref()
+        .map(|fr| (fr.scp_iterations, fr.nodes))
+        .unwrap_or((0, cfg.free.nodes));
     let summary = RunSummary {
         name: cfg.name.clone(),
         joint: cfg.cat.joint.name(),
         peak_norm: cfg.norm(),
         max_torque_nm: cfg.limits.max_torque,
-        phased_over_analytic: methods[1].peak_torque_nm / methods[0].peak_torque_nm,
-        free_over_phased: methods[2].peak_torque_nm / methods[1].peak_torque_nm,
+        outcome: if methods.iter().all(|m| m.verdict == Verdict::Ok) {
+            "ok"
+        } else {
+            "partial"
+        },
+        phased_over_analytic: ratio("phased", "analytic"),
+        free_over_phased: ratio("free", "phased"),
         methods,
-        scp_iterations: fr.scp_iterations,
-        nodes: fr.nodes,
-        analytic: a.closed.clone(),
+        scp_iterations,
+        nodes,
+        analytic: crate::design::analytic::closed_forms(cfg),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
     };
     let header = TABLE_HEADER;
     let rows: Vec<Vec<String>> = summary.methods.iter().map(table_row).collect();
-    let notes = vec![
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+    notes.insert(
+        0,
         format!(
-            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {:.3}; phased / analytic: {:.3}. Free-form: {} SCP iterations, {} nodes per phase.",
+            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form: {} SCP iterations, {} nodes per phase.",
             summary.joint,
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,
-            summary.free_over_phased,
-            summary.phased_over_analytic,
+            show(summary.free_over_phased),
+            show(summary.phased_over_analytic),
             summary.scp_iterations,
             summary.nodes
         ),
-        "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking).".into(),
-    ];
+    );
+    notes.insert(1, "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking).".into());
+    if summary.outcome != "ok" {
+        notes.insert(
+            0,
+            "PARTIAL RESULT: some methods are flagged or failed; the verdict column says why. Their schedules, if any, are written but miss a target.".into(),
+        );
+    }
     let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
     output.add(
         "index.html",
@@ -296,19 +527,17 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         "summary.json",
         serde_json::to_string_pretty(&summary).expect("summary serialises"),
     );
-    progress(Progress::StageDone {
-        seconds: clock.elapsed().as_secs_f64(),
-    });
+    stage_end(&mut progress, clock, None);
     Ok(RunResult {
         summary,
         output,
         traces,
-        iterations: fr.iterations,
+        iterations,
     })
 }
 
 /// Columns of the comparison table (terminal and index.html).
-pub const TABLE_HEADER: [&str; 9] = [
+pub const TABLE_HEADER: [&str; 10] = [
     "method",
     "status",
     "peak N m",
@@ -318,20 +547,32 @@ pub const TABLE_HEADER: [&str; 9] = [
     "tilt deg",
     "sim peak N m",
     "solve s",
+    "verdict",
 ];
 
-/// One line of the comparison table.
+/// One line of the comparison table; a failed method shows `-` for its numbers.
 pub fn table_row(m: &MethodSummary) -> Vec<String> {
-    let d = m.phase_durations_s;
-    vec![
-        m.method.to_string(),
-        m.status.clone(),
-        format!("{:.5}", m.peak_torque_nm),
-        format!("{:.2}", m.bend_deg),
-        format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
-        format!("{:.2e}", m.flip_error_rad),
-        format!("{:.2e}", m.tilt_deg),
-        format!("{:.5}", m.sim_peak_torque_nm),
-        format!("{:.3}", m.solve_time_s),
-    ]
+    let verdict = match (m.verdict, &m.reason) {
+        (Verdict::Ok, _) => "ok".to_string(),
+        (Verdict::Flagged, r) => format!("FLAGGED: {}", r.as_deref().unwrap_or("")),
+        (Verdict::Failed, r) => format!("FAILED: {}", r.as_deref().unwrap_or("")),
+    };
+    let mut row = vec![m.method.to_string(), m.status.clone()];
+    match &m.result {
+        Some(n) => {
+            let d = n.phase_durations_s;
+            row.extend([
+                format!("{:.5}", n.peak_torque_nm),
+                format!("{:.2}", n.bend_deg),
+                format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
+                format!("{:.2e}", n.flip_error_rad),
+                format!("{:.2e}", n.tilt_deg),
+                format!("{:.5}", n.sim_peak_torque_nm),
+                format!("{:.3}", n.solve_time_s),
+            ]);
+        }
+        None => row.extend(std::iter::repeat_n("-".to_string(), 7)),
+    }
+    row.push(verdict);
+    row
 }

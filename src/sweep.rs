@@ -33,7 +33,7 @@ pub struct SweepSpec {
 impl std::str::FromStr for SweepSpec {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        let bad = |m: &str| Error::Override {
+        let bad = |m: &str| Error::Range {
             arg: s.into(),
             message: format!("{m}; expected KEY=FROM:TO:COUNT, e.g. fall.height=0.5:10:40"),
         };
@@ -52,8 +52,13 @@ impl std::str::FromStr for SweepSpec {
             .trim()
             .parse()
             .map_err(|_| bad("COUNT must be a whole number"))?;
-        if count < 1 || !from.is_finite() || !to.is_finite() {
+        if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
+        }
+        if count > MAX_POINTS {
+            return Err(bad(&format!(
+                "COUNT {count} is more than the {MAX_POINTS} points a sweep may have; split the range into several sweeps"
+            )));
         }
         Ok(SweepSpec {
             key: key.trim().into(),
@@ -64,13 +69,22 @@ impl std::str::FromStr for SweepSpec {
     }
 }
 
+/// Most points a sweep may have: each point runs whole optimisations, so
+/// more would take days; the bound also keeps the result table in memory.
+pub const MAX_POINTS: usize = 10_000;
+
 impl SweepSpec {
+    /// The argument as the user would write it, for messages.
+    pub fn arg(&self) -> String {
+        format!("{}={}:{}:{}", self.key, self.from, self.to, self.count)
+    }
+
     pub fn values(&self) -> Vec<f64> {
         if self.count == 1 {
             return vec![self.from];
         }
         (0..self.count)
-            .map(|i| self.from + (self.to - self.from) * i as f64 / (self.count - 1) as f64)
+            .map(|i| self.from + (self.to - self.from) * (i as f64 / (self.count - 1) as f64))
             .collect()
     }
 }
@@ -139,10 +153,10 @@ impl Shard {
 impl std::str::FromStr for Shard {
     type Err = Error;
     fn from_str(s: &str) -> Result<Self> {
-        let bad = || Error::Invalid {
-            key: "--shard".into(),
-            value: s.into(),
-            expected: "K/N with 1 <= K <= N, e.g. 3/10 (the 3rd of 10 slices)".into(),
+        let bad = || {
+            Error::Usage(format!(
+                "--shard {s}: expected K/N with 1 <= K <= N, e.g. 3/10 (the 3rd of 10 slices)"
+            ))
         };
         let (k, n) = s.split_once('/').ok_or_else(bad)?;
         let (index, count): (usize, usize) = (
@@ -169,19 +183,7 @@ fn point(
         value,
         ..Default::default()
     };
-    let fr = point_into(cfg, methods, warm, &mut p);
-    if let Err(e) = &fr {
-        p.error = Some(e.to_string());
-    }
-    (p, fr.ok().flatten())
-}
-
-fn point_into(
-    cfg: &Config,
-    methods: Methods,
-    warm: Option<&FreeResult>,
-    p: &mut SweepPoint,
-) -> Result<Option<FreeResult>> {
+    let mut kept = None;
     let limit = cfg.limits.max_torque;
     let mut cfg = cfg.clone();
     cfg.limits.max_torque = None;
@@ -196,31 +198,100 @@ fn point_into(
             .0,
         );
     }
-    let ph = if methods.phased || (methods.free && warm.is_none()) {
-        Some(crate::design::phased::optimize(&cfg, |_| {})?)
-    } else {
-        None
-    };
-    if let (true, Some(ph)) = (methods.phased, &ph) {
-        p.phased_peak_nm = Some(ph.peak_torque_nm);
-        p.phased_bend_deg = Some(ph.bend_deg);
-        p.least_height_phased_m = limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
-    }
-    if !methods.free {
-        return Ok(None);
-    }
-    let fr = match (warm, &ph) {
-        (Some(w), _) => crate::design::free::continue_from(&cfg, w, |_| {})?,
-        (None, Some(ph)) => {
-            crate::design::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})?
+    // a method that fails leaves its columns empty and its reason in `error`;
+    // the other methods' numbers are kept
+    let mut errors = Vec::new();
+    if methods.phased || methods.free {
+        // within a chunk the free-form design continues from its neighbour
+        // and needs no phased seed
+        let ph = if methods.phased || warm.is_none() {
+            crate::design::phased::optimize(&cfg, |_| {})
+        } else {
+            Err(Error::Unreachable {
+                reason: "not computed".into(),
+            })
+        };
+        match &ph {
+            Ok(ph) if methods.phased => {
+                errors.extend(flagged(
+                    "phased",
+                    &format!("{:?}", ph.status),
+                    ph.flip_error_rad,
+                    ph.tilt_deg,
+                    &cfg,
+                ));
+                p.phased_peak_nm = Some(ph.peak_torque_nm);
+                p.phased_bend_deg = Some(ph.bend_deg);
+                p.least_height_phased_m =
+                    limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
+            }
+            Err(e) if methods.phased => errors.push(format!("phased: {e}")),
+            _ => {}
         }
-        (None, None) => unreachable!("the phased design seeds a chunk's first point"),
-    };
-    p.free_peak_nm = Some(fr.peak_torque_nm);
-    p.free_bend_deg = Some(fr.bend_deg);
-    p.free_status = Some(format!("{:?}", fr.status));
-    p.least_height_free_m = limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
-    Ok(Some(fr))
+        if methods.free {
+            // seeded by the phased design, or by the analytic plan when that failed
+            let fr = match (&ph, warm) {
+                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, |_| {}),
+                (Ok(ph), None) => crate::design::free::optimize_from(
+                    &cfg,
+                    &ph.plan,
+                    "phased",
+                    cfg.free.nodes,
+                    |_| {},
+                ),
+                (Err(_), None) => crate::design::free::optimize_from(
+                    &cfg,
+                    &analytic_plan(&cfg),
+                    "analytic",
+                    cfg.free.nodes,
+                    |_| {},
+                ),
+            };
+            match fr {
+                Ok(fr) => {
+                    errors.extend(flagged(
+                        "free",
+                        &format!("{:?}", fr.status),
+                        fr.flip_error_rad,
+                        fr.tilt_deg,
+                        &cfg,
+                    ));
+                    p.free_peak_nm = Some(fr.peak_torque_nm);
+                    p.free_bend_deg = Some(fr.bend_deg);
+                    p.least_height_free_m =
+                        limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+                    p.free_status = Some(format!("{:?}", fr.status));
+                    kept = Some(fr);
+                }
+                Err(e) => errors.push(format!("free: {e}")),
+            }
+        }
+    }
+    if !errors.is_empty() {
+        p.error = Some(errors.join("; "));
+    }
+    (p, kept)
+}
+
+/// A kept design that misses a target (unconverged, flip missed) is named in
+/// the point's `error` column beside its numbers.
+fn flagged(
+    method: &str,
+    status: &str,
+    flip_error: f64,
+    tilt_deg: f64,
+    cfg: &Config,
+) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "Solved" | "Converged") {
+        why.push(format!("solver status {}", status.to_lowercase()));
+    }
+    why.extend(crate::verify::simulate::misses_flip(
+        flip_error,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
 /// Runs a sweep on the config at `path` (with `overrides`), `threads` chunks at a time.
@@ -261,10 +332,31 @@ pub fn sweep_shard(
         ov.push(format!("{}={}", spec.key, v));
         Config::load(path, &ov)
     };
-    // a bad key or an out-of-range end fails before any work
-    let mut configs = Vec::with_capacity(values.len());
-    for &v in values {
-        configs.push(load(v)?);
+    // a point whose config is invalid is that point's failure; when every
+    // point is invalid (e.g. an unknown key) the sweep fails before any work
+    let configs: Vec<Result<Config>> = values
+        .iter()
+        .map(|&v| {
+            load(v).map_err(|e| Error::Range {
+                arg: spec.arg(),
+                message: match e {
+                    // the override is internal: name the point, not a `--set`
+                    Error::Override { message, .. } => format!("at {} = {v}: {message}", spec.key),
+                    e => format!("at {} = {v}: {e}", spec.key),
+                },
+            })
+        })
+        .collect();
+    if let Some(Err(first)) = configs.first()
+        && configs.iter().all(|c| c.is_err())
+    {
+        return Err(Error::Range {
+            arg: spec.arg(),
+            message: match first {
+                Error::Range { message, .. } => format!("every point is invalid; {message}"),
+                e => e.to_string(),
+            },
+        });
     }
     // shards start on chunk boundaries, so local chunks are global chunks
     let chunks: Vec<std::ops::Range<usize>> = (0..values.len())
@@ -284,7 +376,17 @@ pub fn sweep_shard(
                     }
                     let mut warm: Option<FreeResult> = None;
                     for i in chunks[c].clone() {
-                        let (p, fr) = point(&configs[i], values[i], methods, warm.as_ref());
+                        let (p, fr) = match &configs[i] {
+                            Ok(cfg) => point(cfg, values[i], methods, warm.as_ref()),
+                            Err(e) => (
+                                SweepPoint {
+                                    value: values[i],
+                                    error: Some(e.to_string()),
+                                    ..Default::default()
+                                },
+                                None,
+                            ),
+                        };
                         // a failed point leaves the last good design as the start
                         if fr.is_some() {
                             warm = fr;

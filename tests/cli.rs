@@ -54,7 +54,7 @@ fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
         assert!(v.get(key).is_some(), "missing {key}");
     }
     assert!((v["flip_deg"].as_f64().unwrap().abs() - 180.0).abs() < 1e-6);
-    let csv = std::fs::read_to_string(dir.path().join("output/seed/analytic.csv")).unwrap();
+    let csv = std::fs::read_to_string(dir.path().join("output/seed/analyze/analytic.csv")).unwrap();
     let mut lines = csv.lines();
     let header = lines.next().unwrap();
     assert!(header.starts_with("t_s,phase,"));
@@ -78,7 +78,7 @@ fn simulate_replays_a_written_schedule() {
     let cfg = configs().join("seed.toml");
     let o = run(&["analyze", cfg.to_str().unwrap()], dir.path());
     assert!(o.status.success());
-    let sched = dir.path().join("output/seed/analytic.csv");
+    let sched = dir.path().join("output/seed/analyze/analytic.csv");
     let o = run(
         &[
             "simulate",
@@ -224,11 +224,13 @@ fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
     assert_eq!(v["mode"], "phased");
     assert_eq!(v["status"], "solved");
     let on_disk: serde_json::Value = serde_json::from_str(
-        &std::fs::read_to_string(dir.path().join("output/seed/phased.json")).unwrap(),
+        &std::fs::read_to_string(dir.path().join("output/seed/optimize-phased/phased.json"))
+            .unwrap(),
     )
     .unwrap();
     assert_eq!(on_disk["peak_torque_nm"], v["peak_torque_nm"]);
-    let csv = std::fs::read_to_string(dir.path().join("output/seed/phased.csv")).unwrap();
+    let csv =
+        std::fs::read_to_string(dir.path().join("output/seed/optimize-phased/phased.csv")).unwrap();
     let last: Vec<&str> = csv.lines().last().unwrap().split(',').collect();
     let total: f64 = v["phase_durations_s"]
         .as_array()
@@ -287,5 +289,9 @@ fn optimize_free_reports_iterations_and_nodes() {
         v["iterations"].as_array().unwrap().len() as u64,
         v["scp_iterations"].as_u64().unwrap()
     );
-    assert!(dir.path().join("output/seed/free.csv").exists());
+    assert!(
+        dir.path()
+            .join("output/seed/optimize-free/free.csv")
+            .exists()
+    );
 }

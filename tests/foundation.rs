@@ -179,8 +179,7 @@ fn dynamic_simulation_of_inverse_dynamics_torque_reproduces_the_plan() {
         let open_loop = Controller {
             kp: 0.0,
             kd: 0.0,
-            limit: None,
-            norm: cfg.norm(),
+            motor: catflip::model::motor::Motor::unlimited(cfg.norm()),
         };
         let d = dynamic(&cat, &p, &open_loop, &tight()).unwrap();
         let k = kinematic(&cat, &p, &tight()).unwrap();

@@ -53,7 +53,7 @@ fn run_writes_a_complete_consistent_report() {
         out.contains("analytic") && out.contains("phased") && out.contains("free"),
         "{out}"
     );
-    let base = dir.path().join("output/seed");
+    let base = dir.path().join("output/seed/run");
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
     let methods = summary["methods"].as_array().unwrap();
@@ -95,7 +95,17 @@ fn run_writes_a_complete_consistent_report() {
             "{name} peak missing from index.html"
         );
         assert!(m["flip_error_rad"].as_f64().unwrap().abs() < 1e-3, "{name}");
+        // one flip convention, unwrapped: every method turns the seed the same way
+        let flip = m["flip_deg"].as_f64().unwrap();
+        assert!((flip + 180.0).abs() < 1e-3, "{name}: flip {flip}");
+        for sim in ["mujoco", "pybullet"] {
+            assert!(
+                base.join(format!("{name}.{sim}.csv")).exists(),
+                "{name} {sim}"
+            );
+        }
     }
+    assert!(base.join("seed.mjcf.xml").exists() && base.join("seed.urdf").exists());
     let peaks: Vec<f64> = methods
         .iter()
         .map(|m| m["peak_torque_nm"].as_f64().unwrap())
@@ -178,14 +188,18 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         dir.path(),
     );
     assert!(ok, "{err}");
-    let csv = std::fs::read_to_string(dir.path().join("output/seed/sweep-cat_mass.csv")).unwrap();
+    let csv = std::fs::read_to_string(
+        dir.path()
+            .join("output/seed/sweep-cat_mass/sweep-cat_mass.csv"),
+    )
+    .unwrap();
     let rows: Vec<&str> = csv.lines().collect();
     assert_eq!(rows.len(), 3);
     assert!(rows[0].starts_with("cat.mass,"));
     // with a torque limit, the least drop height of F7 is there
     assert!(
         dir.path()
-            .join("output/seed/sweep-cat_mass-least-height.svg")
+            .join("output/seed/sweep-cat_mass/sweep-cat_mass-least-height.svg")
             .exists()
     );
     let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
@@ -194,67 +208,4 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         let (ok, _, err) = run(&["sweep", c, "--set-range", bad], dir.path());
         assert!(!ok && !err.is_empty(), "{bad} should fail");
     }
-}
-
-#[test]
-fn exports_parse_and_carry_the_model_masses_and_inertias() {
-    for name in ["seed", "robot-universal"] {
-        let cfg = catflip::Config::load(&configs().join(format!("{name}.toml")), &[]).unwrap();
-        let cat = cfg.cat();
-        let close = |s: &str, want: f64| (s.parse::<f64>().unwrap() - want).abs() < 1e-8;
-        let urdf = catflip::export::urdf(&cfg);
-        let doc = roxmltree::Document::parse(&urdf).unwrap();
-        let masses: Vec<_> = doc
-            .descendants()
-            .filter(|n| n.has_tag_name("mass"))
-            .collect();
-        assert_eq!(masses.len(), 2);
-        assert!(
-            masses
-                .iter()
-                .all(|m| close(m.attribute("value").unwrap(), cat.mass))
-        );
-        for i in doc.descendants().filter(|n| n.has_tag_name("inertia")) {
-            assert!(
-                close(i.attribute("ixx").unwrap(), cat.i_t())
-                    && close(i.attribute("izz").unwrap(), cat.i_a())
-            );
-        }
-        let joints: Vec<_> = doc
-            .descendants()
-            .filter(|n| n.has_tag_name("joint"))
-            .collect();
-        match cat.joint {
-            catflip::model::Joint::Universal => assert!(
-                joints.len() == 2
-                    && joints
-                        .iter()
-                        .all(|j| j.attribute("type") == Some("revolute"))
-            ),
-            catflip::model::Joint::NoTwist => {
-                assert!(joints.len() == 1 && joints[0].attribute("type") == Some("spherical"))
-            }
-        }
-        let mjcf = catflip::export::mjcf(&cfg);
-        let doc = roxmltree::Document::parse(&mjcf).unwrap();
-        let inertials: Vec<_> = doc
-            .descendants()
-            .filter(|n| n.has_tag_name("inertial"))
-            .collect();
-        assert_eq!(inertials.len(), 2);
-        for n in inertials {
-            assert!(close(n.attribute("mass").unwrap(), cat.mass));
-            let d: Vec<&str> = n.attribute("diaginertia").unwrap().split(' ').collect();
-            assert!(close(d[0], cat.i_t()) && close(d[1], cat.i_t()) && close(d[2], cat.i_a()));
-        }
-    }
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = configs().join("robot-universal.toml");
-    let (ok, _, err) = run(&["export", "mjcf", cfg.to_str().unwrap()], dir.path());
-    assert!(ok, "{err}");
-    assert!(
-        dir.path()
-            .join("output/robot-universal/robot-universal.mjcf.xml")
-            .exists()
-    );
 }

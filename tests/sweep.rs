@@ -79,7 +79,11 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     args.extend(["--threads", "2", "--out", "full"]);
     let (ok, _, err) = run(&args, dir.path());
     assert!(ok, "{err}");
-    let full = std::fs::read_to_string(dir.path().join("full/seed/sweep-cat_radius.csv")).unwrap();
+    let full = std::fs::read_to_string(
+        dir.path()
+            .join("full/seed/sweep-cat_radius/sweep-cat_radius.csv"),
+    )
+    .unwrap();
     assert_eq!(full.lines().count(), 12);
     let mut joined = String::new();
     for k in 1..=3 {
@@ -88,10 +92,9 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
         args.extend(["--threads", "1", "--shard", &shard, "--out", "shards"]);
         let (ok, _, err) = run(&args, dir.path());
         assert!(ok, "{err}");
-        let part = std::fs::read_to_string(
-            dir.path()
-                .join(format!("shards/seed/sweep-cat_radius.shard-{k}-of-3.csv")),
-        )
+        let part = std::fs::read_to_string(dir.path().join(format!(
+            "shards/seed/sweep-cat_radius.shard-{k}-of-3/sweep-cat_radius.shard-{k}-of-3.csv"
+        )))
         .unwrap();
         let skip = if k == 1 { 0 } else { 1 };
         for line in part.lines().skip(skip) {

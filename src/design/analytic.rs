@@ -69,7 +69,8 @@ pub fn closed_forms(cfg: &Config) -> ClosedForms {
     let d = cfg.analytic.split.map(|f| f * avail);
     let twist = PI / c;
     let omega0 = twist / d[1];
-    let i_star = i_t + cat.mass * (cat.length / 2.0).powi(2);
+    // the seed swings the front half about the joint
+    let i_star = cat.front.i_t() + cat.front.mass * cat.front.half_length().powi(2);
     let est = [
         PI * PI / (d[0] * d[0]) * i_star,
         omega0 * PI / d[1] * i_star,

@@ -892,13 +892,13 @@ mod tests {
     #[test]
     fn torque_hessian_matches_second_differences_of_the_inverse_dynamics() {
         for joint in [crate::model::Joint::NoTwist, crate::model::Joint::Universal] {
-            let cat = Cat {
-                mass: 1.0,
-                length: 1.0,
-                radius: 0.1,
-                joint,
-                inertia: crate::model::InertiaFormula::SolidCylinder,
-            };
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+            let cfg = Config::load(
+                std::path::Path::new(path),
+                &[format!("cat.joint={}", joint.name())],
+            )
+            .unwrap();
+            let cat = cfg.cat();
             let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
             let y = [0.8, -1.3];
             let g = weighted_torque_hessian(&cat, x, y);

@@ -3,9 +3,13 @@
 //! (collocation + successive convexification), with the shape plans and
 //! sampled schedules they produce and the conic solver they share.
 pub mod analytic;
+pub mod bend_search;
 pub mod collocation;
 pub mod conic;
+pub mod envelope;
 pub mod free;
+pub mod least_height;
+pub mod objective;
 pub mod path;
 pub mod phased;
 pub mod plan;

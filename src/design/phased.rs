@@ -10,7 +10,9 @@
 
 use crate::config::Config;
 use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::design::bend_search::{Scored, scan_then_golden};
 use crate::design::conic::SolveStatus;
+use crate::design::objective::Objective;
 use crate::design::path::{Path, PhasedPlan, Timing};
 use crate::design::timing::{PhaseTiming, TimingProblem};
 use crate::error::{Error, Result};
@@ -69,13 +71,14 @@ impl BendDesign {
 
 /// Twist of the bend direction that flips the cat by exactly pi.
 ///
-/// `no-twist`: `pi / C` (F1, exact). `universal`: F1 is only approximate (F4),
-/// so the twist is root-found on the integrated attitude; by F2 the timing is
-/// irrelevant and a unit-time cosine plan is used.
+/// `no-twist` with identical halves: `pi / C` (F1, exact). `universal` (F4)
+/// or unequal halves: F1 is only approximate, so the twist is root-found on
+/// the integrated attitude, starting from `pi / C` with the mean half; by F2
+/// the timing is irrelevant and a unit-time cosine plan is used.
 pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
     let guess = PI / c;
-    if cat.joint == Joint::NoTwist {
+    if cat.joint == Joint::NoTwist && cat.is_symmetric() {
         return Ok(guess);
     }
     let ode = OdeSettings {
@@ -101,7 +104,12 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     }
     Err(Error::Unreachable {
         reason: format!(
-            "no twist angle flips the universal-joint cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            "no twist angle flips the {} cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
+            if cat.is_symmetric() {
+                "universal-joint"
+            } else {
+                "unequal-halves"
+            },
             bend.to_degrees()
         ),
     })
@@ -111,6 +119,9 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct BendEvaluation {
     pub bend_deg: f64,
+    /// The objective at this bend, in its unit (`design.objective`; infinite
+    /// where no timing fits the motor envelope).
+    pub value: f64,
     pub unit_peak: f64,
     pub peak_nm: f64,
 }
@@ -118,9 +129,10 @@ pub struct BendEvaluation {
 /// Designs the phases at one bend.
 ///
 /// For the `no-twist` joint the unfold is the fold run backwards and rotated
-/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`) and the
-/// torque is invariant under time reversal, so the unfold reuses the fold's
-/// timing reversed (the discrete SOCP has the same symmetry, tested).
+/// about the spine: the model is axisymmetric (`M(R q) = R M(q) R'`, which
+/// holds for unequal halves too, each being a cylinder about its own axis)
+/// and the torque is invariant under time reversal, so the unfold reuses the
+/// fold's timing reversed (the discrete SOCP has the same symmetry, tested).
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
     let twist = twist_for(cat, bend)?;
     let paths = Path::phased(bend, twist);
@@ -145,6 +157,12 @@ pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<Be
 pub struct PhasedResult {
     pub mode: &'static str,
     pub status: SolveStatus,
+    pub objective: Objective,
+    /// The objective's value for the written schedule, in [`Objective::unit`]
+    /// (peak torque N m, manoeuvre time s, or `integral |tau|^2 dt` N^2 m^2 s).
+    pub objective_value: f64,
+    /// Manoeuvre time of the schedule, s.
+    pub manoeuvre_time_s: f64,
     /// Peak joint torque of the written schedule (inverse dynamics, sampled
     /// densely), N m: what the motors must give.
     pub peak_torque_nm: f64,
@@ -181,14 +199,26 @@ pub struct PhasedResult {
     pub sim: Option<SimReport>,
 }
 
-/// Bend search: scan, then golden section in the best bracket.
-pub fn search_bend(
-    cfg: &Config,
-    problem: &mut TimingProblem,
-    mut observe: impl FnMut(&BendEvaluation),
-) -> Result<(BendDesign, Vec<BendEvaluation>)> {
+/// The coarse bend scan over `[lo, hi]` rad: `phased.scan_points` even
+/// points plus the one-turn bend (F6) and the config's bend where inside.
+pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
     let cat = cfg.cat();
-    let t = cfg.available_time();
+    let n = cfg.phased.scan_points;
+    let mut xs: Vec<f64> = (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect();
+    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
+    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
+    for b in [one_turn, seed_bend] {
+        if b > lo && b < hi {
+            xs.push(b);
+        }
+    }
+    xs
+}
+
+/// The bend range the config allows, rad.
+pub fn bend_range(cfg: &Config) -> Result<(f64, f64)> {
     let lo = cfg.phased.bend_min_deg.to_radians();
     let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
     if hi <= lo {
@@ -201,11 +231,31 @@ pub fn search_bend(
             ),
         });
     }
+    Ok((lo, hi))
+}
+
+impl Scored for BendDesign {
+    fn score(&self) -> f64 {
+        self.unit_peak()
+    }
+}
+
+/// Bend search: scan (with the one-turn and the config's bend), then golden
+/// section in the best bracket.
+pub fn search_bend(
+    cfg: &Config,
+    problem: &mut TimingProblem,
+    mut observe: impl FnMut(&BendEvaluation),
+) -> Result<(BendDesign, Vec<BendEvaluation>)> {
+    let cat = cfg.cat();
+    let t = cfg.available_time();
+    let (lo, hi) = bend_range(cfg)?;
     let mut evals = Vec::new();
     let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
         let d = design_at(&cat, problem, b)?;
         let e = BendEvaluation {
             bend_deg: b.to_degrees(),
+            value: d.unit_peak() / (t * t),
             unit_peak: d.unit_peak(),
             peak_nm: d.unit_peak() / (t * t),
         };
@@ -213,56 +263,9 @@ pub fn search_bend(
         evals.push(e);
         Ok(d)
     };
-    let n = cfg.phased.scan_points;
-    let mut xs: Vec<f64> = (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect();
-    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
-    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
-    for b in [one_turn, seed_bend] {
-        if b > lo && b < hi {
-            xs.push(b);
-        }
-    }
-    xs.sort_by(|a, b| a.partial_cmp(b).unwrap());
-    let mut designs = Vec::new();
-    for &x in &xs {
-        designs.push(eval(x, &mut evals)?);
-    }
-    let best = (0..xs.len())
-        .min_by(|&i, &j| {
-            designs[i]
-                .unit_peak()
-                .partial_cmp(&designs[j].unit_peak())
-                .unwrap()
-        })
-        .unwrap();
-    let (mut a, mut b) = (xs[best.saturating_sub(1)], xs[(best + 1).min(xs.len() - 1)]);
-    let mut best_d = designs.swap_remove(best);
-    let g = (5f64.sqrt() - 1.0) / 2.0;
+    let xs = bend_scan(cfg, lo, hi);
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    let mut x1 = b - g * (b - a);
-    let mut x2 = a + g * (b - a);
-    let mut d1 = eval(x1, &mut evals)?;
-    let mut d2 = eval(x2, &mut evals)?;
-    while b - a > tol {
-        if d1.unit_peak() <= d2.unit_peak() {
-            b = x2;
-            (x2, d2) = (x1, d1);
-            x1 = b - g * (b - a);
-            d1 = eval(x1, &mut evals)?;
-        } else {
-            a = x1;
-            (x1, d1) = (x2, d2);
-            x2 = a + g * (b - a);
-            d2 = eval(x2, &mut evals)?;
-        }
-    }
-    for d in [d1, d2] {
-        if d.unit_peak() < best_d.unit_peak() {
-            best_d = d;
-        }
-    }
+    let best_d = scan_then_golden(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
 }
 
@@ -289,6 +292,9 @@ pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Resul
 
 /// The phased optimiser: bend search, optimal split, reconstruction, verification.
 pub fn optimize(cfg: &Config, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    if cfg.uses_envelope() {
+        return crate::design::envelope::optimize(cfg, observe);
+    }
     let start = Instant::now();
     let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
     let (design, evals) = search_bend(cfg, &mut problem, observe)?;
@@ -321,6 +327,9 @@ pub fn finish(
     Ok(PhasedResult {
         mode: "phased",
         status,
+        objective: Objective::PeakTorque,
+        objective_value: peak,
+        manoeuvre_time_s: t,
         peak_torque_nm: peak,
         socp_peak_torque_nm: socp_peak,
         unit_peak_nm_s2: peak * t * t,

@@ -1,123 +1,60 @@
-//! The cat as a URDF (pyBullet, as the seed used) and as an MJCF (MuJoCo),
-//! with the model's masses and inertias, so that a schedule can be replayed
-//! in those simulators.
+//! The cat and its schedules in a simulator's own terms: a URDF (pyBullet,
+//! as the seed used, and MuJoCo), an MJCF (MuJoCo), and per schedule the
+//! joint positions, velocities and actuator torques at the simulator's time
+//! step, so that a schedule replays unedited.
 //!
 //! Frames follow MODEL.md: the rear half A's frame sits at its centre of mass
 //! with `z` towards the joint at `(0, 0, l/2)`; the front half B's centre of
 //! mass is `l/2` beyond the joint along its own `z`. `universal`: motor 1
 //! about A's `x`, then motor 2 about the rotated `y` (`R = Rx(q1) Ry(q2)`).
-//! `no-twist`: the Kane & Scher joint is a ball joint whose relative rotation
-//! is `exp(hat(q1, q2, 0))`; both formats carry it as a ball / spherical joint.
+//! `no-twist`: a ball joint whose relative rotation is `exp(hat(q1, q2, 0))`,
+//! driven by three motors about the front half's own axes (see [`controls`]).
+
+pub mod controls;
+pub mod mjcf;
+pub mod urdf;
+
+pub use mjcf::mjcf;
+pub use urdf::urdf;
 
 use crate::config::Config;
-use crate::model::Joint;
+use crate::design::plan::ShapePlan;
+use crate::model::Half;
+use crate::output::Output;
 
-fn f(x: f64) -> String {
-    format!("{x:.9}")
+/// The rear (A) and front (B) halves, from the one place that knows them
+/// (each half's mass, length, radius and inertia: [`Half`]).
+pub fn halves(cfg: &Config) -> [Half; 2] {
+    let cat = cfg.cat();
+    [cat.rear, cat.front]
 }
 
-/// URDF text of the cat of `cfg`.
-pub fn urdf(cfg: &Config) -> String {
-    let cat = cfg.cat();
-    let (m, l, r, it, ia) = (cat.mass, cat.length, cat.radius, cat.i_t(), cat.i_a());
-    let h = l / 2.0;
-    let link = |name: &str, z: f64| {
-        format!(
-            r#"  <link name="{name}">
-    <inertial>
-      <origin xyz="0 0 {z}" rpy="0 0 0"/>
-      <mass value="{m}"/>
-      <inertia ixx="{it}" ixy="0" ixz="0" iyy="{it}" iyz="0" izz="{ia}"/>
-    </inertial>
-    <visual><origin xyz="0 0 {z}"/><geometry><cylinder radius="{r}" length="{l}"/></geometry></visual>
-    <collision><origin xyz="0 0 {z}"/><geometry><cylinder radius="{r}" length="{l}"/></geometry></collision>
-  </link>
-"#,
-            z = f(z),
-            m = f(m),
-            it = f(it),
-            ia = f(ia),
-            r = f(r),
-            l = f(l)
-        )
-    };
-    let mut s = format!(
-        "<?xml version=\"1.0\"?>\n<!-- catflip: {} ({} joint). Masses and inertias as in the model (MODEL.md); angles in rad, torques in N m. -->\n<robot name=\"{}\">\n",
-        cfg.name,
-        cat.joint.name(),
-        cfg.name
-    );
-    s.push_str(&link("rear", 0.0));
-    match cat.joint {
-        Joint::Universal => {
-            s.push_str("  <link name=\"cross\"/>\n");
-            s.push_str(&format!(
-                "  <joint name=\"motor1\" type=\"revolute\">\n    <parent link=\"rear\"/>\n    <child link=\"cross\"/>\n    <origin xyz=\"0 0 {}\"/>\n    <axis xyz=\"1 0 0\"/>\n    <limit lower=\"-3.14159\" upper=\"3.14159\" effort=\"{}\" velocity=\"100\"/>\n  </joint>\n",
-                f(h),
-                f(cfg.limits.max_torque.unwrap_or(1e3))
-            ));
-            s.push_str(&format!(
-                "  <joint name=\"motor2\" type=\"revolute\">\n    <parent link=\"cross\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"0 0 0\"/>\n    <axis xyz=\"0 1 0\"/>\n    <limit lower=\"-3.14159\" upper=\"3.14159\" effort=\"{}\" velocity=\"100\"/>\n  </joint>\n",
-                f(cfg.limits.max_torque.unwrap_or(1e3))
-            ));
-        }
-        Joint::NoTwist => {
-            s.push_str(&format!(
-                "  <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)) -->\n  <joint name=\"spine\" type=\"spherical\">\n    <parent link=\"rear\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"0 0 {}\"/>\n  </joint>\n",
-                f(h)
-            ));
+/// Largest joint torque the exports allow, N m (the config's stall torque).
+pub(crate) fn torque_limit(cfg: &Config) -> Option<f64> {
+    cfg.limits.max_torque
+}
+
+/// Joint speed limit for the model files, rad/s: the config's hard limit, else
+/// the motor's no-load speed (it cannot drive faster), else none.
+pub(crate) fn speed_limit(cfg: &Config) -> Option<f64> {
+    cfg.limits.max_speed.or(cfg.limits.no_load_speed)
+}
+
+/// Numbers in model files: the shortest text that reads back to the same f64.
+pub(crate) fn f(x: f64) -> String {
+    format!("{x}")
+}
+
+/// Everything `catflip run` writes for the simulators: both models and, per
+/// method, the MuJoCo and pyBullet controls (`<method>.mujoco.csv`,
+/// `<method>.pybullet.csv`).
+pub fn add_simulator_files(cfg: &Config, out: &mut Output, methods: &[(&str, &dyn ShapePlan)]) {
+    out.add(format!("{}.mjcf.xml", cfg.name), mjcf(cfg));
+    out.add(format!("{}.urdf", cfg.name), urdf(cfg));
+    for (name, plan) in methods {
+        for sim in [controls::Simulator::Mujoco, controls::Simulator::Pybullet] {
+            let c = controls::Controls::sample(cfg, *plan, sim);
+            out.add(format!("{name}.{}.csv", sim.name()), c.to_csv(cfg, name));
         }
     }
-    s.push_str(&link("front", h));
-    s.push_str("</robot>\n");
-    s
-}
-
-/// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
-pub fn mjcf(cfg: &Config) -> String {
-    let cat = cfg.cat();
-    let (m, l, r, it, ia) = (cat.mass, cat.length, cat.radius, cat.i_t(), cat.i_a());
-    let h = l / 2.0;
-    let joints = match cat.joint {
-        Joint::Universal => "        <joint name=\"motor1\" type=\"hinge\" axis=\"1 0 0\"/>\n        <joint name=\"motor2\" type=\"hinge\" axis=\"0 1 0\"/>\n".to_string(),
-        Joint::NoTwist => "        <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)) -->\n        <joint name=\"spine\" type=\"ball\"/>\n".to_string(),
-    };
-    let actuators = match cat.joint {
-        Joint::Universal => {
-            "    <motor name=\"tau1\" joint=\"motor1\" gear=\"1\"/>\n    <motor name=\"tau2\" joint=\"motor2\" gear=\"1\"/>\n"
-        }
-        Joint::NoTwist => {
-            "    <motor name=\"tau_x\" joint=\"spine\" gear=\"1 0 0 0 0 0\"/>\n    <motor name=\"tau_y\" joint=\"spine\" gear=\"0 1 0 0 0 0\"/>\n"
-        }
-    };
-    format!(
-        r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md). -->
-<mujoco model="{name}">
-  <option gravity="0 0 -{g}" timestep="0.0005" integrator="RK4"/>
-  <worldbody>
-    <!-- spine (the rear half's z axis) horizontal along world x; rotate about it to set the initial roll -->
-    <body name="rear" pos="0 0 {height}" euler="0 90 0">
-      <freejoint name="fall"/>
-      <inertial pos="0 0 0" mass="{m}" diaginertia="{it} {it} {ia}"/>
-      <geom type="cylinder" size="{r} {h}" mass="0"/>
-      <body name="front" pos="0 0 {h}">
-{joints}        <inertial pos="0 0 {h}" mass="{m}" diaginertia="{it} {it} {ia}"/>
-        <geom type="cylinder" size="{r} {h}" pos="0 0 {h}" mass="0"/>
-      </body>
-    </body>
-  </worldbody>
-  <actuator>
-{actuators}  </actuator>
-</mujoco>
-"#,
-        name = cfg.name,
-        joint = cat.joint.name(),
-        g = f(cfg.fall.gravity),
-        height = f(cfg.fall.height),
-        m = f(m),
-        it = f(it),
-        ia = f(ia),
-        r = f(r),
-        h = f(h),
-    )
 }

@@ -150,12 +150,16 @@ pub fn angular_momentum(
     let rel = cat.rel_rotation(qe);
     let (_, d) = cat.offsets(&rel);
     let rb = mat_mul(&ra, &rel);
-    // centre-of-mass offsets from the common centre: -/+ R_A d / 2
-    let half_d = mat_vec(&ra, scale3(D::from(0.5), d));
-    let ic = cat.body_inertia::<f64>();
+    // centre-of-mass offsets from the common centre: -m_B/m R_A d and +m_A/m R_A d
+    let d_world = mat_vec(&ra, d);
+    let m = cat.mass();
     let mut l = [0.0; 3];
-    for (rot, sign) in [(ra, -1.0), (rb, 1.0)] {
-        let r = scale3(D::from(sign), half_d);
+    for (rot, half, share) in [
+        (ra, &cat.rear, -cat.front.mass / m),
+        (rb, &cat.front, cat.rear.mass / m),
+    ] {
+        let ic = Cat::body_inertia::<f64>(half);
+        let r = scale3(D::from(share), d_world);
         let rv = r.map(|x| x.re);
         let vv = r.map(|x| x.eps);
         let rr = rot.map(|row| row.map(|x| x.re));
@@ -164,7 +168,7 @@ pub fn angular_momentum(
         let wm = mat_mul(&rdot, &transpose(&rr));
         let w = [wm[2][1], wm[0][2], wm[1][0]];
         let iw = mat_vec(&mat_mul(&mat_mul(&rr, &ic), &transpose(&rr)), w);
-        let orb = scale3(cat.mass, cross(rv, vv));
+        let orb = scale3(half.mass, cross(rv, vv));
         l = add3(l, add3(iw, orb));
     }
     l
@@ -173,16 +177,18 @@ pub fn angular_momentum(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::model::{InertiaFormula, Joint};
+    use crate::model::{Half, InertiaFormula, Joint};
 
     fn cat(joint: Joint) -> Cat {
-        Cat {
-            mass: 1.3,
-            length: 0.8,
-            radius: 0.12,
+        Cat::symmetric(
+            Half {
+                mass: 1.3,
+                length: 0.8,
+                radius: 0.12,
+                inertia: InertiaFormula::SolidCylinder,
+            },
             joint,
-            inertia: InertiaFormula::SolidCylinder,
-        }
+        )
     }
 
     #[test]

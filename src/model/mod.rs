@@ -1,23 +1,29 @@
-//! The two-cylinder cat of MODEL.md: geometry, joint kinematics and the locked
-//! inertia terms of the zero-momentum reduction, written once generically so
-//! that num-dual evaluates exact first and second derivatives of them.
+//! The two-cylinder cat (docs/model.md): geometry, joint kinematics and the
+//! locked inertia terms of the zero-momentum reduction, written once
+//! generically so that num-dual evaluates exact first and second derivatives.
 //!
-//! Kinetic energy, all vectors in body A's frame (MODEL.md section 1):
-//! with `w = S(q) q_dot` the relative angular velocity of B, `d` the vector
-//! from A's to B's centre of mass, `s = R_rel (0,0,l/2)` the vector from the
-//! joint to B's centre of mass and `mu = m/2` the reduced mass of the pair,
+//! Kinetic energy about the common centre of mass, all vectors in body A's
+//! frame: with `w = S(q) q_dot` the relative angular velocity of B, `s =
+//! R_rel (0,0,l_B/2)` the vector from the joint to B's centre of mass, `d = s +
+//! (0,0,l_A/2)` the vector from A's to B's centre of mass, `I_A` and `I_B` the
+//! halves' inertias (B's rotated into A's frame) and `mu = m_A m_B / (m_A + m_B)`
+//! the reduced mass of the pair (the halves may differ, [`body`]):
 //!
-//! `T = 1/2 w_A' I_c w_A + 1/2 (w_A + w)' I_B (w_A + w) + 1/2 mu |w_A x d + w x s|^2`
+//! `T = 1/2 w_A' I_A w_A + 1/2 (w_A + w)' I_B (w_A + w) + 1/2 mu |w_A x d + w x s|^2`
 //!   `= 1/2 w_A' J w_A + w_A' Kt w + 1/2 w' Nt w`
 //!
-//! with `J = I_c + I_B + mu hat(d)'hat(d)`, `Kt = I_B + mu hat(d)'hat(s)`,
+//! with `J = I_A + I_B + mu hat(d)'hat(d)`, `Kt = I_B + mu hat(d)'hat(s)`,
 //! `Nt = I_B + mu hat(s)'hat(s)` and `hat(a)'hat(b) = (a.b) I - b a'`.
 //! Zero angular momentum gives `w_A = -J^-1 K q_dot` with `K = Kt S`, and the
 //! reduced mass matrix is `M = S' Nt S - K' J^-1 K`.
 
+pub mod body;
 pub mod dynamics;
+pub mod motor;
 pub mod small;
 pub mod so3;
+
+pub use body::{Half, InertiaFormula};
 
 use crate::model::small::*;
 use nalgebra::{Const, U1};
@@ -68,57 +74,67 @@ impl TorqueNorm {
     }
 }
 
-/// Which transverse-inertia formula to use (MODEL.md E1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
-#[serde(rename_all = "kebab-case")]
-pub enum InertiaFormula {
-    /// Solid cylinder, `m (3 r^2 + l^2) / 12`.
-    #[default]
-    SolidCylinder,
-    /// The seed's `m (r^2 + l^2) / 12` (erratum E1), only to reproduce its example.
-    Seed,
-}
-
-/// Two identical cylinders joined at the middle.
+/// The two halves joined at the middle: rear half A (whose frame is the
+/// reference) and front half B.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cat {
-    /// Mass of each half, kg.
-    pub mass: f64,
-    /// Length of each half, m.
-    pub length: f64,
-    /// Radius, m.
-    pub radius: f64,
+    pub rear: Half,
+    pub front: Half,
     pub joint: Joint,
-    pub inertia: InertiaFormula,
 }
 
 impl Cat {
-    /// Transverse inertia of one half about its own centre of mass, `I_t`.
-    pub fn i_t(&self) -> f64 {
-        let (m, r, l) = (self.mass, self.radius, self.length);
-        match self.inertia {
-            InertiaFormula::SolidCylinder => m * (3.0 * r * r + l * l) / 12.0,
-            InertiaFormula::Seed => m * (r * r + l * l) / 12.0,
+    /// Two identical halves (the seed's cat).
+    pub fn symmetric(half: Half, joint: Joint) -> Cat {
+        Cat {
+            rear: half,
+            front: half,
+            joint,
         }
     }
 
-    /// Axial inertia of one half, `I_a = m r^2 / 2`.
+    /// Whether both halves are the same cylinder (the seed's closed forms are exact only then).
+    pub fn is_symmetric(&self) -> bool {
+        self.rear == self.front
+    }
+
+    /// Transverse inertia of a half, `I_t`; with unequal halves, the mean of the two
+    /// (used only by the seed's closed forms, which assume identical halves).
+    pub fn i_t(&self) -> f64 {
+        0.5 * (self.rear.i_t() + self.front.i_t())
+    }
+
+    /// Axial inertia of a half, `I_a`; with unequal halves, the mean of the two.
     pub fn i_a(&self) -> f64 {
-        self.mass * self.radius * self.radius / 2.0
+        0.5 * (self.rear.i_a() + self.front.i_a())
+    }
+
+    /// Total mass, kg.
+    pub fn mass(&self) -> f64 {
+        self.rear.mass + self.front.mass
+    }
+
+    /// Reduced mass of the pair, `m_A m_B / (m_A + m_B)`.
+    pub fn reduced_mass(&self) -> f64 {
+        self.rear.mass * self.front.mass / self.mass()
+    }
+
+    /// `M(0)`, the straight cat's mass matrix (a multiple of the identity by
+    /// axisymmetry), in closed form: with `a = l_A/2`, `b = l_B/2`, `D = a + b`
+    /// and `mu` the reduced mass,
+    /// `M(0) = I_tB + mu b^2 - (I_tB + mu D b)^2 / (I_tA + I_tB + mu D^2)`,
+    /// which is `I_t / 2` for identical halves.
+    pub fn straight_inertia(&self) -> f64 {
+        let (ita, itb) = (self.rear.i_t(), self.front.i_t());
+        let (a, b) = (self.rear.half_length(), self.front.half_length());
+        let (d, mu) = (a + b, self.reduced_mass());
+        itb + mu * b * b - (itb + mu * d * b).powi(2) / (ita + itb + mu * d * d)
     }
 
     /// Rotation of B relative to A, in A's frame.
     pub fn rel_rotation<T: Real>(&self, q: [T; 2]) -> M3<T> {
         match self.joint {
-            Joint::NoTwist => {
-                let v = [q[0], q[1], T::zero()];
-                let (a, b, _) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
-                let h = hat(v);
-                mat_add(
-                    &mat_add(&eye3(), &mat_scale(a, &h)),
-                    &mat_scale(b, &mat_mul(&h, &h)),
-                )
-            }
+            Joint::NoTwist => exp_so3([q[0], q[1], T::zero()]),
             Joint::Universal => mat_mul(&rot_x(q[0]), &rot_y(q[1])),
         }
     }
@@ -127,18 +143,8 @@ impl Cat {
     pub fn rel_rate_jacobian<T: Real>(&self, q: [T; 2]) -> [V3<T>; 2] {
         match self.joint {
             Joint::NoTwist => {
-                // Left Jacobian of SO(3): R_dot R' = hat(J_l(v) v_dot).
-                let v = [q[0], q[1], T::zero()];
-                let (_, b, c) = rodrigues_coefficients(q[0] * q[0] + q[1] * q[1]);
-                let h = hat(v);
-                let jl = mat_add(
-                    &mat_add(&eye3(), &mat_scale(b, &h)),
-                    &mat_scale(c, &mat_mul(&h, &h)),
-                );
-                [
-                    [jl[0][0], jl[1][0], jl[2][0]],
-                    [jl[0][1], jl[1][1], jl[2][1]],
-                ]
+                let jl = left_jacobian_columns([q[0], q[1], T::zero()]);
+                [jl[0], jl[1]]
             }
             Joint::Universal => {
                 let z = T::zero();
@@ -149,29 +155,47 @@ impl Cat {
 
     /// Joint-to-B vector `s` and A-to-B vector `d`, both in A's frame.
     pub fn offsets<T: Real>(&self, rel: &M3<T>) -> (V3<T>, V3<T>) {
-        let half = c::<T>(self.length / 2.0);
-        let s = [rel[0][2] * half, rel[1][2] * half, rel[2][2] * half];
-        let d = [s[0], s[1], s[2] + half];
+        let b = c::<T>(self.front.half_length());
+        let s = [rel[0][2] * b, rel[1][2] * b, rel[2][2] * b];
+        let d = [s[0], s[1], s[2] + c::<T>(self.rear.half_length())];
         (s, d)
     }
 
-    /// Principal inertia of one half in its own frame.
-    pub fn body_inertia<T: Real>(&self) -> M3<T> {
+    /// Principal inertia of a half in its own frame.
+    pub fn body_inertia<T: Real>(half: &Half) -> M3<T> {
         let mut m = zero3();
-        m[0][0] = c(self.i_t());
-        m[1][1] = c(self.i_t());
-        m[2][2] = c(self.i_a());
+        m[0][0] = c(half.i_t());
+        m[1][1] = c(half.i_t());
+        m[2][2] = c(half.i_a());
         m
     }
 
     /// Reduced mass matrix `M(q)` and connection `A(q) = J^-1 K` (body rate `w_A = -A q_dot`).
     pub fn locked_terms<T: Real>(&self, q: [T; 2]) -> ([[T; 2]; 2], [V3<T>; 2]) {
-        let rel = self.rel_rotation(q);
-        let sj = self.rel_rate_jacobian(q);
-        let (s, d) = self.offsets(&rel);
-        let mu = c::<T>(self.mass / 2.0);
-        let ic = self.body_inertia::<T>();
-        let ib = mat_mul(&mat_mul(&rel, &ic), &transpose(&rel));
+        self.locked_terms_of(&self.rel_rotation(q), self.rel_rate_jacobian(q))
+    }
+
+    /// [`Cat::locked_terms`] of the no-twist cat with its twist freed: `v` is the
+    /// full rotation vector of B relative to A (a ball joint), so `M` is 3 x 3.
+    /// At `v3 = 0` its upper-left 2 x 2 block is the no-twist `M`; its third row
+    /// gives the torque that holds the twist at zero.
+    pub fn ball_locked_terms<T: Real>(&self, v: [T; 3]) -> ([[T; 3]; 3], [V3<T>; 3]) {
+        self.locked_terms_of(&exp_so3(v), left_jacobian_columns(v))
+    }
+
+    /// Locked terms for any joint with relative rotation `rel` and rate columns `sj`.
+    fn locked_terms_of<T: Real, const N: usize>(
+        &self,
+        rel: &M3<T>,
+        sj: [V3<T>; N],
+    ) -> ([[T; N]; N], [V3<T>; N]) {
+        let (s, d) = self.offsets(rel);
+        let mu = c::<T>(self.reduced_mass());
+        let ic = Self::body_inertia::<T>(&self.rear);
+        let ib = mat_mul(
+            &mat_mul(rel, &Self::body_inertia::<T>(&self.front)),
+            &transpose(rel),
+        );
         let gram = |a: V3<T>, b: V3<T>| {
             // hat(a)' hat(b) = (a.b) I - b a'
             let mut m = mat_scale(dot(a, b), &eye3());
@@ -186,11 +210,11 @@ impl Cat {
         let j = mat_add(&mat_add(&ic, &ib), &mat_scale(mu, &gram(d, d)));
         let kt = mat_add(&ib, &mat_scale(mu, &gram(d, s)));
         let nt = mat_add(&ib, &mat_scale(mu, &gram(s, s)));
-        let k = [mat_vec(&kt, sj[0]), mat_vec(&kt, sj[1])];
-        let a = [solve3(&j, k[0]), solve3(&j, k[1])];
-        let mut m = [[T::zero(); 2]; 2];
-        for r in 0..2 {
-            for cidx in 0..2 {
+        let k: [V3<T>; N] = std::array::from_fn(|i| mat_vec(&kt, sj[i]));
+        let a: [V3<T>; N] = std::array::from_fn(|i| solve3(&j, k[i]));
+        let mut m = [[T::zero(); N]; N];
+        for r in 0..N {
+            for cidx in 0..N {
                 m[r][cidx] = dot(sj[r], mat_vec(&nt, sj[cidx])) - dot(k[r], a[cidx]);
             }
         }
@@ -206,6 +230,27 @@ impl Cat {
             -(a[0][2] * qd[0] + a[1][2] * qd[1]),
         ]
     }
+}
+
+/// `exp(hat(v))` (Rodrigues).
+fn exp_so3<T: Real>(v: V3<T>) -> M3<T> {
+    let (a, b, _) = rodrigues_coefficients(dot(v, v));
+    let h = hat(v);
+    mat_add(
+        &mat_add(&eye3(), &mat_scale(a, &h)),
+        &mat_scale(b, &mat_mul(&h, &h)),
+    )
+}
+
+/// Columns of the left Jacobian of SO(3): `R_dot R' = hat(J_l(v) v_dot)`.
+fn left_jacobian_columns<T: Real>(v: V3<T>) -> [V3<T>; 3] {
+    let (_, b, c) = rodrigues_coefficients(dot(v, v));
+    let h = hat(v);
+    let jl = mat_add(
+        &mat_add(&eye3(), &mat_scale(b, &h)),
+        &mat_scale(c, &mat_mul(&h, &h)),
+    );
+    [0, 1, 2].map(|k| [jl[0][k], jl[1][k], jl[2][k]])
 }
 
 fn rot_x<T: Real>(a: T) -> M3<T> {
@@ -370,12 +415,49 @@ mod tests {
     use super::*;
 
     pub fn seed_cat(joint: Joint) -> Cat {
-        Cat {
-            mass: 1.0,
-            length: 1.0,
-            radius: 0.1,
+        Cat::symmetric(
+            Half {
+                mass: 1.0,
+                length: 1.0,
+                radius: 0.1,
+                inertia: InertiaFormula::SolidCylinder,
+            },
             joint,
+        )
+    }
+
+    /// A heavy short rear and a light long front.
+    pub fn unequal_cat(joint: Joint) -> Cat {
+        let mut cat = seed_cat(joint);
+        cat.rear = Half {
+            mass: 2.5,
+            length: 0.6,
+            radius: 0.15,
             inertia: InertiaFormula::SolidCylinder,
+        };
+        cat
+    }
+
+    #[test]
+    fn straight_mass_matrix_of_unequal_halves_matches_its_closed_form() {
+        for joint in [Joint::NoTwist, Joint::Universal] {
+            for cat in [unequal_cat(joint), {
+                let c = unequal_cat(joint);
+                Cat {
+                    rear: c.front,
+                    front: c.rear,
+                    joint,
+                }
+            }] {
+                let t = ShapeTerms::second(&cat, [0.0, 0.0]);
+                let m0 = cat.straight_inertia();
+                assert!((t.m[0][0] - m0).abs() < 1e-14 * m0, "{:?} vs {m0}", t.m);
+                assert!((t.m[1][1] - m0).abs() < 1e-14 * m0);
+                assert!(t.m[0][1].abs() < 1e-14 * m0);
+            }
+            // and it reduces to I_t / 2 for identical halves
+            let c = seed_cat(joint);
+            assert!((c.straight_inertia() - c.i_t() / 2.0).abs() < 1e-15);
         }
     }
 

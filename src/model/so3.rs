@@ -11,8 +11,9 @@ pub fn from_na(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     [0, 1, 2].map(|i| [0, 1, 2].map(|j| m[(i, j)]))
 }
 
-/// Flip (signed rotation about the initial spine, `(-pi, pi]`) and tilt
-/// (angle between final and initial spine) of an attitude, both in radians.
+/// Flip (signed rotation about the initial spine, wrapped to `(-pi, pi]`) and
+/// tilt (angle between final and initial spine) of an attitude, both in radians.
+/// A run reports the flip unwrapped along its trajectory: see [`FlipTracker`].
 ///
 /// Swing-twist decomposition `R = swing * Rz(flip)`; the twist angle of a unit
 /// quaternion about z is `2 atan2(q_z, q_w)`.
@@ -21,6 +22,32 @@ pub fn flip_and_tilt(q: &UnitQuaternion<f64>) -> (f64, f64) {
     let spine = q * Vector3::z();
     let tilt = spine.z.clamp(-1.0, 1.0).acos();
     (flip, tilt)
+}
+
+/// The one flip convention of catflip: the rotation about the initial spine,
+/// positive counter-clockwise about A's initial `z` (right-hand rule), unwrapped
+/// along the run so that a turn just past `-pi` reads `-180.x` deg, never `+179.x`.
+///
+/// Feed it every recorded attitude in time order (steps well under half a turn).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FlipTracker {
+    last: f64,
+    acc: f64,
+}
+
+impl FlipTracker {
+    /// Adds the next attitude; returns the unwrapped flip and the tilt, rad.
+    pub fn push(&mut self, q: &UnitQuaternion<f64>) -> (f64, f64) {
+        let (f, tilt) = flip_and_tilt(q);
+        self.acc += wrap(f - self.last);
+        self.last = f;
+        (self.acc, tilt)
+    }
+
+    /// The unwrapped flip so far, rad.
+    pub fn flip(&self) -> f64 {
+        self.acc
+    }
 }
 
 /// Wraps an angle to `(-pi, pi]`.
@@ -121,6 +148,40 @@ mod tests {
         let q = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 0.3);
         let (f, t) = flip_and_tilt(&q);
         assert!(f.abs() < 1e-14 && (t - 0.3).abs() < 1e-12);
+    }
+
+    #[test]
+    fn tracked_flip_past_minus_pi_stays_near_minus_180() {
+        let mut tr = FlipTracker::default();
+        let n = 400;
+        let end = -std::f64::consts::PI - 0.02;
+        let mut last = 0.0;
+        for k in 0..=n {
+            let a = end * k as f64 / n as f64;
+            // a small tilt on the way, as in a real run
+            let q = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), a)
+                * UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 1e-3 * (k as f64).sin());
+            let (f, _) = tr.push(&q);
+            assert!((f - a).abs() < 1e-2, "{f} {a}");
+            last = f;
+        }
+        assert!(
+            (last.to_degrees() + 181.146).abs() < 0.01,
+            "{}",
+            last.to_degrees()
+        );
+        // the wrapped value alone would read +178.85 deg
+        let (w, _) = flip_and_tilt(&UnitQuaternion::from_axis_angle(&Vector3::z_axis(), end));
+        assert!(w > 0.0);
+        // and the same path the other way round mirrors it
+        let mut tr = FlipTracker::default();
+        for k in 0..=n {
+            tr.push(&UnitQuaternion::from_axis_angle(
+                &Vector3::z_axis(),
+                -end * k as f64 / n as f64,
+            ));
+        }
+        assert!((tr.flip() + last).abs() < 1e-9);
     }
 
     #[test]

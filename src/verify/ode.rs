@@ -32,6 +32,8 @@ pub enum OdeStatus {
     Done,
     StepBudget,
     NonFinite,
+    /// `observe` asked to stop (e.g. the state left the model's domain).
+    Stopped,
 }
 
 const A: [[f64; 6]; 6] = [
@@ -76,7 +78,8 @@ const E: [f64; 7] = [
 ];
 
 /// Integrates `y' = f(t, y)` from `t0` to `t1`, calling `observe(t, y)` after
-/// the start and every accepted step, and `project(y)` after every step.
+/// the start and every accepted step (it returns false to stop), and
+/// `project(y)` after every step.
 pub fn integrate<const N: usize>(
     mut f: impl FnMut(f64, &[f64; N]) -> [f64; N],
     mut project: impl FnMut(&mut [f64; N]),
@@ -84,11 +87,13 @@ pub fn integrate<const N: usize>(
     y0: [f64; N],
     t1: f64,
     settings: &OdeSettings,
-    mut observe: impl FnMut(f64, &[f64; N]),
+    mut observe: impl FnMut(f64, &[f64; N]) -> bool,
 ) -> ([f64; N], OdeStatus) {
     let mut t = t0;
     let mut y = y0;
-    observe(t, &y);
+    if !observe(t, &y) {
+        return (y, OdeStatus::Stopped);
+    }
     if t1 <= t0 {
         return (y, OdeStatus::Done);
     }
@@ -133,7 +138,9 @@ pub fn integrate<const N: usize>(
             y = yt;
             project(&mut y);
             k[0] = if y == yt { k[6] } else { f(t, &y) };
-            observe(t, &y);
+            if !observe(t, &y) {
+                return (y, OdeStatus::Stopped);
+            }
         }
         let fac = if err == 0.0 {
             5.0
@@ -163,7 +170,7 @@ mod tests {
             [1.0, 0.0],
             10.0,
             &s,
-            |_, _| {},
+            |_, _| true,
         );
         assert_eq!(st, OdeStatus::Done);
         assert!((y[0] - 10f64.cos()).abs() < 1e-9);
@@ -188,7 +195,7 @@ mod tests {
                 [1.0],
                 2.0,
                 &s,
-                |_, _| {},
+                |_, _| true,
             );
             (y[0] - 2f64.sin().exp()).abs()
         };

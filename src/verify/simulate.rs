@@ -8,11 +8,12 @@
 //! renormalised after each step.
 
 use crate::config::Config;
-use crate::design::plan::ShapePlan;
+use crate::design::plan::{Schedule, ShapePlan};
 use crate::error::{Error, Result};
 use crate::model::dynamics::{angular_momentum, bias, solve2};
-use crate::model::so3::{flip_and_tilt, from_na, normalize_quat, quat_from, quat_rate, wrap};
-use crate::model::{Cat, ShapeTerms, TorqueNorm};
+use crate::model::motor::Motor;
+use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate};
+use crate::model::{Cat, ShapeTerms};
 use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
 
@@ -30,7 +31,8 @@ pub struct TracePoint {
 /// What a simulation reports.
 #[derive(Debug, Clone, Serialize)]
 pub struct SimReport {
-    /// Final rotation about the initial spine, `(-pi, pi]`, degrees.
+    /// Final rotation about the initial spine, unwrapped along the run
+    /// ([`FlipTracker`], the one convention of tables, JSON, figures), degrees.
     pub flip_deg: f64,
     /// `pi - |flip|`, rad.
     pub flip_error_rad: f64,
@@ -50,6 +52,24 @@ pub struct SimReport {
     pub trace: Vec<TracePoint>,
 }
 
+impl SimReport {
+    /// The report of a simulation that failed: every number NaN (null in JSON).
+    pub fn failed() -> SimReport {
+        SimReport {
+            flip_deg: f64::NAN,
+            flip_error_rad: f64::NAN,
+            tilt_deg: f64::NAN,
+            final_shape_error_rad: f64::NAN,
+            final_rate_error_rad_s: f64::NAN,
+            max_tracking_error_rad: f64::NAN,
+            momentum_drift_nms: f64::NAN,
+            peak_torque_nm: f64::NAN,
+            steps: 0,
+            trace: Vec::new(),
+        }
+    }
+}
+
 fn settings(cfg: &Config) -> OdeSettings {
     OdeSettings {
         rtol: cfg.simulate.rtol,
@@ -58,32 +78,79 @@ fn settings(cfg: &Config) -> OdeSettings {
     }
 }
 
-/// Tracks the unwrapped flip angle along a run.
-struct Unwrap {
-    last: f64,
-    acc: f64,
+/// Why a run stopped early, in words that name the cause and the remedy.
+fn failure(
+    status: OdeStatus,
+    trace: &[TracePoint],
+    ode: &OdeSettings,
+    limit: Option<f64>,
+) -> Error {
+    let cause = match limit {
+        Some(l) => format!(
+            "the schedule's torques do not fit this cat, or limits.max_torque = {l} N m holds the motors below what the schedule needs (check the torque units, N m, the config the schedule was designed for, and the limit)"
+        ),
+        None => "the schedule's torques do not fit this cat (check their units, N m, and the config the schedule was designed for)".to_string(),
+    };
+    let last = trace.last();
+    let at = last.map(|p| p.t).unwrap_or(0.0);
+    let peak = trace
+        .iter()
+        .map(|p| p.tau[0].hypot(p.tau[1]))
+        .fold(0.0, f64::max);
+    Error::Simulation(match status {
+        OdeStatus::Stopped
+            if last.is_some_and(|p| p.q.iter().chain(&p.tau).all(|x| x.is_finite())) =>
+        {
+            format!(
+                "the motion diverged at t = {at:.6} s: the shape left the schedule by more than a full turn (applied torque up to {peak:.4e} N m); {cause}"
+            )
+        }
+        OdeStatus::NonFinite | OdeStatus::Stopped => format!(
+            "the motion diverged: the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); {cause}"
+        ),
+        OdeStatus::StepBudget => format!(
+            "the integrator used its {} steps per phase by t = {at:.6} s (applied torque up to {peak:.4e} N m): the motion is too fast or too rough for simulate.rtol = {:e}; a schedule with very many rows or huge torques is the usual cause, and simulate.rtol = 1e-8 may help",
+            ode.max_steps, ode.rtol
+        ),
+        OdeStatus::Done => unreachable!("a finished run is no failure"),
+    })
 }
 
-impl Unwrap {
-    fn push(&mut self, a: f64) -> f64 {
-        self.acc += wrap(a - self.last);
-        self.last = a;
-        self.acc
+/// Tracking error, rad, beyond which the simulated shape has left the
+/// schedule for good: more than a full turn (a saturated motor lags by less).
+const MAX_TRACKING_ERROR: f64 = 2.0 * std::f64::consts::PI;
+
+/// Why a simulated flip misses its target (flip error or spine tilt beyond
+/// `tol`, rad), if it does; NaN counts as a miss.
+pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
+    let mut why = Vec::new();
+    // NaN compares false: a failed number is a miss
+    let beyond = |x: f64| x.is_nan() || x.abs() > tol;
+    if beyond(flip_error_rad) {
+        why.push(format!(
+            "misses the flip by {flip_error_rad:.3e} rad (simulate.flip_tolerance = {tol:e} rad)"
+        ));
     }
+    if beyond(tilt_deg.to_radians()) {
+        why.push(format!(
+            "tilts the spine by {tilt_deg:.3} deg (simulate.flip_tolerance = {tol:e} rad)"
+        ));
+    }
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 fn finish(
-    y_quat: &[f64],
+    flip: f64,
+    tilt: f64,
     trace: Vec<TracePoint>,
     steps: usize,
     status: OdeStatus,
+    ode: &OdeSettings,
+    limit: Option<f64>,
 ) -> Result<SimReport> {
     if status != OdeStatus::Done {
-        return Err(Error::Simulation(format!(
-            "the integrator stopped early ({status:?}); loosen simulate.rtol / simulate.atol or check the schedule"
-        )));
+        return Err(failure(status, &trace, ode, limit));
     }
-    let (flip, tilt) = flip_and_tilt(&quat_from(y_quat));
     Ok(SimReport {
         flip_deg: flip.to_degrees(),
         flip_error_rad: crate::model::so3::flip_error(flip),
@@ -102,7 +169,7 @@ fn finish(
 struct Recorder<'a> {
     cat: &'a Cat,
     trace: Vec<TracePoint>,
-    unwrap: Unwrap,
+    flip: FlipTracker,
     steps: usize,
     drift: f64,
 }
@@ -112,20 +179,18 @@ impl<'a> Recorder<'a> {
         Self {
             cat,
             trace: Vec::new(),
-            unwrap: Unwrap {
-                last: 0.0,
-                acc: 0.0,
-            },
+            flip: FlipTracker::default(),
             steps: 0,
             drift: 0.0,
         }
     }
 
     /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from `q`, `qd`.
-    fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) {
+    /// False when the state is no longer finite (the motion diverged).
+    fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) -> bool {
         self.steps += 1;
         let qa = quat_from(quat);
-        let (f, tilt) = flip_and_tilt(&qa);
+        let (flip, tilt) = self.flip.push(&qa);
         let ra = from_na(qa.to_rotation_matrix().matrix());
         let l = angular_momentum(self.cat, &ra, self.cat.body_rate(q, qd), q, qd);
         self.drift = self
@@ -133,15 +198,27 @@ impl<'a> Recorder<'a> {
             .max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
         self.trace.push(TracePoint {
             t,
-            flip: self.unwrap.push(f),
+            flip,
             tilt,
             q,
             tau,
         });
+        quat.iter()
+            .chain(&q)
+            .chain(&qd)
+            .chain(&tau)
+            .all(|x| x.is_finite())
     }
 
-    fn finish(self, quat: &[f64], status: OdeStatus) -> Result<SimReport> {
-        let mut r = finish(quat, self.trace, self.steps, status)?;
+    fn finish(
+        mut self,
+        quat: &[f64],
+        status: OdeStatus,
+        ode: &OdeSettings,
+        limit: Option<f64>,
+    ) -> Result<SimReport> {
+        let (flip, tilt) = self.flip.push(&quat_from(quat));
+        let mut r = finish(flip, tilt, self.trace, self.steps, status, ode, limit)?;
         r.momentum_drift_nms = self.drift;
         Ok(r)
     }
@@ -154,7 +231,7 @@ fn over_phases<const N: usize>(
     y0: [f64; N],
     ode: &OdeSettings,
     rhs: impl Fn(usize, f64, &[f64; N]) -> [f64; N],
-    mut observe: impl FnMut(usize, f64, &[f64; N]),
+    mut observe: impl FnMut(usize, f64, &[f64; N]) -> bool,
 ) -> ([f64; N], OdeStatus) {
     let b = plan.phase_bounds();
     let mut y = y0;
@@ -192,29 +269,29 @@ pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<S
         },
         |i, t, y| {
             let s = plan.state_in(i, t);
-            rec.record(t, y, s.q, s.qd, [0.0; 2]);
+            rec.record(t, y, s.q, s.qd, [0.0; 2])
         },
     );
-    let mut r = rec.finish(&y, status)?;
+    let mut r = rec.finish(&y, status, ode, None)?;
     let end = plan.state(plan.duration());
     r.final_shape_error_rad = end.q[0].hypot(end.q[1]);
     r.final_rate_error_rad_s = end.qd[0].hypot(end.qd[1]);
     Ok(r)
 }
 
-/// PD tracking and saturation of a position-controlled motor.
+/// PD tracking of the plan, and the motor model: the commanded torque is
+/// clipped to the motor envelope at the current joint speed.
 #[derive(Debug, Clone, Copy)]
 pub struct Controller {
     pub kp: f64,
     pub kd: f64,
-    pub limit: Option<f64>,
-    pub norm: TorqueNorm,
+    pub motor: Motor,
 }
 
 impl Controller {
     /// Gains from the config: natural frequency `2 pi f` about `M(0) = I_t / 2`.
     pub fn from_config(cfg: &Config) -> Controller {
-        let m0 = cfg.cat().i_t() / 2.0;
+        let m0 = cfg.cat().straight_inertia();
         let wn = 2.0 * std::f64::consts::PI * cfg.simulate.pd_bandwidth_hz;
         let (kp, kd) = if cfg.simulate.pd {
             (m0 * wn * wn, 2.0 * cfg.simulate.pd_damping * m0 * wn)
@@ -224,8 +301,7 @@ impl Controller {
         Controller {
             kp,
             kd,
-            limit: cfg.limits.max_torque,
-            norm: cfg.norm(),
+            motor: cfg.motor(),
         }
     }
 
@@ -241,18 +317,7 @@ impl Controller {
         for j in 0..2 {
             tau[j] = ff[j] + self.kp * (q_ref[j] - q[j]) + self.kd * (qd_ref[j] - qd[j]);
         }
-        if let Some(lim) = self.limit {
-            match self.norm {
-                TorqueNorm::PerMotor => tau = tau.map(|x| x.clamp(-lim, lim)),
-                TorqueNorm::Euclidean => {
-                    let n = tau[0].hypot(tau[1]);
-                    if n > lim {
-                        tau = tau.map(|x| x * lim / n);
-                    }
-                }
-            }
-        }
-        tau
+        self.motor.clip(tau, qd)
     }
 }
 
@@ -287,12 +352,14 @@ pub fn dynamic(
         |i, t, y| {
             let (tau, qref) = applied(i, t, y);
             let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
-            peak = peak.max(ctrl.norm.of(tau));
-            track = track.max((q[0] - qref[0]).hypot(q[1] - qref[1]));
-            rec.record(t, y, q, qd, tau);
+            peak = peak.max(ctrl.motor.norm.of(tau));
+            let off = (q[0] - qref[0]).hypot(q[1] - qref[1]);
+            track = track.max(off);
+            // a shape a full turn away from the plan has left the schedule
+            rec.record(t, y, q, qd, tau) && off <= MAX_TRACKING_ERROR
         },
     );
-    let mut r = rec.finish(&y, status)?;
+    let mut r = rec.finish(&y, status, ode, ctrl.motor.max_torque)?;
     r.peak_torque_nm = peak;
     r.max_tracking_error_rad = track;
     r.final_shape_error_rad = y[4].hypot(y[5]);
@@ -313,4 +380,44 @@ pub fn dynamic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
         &Controller::from_config(cfg),
         &settings(cfg),
     )
+}
+
+/// Most rows a schedule file may have. Every row is a kink of the
+/// feed-forward torque that the adaptive integrator must resolve, so the cost
+/// grows with the rows; catflip's own schedules have at most
+/// `3 * (30000 + 1)` rows (`simulate.samples_per_phase` <= 30000).
+pub const MAX_SCHEDULE_ROWS: usize = 100_000;
+
+/// Reads a schedule CSV for replay on `cfg`'s fall: bounded in size, and
+/// lasting as long as the manoeuvre the config leaves (fall time minus margin).
+pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule> {
+    let rows = text.lines().filter(|l| !l.trim().is_empty()).count();
+    if rows > MAX_SCHEDULE_ROWS + 1 {
+        return Err(Error::Schedule {
+            file: origin.into(),
+            line: MAX_SCHEDULE_ROWS + 2,
+            message: format!(
+                "{} rows, more than the {MAX_SCHEDULE_ROWS} a schedule may have; resample it more coarsely (catflip writes 3 * (simulate.samples_per_phase + 1) rows)",
+                rows - 1
+            ),
+        });
+    }
+    let s = Schedule::from_csv(text, origin)?;
+    let b = s.phase_bounds();
+    let (start, end) = (b[0], b[3]);
+    let want = cfg.available_time();
+    let tol = 1e-6 * (1.0 + want);
+    if start.abs() > tol || (end - want).abs() > tol {
+        return Err(Error::Schedule {
+            file: origin.into(),
+            line: s.rows.len() + 1,
+            message: format!(
+                "the schedule runs from t = {start} s to {end} s, but config `{}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then; replay it with the config it was designed for (fall.height, fall.gravity, fall.margin), or design one for this fall with `catflip optimize`",
+                cfg.name,
+                cfg.fall_time(),
+                cfg.fall.margin
+            ),
+        });
+    }
+    Ok(s)
 }

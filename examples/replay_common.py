@@ -1,0 +1,199 @@
+"""Shared parts of replay_mujoco.py and replay_pybullet.py: reading catflip's
+exported controls and summary, rotation helpers, the flip convention, and the
+comparison table. Needs numpy only."""
+
+import argparse
+import json
+import math
+import pathlib
+import sys
+
+import numpy as np
+
+
+def read_controls(path):
+    """Header keys (`# key = value` lines), column names and the rows of a
+    `<method>.<simulator>.csv` written by catflip."""
+    meta, cols, rows = {}, None, []
+    for line in pathlib.Path(path).read_text().splitlines():
+        if line.startswith("#"):
+            if " = " in line:
+                k, v = line[1:].split(" = ", 1)
+                meta[k.strip()] = v.strip()
+        elif cols is None:
+            cols = line.split(",")
+        elif line.strip():
+            rows.append([float(x) for x in line.split(",")])
+    data = np.array(rows)
+    pick = lambda prefix: data[:, [i for i, c in enumerate(cols) if c.startswith(prefix)]]
+    limit = None if meta["max_torque_nm"] == "none" else float(meta["max_torque_nm"])
+    return {
+        "slope": float(meta.get("motor_slope_nm_s", "0")),
+        "dt": float(meta["dt_s"]),
+        "steps": int(meta["steps"]),
+        "kp": float(meta["pd_kp"]),
+        "kd": float(meta["pd_kd"]),
+        "limit": limit,
+        "norm": meta["peak_norm"],
+        "t": data[:, 0],
+        "cols": cols,
+        "data": data,
+        "pick": pick,
+    }
+
+
+# --- rotations (quaternions as w, x, y, z) ---------------------------------
+
+def quat_mul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return np.array([
+        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
+        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
+        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
+    ])
+
+
+def quat_conj(q):
+    return np.array([q[0], -q[1], -q[2], -q[3]])
+
+
+def quat_log(q):
+    """Rotation vector of a unit quaternion (w, x, y, z)."""
+    q = np.asarray(q, float)
+    if q[0] < 0:
+        q = -q
+    s = np.linalg.norm(q[1:])
+    if s < 1e-12:
+        return 2.0 * q[1:]
+    return q[1:] * (2.0 * math.atan2(s, q[0]) / s)
+
+
+def hat(v):
+    return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+
+
+def right_jacobian(v):
+    """J_r(v): exp(v + dv) = exp(v) exp(J_r(v) dv); child-frame rate = J_r(v) v_dot."""
+    t2 = float(v @ v)
+    h = hat(v)
+    if t2 < 1e-8:
+        b, c = 0.5 - t2 / 24.0, 1.0 / 6.0 - t2 / 120.0
+    else:
+        t = math.sqrt(t2)
+        b, c = (1.0 - math.cos(t)) / t2, (t - math.sin(t)) / (t2 * t)
+    return np.eye(3) - b * h + c * h @ h
+
+
+def wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class FlipTracker:
+    """catflip's one flip convention (src/model/so3.rs FlipTracker): rotation
+    about the rear half's initial z axis (the spine), right-handed, from the
+    swing-twist split of the attitude relative to the start, unwrapped along
+    the run. Tilt: angle between the final and the initial spine."""
+
+    def __init__(self, q0):
+        self.q0 = np.asarray(q0, float)
+        self.last = 0.0
+        self.acc = 0.0
+        self.tilt = 0.0
+
+    def push(self, q):
+        r = quat_mul(quat_conj(self.q0), np.asarray(q, float))
+        f = 2.0 * math.atan2(r[3], r[0])
+        self.acc += wrap(f - self.last)
+        self.last = f
+        # spine z after rotation r: third component of R(r) e_z
+        zz = 1.0 - 2.0 * (r[1] ** 2 + r[2] ** 2)
+        self.tilt = math.acos(max(-1.0, min(1.0, zz)))
+        return self.acc
+
+
+def limit_catflip_torque(tau_v, qd, c):
+    """catflip's motor envelope on its two joint torques at joint speed `qd`
+    (src/model/motor.rs Motor::clip): |tau + k qd| <= T per motor, or the disc
+    of radius T about -k qd for the Euclidean norm."""
+    limit, k = c["limit"], c["slope"]
+    if limit is None:
+        return tau_v
+    tau_v = np.array(tau_v, float)
+    centre = -k * np.asarray(qd[:2], float)
+    e = tau_v[:2] - centre
+    if c["norm"] == "per-motor":
+        e = np.clip(e, -limit, limit)
+    else:
+        n = math.hypot(e[0], e[1])
+        if n > limit:
+            e *= limit / n
+    tau_v[:2] = centre + e
+    return tau_v
+
+
+def peak_of(tau_v, norm):
+    return max(abs(tau_v[0]), abs(tau_v[1])) if norm == "per-motor" else math.hypot(tau_v[0], tau_v[1])
+
+
+# --- command line and report -----------------------------------------------
+
+def parse_args(engine, default_tol):
+    p = argparse.ArgumentParser(
+        description=f"Replay catflip's exported schedules in {engine}, feed-forward only and "
+        "feed-forward + PD, and compare with catflip's summary.json."
+    )
+    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run")
+    p.add_argument("--methods", default=None,
+                   help="comma-separated methods (default: all in summary.json)")
+    p.add_argument("--tol-deg", type=float, default=default_tol,
+                   help=f"largest |flip - catflip's flip| of the checked PD replay, deg (default {default_tol})")
+    p.add_argument("--ff-tol-deg", type=float, default=0.05,
+                   help="largest |flip - catflip's flip| of the feed-forward-only replay of an "
+                   "optimised, unsaturated schedule, deg (default 0.05)")
+    return p.parse_args()
+
+
+def load_summary(out):
+    s = json.loads((pathlib.Path(out) / "summary.json").read_text())
+    return s
+
+
+def report(engine, summary, results, flip_tol, ff_tol):
+    """Prints the table; returns the list of failures. `flip_tol` maps a mode to
+    the largest |flip - catflip's| allowed, deg; `ff_tol` (or None) bounds the
+    feed-forward-only flip of optimised, unsaturated schedules."""
+    print(f"{engine} replay of {summary['name']} ({summary['joint']} joint); flip in catflip's convention")
+    print(f"  {'method':<9} {'mode':<5} {'flip deg':>16} {'catflip deg':>16} {'diff deg':>10} {'tilt deg':>10} "
+          f"{'shape err rad':>13} {'peak N m':>10} {'catflip N m':>11}")
+    fails = []
+    for name, mode, r in results:
+        m = next(x for x in summary["methods"] if x["method"] == name)
+        diff = r["flip_deg"] - m["flip_deg"]
+        print(f"  {name:<9} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
+              f"{r['tilt_deg']:10.2e} {r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+        saturating = summary.get("max_torque_nm") is not None and m["peak_torque_nm"] > summary["max_torque_nm"]
+        if mode in flip_tol and abs(diff) > flip_tol[mode]:
+            fails.append(f"{name}: {mode} replay flip differs by {diff:.3e} deg (> {flip_tol[mode]:g})")
+        if mode == "pd":
+            if abs(r["peak_nm"] - m["sim_peak_torque_nm"]) > 0.02 * m["sim_peak_torque_nm"]:
+                fails.append(f"{name}: PD replay peak torque {r['peak_nm']:.5f} vs catflip "
+                             f"{m['sim_peak_torque_nm']:.5f} N m (> 2 %)")
+            if not saturating and r["shape_error_rad"] > 1e-3:
+                fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight")
+        elif mode == "ff" and ff_tol is not None and name != "analytic" and not saturating \
+                and abs(diff) > ff_tol:
+            fails.append(f"{name}: feed-forward replay flip differs by {diff:.3e} deg (> {ff_tol:g})")
+    print("  modes: ff = feed-forward only, pd = feed-forward + catflip's PD. catflip = summary.json: its own\n"
+          "  simulation (feed-forward + PD, the config's torque limit); a saturating schedule is compared\n"
+          "  with that saturated simulation.")
+    return fails
+
+
+def finish(fails):
+    if fails:
+        for f in fails:
+            print("MISMATCH:", f, file=sys.stderr)
+        sys.exit(1)
+    print("  all replays agree with catflip")

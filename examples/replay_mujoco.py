@@ -1,0 +1,133 @@
+#!/usr/bin/env python3
+"""Replay catflip's schedules in MuJoCo, unedited.
+
+    catflip run configs/seed.toml
+    python examples/replay_mujoco.py output/seed/run
+
+Loads output/<name>/run/<name>.mjcf.xml and each output/<name>/run/<method>.mujoco.csv
+as catflip wrote them, steps MuJoCo at the model's time step (the CSV's), and
+holds each row's torque over its step: once feed-forward only, once
+feed-forward plus catflip's PD (gains and torque limit from the CSV header).
+Prints flip, tilt, final shape error and peak torque beside catflip's
+summary.json; exits non-zero on a mismatch. Also checks that the URDF loads in
+MuJoCo (universal joint) with the same masses and inertias.
+Needs: pip install mujoco numpy
+"""
+
+import math
+import pathlib
+
+import mujoco
+import numpy as np
+
+from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
+                           peak_of, quat_log, read_controls, report, right_jacobian)
+
+
+def replay(model, c, pd):
+    """One replay; returns flip, tilt, final shape error and peak catflip-coordinate torque."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    ball = model.jnt_type[1] == mujoco.mjtJoint.mjJNT_BALL
+    qa, va = model.jnt_qposadr[1], model.jnt_dofadr[1]
+    rear = model.body("rear").id
+    tracker = FlipTracker(data.xquat[rear].copy())
+    pos, vel, ff = c["pick"]("qpos"), c["pick"]("qvel"), c["pick"]("ctrl")
+    peak = 0.0
+    for k in range(c["steps"]):
+        if ball:
+            v = quat_log(data.qpos[qa:qa + 4])
+            jr = right_jacobian(v)
+            vd = np.linalg.solve(jr, data.qvel[va:va + 3])
+            v_ref = quat_log(pos[k])
+            vd_ref = np.linalg.solve(right_jacobian(v_ref), vel[k])
+            # catflip's PD acts on the rotation-vector coordinates; the twist v3 is held at 0
+            tau_v = jr.T @ ff[k]
+            if pd:
+                tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
+            tau_v = limit_catflip_torque(tau_v, vd, c)
+            data.ctrl[:] = np.linalg.solve(jr.T, tau_v)
+        else:
+            q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
+            tau_v = ff[k].copy()
+            if pd:
+                tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
+            tau_v = limit_catflip_torque(tau_v, qd, c)
+            data.ctrl[:] = tau_v
+        peak = max(peak, peak_of(tau_v, c["norm"]))
+        mujoco.mj_step(model, data)
+        tracker.push(data.xquat[rear])
+    if ball:
+        shape = np.linalg.norm(quat_log(data.qpos[qa:qa + 4]))
+    else:
+        shape = np.linalg.norm(data.qpos[qa:qa + 2])
+    return {
+        "flip_deg": math.degrees(tracker.acc),
+        "tilt_deg": math.degrees(tracker.tilt),
+        "shape_error_rad": float(shape),
+        "peak_nm": peak,
+    }
+
+
+def check_urdf(out, name, model, controls, mjcf_flips):
+    """The URDF loads in MuJoCo unedited with the MJCF's masses and inertias.
+    MuJoCo fixes a URDF's root link to the world, so to measure the effect of
+    the universal joint's near-massless `cross` link the script then frees the
+    root and adds the two motors in memory, and replays the PD schedules."""
+    path = out / f"{name}.urdf"
+    try:
+        u = mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as e:
+        return [f"{path.name} does not load in MuJoCo: {e}"]
+    fails = []
+    for body in ("rear", "front"):
+        a, b = model.body(body), u.body(body)
+        if abs(a.mass[0] - b.mass[0]) > 1e-9 or np.abs(np.sort(a.inertia) - np.sort(b.inertia)).max() > 1e-9:
+            fails.append(f"{path.name}: body {body} mass/inertia {b.mass}, {b.inertia} differ from the MJCF's {a.mass}, {a.inertia}")
+    print(f"  {path.name} loads in MuJoCo: bodies "
+          + ", ".join(f"{u.body(i).name} {u.body_mass[i]:.6g} kg" for i in range(1, u.nbody)))
+    spec = mujoco.MjSpec.from_file(str(path))
+    spec.body("rear").add_freejoint()
+    for j in ("motor1", "motor2"):
+        spec.add_actuator(name=j, target=j, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    # the rear and front cylinders touch at the joint and are not parent and child here
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    free = spec.compile()
+    for method, c in controls:
+        free.opt.timestep = c["dt"]
+        r = replay(free, c, True)
+        d = r["flip_deg"] - mjcf_flips[method]
+        print(f"  {method}: URDF (with its cross link) freed, PD replay: flip {r['flip_deg']:.9f} deg, "
+              f"{d:+.2e} deg from the MJCF's (the cross link's effect)")
+        if abs(d) > 1e-5:
+            fails.append(f"{method}: the URDF's cross link moves the flip by {d:.3e} deg (> 1e-5)")
+    return fails
+
+
+def main():
+    args = parse_args("MuJoCo", 1e-3)
+    out = pathlib.Path(args.output)
+    summary = load_summary(out)
+    name = summary["name"]
+    model = mujoco.MjModel.from_xml_path(str(out / f"{name}.mjcf.xml"))
+    methods = args.methods.split(",") if args.methods else [m["method"] for m in summary["methods"]]
+    results, fails, controls = [], [], []
+    for method in methods:
+        c = read_controls(out / f"{method}.mujoco.csv")
+        controls.append((method, c))
+        if abs(c["dt"] - model.opt.timestep) > 1e-12 * c["dt"]:
+            # a schedule of another duration (export --schedule): its own step tiles it
+            print(f"  note: {method} uses its CSV's time step {c['dt']:.9e} s (model: {model.opt.timestep:.9e} s)")
+            model.opt.timestep = c["dt"]
+        for mode in ("ff", "pd"):
+            results.append((method, mode, replay(model, c, mode == "pd")))
+    fails += report("MuJoCo", summary, results, {"pd": args.tol_deg}, args.ff_tol_deg)
+    if summary["joint"] == "universal":
+        pd_flips = {m: r["flip_deg"] for m, mode, r in results if mode == "pd"}
+        fails += check_urdf(out, name, model, controls, pd_flips)
+    finish(fails)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,141 @@
+#!/usr/bin/env python3
+"""Replay catflip's schedules in pyBullet, unedited.
+
+    catflip run configs/seed.toml
+    python examples/replay_pybullet.py output/seed/run
+
+Loads output/<name>/run/<name>.urdf with URDF_USE_INERTIA_FROM_FILE (without it
+pyBullet recomputes the inertias from the collision cylinders) and each
+output/<name>/run/<method>.pybullet.csv as catflip wrote them; sets the links'
+damping to zero (pyBullet's default is 0.04), steps at the CSV's time step
+and holds each row's torque over its step: once feed-forward only, once
+feed-forward plus catflip's PD. Prints flip, tilt, final shape error and peak
+torque beside catflip's summary.json; exits non-zero on a mismatch.
+
+pyBullet's integrator is first order (semi-implicit Euler), so its flip
+differs from catflip's by its own integration error: measured against the
+time step: the PD replay runs at the CSV's step and at half of it, and the flip
+extrapolated to zero step must agree with catflip's.
+Needs: pip install pybullet numpy
+"""
+
+import math
+import pathlib
+import sys
+
+import numpy as np
+import pybullet as p
+
+from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
+                           peak_of, quat_log, read_controls, report, right_jacobian)
+
+# pyBullet integrates with semi-implicit Euler: its flip error is first order in
+# the step (1 to 3 deg at catflip's 0.25 ms step on the seed and robot configs,
+# halving with the step; MuJoCo's Euler integrator gives the same numbers). The
+# PD replay at dt and dt/2 measures that error; with it removed (Richardson) the
+# flip must agree with catflip's to this, deg.
+PYBULLET_TOL_DEG = 2e-2
+
+
+def xyzw_to_wxyz(q):
+    return np.array([q[3], q[0], q[1], q[2]])
+
+
+def replay(urdf, c, pd, substeps=1):
+    """One replay; `substeps` > 1 splits each step (same held torque) to measure the integration error."""
+    cid = p.connect(p.DIRECT)
+    try:
+        p.setGravity(0, 0, -9.81, physicsClientId=cid)
+        p.setPhysicsEngineParameter(fixedTimeStep=c["dt"] / substeps, numSubSteps=0,
+                                    physicsClientId=cid)
+        body = p.loadURDF(str(urdf), [0, 0, 10], flags=p.URDF_USE_INERTIA_FROM_FILE,
+                          useFixedBase=False, physicsClientId=cid)
+        for link in range(-1, p.getNumJoints(body, physicsClientId=cid)):
+            p.changeDynamics(body, link, linearDamping=0.0, angularDamping=0.0,
+                             jointDamping=0.0, physicsClientId=cid)
+        joints = [j for j in range(p.getNumJoints(body, physicsClientId=cid))
+                  if p.getJointInfo(body, j, physicsClientId=cid)[2] != p.JOINT_FIXED]
+        ball = p.getJointInfo(body, joints[0], physicsClientId=cid)[2] == p.JOINT_SPHERICAL
+        # switch off the default velocity motors so that torque control is all there is
+        if ball:
+            p.setJointMotorControlMultiDof(body, joints[0], p.POSITION_CONTROL, targetPosition=[0, 0, 0, 1],
+                                           positionGain=0, velocityGain=0, force=[0, 0, 0],
+                                           physicsClientId=cid)
+        else:
+            p.setJointMotorControlArray(body, joints, p.VELOCITY_CONTROL, forces=[0.0] * len(joints),
+                                        physicsClientId=cid)
+        _, q0 = p.getBasePositionAndOrientation(body, physicsClientId=cid)
+        tracker = FlipTracker(xyzw_to_wxyz(q0))
+        pos, vel, ff = c["pick"]("pos"), c["pick"]("vel"), c["pick"]("force")
+        peak = 0.0
+        for k in range(c["steps"]):
+            if ball:
+                st = p.getJointStateMultiDof(body, joints[0], physicsClientId=cid)
+                v = quat_log(xyzw_to_wxyz(st[0]))
+                jr = right_jacobian(v)
+                vd = np.linalg.solve(jr, np.array(st[1]))
+                v_ref = quat_log(xyzw_to_wxyz(pos[k]))
+                vd_ref = np.linalg.solve(right_jacobian(v_ref), vel[k])
+                tau_v = jr.T @ ff[k]
+                if pd:
+                    tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
+                tau_v = limit_catflip_torque(tau_v, vd, c)
+                u = np.linalg.solve(jr.T, tau_v)
+            else:
+                st = p.getJointStates(body, joints, physicsClientId=cid)
+                q = np.array([s[0] for s in st])
+                qd = np.array([s[1] for s in st])
+                tau_v = ff[k].copy()
+                if pd:
+                    tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
+                tau_v = limit_catflip_torque(tau_v, qd, c)
+                u = tau_v
+            peak = max(peak, peak_of(tau_v, c["norm"]))
+            for _ in range(substeps):
+                if ball:
+                    p.setJointMotorControlMultiDof(body, joints[0], p.TORQUE_CONTROL, force=list(u),
+                                                   physicsClientId=cid)
+                else:
+                    p.setJointMotorControlArray(body, joints, p.TORQUE_CONTROL, forces=list(u),
+                                                physicsClientId=cid)
+                p.stepSimulation(physicsClientId=cid)
+                _, qb = p.getBasePositionAndOrientation(body, physicsClientId=cid)
+                tracker.push(xyzw_to_wxyz(qb))
+        if ball:
+            st = p.getJointStateMultiDof(body, joints[0], physicsClientId=cid)
+            shape = np.linalg.norm(quat_log(xyzw_to_wxyz(st[0])))
+        else:
+            shape = np.linalg.norm([s[0] for s in p.getJointStates(body, joints, physicsClientId=cid)])
+        return {
+            "flip_deg": math.degrees(tracker.acc),
+            "tilt_deg": math.degrees(tracker.tilt),
+            "shape_error_rad": float(shape),
+            "peak_nm": peak,
+        }
+    finally:
+        p.disconnect(cid)
+
+
+def main():
+    args = parse_args("pyBullet", PYBULLET_TOL_DEG)
+    out = pathlib.Path(args.output)
+    summary = load_summary(out)
+    urdf = out / f"{summary['name']}.urdf"
+    methods = args.methods.split(",") if args.methods else [m["method"] for m in summary["methods"]]
+    results = []
+    for method in methods:
+        c = read_controls(out / f"{method}.pybullet.csv")
+        results.append((method, "ff", replay(urdf, c, False)))
+        pd = replay(urdf, c, True)
+        half = replay(urdf, c, True, substeps=2)
+        # first-order integrator: error(dt) ~ 2 (flip(dt) - flip(dt/2)); remove it (Richardson)
+        extrapolated = dict(pd, flip_deg=2.0 * half["flip_deg"] - pd["flip_deg"])
+        results += [(method, "pd", pd), (method, "pd/2", half), (method, "pd-x", extrapolated)]
+    fails = report("pyBullet", summary, results, {"pd-x": args.tol_deg}, None)
+    print("  pd/2 = the same rows with two pyBullet steps each (dt/2); pd-x = 2 pd/2 - pd, the flip with\n"
+          "  pyBullet's first-order integration error (2 (pd - pd/2)) removed: that one must agree with catflip.")
+    finish(fails)
+
+
+if __name__ == "__main__":
+    main()

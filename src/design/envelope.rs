@@ -1,0 +1,720 @@
+//! Phased designs inside the motor envelope, for every objective.
+//!
+//! Once the motors have a speed limit or a torque-speed line, time scaling
+//! (F3) no longer separates the phases: a phase cannot simply be sped up. So
+//! the three rest-to-rest phases of one bend go into ONE second-order cone
+//! program in the path-timing variables of [`crate::design::timing`]
+//! (`a = s_ddot` piecewise linear, `beta = s_dot^2`), sharing the time budget
+//! (peak and energy objectives) or minimising the total time (`time`).
+//!
+//! What is exact and what is approximated (all at the grid points and the
+//! interval midpoints):
+//! - torque `tau = m a + c beta` is linear; a torque bound is exact (per motor:
+//!   linear rows; Euclidean: a cone);
+//! - a speed limit `|q'| sqrt(beta) <= w` is `beta <= w^2 / |q'|^2`: linear, exact;
+//! - the torque-speed line `|tau + k q' sqrt(beta)| <= T` is NOT convex in
+//!   `beta` (`sqrt` is concave). Per motor, each side is one row
+//!   `+-tau_i + k q'_i sqrt(beta) (+-) <= T`: where the `sqrt(beta)` term enters
+//!   with a negative sign it is replaced by `c <= sqrt(beta)` (the time
+//!   model's own SOC variable; a lower bound, so conservative); where it enters
+//!   with a positive sign by its tangent at the previous iterate,
+//!   `(beta + beta0) / (2 sqrt(beta0))`, an upper bound of the concave `sqrt`,
+//!   so conservative too. The tangent point is updated until it stops moving
+//!   (a convex-concave procedure: every iterate after the first is inside the
+//!   envelope at the points, and the objective does not increase). For the
+//!   Euclidean disc the tangent enters inside the norm, which is exact at the
+//!   converged point only.
+//! - Between the points the torque is second-order accurate; every written
+//!   row is then checked, and if any leaves the envelope the limits are backed
+//!   off by the excess and the design solved again.
+//! - Energy `integral |tau|^2 / sqrt(beta) ds` is the trapezoid rule over the
+//!   grid points and midpoints with `|tau|^2 <= e c` (a rotated cone) and
+//!   `c <= sqrt(beta)`, the two rest-end half intervals (where the integrand
+//!   is singular) in closed form from rest at constant acceleration; time is the
+//!   timing SOC model's `sum 2 ds / (c_k + c_{k+1})`.
+//!
+//! Units: the program is solved in a time unit `ts` (the fall time or an
+//! estimate) and the torque unit `M(0) / ts^2`, so its data are of order one
+//! whatever the size of the cat.
+
+use crate::config::Config;
+use crate::design::analytic::plan as cosine_plan;
+use crate::design::bend_search::{Scored, scan_then_golden};
+use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::design::objective::Objective;
+use crate::design::path::{GridTiming, Path, PhasedPlan, Timing};
+use crate::design::phased::{BendEvaluation, PhasedResult, bend_range, bend_scan, twist_for};
+use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::timing::path_coefficients;
+use crate::error::{Error, Result};
+use crate::model::motor::{Motor, MotorUse};
+use crate::model::{Cat, TorqueNorm};
+use crate::verify::analyze::{dense_samples, peak_along};
+use crate::verify::simulate::dynamic_cfg;
+use std::time::Instant;
+
+/// A linear expression: `(column, coefficient)` pairs.
+type Expr = Vec<(usize, f64)>;
+
+/// The three-phase timing program of one bend.
+pub struct EnvelopeProblem {
+    /// Grid intervals per phase.
+    pub k: usize,
+    pub motor: Motor,
+    pub objective: Objective,
+    /// Manoeuvre time available, s (`None` for the `time` objective).
+    pub budget: Option<f64>,
+    solver: Option<ConicSolver>,
+}
+
+/// Path data at one point of one phase: `m = M q'`, `c = M q'' + Gamma(q', q')`, `q'`.
+#[derive(Debug, Clone, Copy)]
+struct PointData {
+    m: [f64; 2],
+    c: [f64; 2],
+    dq: [f64; 2],
+}
+
+/// The outcome at one bend.
+#[derive(Debug, Clone)]
+pub struct EnvelopeDesign {
+    pub bend: f64,
+    pub twist: f64,
+    pub timings: Option<[GridTiming; 3]>,
+    /// Phase durations, s.
+    pub durations: [f64; 3],
+    /// The program's objective value in physical units (see [`Objective::unit`]);
+    /// infinite when no timing fits the envelope at this bend.
+    pub value: f64,
+    pub status: SolveStatus,
+    /// Tangent updates of the torque-speed line.
+    pub iterations: usize,
+}
+
+impl Scored for EnvelopeDesign {
+    fn score(&self) -> f64 {
+        self.value
+    }
+}
+
+impl EnvelopeDesign {
+    pub fn plan(&self) -> Option<PhasedPlan> {
+        let t = self.timings.as_ref()?;
+        Some(PhasedPlan {
+            paths: Path::phased(self.bend, self.twist),
+            timings: t.clone().map(Timing::Grid),
+            durations: self.durations,
+        })
+    }
+}
+
+/// Column layout of the program.
+struct Cols {
+    k: usize,
+    per: usize,
+    energy: bool,
+}
+
+impl Cols {
+    fn new(k: usize, objective: Objective) -> Self {
+        let energy = objective == Objective::Energy;
+        let per = (k + 1) * 2 + (2 * k + 1) + k + if energy { 2 * k + 1 } else { 0 };
+        Self { k, per, energy }
+    }
+    fn beta(&self, p: usize, i: usize) -> usize {
+        p * self.per + i
+    }
+    fn a(&self, p: usize, i: usize) -> usize {
+        p * self.per + self.k + 1 + i
+    }
+    /// `c <= sqrt(beta)` at point `j` (grid point `j/2` or a midpoint).
+    fn c(&self, p: usize, j: usize) -> usize {
+        p * self.per + 2 * self.k + 2 + j
+    }
+    fn d(&self, p: usize, i: usize) -> usize {
+        p * self.per + 4 * self.k + 3 + i
+    }
+    /// `e >= |tau|^2 / sqrt(beta)` at point `j`.
+    fn e(&self, p: usize, j: usize) -> usize {
+        debug_assert!(self.energy);
+        p * self.per + 5 * self.k + 3 + j
+    }
+    /// The peak variable (peak objective only).
+    fn t(&self) -> usize {
+        3 * self.per
+    }
+    fn n(&self, objective: Objective) -> usize {
+        3 * self.per + usize::from(objective == Objective::PeakTorque)
+    }
+    fn points(&self) -> usize {
+        2 * self.k + 1
+    }
+    fn ds(&self) -> f64 {
+        1.0 / self.k as f64
+    }
+    /// `beta` at point `j`: exact for the piecewise-quadratic `beta`.
+    fn beta_at(&self, p: usize, j: usize) -> Expr {
+        let i = j / 2;
+        if j.is_multiple_of(2) {
+            vec![(self.beta(p, i), 1.0)]
+        } else {
+            let ds = self.ds();
+            vec![
+                (self.beta(p, i), 1.0),
+                (self.a(p, i), 0.75 * ds),
+                (self.a(p, i + 1), 0.25 * ds),
+            ]
+        }
+    }
+    fn a_at(&self, p: usize, j: usize) -> Expr {
+        let i = j / 2;
+        if j.is_multiple_of(2) {
+            vec![(self.a(p, i), 1.0)]
+        } else {
+            vec![(self.a(p, i), 0.5), (self.a(p, i + 1), 0.5)]
+        }
+    }
+}
+
+fn scaled(e: &Expr, s: f64) -> Expr {
+    e.iter().map(|&(c, v)| (c, v * s)).collect()
+}
+
+fn plus(mut a: Expr, b: Expr) -> Expr {
+    a.extend(b);
+    a
+}
+
+/// `(beta, a)` of one phase at its grid points, from a solution vector.
+fn grid_values(cols: &Cols, x: &[f64], p: usize) -> (Vec<f64>, Vec<f64>) {
+    let beta = (0..=cols.k).map(|i| x[cols.beta(p, i)].max(0.0)).collect();
+    let a = (0..=cols.k).map(|i| x[cols.a(p, i)]).collect();
+    (beta, a)
+}
+
+/// `beta` at every point of one phase from a solution vector.
+fn point_betas(cols: &Cols, x: &[f64], p: usize) -> Vec<f64> {
+    (0..cols.points())
+        .map(|j| {
+            cols.beta_at(p, j)
+                .iter()
+                .map(|&(c, v)| v * x[c])
+                .sum::<f64>()
+                .max(0.0)
+        })
+        .collect()
+}
+
+/// Limits and units of one build.
+#[derive(Debug, Clone, Copy)]
+struct Scaled {
+    /// Stall torque in torque units.
+    torque: Option<f64>,
+    /// Speed limit in 1/ts.
+    speed: Option<f64>,
+    /// Torque-speed slope in torque units per (1/ts).
+    slope: f64,
+    /// Budget in ts.
+    budget: Option<f64>,
+}
+
+impl EnvelopeProblem {
+    pub fn new(k: usize, motor: Motor, objective: Objective, budget: Option<f64>) -> Self {
+        Self {
+            k,
+            motor,
+            objective,
+            budget,
+            solver: None,
+        }
+    }
+
+    fn build(&self, data: &[Vec<PointData>; 3], lim: &Scaled, beta0: &[Vec<f64>; 3]) -> ConicData {
+        let cols = Cols::new(self.k, self.objective);
+        let (k, ds, np) = (self.k, cols.ds(), cols.points());
+        let mut d = ConicData::new(cols.n(self.objective));
+        match self.objective {
+            Objective::PeakTorque => d.q[cols.t()] = 1.0,
+            Objective::Time => {
+                for p in 0..3 {
+                    for i in 0..k {
+                        d.q[cols.d(p, i)] = 2.0 * ds;
+                    }
+                }
+            }
+            Objective::Energy => {
+                // trapezoid on the half grid between the first and last
+                // midpoints; each rest-end half interval (where the integrand
+                // has a 1/sqrt(s) singularity) from rest at constant
+                // acceleration: it lasts ds / c_1, so its energy is
+                // ds |tau_0|^2 / c_1
+                for p in 0..3 {
+                    for j in 0..np {
+                        d.q[cols.e(p, j)] = if j == 0 || j == np - 1 {
+                            ds
+                        } else if j == 1 || j == np - 2 {
+                            ds / 4.0
+                        } else {
+                            ds / 2.0
+                        };
+                    }
+                }
+            }
+        }
+        let torque = |p: usize, j: usize, comp: usize| -> Expr {
+            let pd = &data[p][j];
+            plus(
+                scaled(&cols.a_at(p, j), pd.m[comp]),
+                scaled(&cols.beta_at(p, j), pd.c[comp]),
+            )
+        };
+        // rest to rest, beta' = 2 a
+        for p in 0..3 {
+            d.row(&[(cols.beta(p, 0), 1.0)], 0.0);
+            d.row(&[(cols.beta(p, k), 1.0)], 0.0);
+            for i in 0..k {
+                d.row(
+                    &[
+                        (cols.beta(p, i + 1), 1.0),
+                        (cols.beta(p, i), -1.0),
+                        (cols.a(p, i), -ds),
+                        (cols.a(p, i + 1), -ds),
+                    ],
+                    0.0,
+                );
+            }
+        }
+        d.cone(Cone::Zero(3 * (k + 2)));
+        // linear inequalities
+        let mut rows = 0;
+        if let Some(b) = lim.budget {
+            let row: Expr = (0..3)
+                .flat_map(|p| (0..k).map(move |i| (p, i)))
+                .map(|(p, i)| (cols.d(p, i), 2.0 * ds))
+                .collect();
+            d.row(&row, b);
+            rows += 1;
+        }
+        let per_motor = self.motor.norm == TorqueNorm::PerMotor;
+        for p in 0..3 {
+            for j in 0..np {
+                let pd = &data[p][j];
+                if let Some(w) = lim.speed {
+                    // |q'| sqrt(beta) <= w, with |q'| in the motor norm
+                    let g = self.motor.norm.of(pd.dq);
+                    if g > 1e-9 {
+                        d.row(&cols.beta_at(p, j), (w / g).powi(2));
+                    } else {
+                        d.row(&scaled(&cols.beta_at(p, j), 0.0), 1.0);
+                    }
+                    rows += 1;
+                }
+                if !per_motor {
+                    continue;
+                }
+                for comp in 0..2 {
+                    let tau = torque(p, j, comp);
+                    for sign in [1.0, -1.0] {
+                        let mut row = scaled(&tau, sign);
+                        let mut rhs = 0.0;
+                        if self.objective == Objective::PeakTorque {
+                            row.push((cols.t(), -1.0));
+                            d.row(&row, 0.0);
+                            rows += 1;
+                            row = scaled(&tau, sign);
+                        }
+                        let Some(t) = lim.torque else { continue };
+                        // sign * (tau + k q' sqrt(beta)) <= T
+                        let g = sign * lim.slope * pd.dq[comp];
+                        let (cc, bb) = if g <= 0.0 {
+                            (g, 0.0)
+                        } else {
+                            let b = beta0[p][j].max(1e-8);
+                            rhs = -g * b.sqrt() / 2.0;
+                            (0.0, g / (2.0 * b.sqrt()))
+                        };
+                        row.push((cols.c(p, j), cc));
+                        row.extend(scaled(&cols.beta_at(p, j), bb));
+                        d.row(&row, t + rhs);
+                        rows += 1;
+                    }
+                }
+            }
+        }
+        d.cone(Cone::Nonneg(rows));
+        // cones
+        for p in 0..3 {
+            for j in 0..np {
+                let pd = &data[p][j];
+                if !per_motor {
+                    let tau = [torque(p, j, 0), torque(p, j, 1)];
+                    if self.objective == Objective::PeakTorque {
+                        d.row(&[(cols.t(), -1.0)], 0.0);
+                        for t in &tau {
+                            d.row(&scaled(t, -1.0), 0.0);
+                        }
+                        d.cone(Cone::Soc(3));
+                    }
+                    if let Some(t) = lim.torque {
+                        // |tau + k q' L(beta)| <= T with L the tangent of sqrt
+                        d.row(&[], t);
+                        for comp in 0..2 {
+                            let g = lim.slope * pd.dq[comp];
+                            let b = beta0[p][j].max(1e-8);
+                            let (bb, rhs) = (g / (2.0 * b.sqrt()), g * b.sqrt() / 2.0);
+                            let row =
+                                plus(scaled(&tau[comp], -1.0), scaled(&cols.beta_at(p, j), -bb));
+                            d.row(&row, rhs);
+                        }
+                        d.cone(Cone::Soc(3));
+                    }
+                }
+                // c <= sqrt(beta): ||(2 c, beta - 1)|| <= beta + 1
+                let b = cols.beta_at(p, j);
+                d.row(&scaled(&b, -1.0), 1.0);
+                d.row(&[(cols.c(p, j), -2.0)], 0.0);
+                d.row(&scaled(&b, -1.0), -1.0);
+                d.cone(Cone::Soc(3));
+            }
+            // d_i (c_i + c_{i+1}) >= 1 on the grid points: ||(2, d - u)|| <= d + u
+            for i in 0..k {
+                let (c0, c1, dd) = (cols.c(p, 2 * i), cols.c(p, 2 * i + 2), cols.d(p, i));
+                d.row(&[(dd, -1.0), (c0, -1.0), (c1, -1.0)], 0.0);
+                d.row(&[], 2.0);
+                d.row(&[(dd, -1.0), (c0, 1.0), (c1, 1.0)], 0.0);
+                d.cone(Cone::Soc(3));
+            }
+            if cols.energy {
+                // |tau|^2 <= e c: ||(2 tau, e - c)|| <= e + c; the rest ends use
+                // their neighbour's c (see the objective)
+                for j in 0..np {
+                    let jc = j.clamp(1, np - 2);
+                    let (e, c) = (cols.e(p, j), cols.c(p, jc));
+                    d.row(&[(e, -1.0), (c, -1.0)], 0.0);
+                    for comp in 0..2 {
+                        d.row(&scaled(&torque(p, j, comp), -2.0), 0.0);
+                    }
+                    d.row(&[(e, -1.0), (c, 1.0)], 0.0);
+                    d.cone(Cone::Soc(4));
+                }
+            }
+        }
+        d
+    }
+
+    /// Designs the timing of the three paths of a bend; `shrink` (<= 1)
+    /// tightens the torque and speed limits (the back-off of the dense check).
+    pub fn solve(
+        &mut self,
+        cat: &Cat,
+        bend: f64,
+        twist: f64,
+        shrink: f64,
+    ) -> Result<EnvelopeDesign> {
+        let paths = Path::phased(bend, twist);
+        let cols = Cols::new(self.k, self.objective);
+        let m0 = cat.straight_inertia();
+        // time unit: the budget, or the time to sweep the bend at the speed or
+        // torque limit, whichever is slower
+        let ts = self.budget.unwrap_or_else(|| {
+            let len = bend * (2.0 + twist.abs());
+            let by_speed = self.motor.max_speed.map_or(0.0, |w| len / w);
+            let by_torque = self.motor.max_torque.map_or(0.0, |t| (m0 * len / t).sqrt());
+            by_speed.max(by_torque).max(1e-6)
+        });
+        let nu = m0 / (ts * ts);
+        let lim = Scaled {
+            torque: self.motor.max_torque.map(|t| shrink * t / nu),
+            speed: self.motor.max_speed.map(|w| shrink * w * ts),
+            slope: self.motor.slope() / (ts * nu),
+            budget: self.budget.map(|b| b / ts),
+        };
+        if self.objective == Objective::Time && lim.torque.is_none() && lim.speed.is_none() {
+            return Err(Error::Invalid {
+                key: "design.objective".into(),
+                value: "\"time\"".into(),
+                expected:
+                    "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
+                        .into(),
+            });
+        }
+        let data: [Vec<PointData>; 3] = paths.each_ref().map(|path| {
+            (0..cols.points())
+                .map(|j| {
+                    let s = j as f64 * cols.ds() / 2.0;
+                    let (m, c) = path_coefficients(cat, path, s);
+                    PointData {
+                        m: m.map(|x| x / m0),
+                        c: c.map(|x| x / m0),
+                        dq: path.eval(s)[1],
+                    }
+                })
+                .collect()
+        });
+        let tangents = lim.torque.is_some() && lim.slope > 0.0;
+        // first tangent of sqrt(beta) where the path runs at the no-load
+        // speed: beyond it a motor can only brake, so this is where the line
+        // matters, and the first program is already conservative
+        let no_load = lim.torque.unwrap_or(0.0) / lim.slope.max(1e-300);
+        let mut beta0: [Vec<f64>; 3] = data.each_ref().map(|pts| {
+            pts.iter()
+                .map(|pd| {
+                    (no_load / self.motor.norm.of(pd.dq).max(1e-9))
+                        .powi(2)
+                        .min(1e12)
+                })
+                .collect()
+        });
+        let mut out: Option<(SolveStatus, Vec<f64>, f64)> = None;
+        let mut iterations = 0;
+        for it in 0..40 {
+            let prob = self.build(&data, &lim, &beta0);
+            let (status, x, obj) = solve_reusing(&mut self.solver, &prob)?;
+            iterations = it;
+            if !status.ok() {
+                if out.is_none() {
+                    return Ok(EnvelopeDesign {
+                        bend,
+                        twist,
+                        timings: None,
+                        durations: [f64::NAN; 3],
+                        value: f64::INFINITY,
+                        status,
+                        iterations,
+                    });
+                }
+                break;
+            }
+            let prev = out.as_ref().map_or(f64::INFINITY, |o| o.2);
+            out = Some((status, x, obj));
+            if !tangents || (prev - obj).abs() <= 1e-5 * obj.abs() {
+                break;
+            }
+            let x = &out.as_ref().unwrap().1;
+            beta0 = [0, 1, 2].map(|p| point_betas(&cols, x, p));
+        }
+        let (status, x, obj) = out.expect("a solved iterate");
+        let timings = [0, 1, 2].map(|p| {
+            let (beta, a) = grid_values(&cols, &x, p);
+            let s = (0..=cols.k).map(|i| i as f64 * cols.ds()).collect();
+            let mut beta = beta;
+            beta[0] = 0.0;
+            beta[cols.k] = 0.0;
+            GridTiming::new(s, beta, a)
+        });
+        let durations = timings.each_ref().map(|g| g.raw_time * ts);
+        let value = match self.objective {
+            Objective::PeakTorque => obj * nu,
+            Objective::Time => durations.iter().sum(),
+            Objective::Energy => obj * nu * nu * ts,
+        };
+        Ok(EnvelopeDesign {
+            bend,
+            twist,
+            timings: Some(timings),
+            durations,
+            value,
+            status,
+            iterations,
+        })
+    }
+}
+
+/// Designs at one bend, the twist chosen to flip by pi.
+pub fn design_at(
+    cat: &Cat,
+    problem: &mut EnvelopeProblem,
+    bend: f64,
+    shrink: f64,
+) -> Result<EnvelopeDesign> {
+    let twist = twist_for(cat, bend)?;
+    problem.solve(cat, bend, twist, shrink)
+}
+
+/// Bend search for the best design inside the envelope over `[lo, hi]` rad.
+pub fn search(
+    cat: &Cat,
+    problem: &mut EnvelopeProblem,
+    scan: Vec<f64>,
+    tol: f64,
+    mut observe: impl FnMut(&EnvelopeDesign),
+) -> Result<EnvelopeDesign> {
+    scan_then_golden(scan, tol, |b| {
+        let d = design_at(cat, problem, b, 1.0)?;
+        observe(&d);
+        Ok(d)
+    })
+}
+
+/// The motor usage of a plan at the rows a schedule would carry.
+pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
+    let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+    cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
+}
+
+/// `integral |tau|^2 dt` along a plan (trapezoid on `per_phase` samples a phase), N^2 m^2 s.
+pub fn torque_squared_integral(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize) -> f64 {
+    let b = plan.phase_bounds();
+    let mut sum = 0.0;
+    for i in 0..3 {
+        let h = (b[i + 1] - b[i]) / per_phase as f64;
+        for k in 0..=per_phase {
+            let tau = plan.torque_in(cat, i, b[i] + h * k as f64);
+            let w = if k == 0 || k == per_phase { 0.5 } else { 1.0 };
+            sum += w * h * (tau[0] * tau[0] + tau[1] * tau[1]);
+        }
+    }
+    sum
+}
+
+/// Least drop height for a manoeuvre of `time` seconds, m.
+pub fn height_for(cfg: &Config, time: f64) -> f64 {
+    0.5 * cfg.fall.gravity * (time + cfg.fall.margin).powi(2)
+}
+
+/// Solves at `bend` and makes the result exact where the program is not:
+/// the budget it is given is corrected until the reconstructed (integrated)
+/// time equals the fall's, and the limits are backed off until every
+/// schedule row is inside the envelope. `None` when nothing fits.
+fn verified_design(
+    cfg: &Config,
+    problem: &mut EnvelopeProblem,
+    bend: f64,
+) -> Result<Option<(EnvelopeDesign, PhasedPlan)>> {
+    let cat = cfg.cat();
+    let budget = problem.budget;
+    let mut shrink = 1.0;
+    for _ in 0..12 {
+        let d = design_at(&cat, problem, bend, shrink)?;
+        let Some(mut plan) = d.plan() else {
+            problem.budget = budget;
+            return Ok(None);
+        };
+        let mut on_time = true;
+        if let (Some(want), Some(given)) = (budget, problem.budget) {
+            let total: f64 = plan.durations.iter().sum();
+            let ratio = want / total;
+            on_time = (ratio - 1.0).abs() < 1e-4;
+            problem.budget = Some(given * ratio);
+            plan.durations = plan.durations.map(|x| x * ratio);
+        }
+        let margin = usage_of(cfg, &plan).min_margin.unwrap_or(1.0);
+        if margin < -1e-7 {
+            shrink *= 1.0 + 1.2 * margin;
+        } else if on_time {
+            problem.budget = budget;
+            return Ok(Some((d, plan)));
+        }
+    }
+    problem.budget = budget;
+    Ok(None)
+}
+
+/// The phased optimiser inside the motor envelope, for `design.objective`.
+pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    let start = Instant::now();
+    let cat = cfg.cat();
+    let objective = cfg.design.objective;
+    let budget = (objective != Objective::Time).then(|| cfg.available_time());
+    let (lo, hi) = bend_range(cfg)?;
+    let mut evals = Vec::new();
+    // the bend is searched on a half-resolution grid (the optimum moves at
+    // second order with the grid), the final design at full resolution
+    let mut coarse = EnvelopeProblem::new(
+        (cfg.phased.nodes / 2).max(8),
+        cfg.motor(),
+        objective,
+        budget,
+    );
+    let mut problem = EnvelopeProblem::new(cfg.phased.nodes, cfg.motor(), objective, budget);
+    let best = search(
+        &cat,
+        &mut coarse,
+        bend_scan(cfg, lo, hi),
+        cfg.phased.bend_tol_deg.to_radians(),
+        |d| {
+            let e = BendEvaluation {
+                bend_deg: d.bend.to_degrees(),
+                value: d.value,
+                unit_peak: f64::NAN,
+                peak_nm: if objective == Objective::PeakTorque {
+                    d.value
+                } else {
+                    f64::NAN
+                },
+            };
+            observe(&e);
+            evals.push(e);
+        },
+    )?;
+    let found = if best.value.is_finite() {
+        verified_design(cfg, &mut problem, best.bend)?
+    } else {
+        None
+    };
+    let Some((design, plan)) = found else {
+        return Err(unreachable_here(cfg));
+    };
+    let solve_time = start.elapsed().as_secs_f64();
+    let time: f64 = plan.durations.iter().sum();
+    let (peak, _) = peak_along(cfg, &plan, dense_samples(cfg));
+    let value = match objective {
+        Objective::PeakTorque => peak,
+        Objective::Time => time,
+        Objective::Energy => torque_squared_integral(&cat, &plan, dense_samples(cfg)),
+    };
+    let split = cfg.analytic.split.map(|f| f * time);
+    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);
+    let sim = dynamic_cfg(cfg, &plan)?;
+    Ok(PhasedResult {
+        mode: "phased",
+        status: design.status,
+        objective,
+        objective_value: value,
+        manoeuvre_time_s: time,
+        peak_torque_nm: peak,
+        socp_peak_torque_nm: f64::NAN,
+        unit_peak_nm_s2: peak * time * time,
+        bend_deg: design.bend.to_degrees(),
+        theta_deg: 180.0 - design.bend.to_degrees(),
+        twist_rad: design.twist,
+        phase_durations_s: plan.durations,
+        phase_unit_peaks_nm_s2: [f64::NAN; 3],
+        analytic_peak_same_bend_nm: analytic_peak,
+        optimum_same_split_nm: f64::NAN,
+        improvement_factor: analytic_peak / peak,
+        flip_deg: sim.flip_deg,
+        flip_error_rad: sim.flip_error_rad,
+        tilt_deg: sim.tilt_deg,
+        sim_peak_torque_nm: sim.peak_torque_nm,
+        momentum_drift_nms: sim.momentum_drift_nms,
+        nodes: cfg.phased.nodes,
+        evaluations: evals,
+        solve_time_s: solve_time,
+        plan,
+        design: None,
+        sim: Some(sim),
+    })
+}
+
+/// The error when nothing fits the envelope in the fall: it names the least
+/// drop height (the `time` design) when that can be found.
+fn unreachable_here(cfg: &Config) -> Error {
+    let mut timed = cfg.clone();
+    timed.design.objective = Objective::Time;
+    let least = (cfg.design.objective != Objective::Time)
+        .then(|| optimize(&timed, |_| {}).ok())
+        .flatten()
+        .map(|r| height_for(cfg, r.manoeuvre_time_s));
+    Error::Unreachable {
+        reason: match least {
+            Some(h) => format!(
+                "no {} schedule fits the motor envelope (limits.max_torque, no_load_speed, max_speed) in the {:.4} s fall from {} m; drop the cat from at least {h:.3} m (fall.height) or use stronger or faster motors",
+                cfg.design.objective.name(),
+                cfg.available_time(),
+                cfg.fall.height
+            ),
+            None => "no phased schedule fits the motor envelope at any bend; widen phased.bend_min_deg / bend_max_deg or relax the limits".into(),
+        },
+    }
+}

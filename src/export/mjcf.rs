@@ -1,0 +1,103 @@
+//! The cat as an MJCF model for MuJoCo.
+
+use super::controls::{Simulator, time_step};
+use super::{Half, f, halves, torque_limit};
+use crate::config::Config;
+use crate::model::Joint;
+
+/// `<inertial>` and `<geom>` of one half whose centre of mass is at `z` on its own axis.
+fn body_parts(h: &Half, z: f64) -> String {
+    format!(
+        "      <inertial pos=\"0 0 {z}\" mass=\"{m}\" diaginertia=\"{it} {it} {ia}\"/>\n      <geom type=\"cylinder\" size=\"{r} {hl}\" pos=\"0 0 {z}\" mass=\"0\"/>\n",
+        z = f(z),
+        m = f(h.mass),
+        it = f(h.i_t()),
+        ia = f(h.i_a()),
+        r = f(h.radius),
+        hl = f(h.length / 2.0),
+    )
+}
+
+/// The motor envelope in words, for the model files' header comments.
+pub(crate) fn motor_note(cfg: &Config) -> String {
+    let m = cfg.motor();
+    let mut s = String::new();
+    if let Some(t) = m.max_torque {
+        s.push_str(&format!("\n     Motor: stall torque {t} N m"));
+        if m.slope() > 0.0 {
+            s.push_str(&format!(
+                ", torque-speed line |tau + {k} w| <= {t} (not expressible here: apply it to the command)",
+                k = m.slope()
+            ));
+        }
+        s.push('.');
+    }
+    if let Some(w) = super::speed_limit(cfg) {
+        s.push_str(&format!("\n     Joint speed limit {w} rad/s."));
+    }
+    s
+}
+
+/// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
+///
+/// The time step tiles the config's manoeuvre time (at most 0.5 ms), the step
+/// of the `*.mujoco.csv` controls. The torque limit becomes `ctrlrange` and
+/// `forcerange` of every motor (unless a torque-speed line makes it speed
+/// dependent, which MJCF motors cannot say; the header comment then states it).
+pub fn mjcf(cfg: &Config) -> String {
+    let [rear, front] = halves(cfg);
+    let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
+    // A box on the torque is exact only without a torque-speed line; with one
+    // (|tau + k w| <= T) the replay clips to the envelope itself.
+    let limit = torque_limit(cfg)
+        .filter(|_| cfg.motor().slope() == 0.0)
+        .map(|l| {
+            format!(
+                " ctrllimited=\"true\" ctrlrange=\"{a} {b}\" forcelimited=\"true\" forcerange=\"{a} {b}\"",
+                a = f(-l),
+                b = f(l)
+            )
+        })
+        .unwrap_or_default();
+    let (joints, actuators) = match cfg.cat.joint {
+        Joint::Universal => (
+            "      <!-- universal joint: motor1 about the rear's x, then motor2 about the rotated y -->\n      <joint name=\"motor1\" type=\"hinge\" axis=\"1 0 0\"/>\n      <joint name=\"motor2\" type=\"hinge\" axis=\"0 1 0\"/>\n".to_string(),
+            format!(
+                "    <motor name=\"tau1\" joint=\"motor1\" gear=\"1\"{limit}/>\n    <motor name=\"tau2\" joint=\"motor2\" gear=\"1\"{limit}/>\n"
+            ),
+        ),
+        Joint::NoTwist => (
+            "      <!-- Kane & Scher no-twist joint as a ball: qpos is the quaternion of exp(hat(q1, q2, 0)),\n           qvel the relative rate in this (front) body's frame; the twist is held by the third motor -->\n      <joint name=\"spine\" type=\"ball\"/>\n".to_string(),
+            format!(
+                "    <!-- torques about the front half's own axes: ctrl = J_r(v)^-T (tau1, tau2, tau3), see *.mujoco.csv -->\n    <motor name=\"tau_x\" joint=\"spine\" gear=\"1 0 0\"{limit}/>\n    <motor name=\"tau_y\" joint=\"spine\" gear=\"0 1 0\"{limit}/>\n    <motor name=\"tau_z\" joint=\"spine\" gear=\"0 0 1\"{limit}/>\n"
+            ),
+        ),
+    };
+    format!(
+        r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);
+     SI units, angles in rad. Time step {dt:.9e} s = the manoeuvre time / an integer, the
+     step of catflip's *.mujoco.csv controls (torque held over each step).{motor_note} -->
+<mujoco model="{name}">
+  <option gravity="0 0 -{g}" timestep="{dt:.15e}" integrator="RK4"/>
+  <worldbody>
+    <!-- spine (the rear half's z axis) horizontal along world x; rotate about it to set the initial roll -->
+    <body name="rear" pos="0 0 {height}" euler="0 90 0">
+      <freejoint name="fall"/>
+{rear_parts}      <body name="front" pos="0 0 {joint_z}">
+{joints}{front_parts}      </body>
+    </body>
+  </worldbody>
+  <actuator>
+{actuators}  </actuator>
+</mujoco>
+"#,
+        name = cfg.name,
+        joint = cfg.cat.joint.name(),
+        g = f(cfg.fall.gravity),
+        height = f(cfg.fall.height),
+        joint_z = f(rear.length / 2.0),
+        motor_note = motor_note(cfg),
+        rear_parts = body_parts(&rear, 0.0),
+        front_parts = body_parts(&front, front.length / 2.0),
+    )
+}

@@ -1,0 +1,134 @@
+//! Phased designs inside the motor envelope (design/envelope.rs) against
+//! F7, time scaling, the unit-time peak program, and the motor model.
+
+use catflip::Config;
+use catflip::design::envelope::{height_for, torque_squared_integral, usage_of};
+use catflip::design::phased::optimize;
+use catflip::design::plan::Schedule;
+
+fn seed(overrides: &[&str]) -> Config {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
+    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Config::from_toml(&text, "seed.toml", &ov).unwrap()
+}
+
+#[test]
+fn time_with_a_torque_limit_alone_is_f7() {
+    // F7: T_min = sqrt(P / tau_max) with P the unit-time optimum of the peak design
+    let tau_max = 0.8;
+    let peak = optimize(&seed(&[]), |_| {}).unwrap();
+    let t_f7 = (peak.unit_peak_nm_s2 / tau_max).sqrt();
+    let timed = optimize(
+        &seed(&[
+            "design.objective=time",
+            &format!("limits.max_torque={tau_max}"),
+        ]),
+        |_| {},
+    )
+    .unwrap();
+    let rel = (timed.manoeuvre_time_s - t_f7).abs() / t_f7;
+    assert!(rel < 5e-3, "time {} vs F7 {t_f7}", timed.manoeuvre_time_s);
+    let cfg = seed(&[]);
+    let (h, h_f7) = (
+        height_for(&cfg, timed.manoeuvre_time_s),
+        0.5 * cfg.fall.gravity * t_f7 * t_f7,
+    );
+    assert!((h - h_f7).abs() < 1e-2 * h_f7, "{h} vs {h_f7}");
+    assert!(timed.peak_torque_nm <= tau_max * (1.0 + 1e-6));
+}
+
+#[test]
+fn time_with_a_speed_limit_alone_scales_as_one_over_the_limit() {
+    let t = |w: f64| {
+        optimize(
+            &seed(&["design.objective=time", &format!("limits.max_speed={w}")]),
+            |_| {},
+        )
+        .unwrap()
+        .manoeuvre_time_s
+    };
+    let (a, b) = (t(1.5), t(4.5));
+    assert!((a / b - 3.0).abs() < 1e-4, "{a} / {b} = {}", a / b);
+}
+
+#[test]
+fn envelope_path_with_no_binding_limit_matches_the_unit_time_peak_program() {
+    // a speed limit far above anything the design reaches sends the design
+    // through the three-phase envelope program; its optimum must be the
+    // unit-time program's (two formulations of the same optimum)
+    let plain = optimize(&seed(&[]), |_| {}).unwrap();
+    let env = optimize(&seed(&["limits.max_speed=1000"]), |_| {}).unwrap();
+    let rel = (env.peak_torque_nm - plain.peak_torque_nm).abs() / plain.peak_torque_nm;
+    assert!(
+        rel < 3e-3,
+        "envelope {} vs unit-time {}",
+        env.peak_torque_nm,
+        plain.peak_torque_nm
+    );
+}
+
+#[test]
+fn every_row_inside_the_envelope_and_the_motor_model_flips() {
+    let limits = [
+        "limits.max_torque=1",
+        "limits.no_load_speed=3",
+        "fall.height=30",
+        "phased.nodes=24",
+    ];
+    let mut results = Vec::new();
+    for (objective, norm) in [
+        ("time", "euclidean"),
+        ("time", "per-motor"),
+        ("peak-torque", "euclidean"),
+        ("energy", "per-motor"),
+    ] {
+        let mut ov = limits.to_vec();
+        let (o, n) = (
+            format!("design.objective={objective}"),
+            format!("limits.norm={norm}"),
+        );
+        ov.push(&o);
+        ov.push(&n);
+        let cfg = seed(&ov);
+        let r = optimize(&cfg, |_| {}).unwrap();
+        let u = usage_of(&cfg, &r.plan);
+        assert!(
+            u.min_margin.unwrap() >= -1e-6,
+            "{objective} {norm}: margin {:?}",
+            u.min_margin
+        );
+        // the motor model (torque clipped to the envelope) still flips by pi
+        assert!(
+            r.flip_error_rad.abs() < 1e-3,
+            "{objective} {norm}: flip error {}",
+            r.flip_error_rad
+        );
+        // within the fall: the program's time model is corrected to the fall time
+        if objective != "time" {
+            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
+            let end = sched.rows.last().unwrap().t;
+            assert!(
+                (end - cfg.available_time()).abs() < 1e-3 * end,
+                "{objective}: ends at {end} s, fall {}",
+                cfg.available_time()
+            );
+        }
+        results.push((objective, norm, cfg, r));
+    }
+    // each objective is best at its own measure (same norm: per-motor rows)
+    let (_, _, cfg_e, energy) = &results[3];
+    let mut ov = limits.to_vec();
+    ov.push("limits.norm=per-motor");
+    let peak = optimize(&seed(&ov), |_| {}).unwrap();
+    let cat = cfg_e.cat();
+    let (e_of_energy, e_of_peak) = (
+        torque_squared_integral(&cat, &energy.plan, 2000),
+        torque_squared_integral(&cat, &peak.plan, 2000),
+    );
+    assert!(
+        e_of_energy <= e_of_peak * (1.0 + 1e-3),
+        "energy design {e_of_energy} vs peak design {e_of_peak}"
+    );
+    assert!(peak.peak_torque_nm <= energy.peak_torque_nm * (1.0 + 1e-3));
+}

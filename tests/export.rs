@@ -1,0 +1,344 @@
+//! Simulator exports: the model files carry the model, and the controls are
+//! the schedule in the simulator's coordinates. The engines themselves
+//! (MuJoCo, pyBullet) check the replays in `.ci/run` (examples/replay_*.py).
+
+use catflip::Config;
+use catflip::export::controls::{Controls, Simulator, time_step};
+use catflip::model::Joint;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+}
+
+fn config(name: &str, set: &[&str]) -> Config {
+    let ov: Vec<String> = set.iter().map(|s| s.to_string()).collect();
+    Config::load(&configs().join(format!("{name}.toml")), &ov).unwrap()
+}
+
+fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+fn num(s: &str) -> f64 {
+    s.parse()
+        .unwrap_or_else(|_| panic!("`{s}` is not a number"))
+}
+
+fn close(s: &str, want: f64) -> bool {
+    (num(s) - want).abs() <= 1e-12 * want.abs().max(1e-300)
+}
+
+/// Header keys and numeric rows of a controls CSV.
+fn read_controls(
+    text: &str,
+) -> (
+    std::collections::HashMap<String, String>,
+    Vec<String>,
+    Vec<Vec<f64>>,
+) {
+    let mut meta = std::collections::HashMap::new();
+    let mut cols = Vec::new();
+    let mut rows = Vec::new();
+    for line in text.lines() {
+        if let Some(rest) = line.strip_prefix('#') {
+            if let Some((k, v)) = rest.split_once(" = ") {
+                meta.insert(k.trim().to_string(), v.trim().to_string());
+            }
+        } else if cols.is_empty() {
+            cols = line.split(',').map(String::from).collect();
+        } else {
+            rows.push(line.split(',').map(num).collect());
+        }
+    }
+    (meta, cols, rows)
+}
+
+#[test]
+fn models_carry_the_masses_inertias_limits_and_actuators() {
+    let unequal = [
+        "cat.front.mass=0.4",
+        "cat.front.length=0.15",
+        "cat.front.radius=0.02",
+    ];
+    for (name, set) in [
+        ("seed", &[][..]),
+        ("robot-universal", &[][..]),
+        ("robot-universal", &unequal[..]),
+        ("seed", &unequal[..2]),
+    ] {
+        let cfg = config(name, set);
+        let cat = cfg.cat();
+        let half = |link: &str| match link {
+            "rear" => cat.rear,
+            "front" => cat.front,
+            other => panic!("unexpected link {other}"),
+        };
+        let limit = cfg.limits.max_torque;
+
+        let urdf = catflip::export::urdf(&cfg);
+        assert!(urdf.contains("URDF_USE_INERTIA_FROM_FILE"));
+        let doc = roxmltree::Document::parse(&urdf).unwrap();
+        for link in doc.descendants().filter(|n| n.has_tag_name("link")) {
+            let lname = link.attribute("name").unwrap();
+            let mass = link
+                .descendants()
+                .find(|n| n.has_tag_name("mass"))
+                .unwrap_or_else(|| panic!("{name}: link {lname} has no mass"));
+            let inertia = link
+                .descendants()
+                .find(|n| n.has_tag_name("inertia"))
+                .unwrap();
+            if lname == "cross" {
+                // massive (simulators need it) but negligible
+                let m = num(mass.attribute("value").unwrap());
+                assert!(m > 0.0 && m < 1e-6 * cat.rear.mass, "{m}");
+                let i = num(inertia.attribute("ixx").unwrap());
+                assert!(i > 1e-15 && i < 1e-6 * cat.rear.i_a(), "{i}");
+            } else {
+                let h = half(lname);
+                assert!(close(mass.attribute("value").unwrap(), h.mass));
+                assert!(close(inertia.attribute("ixx").unwrap(), h.i_t()));
+                assert!(close(inertia.attribute("iyy").unwrap(), h.i_t()));
+                assert!(close(inertia.attribute("izz").unwrap(), h.i_a()));
+                let cyl = link
+                    .descendants()
+                    .find(|n| n.has_tag_name("cylinder"))
+                    .unwrap();
+                assert!(close(cyl.attribute("length").unwrap(), h.length));
+                assert!(close(cyl.attribute("radius").unwrap(), h.radius));
+            }
+        }
+        let joints: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("joint"))
+            .collect();
+        match cat.joint {
+            Joint::Universal => {
+                assert_eq!(joints.len(), 2);
+                for j in &joints {
+                    assert_eq!(j.attribute("type"), Some("revolute"));
+                    let lim = j.children().find(|n| n.has_tag_name("limit")).unwrap();
+                    assert!(close(lim.attribute("effort").unwrap(), limit.unwrap()));
+                }
+            }
+            Joint::NoTwist => {
+                assert!(joints.len() == 1 && joints[0].attribute("type") == Some("spherical"))
+            }
+        }
+
+        let mjcf = catflip::export::mjcf(&cfg);
+        let doc = roxmltree::Document::parse(&mjcf).unwrap();
+        let bodies: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("body"))
+            .collect();
+        assert_eq!(bodies.len(), 2);
+        for b in bodies {
+            let h = half(b.attribute("name").unwrap());
+            let n = b.children().find(|n| n.has_tag_name("inertial")).unwrap();
+            assert!(close(n.attribute("mass").unwrap(), h.mass));
+            let d: Vec<&str> = n.attribute("diaginertia").unwrap().split(' ').collect();
+            assert!(close(d[0], h.i_t()) && close(d[1], h.i_t()) && close(d[2], h.i_a()));
+            // centre of mass l/2 along the half's own axis (the rear's at its origin)
+            let z = n
+                .attribute("pos")
+                .unwrap()
+                .split(' ')
+                .nth(2)
+                .map(num)
+                .unwrap();
+            let want = if b.attribute("name") == Some("rear") {
+                0.0
+            } else {
+                h.length / 2.0
+            };
+            assert!((z - want).abs() < 1e-12);
+        }
+        // the joint sits at the rear's end face
+        let front = doc
+            .descendants()
+            .find(|n| n.attribute("name") == Some("front"))
+            .unwrap();
+        let jz = front
+            .attribute("pos")
+            .unwrap()
+            .split(' ')
+            .nth(2)
+            .map(num)
+            .unwrap();
+        assert!((jz - cat.rear.length / 2.0).abs() < 1e-12);
+        // the model's step is the controls' step
+        let opt = doc
+            .descendants()
+            .find(|n| n.has_tag_name("option"))
+            .unwrap();
+        let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
+        assert!(close(opt.attribute("timestep").unwrap(), dt));
+        let motors: Vec<_> = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("motor"))
+            .collect();
+        match cat.joint {
+            // a ball has three degrees of freedom: one motor about each child axis
+            Joint::NoTwist => {
+                let gears: Vec<_> = motors
+                    .iter()
+                    .map(|m| m.attribute("gear").unwrap())
+                    .collect();
+                assert_eq!(gears, ["1 0 0", "0 1 0", "0 0 1"]);
+            }
+            Joint::Universal => assert_eq!(motors.len(), 2),
+        }
+        for m in &motors {
+            match limit {
+                Some(l) => {
+                    let r: Vec<&str> = m.attribute("ctrlrange").unwrap().split(' ').collect();
+                    assert!(close(r[0], -l) && close(r[1], l));
+                    assert_eq!(m.attribute("ctrllimited"), Some("true"));
+                    assert!(m.attribute("forcerange").is_some());
+                }
+                None => assert!(m.attribute("ctrlrange").is_none()),
+            }
+        }
+    }
+}
+
+/// The held torques carry the schedule's impulse exactly: the schedule's
+/// torque is linear between rows, so its integral is the trapezoid rule.
+#[test]
+fn held_torques_carry_the_schedules_impulse() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg_path = configs().join("robot-universal.toml");
+    let c = cfg_path.to_str().unwrap();
+    let (ok, _, err) = run(&["analyze", c], dir.path());
+    assert!(ok, "{err}");
+    let sched = dir
+        .path()
+        .join("output/robot-universal/analyze/analytic.csv");
+    let base = dir.path().join("output/robot-universal/export-mjcf");
+    let (ok, out, err) = run(
+        &["export", "mjcf", c, "--schedule", sched.to_str().unwrap()],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("analytic.mujoco.csv"), "{out}");
+    let (meta, cols, rows) =
+        read_controls(&std::fs::read_to_string(base.join("analytic.mujoco.csv")).unwrap());
+    let dt = num(&meta["dt_s"]);
+    let steps: usize = meta["steps"].parse().unwrap();
+    assert_eq!(rows.len(), steps + 1);
+    assert!(steps >= catflip::export::controls::MIN_STEPS);
+    let s = catflip::design::plan::Schedule::from_csv(
+        &std::fs::read_to_string(&sched).unwrap(),
+        "analytic.csv",
+    )
+    .unwrap();
+    let duration = s.rows.last().unwrap().t - s.rows[0].t;
+    assert!((dt * steps as f64 - duration).abs() < 1e-12);
+    let i1 = cols.iter().position(|c| c == "ctrl_tau1").unwrap();
+    for j in 0..2 {
+        let held: f64 = rows[..steps].iter().map(|r| r[i1 + j] * dt).sum();
+        let exact: f64 = s
+            .rows
+            .windows(2)
+            .map(|w| 0.5 * (w[0].tau[j] + w[1].tau[j]) * (w[1].t - w[0].t))
+            .sum();
+        assert!(
+            (held - exact).abs()
+                < 1e-12 * s.rows.iter().map(|r| r.tau[j].abs()).fold(0.0, f64::max),
+            "motor {j}: {held} vs {exact}"
+        );
+    }
+    // positions are the schedule's at each step start
+    let iq = cols.iter().position(|c| c == "qpos_motor1").unwrap();
+    let mid = rows[steps / 3][0];
+    let want = catflip::design::plan::ShapePlan::state(&s, mid).q;
+    assert!((rows[steps / 3][iq] - want[0]).abs() < 1e-12);
+}
+
+/// Ball joint: positions are unit quaternions and the velocity column is the
+/// relative rate in the child frame, `2 Im(conj(q_k) q_k+1) / dt` between rows;
+/// pyBullet's file holds the same numbers with the quaternion as x y z w.
+#[test]
+fn ball_controls_are_quaternions_and_child_frame_rates() {
+    let cfg = config("seed", &[]);
+    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let mj = Controls::sample(&cfg, &plan, Simulator::Mujoco);
+    let n = mj.rows.len();
+    let mut worst: f64 = 0.0;
+    for k in (0..n - 1).step_by(7) {
+        let (a, b) = (&mj.rows[k].pos, &mj.rows[k + 1].pos);
+        let norm = a.iter().map(|x| x * x).sum::<f64>().sqrt();
+        assert!((norm - 1.0).abs() < 1e-14);
+        // conj(a) * b, imaginary part
+        let im = [
+            a[0] * b[1] - a[1] * b[0] - a[2] * b[3] + a[3] * b[2],
+            a[0] * b[2] + a[1] * b[3] - a[2] * b[0] - a[3] * b[1],
+            a[0] * b[3] - a[1] * b[2] + a[2] * b[1] - a[3] * b[0],
+        ];
+        for i in 0..3 {
+            let fd = 2.0 * im[i] / mj.dt;
+            let mean = 0.5 * (mj.rows[k].vel[i] + mj.rows[k + 1].vel[i]);
+            worst = worst.max((fd - mean).abs());
+        }
+    }
+    let scale = mj
+        .rows
+        .iter()
+        .flat_map(|r| r.vel.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    assert!(worst < 1e-4 * scale, "{worst} vs {scale}");
+    // the ball's twist rate is not zero: the third motor is needed
+    assert!(mj.rows.iter().any(|r| r.vel[2].abs() > 1e-3 * scale));
+    assert!(mj.rows.iter().any(|r| r.torque[2].abs() > 1e-3));
+
+    let pb = Controls::sample(&cfg, &plan, Simulator::Pybullet);
+    let (k, r) = (n / 2, &pb.rows[pb.rows.len() / 2]);
+    if (pb.dt - mj.dt).abs() < 1e-15 {
+        assert_eq!(
+            r.pos,
+            [
+                mj.rows[k].pos[1],
+                mj.rows[k].pos[2],
+                mj.rows[k].pos[3],
+                mj.rows[k].pos[0]
+            ]
+        );
+    }
+    let norm = r.pos.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!((norm - 1.0).abs() < 1e-14 && r.pos[3] > 0.0);
+}
+
+#[test]
+fn export_with_a_bad_schedule_fails_and_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("broken.csv");
+    std::fs::write(&bad, "t_s,phase,q1_rad\n0,fold,0\n").unwrap();
+    let cfg = configs().join("seed.toml");
+    for sched in [bad.to_str().unwrap(), "missing.csv"] {
+        let (ok, _, err) = run(
+            &["export", "mjcf", cfg.to_str().unwrap(), "--schedule", sched],
+            dir.path(),
+        );
+        assert!(!ok, "{sched} should fail");
+        assert!(
+            err.contains("broken.csv") || err.contains("missing.csv"),
+            "{err}"
+        );
+        assert!(
+            !dir.path().join("output").exists(),
+            "{sched}: wrote something"
+        );
+    }
+}
