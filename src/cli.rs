@@ -579,6 +579,26 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
             );
             row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+            let cert = &r.certificate;
+            row(
+                "certificate",
+                format!(
+                    "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {:?})",
+                    cert.step, cert.constraint_violation, cert.criticality, cert.rule
+                ),
+            );
+            if let Some(m) = &r.mesh_check {
+                row(
+                    "mesh check (N vs 2N)",
+                    format!(
+                        "{:.5} N m at {} nodes per phase ({:+.2} %), {:?}",
+                        m.peak_torque_nm,
+                        m.nodes,
+                        100.0 * m.relative_change,
+                        m.status
+                    ),
+                );
+            }
             design_rows(
                 r.phase_durations_s,
                 (

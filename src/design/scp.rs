@@ -17,8 +17,8 @@
 //! halves when `rho < 0.1` and doubles when `rho > 0.5`.
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
-//! that fell by less than `tolerance` (relative) over the last `window`
-//! iterations, with `max |r| <= feasibility` (converged; the certificate
+//! that fell by less than `tolerance` (relative) per iteration on average
+//! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
 //! names the rule); the penalty grows tenfold when the
 //! model stalls while still infeasible; an iteration limit or a collapsed
 //! trust region (stalled) end the run.
@@ -87,7 +87,7 @@ pub struct ScpSettings {
     /// Initial trust radius in scaled units (default 0.5).
     pub initial_radius: f64,
     /// Iterations over which the merit must fall by `tolerance` (relative)
-    /// to keep going (default 10).
+    /// per iteration on average to keep going (default 10).
     pub window: usize,
     /// Penalty weight relative to the initial peak (default 2): the exact L1
     /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
@@ -192,8 +192,9 @@ pub enum StopRule {
     None,
     /// Criticality below `tolerance`: a first-order point of the model.
     Criticality,
-    /// The merit fell by less than `tolerance` (relative) over the last
-    /// `window` iterations: no further progress at this tolerance.
+    /// The merit fell by less than `tolerance` (relative) per iteration on
+    /// average over the last `window` iterations: no further progress at
+    /// this tolerance.
     Progress,
 }
 
@@ -505,10 +506,11 @@ pub fn solve_warm(
         let (phi_now, _, inf_now) = merit(p, &z, w);
         window.push(phi_now);
         let critical = rec.criticality() <= settings.tolerance;
-        // the merit moved by less than `tolerance` (relative) over the window
+        // the merit fell by less than `tolerance` (relative) per iteration,
+        // on average over the window
         let slow = window.len() > settings.window
             && window[window.len() - 1 - settings.window] - phi_now
-                <= settings.tolerance * phi_now.abs();
+                <= settings.tolerance * settings.window as f64 * phi_now.abs();
         if critical || slow {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
