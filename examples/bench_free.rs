@@ -1,44 +1,79 @@
-//! Benchmark: free-form SCP solve time and iterations on a config.
-//! `cargo run --release --example bench_free [-- configs/seed.toml [nodes]]`
+//! Benchmark: the free-form design, seeding design included, median of
+//! several runs, with iteration counts, on the three cases of issue 11.
+//! `cargo run --release --example bench_free [-- RUNS]` (default 5 runs).
 use catflip::Config;
+use catflip::design::free::{FreeResult, Seed};
 use std::time::Instant;
 
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+/// The seeding (phased) design and the SCP, timed together, without the
+/// mesh check.
+fn design(cfg: &Config) -> anyhow::Result<(FreeResult, f64, f64)> {
+    let t = Instant::now();
+    let phased = catflip::design::phased::optimize(cfg, |_| {})?;
+    let seed_s = t.elapsed().as_secs_f64();
+    let r = catflip::design::free::optimize_from(
+        cfg,
+        &phased.plan,
+        Seed::Phased.name(),
+        cfg.free.nodes,
+        |_| {},
+    )?;
+    // the SCP's own time (without the verification simulations)
+    Ok((r.clone(), seed_s, seed_s + r.solve_time_s))
+}
+
 fn main() -> anyhow::Result<()> {
-    let mut args = std::env::args().skip(1);
-    let path = args.next().unwrap_or_else(|| "configs/seed.toml".into());
-    let cfg = Config::load(std::path::Path::new(&path), &[])?;
-    let nodes: usize = args
-        .next()
+    let runs: usize = std::env::args()
+        .nth(1)
         .map(|s| s.parse())
         .transpose()?
-        .unwrap_or(cfg.free.nodes);
-    let t = Instant::now();
-    let phased = catflip::design::phased::optimize(&cfg, |_| {})?;
-    let seed_time = t.elapsed().as_secs_f64();
-    let mut best = f64::INFINITY;
-    let mut last = None;
-    for _ in 0..3 {
-        let r = catflip::design::free::optimize_from(&cfg, &phased.plan, "phased", nodes, |_| {})?;
-        best = best.min(r.solve_time_s);
-        last = Some(r);
+        .unwrap_or(5);
+    let root = env!("CARGO_MANIFEST_DIR");
+    let cases = [
+        ("seed, Euclidean", "seed", "euclidean", 0.3),
+        ("seed, per-motor", "seed", "per-motor", 0.5),
+        ("robot-universal", "robot-universal", "per-motor", 0.5),
+    ];
+    println!(
+        "{:<18} {:>9} {:>9} {:>9} {:>6} {:>11} {:>12} {:>10}",
+        "case", "median s", "seed s", "target s", "iters", "status", "peak N m", "criticality"
+    );
+    for (name, file, norm, target) in cases {
+        let path = format!("{root}/configs/{file}.toml");
+        let cfg = Config::load(
+            std::path::Path::new(&path),
+            &[format!("limits.norm={norm}")],
+        )?;
+        let (mut total, mut seed) = (Vec::new(), Vec::new());
+        let mut last = None;
+        for _ in 0..runs {
+            let (r, s, t) = design(&cfg)?;
+            seed.push(s);
+            total.push(t);
+            last = Some(r);
+        }
+        let r = last.expect("at least one run");
+        println!(
+            "{:<18} {:>9.3} {:>9.3} {:>9.1} {:>6} {:>11} {:>12.6} {:>10.1e}",
+            name,
+            median(total),
+            median(seed),
+            target,
+            r.scp_iterations,
+            format!("{:?}", r.status),
+            r.peak_torque_nm,
+            r.certificate.criticality
+        );
     }
-    let r = last.unwrap();
-    let mean_ms = r.iterations.iter().map(|i| i.solve_ms).sum::<f64>() / r.iterations.len() as f64;
-    println!(
-        "config {path}: {nodes} nodes per phase ({} in all), seed phased ({seed_time:.3} s)",
-        3 * nodes
-    );
-    println!(
-        "SCP: {:?} in {} iterations, best solve time {best:.3} s over 3 runs (target < 2 s), mean Clarabel subproblem {mean_ms:.1} ms",
-        r.status, r.scp_iterations
-    );
-    println!(
-        "peak {:.6} N m (phased {:.6} N m, ratio {:.3}); simulated flip error {:.2e} rad, tilt {:.2e} deg",
-        r.peak_torque_nm,
-        phased.peak_torque_nm,
-        r.peak_torque_nm / phased.peak_torque_nm,
-        r.flip_error_rad,
-        r.tilt_deg
-    );
     Ok(())
 }

@@ -62,6 +62,11 @@ enum Command {
         /// Points computed at once (default: the machine's cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// K/N: compute only the K-th of N disjoint slices of the grid (for a
+        /// batch scheduler's job array); the shards' CSVs concatenate into the
+        /// whole sweep's.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
     },
     /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
@@ -156,7 +161,8 @@ pub fn run() -> Result<Status> {
             range,
             methods,
             threads,
-        } => cmd_sweep(&common, &range, &methods, threads),
+            shard,
+        } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref()),
         Command::Export {
             format,
             common,
@@ -576,6 +582,26 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
             );
             row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+            let cert = &r.certificate;
+            row(
+                "certificate",
+                format!(
+                    "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {:?})",
+                    cert.step, cert.constraint_violation, cert.criticality, cert.rule
+                ),
+            );
+            if let Some(m) = &r.mesh_check {
+                row(
+                    "mesh check (N vs 2N)",
+                    format!(
+                        "{:.5} N m at {} nodes per phase ({:+.2} %), {:?}",
+                        m.peak_torque_nm,
+                        m.nodes,
+                        100.0 * m.relative_change,
+                        m.status
+                    ),
+                );
+            }
             design_rows(
                 r.phase_durations_s,
                 (
@@ -729,6 +755,7 @@ fn cmd_sweep(
     range: &str,
     methods: &[String],
     threads: Option<usize>,
+    shard: Option<&str>,
 ) -> Result<Status> {
     let cfg = load(c)?;
     let spec: catflip::sweep::SweepSpec = range.parse()?;
@@ -738,6 +765,10 @@ fn cmd_sweep(
         )
         .into());
     }
+    let shard = match shard {
+        Some(s) => s.parse()?,
+        None => catflip::sweep::Shard::ALL,
+    };
     let mut m = catflip::sweep::Methods {
         analytic: false,
         phased: false,
@@ -774,13 +805,36 @@ fn cmd_sweep(
             }
         })
         .collect();
+    let key = format!("{key}{}", shard.suffix());
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
-    let points = catflip::sweep::sweep(&c.config, &c.set, &spec, m, threads, |done, total| {
-        if !quiet {
-            eprint!("\r  sweep {}: {done}/{total} points", spec.key);
-        }
-    })?;
-    if !quiet {
+    // a live bar on a terminal, plain lines otherwise
+    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let clock = std::time::Instant::now();
+    let points = catflip::sweep::sweep_shard(
+        &c.config,
+        &c.set,
+        &spec,
+        m,
+        threads,
+        shard,
+        |done, total| {
+            if quiet {
+                return;
+            }
+            let line = catflip::sweep::progress_line(
+                &spec.key,
+                done,
+                total,
+                clock.elapsed().as_secs_f64(),
+            );
+            if live {
+                eprint!("\r  {line}");
+            } else {
+                eprintln!("  {line}");
+            }
+        },
+    )?;
+    if !quiet && live {
         eprintln!();
     }
     let partial = points.iter().any(|p| p.error.is_some());

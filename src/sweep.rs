@@ -1,8 +1,18 @@
 //! Parameter sweeps: any numeric config key over a range, every point
-//! designed by each method, points evaluated in parallel.
+//! designed by each method.
+//!
+//! Continuation: the grid is cut into fixed chunks of [`CHUNK`] consecutive
+//! points (a function of the grid only). Within a chunk the points run in
+//! order and each free-form design starts from its neighbour's solution (in
+//! the optimiser's dimensionless units, so a change of height or time is no
+//! change at all, F3); the first point of a chunk starts from its phased
+//! design. Chunks run in parallel, and `--shard K/N` computes a contiguous
+//! run of whole chunks, so every point's result is the same whether the
+//! sweep runs on one machine or on many.
 
 use crate::config::Config;
 use crate::design::analytic::analytic_plan;
+use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
 use crate::verify::analyze::peak_along;
@@ -99,14 +109,81 @@ pub struct SweepPoint {
     pub free_bend_deg: Option<f64>,
     pub least_height_phased_m: Option<f64>,
     pub least_height_free_m: Option<f64>,
+    /// The free-form optimiser's end status (converged, iteration limit, ...).
+    pub free_status: Option<String>,
     pub error: Option<String>,
 }
 
-fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
+/// Points per continuation chunk (fixed, so results do not depend on the
+/// number of threads or shards).
+pub const CHUNK: usize = 8;
+
+/// `K/N`: the K-th (1-based) of N disjoint slices of a sweep's grid.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    pub index: usize,
+    pub count: usize,
+}
+
+impl Shard {
+    /// The whole grid.
+    pub const ALL: Shard = Shard { index: 1, count: 1 };
+
+    /// Indices of the grid points of this shard: whole chunks, contiguous.
+    pub fn points(&self, total: usize) -> std::ops::Range<usize> {
+        let chunks = total.div_ceil(CHUNK);
+        let (a, b) = (
+            chunks * (self.index - 1) / self.count,
+            chunks * self.index / self.count,
+        );
+        (a * CHUNK).min(total)..(b * CHUNK).min(total)
+    }
+
+    /// File-name suffix, `""` for the whole grid, else `.shard-K-of-N` with
+    /// K zero-padded so that the shards' files sort in grid order.
+    pub fn suffix(&self) -> String {
+        if *self == Shard::ALL {
+            return String::new();
+        }
+        let w = self.count.to_string().len();
+        format!(".shard-{:0w$}-of-{}", self.index, self.count)
+    }
+}
+
+impl std::str::FromStr for Shard {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        let bad = || {
+            Error::Usage(format!(
+                "--shard {s}: expected K/N with 1 <= K <= N, e.g. 3/10 (the 3rd of 10 slices)"
+            ))
+        };
+        let (k, n) = s.split_once('/').ok_or_else(bad)?;
+        let (index, count): (usize, usize) = (
+            k.trim().parse().map_err(|_| bad())?,
+            n.trim().parse().map_err(|_| bad())?,
+        );
+        if index < 1 || index > count {
+            return Err(bad());
+        }
+        Ok(Shard { index, count })
+    }
+}
+
+/// One sweep point; `warm` is the previous point's free-form design in the
+/// same chunk (continuation), and the point's own free-form design is
+/// returned for the next.
+fn point(
+    cfg: &Config,
+    value: f64,
+    methods: Methods,
+    warm: Option<&FreeResult>,
+) -> (SweepPoint, Option<FreeResult>) {
     let mut p = SweepPoint {
         value,
         ..Default::default()
     };
+    let mut kept = None;
     let limit = cfg.limits.max_torque;
     let mut cfg = cfg.clone();
     cfg.limits.max_torque = None;
@@ -125,7 +202,15 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
     // the other methods' numbers are kept
     let mut errors = Vec::new();
     if methods.phased || methods.free {
-        let ph = crate::design::phased::optimize(&cfg, |_| {});
+        // within a chunk the free-form design continues from its neighbour
+        // and needs no phased seed
+        let ph = if methods.phased || warm.is_none() {
+            crate::design::phased::optimize(&cfg, |_| {})
+        } else {
+            Err(Error::Unreachable {
+                reason: "not computed".into(),
+            })
+        };
         match &ph {
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
@@ -145,15 +230,16 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
         }
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
-            let fr = match &ph {
-                Ok(ph) => crate::design::free::optimize_from(
+            let fr = match (&ph, warm) {
+                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, |_| {}),
+                (Ok(ph), None) => crate::design::free::optimize_from(
                     &cfg,
                     &ph.plan,
                     "phased",
                     cfg.free.nodes,
                     |_| {},
                 ),
-                Err(_) => crate::design::free::optimize_from(
+                (Err(_), None) => crate::design::free::optimize_from(
                     &cfg,
                     &analytic_plan(&cfg),
                     "analytic",
@@ -174,6 +260,8 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m =
                         limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+                    p.free_status = Some(format!("{:?}", fr.status));
+                    kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
             }
@@ -182,7 +270,7 @@ fn point(cfg: &Config, value: f64, methods: Methods) -> Result<SweepPoint> {
     if !errors.is_empty() {
         p.error = Some(errors.join("; "));
     }
-    Ok(p)
+    (p, kept)
 }
 
 /// A kept design that misses a target (unconverged, flip missed) is named in
@@ -206,7 +294,7 @@ fn flagged(
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
-/// Runs a sweep on the config at `path` (with `overrides`), `threads` points at a time.
+/// Runs a sweep on the config at `path` (with `overrides`), `threads` chunks at a time.
 pub fn sweep(
     path: &Path,
     overrides: &[String],
@@ -215,7 +303,30 @@ pub fn sweep(
     threads: usize,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<Vec<SweepPoint>> {
-    let values = spec.values();
+    sweep_shard(
+        path,
+        overrides,
+        spec,
+        methods,
+        threads,
+        Shard::ALL,
+        progress,
+    )
+}
+
+/// [`sweep`] restricted to one shard of the grid (see [`Shard::points`]).
+pub fn sweep_shard(
+    path: &Path,
+    overrides: &[String],
+    spec: &SweepSpec,
+    methods: Methods,
+    threads: usize,
+    shard: Shard,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
+    let all = spec.values();
+    let range = shard.points(all.len());
+    let values = &all[range];
     let load = |v: f64| {
         let mut ov = overrides.to_vec();
         ov.push(format!("{}={}", spec.key, v));
@@ -247,28 +358,42 @@ pub fn sweep(
             },
         });
     }
+    // shards start on chunk boundaries, so local chunks are global chunks
+    let chunks: Vec<std::ops::Range<usize>> = (0..values.len())
+        .step_by(CHUNK)
+        .map(|a| a..(a + CHUNK).min(values.len()))
+        .collect();
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<SweepPoint>>> = Mutex::new(vec![None; values.len()]);
     std::thread::scope(|s| {
-        for _ in 0..threads.max(1).min(values.len()) {
+        for _ in 0..threads.max(1).min(chunks.len()) {
             s.spawn(|| {
                 loop {
-                    let i = next.fetch_add(1, Ordering::SeqCst);
-                    if i >= values.len() {
+                    let c = next.fetch_add(1, Ordering::SeqCst);
+                    if c >= chunks.len() {
                         break;
                     }
-                    let p = configs[i]
-                        .as_ref()
-                        .map_err(|e| e.to_string())
-                        .and_then(|c| point(c, values[i], methods).map_err(|e| e.to_string()))
-                        .unwrap_or_else(|e| SweepPoint {
-                            value: values[i],
-                            error: Some(e),
-                            ..Default::default()
-                        });
-                    results.lock().unwrap()[i] = Some(p);
-                    progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
+                    let mut warm: Option<FreeResult> = None;
+                    for i in chunks[c].clone() {
+                        let (p, fr) = match &configs[i] {
+                            Ok(cfg) => point(cfg, values[i], methods, warm.as_ref()),
+                            Err(e) => (
+                                SweepPoint {
+                                    value: values[i],
+                                    error: Some(e.to_string()),
+                                    ..Default::default()
+                                },
+                                None,
+                            ),
+                        };
+                        // a failed point leaves the last good design as the start
+                        if fr.is_some() {
+                            warm = fr;
+                        }
+                        results.lock().unwrap()[i] = Some(p);
+                        progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
+                    }
                 }
             });
         }
@@ -281,6 +406,28 @@ pub fn sweep(
         .collect())
 }
 
+/// A progress line for `done` of `total` points after `elapsed` seconds:
+/// a bar and the estimated time left (from the mean time per point so far).
+pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> String {
+    let width = 24;
+    let filled = (width * done) / total.max(1);
+    let eta = if done > 0 {
+        elapsed / done as f64 * (total - done) as f64
+    } else {
+        f64::NAN
+    };
+    let eta = if eta.is_finite() {
+        format!("ETA {eta:.0} s")
+    } else {
+        "ETA -".into()
+    };
+    format!(
+        "sweep {key} [{}{}] {done}/{total} points, {elapsed:.0} s, {eta}",
+        "#".repeat(filled),
+        ".".repeat(width - filled)
+    )
+}
+
 fn cell(x: Option<f64>) -> String {
     x.map(|v| format!("{v:.9e}")).unwrap_or_default()
 }
@@ -288,11 +435,11 @@ fn cell(x: Option<f64>) -> String {
 /// CSV of a sweep: the swept value first.
 pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
     let mut s = format!(
-        "{key},analytic_peak_nm,phased_peak_nm,free_peak_nm,phased_bend_deg,free_bend_deg,least_height_phased_m,least_height_free_m,error\n"
+        "{key},analytic_peak_nm,phased_peak_nm,free_peak_nm,phased_bend_deg,free_bend_deg,least_height_phased_m,least_height_free_m,free_status,error\n"
     );
     for p in points {
         s.push_str(&format!(
-            "{},{},{},{},{},{},{},{},{}\n",
+            "{},{},{},{},{},{},{},{},{},{}\n",
             p.value,
             cell(p.analytic_peak_nm),
             cell(p.phased_peak_nm),
@@ -301,6 +448,7 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
             cell(p.free_bend_deg),
             cell(p.least_height_phased_m),
             cell(p.least_height_free_m),
+            p.free_status.as_deref().unwrap_or(""),
             p.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
         ));
     }

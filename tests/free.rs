@@ -308,3 +308,130 @@ fn bend_limit_holds_in_both_optimisers() {
             .unwrap();
     assert!(free.peak_torque_nm > open.peak_torque_nm);
 }
+
+#[test]
+fn a_torque_limit_that_cannot_bind_changes_nothing() {
+    // issue 10 row 6: 1e9 / 1e12 N m entered the conic data and broke Clarabel
+    let open = cfg("seed", &[]);
+    let phased = catflip::design::phased::optimize(&open, |_| {}).unwrap();
+    let a =
+        catflip::design::free::optimize_from(&open, &phased.plan, "phased", 40, |_| {}).unwrap();
+    for lim in ["1e12"] {
+        let c = cfg("seed", &[&format!("limits.max_torque={lim}")]);
+        let b =
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        assert_eq!(
+            b.status,
+            catflip::design::scp::ScpStatus::Converged,
+            "{lim}"
+        );
+        assert!(
+            (a.peak_torque_nm - b.peak_torque_nm).abs() < 1e-3 * a.peak_torque_nm,
+            "{lim}: {} vs {}",
+            a.peak_torque_nm,
+            b.peak_torque_nm
+        );
+    }
+}
+
+#[test]
+fn extreme_drop_heights_solve_the_same_dimensionless_problem() {
+    // issue 10 row 7 (1e-9 m was "Unbounded"). F3: peak * T^2 does not depend
+    // on the time available, so the designs agree after scaling.
+    let c10 = cfg("seed", &[]);
+    let phased = catflip::design::phased::optimize(&c10, |_| {}).unwrap();
+    let nodes = 40;
+    let base =
+        catflip::design::free::optimize_from(&c10, &phased.plan, "phased", nodes, |_| {}).unwrap();
+    let unit = |c: &catflip::Config, peak: f64| peak * c.available_time().powi(2);
+    for h in ["1e-9", "1e4"] {
+        let c = cfg("seed", &[&format!("fall.height={h}")]);
+        let ph = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+        let r =
+            catflip::design::free::optimize_from(&c, &ph.plan, "phased", nodes, |_| {}).unwrap();
+        assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged, "{h}");
+        let (x, y) = (unit(&c, r.peak_torque_nm), unit(&c10, base.peak_torque_nm));
+        assert!((x - y).abs() < 1e-3 * y, "{h}: {x} vs {y}");
+        assert!(r.flip_error_rad.abs() < 1e-3, "{h}");
+    }
+}
+
+#[test]
+fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
+    // issue 10 row 5: 1 deg needs hundreds of turns of the bend direction
+    let c = cfg(
+        "seed",
+        &["limits.max_bend_deg=1", "phased.bend_min_deg=0.5"],
+    );
+    let t = std::time::Instant::now();
+    let e = catflip::design::free::optimize(&c, catflip::design::free::Seed::Analytic, |_| {})
+        .unwrap_err()
+        .to_string();
+    assert!(t.elapsed().as_secs_f64() < 1.0, "not fast");
+    assert!(e.contains("limits.max_bend_deg"), "{e}");
+    // F6 oracle for the turn count: n = 1 / (2 C), C from F1 at 1 deg
+    let cat = c.cat();
+    let (it, ia) = (cat.i_t(), cat.i_a());
+    let b = 1f64.to_radians();
+    let (s, co) = ((b / 2.0).sin(), (b / 2.0).cos());
+    let n = 1.0 / (2.0 * (1.0 - ia * co / (it * s * s + ia * co * co)));
+    assert!(
+        e.contains(&format!("about {n:.0} turns")),
+        "{e} (expected {n:.0})"
+    );
+    // the advice: the bend it names passes the check at these nodes
+    let at = e.split("at least ").nth(1).unwrap();
+    let bend: f64 = at.split_whitespace().next().unwrap().parse().unwrap();
+    let ok = cfg(
+        "seed",
+        &[
+            &format!("limits.max_bend_deg={bend}"),
+            "phased.bend_min_deg=0.5",
+        ],
+    );
+    catflip::design::free::check_resolvable(&ok, ok.free.nodes).unwrap();
+    let worse = cfg(
+        "seed",
+        &[
+            &format!("limits.max_bend_deg={}", bend - 0.05),
+            "phased.bend_min_deg=0.5",
+        ],
+    );
+    assert!(catflip::design::free::check_resolvable(&worse, worse.free.nodes).is_err());
+}
+
+#[test]
+fn the_certificate_backs_the_status() {
+    for norm in ["euclidean", "per-motor"] {
+        let c = cfg("seed", &[&format!("limits.norm={norm}")]);
+        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+        let r =
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        assert_eq!(
+            r.status,
+            catflip::design::scp::ScpStatus::Converged,
+            "{norm}"
+        );
+        let cert = r.certificate;
+        assert!(
+            cert.constraint_violation <= c.free.attitude_tolerance,
+            "{norm}"
+        );
+        let last = r.iterations.last().unwrap();
+        assert_eq!(cert.step, last.step);
+        match cert.rule {
+            catflip::design::scp::StopRule::Criticality => {
+                assert!(cert.criticality <= c.free.tolerance, "{norm}: {cert:?}")
+            }
+            catflip::design::scp::StopRule::Progress => {
+                let m = &r.iterations;
+                let k = m.len() - 1 - 10;
+                assert!(
+                    m[k].merit_after - last.merit_after
+                        <= 10.0 * c.free.tolerance * last.merit_after * 1.0001
+                );
+            }
+            catflip::design::scp::StopRule::None => panic!("converged without a rule"),
+        }
+    }
+}

@@ -61,6 +61,9 @@ pub struct ConicData {
     pub q: Vec<f64>,
     /// Optional diagonal quadratic term `1/2 x' diag(p) x` (fixed pattern: all `n` entries).
     pub p_diag: Option<Vec<f64>>,
+    /// More quadratic terms: upper-triangle `(row, col, value)` slots of `P`
+    /// (`row <= col`), added to the diagonal; fixed pattern like `A`.
+    pub p_upper: Vec<(usize, usize, f64)>,
     pub rows: Vec<usize>,
     pub cols: Vec<usize>,
     pub vals: Vec<f64>,
@@ -111,6 +114,9 @@ pub struct ConicSolver {
     m: usize,
     cones: Vec<Cone>,
     has_p: bool,
+    /// Slot map of `P`'s entries (diagonal first, then `p_upper`).
+    p_slot: Vec<usize>,
+    p_nnz: usize,
 }
 
 fn settings() -> DefaultSettings<f64> {
@@ -147,11 +153,29 @@ fn csc(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> (Vec<usize>, Vec<u
     (colptr, rowval, slot)
 }
 
-fn p_matrix(n: usize, diag: Option<&Vec<f64>>) -> CscMatrix<f64> {
-    match diag {
-        Some(d) => CscMatrix::new(n, n, (0..=n).collect(), (0..n).collect(), d.clone()),
-        None => CscMatrix::zeros((n, n)),
+/// `P`'s slots: the diagonal (if any) then the upper-triangle triplets.
+fn p_entries(data: &ConicData) -> (Vec<usize>, Vec<usize>, Vec<f64>) {
+    let (mut r, mut c, mut v) = (Vec::new(), Vec::new(), Vec::new());
+    if let Some(d) = &data.p_diag {
+        r.extend(0..data.n);
+        c.extend(0..data.n);
+        v.extend(d);
     }
+    for &(i, j, x) in &data.p_upper {
+        debug_assert!(i <= j);
+        r.push(i);
+        c.push(j);
+        v.push(x);
+    }
+    (r, c, v)
+}
+
+fn fill(slot: &[usize], nnz: usize, vals: &[f64]) -> Vec<f64> {
+    let mut nz = vec![0.0; nnz];
+    for (i, &s) in slot.iter().enumerate() {
+        nz[s] += vals[i];
+    }
+    nz
 }
 
 impl ConicSolver {
@@ -173,7 +197,10 @@ impl ConicSolver {
                 Cone::Soc(k) => SupportedConeT::SecondOrderConeT(k),
             })
             .collect();
-        let p = p_matrix(n, data.p_diag.as_ref());
+        let (pr, pc, pv) = p_entries(data);
+        let (pcolptr, prowval, p_slot) = csc(n, n, &pr, &pc);
+        let p_nnz = prowval.len();
+        let p = CscMatrix::new(n, n, pcolptr, prowval, fill(&p_slot, p_nnz, &pv));
         let solver =
             DefaultSolver::new(&p, &data.q, &a, &data.b, &cones, settings()).map_err(|e| {
                 Error::Solver {
@@ -190,6 +217,8 @@ impl ConicSolver {
             m,
             cones: data.cones.clone(),
             has_p: data.p_diag.is_some(),
+            p_slot,
+            p_nnz,
         })
     }
 
@@ -200,6 +229,7 @@ impl ConicSolver {
             && data.vals.len() == self.slot.len()
             && data.cones == self.cones
             && data.p_diag.is_some() == self.has_p
+            && data.p_upper.len() + if self.has_p { self.n } else { 0 } == self.p_slot.len()
     }
 
     /// Replaces all data values in place (same pattern).
@@ -217,8 +247,11 @@ impl ConicSolver {
         self.solver.update_A(&nz).map_err(err)?;
         self.solver.update_b(&data.b).map_err(err)?;
         self.solver.update_q(&data.q).map_err(err)?;
-        if let Some(d) = &data.p_diag {
-            self.solver.update_P(d).map_err(err)?;
+        if !self.p_slot.is_empty() {
+            let (_, _, pv) = p_entries(data);
+            self.solver
+                .update_P(&fill(&self.p_slot, self.p_nnz, &pv))
+                .map_err(err)?;
         }
         Ok(())
     }
@@ -228,6 +261,12 @@ impl ConicSolver {
         self.solver.solve();
         let s = &self.solver.solution;
         (SolveStatus::from_clarabel(s.status), s.x.clone(), s.obj_val)
+    }
+
+    /// The dual solution `z` of the last solve (one per row; the
+    /// Lagrangian is `q'x + z'(A x - b)`).
+    pub fn duals(&self) -> &[f64] {
+        &self.solver.solution.z
     }
 }
 

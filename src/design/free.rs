@@ -24,7 +24,8 @@ use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
 use crate::design::conic::{Cone, ConicData};
 use crate::design::scp::{
-    Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets, solve,
+    Certificate, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets,
+    WarmStart, solve_warm,
 };
 use crate::error::Result;
 use crate::model::dynamics::{linearize_torque, torque_from};
@@ -41,22 +42,34 @@ type CheckPoint = (usize, [f64; 2], [f64; 2], [f64; 2], [[f64; 4]; 3]);
 /// Magnus sub-steps per collocation interval.
 const SUB: usize = 2;
 
-/// The free-form problem for one config.
+/// The free-form problem for one config, in dimensionless units: durations
+/// in units of the available time `T` and torques in units of `I_t / T^2`
+/// (F3), so that the conic data are O(1) for any cat, drop height or limit.
+/// [`FreeProblem::to_scaled`] / [`FreeProblem::to_physical`] convert `z`.
 pub struct FreeProblem {
     pub cat: Cat,
     pub tr: Transcription,
     pub norm: TorqueNorm,
-    pub available: f64,
+    /// Available time, s (the unit of the durations).
+    pub time_unit: f64,
+    /// `I_t / T^2`, N m (the unit of the peak terms).
+    pub torque_unit: f64,
+    /// Shortest phase, in units of the available time.
     pub min_phase: f64,
     pub max_bend: Option<f64>,
+    /// Torque limit in units of `torque_unit`.
     pub max_torque: Option<f64>,
     scales: Vec<f64>,
 }
 
 impl FreeProblem {
+    /// The problem at `nodes` per phase; `z0` (any units of duration) sets
+    /// the trust-region scales of the shape variables.
     pub fn new(cfg: &Config, nodes: usize, z0: &[f64]) -> Self {
         let tr = Transcription::new(3, nodes);
-        let available = cfg.available_time();
+        let time_unit = cfg.available_time();
+        let cat = cfg.cat();
+        let torque_unit = cat.i_t() / (time_unit * time_unit);
         let mut sq = 0.1f64;
         let mut sv = 0.1f64;
         let mut sa = 0.1f64;
@@ -78,18 +91,61 @@ impl FreeProblem {
                     scales[tr.a(p, k) + j] = sa;
                 }
             }
-            scales[tr.duration(p)] = 0.1 * available;
+            scales[tr.duration(p)] = 0.1;
         }
         Self {
-            cat: cfg.cat(),
+            cat,
             tr,
             norm: cfg.norm(),
-            available,
-            min_phase: 0.02 * available,
+            time_unit,
+            torque_unit,
+            min_phase: 0.02,
             max_bend: cfg.limits.max_bend_deg.map(f64::to_radians),
-            max_torque: cfg.limits.max_torque,
+            max_torque: cfg.limits.max_torque.map(|l| l / torque_unit),
             scales,
         }
+    }
+
+    /// Number of flattened peak terms (two per check point).
+    pub fn terms_len(&self) -> usize {
+        3 * 2 * (2 * self.tr.nodes - 1)
+    }
+
+    /// Physical `z` (durations in s) to the problem's units.
+    pub fn to_scaled(&self, z: &[f64]) -> Vec<f64> {
+        self.with_durations_times(z, 1.0 / self.time_unit)
+    }
+
+    /// The problem's `z` to physical units (durations in s).
+    pub fn to_physical(&self, z: &[f64]) -> Vec<f64> {
+        self.with_durations_times(z, self.time_unit)
+    }
+
+    /// The point nearest to `z` (in the trust-region scales) that meets the
+    /// exact constraints: one small QP, so that a sampled seed (or a
+    /// neighbour's solution) is a feasible start.
+    pub fn project(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let mut d = ConicData::new(self.dim());
+        d.p_diag = Some(self.scales.iter().map(|s| 1.0 / (s * s)).collect());
+        self.add_constraints(&mut d, z, &|i| i);
+        let (st, dz, _) = crate::design::conic::ConicSolver::new(&d)?.solve();
+        if !st.ok() {
+            return Err(crate::error::Error::Solver {
+                what: "projecting the free-form seed onto the constraints".into(),
+                status: format!("{st:?}"),
+                hint: "check limits.max_bend_deg and fall.margin (the seed cannot be made to fit them)"
+                    .into(),
+            });
+        }
+        Ok(z.iter().zip(&dz).map(|(a, b)| a + b).collect())
+    }
+
+    fn with_durations_times(&self, z: &[f64], k: f64) -> Vec<f64> {
+        let mut z = z.to_vec();
+        for p in 0..self.tr.phases {
+            z[self.tr.duration(p)] *= k;
+        }
+        z
     }
 
     /// Final attitude of body A and, if asked, the world-frame Jacobian
@@ -177,7 +233,7 @@ impl FreeProblem {
     fn torques(&self, z: &[f64]) -> Vec<f64> {
         let mut out = Vec::with_capacity(12 * self.tr.nodes);
         for p in 0..3 {
-            let t2 = z[self.tr.duration(p)].powi(2);
+            let t2 = z[self.tr.duration(p)].powi(2) * self.cat.i_t();
             for (_, q, v, a, _) in self.check_points(z, p) {
                 let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
                 out.extend(tau.iter().map(|x| x / t2));
@@ -186,12 +242,13 @@ impl FreeProblem {
         out
     }
 
-    /// Physical rate continuity across the two junctions, scaled to radians:
-    /// `T (q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1})`, with its Jacobian.
+    /// Physical rate continuity across the two junctions, in units of the
+    /// available time (radians): `q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1}`,
+    /// with its Jacobian.
     fn rate_continuity(&self, z: &[f64], row0: usize, jac: Option<&mut Triplets>) -> Vec<f64> {
         let tr = &self.tr;
         let n = tr.nodes;
-        let sc = self.available;
+        let sc = 1.0;
         let mut r = Vec::with_capacity(4);
         let mut jac = jac;
         for p in 0..2 {
@@ -212,7 +269,146 @@ impl FreeProblem {
     }
 }
 
+/// `d tau_i / d(q, q^, q^^)` as one row of six.
+fn torque_gradients(cat: &Cat, x: &[f64; 6], terms: Option<&ShapeTerms>) -> [[f64; 6]; 2] {
+    let q = [x[0], x[1]];
+    let owned;
+    let t = match terms {
+        Some(t) => t,
+        None => {
+            owned = ShapeTerms::second(cat, q);
+            &owned
+        }
+    };
+    let l = linearize_torque(t, [x[2], x[3]], [x[4], x[5]]);
+    [0, 1].map(|i| {
+        [
+            l.d_q[i][0],
+            l.d_q[i][1],
+            l.d_qd[i][0],
+            l.d_qd[i][1],
+            l.d_qdd[i][0],
+            l.d_qdd[i][1],
+        ]
+    })
+}
+
+/// `sum_i y_i Hess tau_i` in `(q, q^, q^^)`: central differences of the
+/// exact gradients (the rate and acceleration blocks are polynomial, so
+/// exact up to rounding), symmetrised.
+fn weighted_torque_hessian(cat: &Cat, x: [f64; 6], y: [f64; 2]) -> [[f64; 6]; 6] {
+    let mut g = [[0.0; 6]; 6];
+    let base = ShapeTerms::second(cat, [x[0], x[1]]);
+    for m in 0..6 {
+        let h = 1e-5 * (1.0 + x[m].abs());
+        let (mut xp, mut xm) = (x, x);
+        xp[m] += h;
+        xm[m] -= h;
+        // the shape terms depend on q only
+        let reuse = if m < 2 { None } else { Some(&base) };
+        let (gp, gm) = (
+            torque_gradients(cat, &xp, reuse),
+            torque_gradients(cat, &xm, reuse),
+        );
+        for c in 0..6 {
+            g[m][c] = (0..2)
+                .map(|i| y[i] * (gp[i][c] - gm[i][c]) / (2.0 * h))
+                .sum();
+        }
+    }
+    for a in 0..6 {
+        for b in a + 1..6 {
+            let v = 0.5 * (g[a][b] + g[b][a]);
+            g[a][b] = v;
+            g[b][a] = v;
+        }
+    }
+    g
+}
+
+/// The nearest positive semidefinite matrix (negative eigenvalues clipped).
+fn psd_part(h: nalgebra::SMatrix<f64, 9, 9>) -> nalgebra::SMatrix<f64, 9, 9> {
+    let e = nalgebra::SymmetricEigen::new(h);
+    let d = e.eigenvalues.map(|x| x.max(0.0));
+    e.eigenvectors * nalgebra::SMatrix::<f64, 9, 9>::from_diagonal(&d) * e.eigenvectors.transpose()
+}
+
 impl ScpProblem for FreeProblem {
+    /// Curvature of the peak terms, interval by interval: each check point's
+    /// `y . tau / (I_t T_p^2)` is a function of its interval's eight node
+    /// values and the phase duration; the 9x9 Hessian of the interval's sum
+    /// is clipped to its PSD part (the attitude's curvature is left to the
+    /// driver's second-order correction).
+    fn hessian(&self, z: &[f64], y: &[f64]) -> Triplets {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        let it = self.cat.i_t();
+        let mut out = Vec::with_capacity(3 * (n - 1) * 45);
+        let mut row = 0;
+        for p in 0..3 {
+            let t = z[tr.duration(p)];
+            let (s2, s3, s4) = (
+                1.0 / (t * t * it),
+                -2.0 / (t * t * t * it),
+                6.0 / (t.powi(4) * it),
+            );
+            let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
+            for (k, q, v, a, coef) in self.check_points(z, p) {
+                let w = [y[row], y[row + 1]];
+                row += 2;
+                if w == [0.0, 0.0] {
+                    continue;
+                }
+                let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
+                let g6 = weighted_torque_hessian(&self.cat, x, w);
+                let gr = torque_gradients(&self.cat, &x, None);
+                let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
+                // C: local inputs (kind, component) from the interval's 8 values (component, idx)
+                let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
+                for kind in 0..3 {
+                    for l in 0..2 {
+                        for idx in 0..4 {
+                            c[(2 * kind + l, 4 * l + idx)] = coef[kind][idx];
+                        }
+                    }
+                }
+                let g = nalgebra::SMatrix::<f64, 6, 6>::from_fn(|i, j| g6[i][j]);
+                let hx = c.transpose() * g * c * s2;
+                let grad6 =
+                    nalgebra::SVector::<f64, 6>::from_fn(|i, _| w[0] * gr[0][i] + w[1] * gr[1][i]);
+                let gx = c.transpose() * grad6 * s3;
+                let b = &mut blocks[k];
+                for i in 0..8 {
+                    for j in 0..8 {
+                        b[(i, j)] += hx[(i, j)];
+                    }
+                    b[(i, 8)] += gx[i];
+                    b[(8, i)] += gx[i];
+                }
+                b[(8, 8)] += (w[0] * tau[0] + w[1] * tau[1]) * s4;
+            }
+            for (k, b) in blocks.into_iter().enumerate() {
+                let b = psd_part(b);
+                let mut cols = [0usize; 9];
+                for l in 0..2 {
+                    let ic = tr.interval_columns(p, k, l);
+                    for idx in 0..4 {
+                        cols[4 * l + idx] = ic[idx];
+                    }
+                }
+                cols[8] = tr.duration(p);
+                for i in 0..9 {
+                    for j in 0..9 {
+                        if cols[i] <= cols[j] {
+                            out.push((cols[i], cols[j], b[(i, j)]));
+                        }
+                    }
+                }
+            }
+        }
+        out
+    }
+
     fn dim(&self) -> usize {
         self.tr.dim()
     }
@@ -230,8 +426,7 @@ impl ScpProblem for FreeProblem {
     }
 
     fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let mut r = self.tr.defects(z, 0, None);
-        r.extend(self.rate_continuity(z, r.len(), None));
+        let mut r = self.rate_continuity(z, 0, None);
         let (rf, _) = self.attitude(z, false);
         r.extend(Self::attitude_error(&rf).iter());
         (self.torques(z), r)
@@ -240,9 +435,7 @@ impl ScpProblem for FreeProblem {
     fn linearize(&self, z: &[f64]) -> Linearization {
         let tr = &self.tr;
         let mut rj: Triplets = Vec::new();
-        let mut residual = tr.defects(z, 0, Some(&mut rj));
-        let more = self.rate_continuity(z, residual.len(), Some(&mut rj));
-        residual.extend(more);
+        let mut residual = self.rate_continuity(z, 0, Some(&mut rj));
         let (rf, g) = self.attitude(z, true);
         let e = Self::attitude_error(&rf);
         let je = right_jacobian_inv(&e) * rf.transpose();
@@ -258,7 +451,8 @@ impl ScpProblem for FreeProblem {
         let mut tj: Triplets = Vec::new();
         for p in 0..3 {
             let t = z[tr.duration(p)];
-            let (s2, s3) = (1.0 / (t * t), -2.0 / (t * t * t));
+            let it = self.cat.i_t();
+            let (s2, s3) = (1.0 / (t * t * it), -2.0 / (t * t * t * it));
             for (k, q, v, a, coef) in self.check_points(z, p) {
                 // normalised-time inverse dynamics; physical torque = tau^ / T^2
                 let lin = linearize_torque(&ShapeTerms::second(&self.cat, q), v, a);
@@ -310,11 +504,22 @@ impl ScpProblem for FreeProblem {
                 }
             }
         }
+        // the collocation defects are linear: exact, D (z + dz) = 0
+        let mut dj = Vec::new();
+        let dz = tr.defects(z, 0, Some(&mut dj));
+        let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); dz.len()];
+        for (r, c, v) in dj {
+            rows[r].push((var(c), v));
+        }
+        for (row, r) in rows.iter().zip(&dz) {
+            d.row(row, -r);
+        }
+        zero += dz.len();
         d.cone(Cone::Zero(zero));
         // total time within the fall; each phase at least min_phase
         let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
         let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
-        d.row(&durs, self.available - total);
+        d.row(&durs, 1.0 - total);
         for p in 0..3 {
             d.row(
                 &[(var(tr.duration(p)), -1.0)],
@@ -367,7 +572,18 @@ pub struct FreeResult {
     pub scp_iterations: usize,
     pub nodes: usize,
     pub solve_time_s: f64,
+    /// The stopping rule's numbers at the end point.
+    pub certificate: Certificate,
+    /// Mesh-refinement check: the same design re-optimised at twice the nodes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mesh_check: Option<MeshCheck>,
     pub iterations: Vec<ScpIteration>,
+    /// The solution in the problem's units and the SCP's end state (a warm
+    /// start for a neighbour).
+    #[serde(skip)]
+    pub z_scaled: Vec<f64>,
+    #[serde(skip)]
+    pub warm: WarmStart,
     #[serde(skip)]
     pub plan: CollocationPlan,
     /// The dynamic simulation the reported flip, tilt and peak come from.
@@ -399,32 +615,92 @@ pub fn optimize_from(
     nodes: usize,
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
-    let start = std::time::Instant::now();
     let tr = Transcription::new(3, nodes);
-    let mut z0 = tr.sample(seed_plan);
-    // fit the seed into the available time (F3 time scaling of the same path)
+    optimize_start(cfg, &tr.sample(seed_plan), None, seed, nodes, observe)
+}
+
+/// An SCP solution before verification.
+struct Solved {
+    /// With `z` in physical units and peaks in N m.
+    res: crate::design::scp::ScpResult,
+    z_scaled: Vec<f64>,
+    plan: CollocationPlan,
+    attitude_error: f64,
+}
+
+/// The SCP from a start `z0` in physical units (durations in s) at `nodes`
+/// per phase: the durations are fitted into the available time (F3 time
+/// scaling of the same path) and the start is projected onto the exact
+/// constraints (ends at rest, continuity, defects, bend limit), so that every
+/// subproblem is feasible at `dz = 0`.
+fn design(
+    cfg: &Config,
+    z0: &[f64],
+    warm: Option<&WarmStart>,
+    nodes: usize,
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<Solved> {
+    check_resolvable(cfg, nodes)?;
+    let tr = Transcription::new(3, nodes);
+    let problem = FreeProblem::new(cfg, nodes, z0);
+    let mut z0 = problem.to_scaled(z0);
     let total: f64 = (0..3).map(|p| z0[tr.duration(p)]).sum();
-    if total > cfg.available_time() {
-        let k = cfg.available_time() / total;
+    if total > 1.0 {
         for p in 0..3 {
-            z0[tr.duration(p)] *= k;
+            z0[tr.duration(p)] /= total;
         }
     }
-    let problem = FreeProblem::new(cfg, nodes, &z0);
+    let z0 = problem.project(&z0)?;
     let settings = ScpSettings {
         max_iterations: cfg.free.max_iterations,
         tolerance: cfg.free.tolerance,
         feasibility: cfg.free.attitude_tolerance,
         ..Default::default()
     };
-    let res = solve(&problem, z0, &settings, observe)?;
-    let solve_time = start.elapsed().as_secs_f64();
+    let unit = problem.torque_unit;
+    let warm = warm.filter(|w| w.multipliers.len() == problem.terms_len());
+    let mut res = solve_warm(&problem, z0, warm, &settings, |it| {
+        observe(&it.in_units(unit))
+    })?;
+    for it in res.iterations.iter_mut() {
+        *it = it.in_units(unit);
+    }
+    res.peak *= unit;
     let (rf, _) = problem.attitude(&res.z, false);
-    let att = FreeProblem::attitude_error(&rf).norm();
+    let attitude_error = FreeProblem::attitude_error(&rf).norm();
+    let z_scaled = std::mem::take(&mut res.z);
+    res.z = problem.to_physical(&z_scaled);
     let plan = CollocationPlan {
         tr,
         z: res.z.clone(),
     };
+    Ok(Solved {
+        res,
+        z_scaled,
+        plan,
+        attitude_error,
+    })
+}
+
+/// Runs the SCP from a start `z0` in physical units (see [`design`]) and
+/// verifies the schedule by simulation.
+pub fn optimize_start(
+    cfg: &Config,
+    z0: &[f64],
+    warm: Option<&WarmStart>,
+    seed: &str,
+    nodes: usize,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    let start = std::time::Instant::now();
+    let Solved {
+        res,
+        z_scaled,
+        plan,
+        attitude_error: att,
+    } = design(cfg, z0, warm, nodes, observe)?;
+    let tr = plan.tr;
+    let solve_time = start.elapsed().as_secs_f64();
     let (peak, _) =
         crate::verify::analyze::peak_along(cfg, &plan, crate::verify::analyze::dense_samples(cfg));
     // a limit that the design breaks fails before any simulation is spent on it
@@ -472,9 +748,116 @@ pub fn optimize_from(
         scp_iterations: res.iterations.len(),
         nodes,
         solve_time_s: solve_time,
+        certificate: res.certificate,
+        mesh_check: None,
+        z_scaled,
+        warm: res.warm.clone(),
         iterations: res.iterations,
         plan,
         sim,
+    })
+}
+
+/// Continuation: the free-form design for `cfg` started from a neighbouring
+/// design `prev` (another point of a sweep). The start is `prev`'s solution
+/// in dimensionless units, so a change of drop height, margin or gravity
+/// (F3) starts exactly at the optimum, and a change of the cat or limits
+/// starts next to it.
+pub fn continue_from(
+    cfg: &Config,
+    prev: &FreeResult,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    let nodes = cfg.free.nodes;
+    let tr = Transcription::new(3, nodes);
+    let mut z0 = if prev.nodes == nodes {
+        prev.z_scaled.clone()
+    } else {
+        let mut z = tr.sample(&prev.plan);
+        let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        for p in 0..3 {
+            z[tr.duration(p)] /= total;
+        }
+        z
+    };
+    for p in 0..3 {
+        z0[tr.duration(p)] *= cfg.available_time();
+    }
+    optimize_start(cfg, &z0, Some(&prev.warm), "continuation", nodes, observe)
+}
+
+/// Turns of the bend direction the mesh resolves: sixteen nodes per turn.
+const NODES_PER_TURN: f64 = 16.0;
+
+/// Twist coefficient `C` of F1 at bend `b` (no-twist joint; for the
+/// universal joint an estimate, F4).
+fn twist_coefficient(cat: &Cat, b: f64) -> f64 {
+    let (it, ia) = (cat.i_t(), cat.i_a());
+    let (s, c) = ((b / 2.0).sin(), (b / 2.0).cos());
+    1.0 - ia * c / (it * s * s + ia * c * c)
+}
+
+/// Fails fast when the bend limit is so small that the flip needs more
+/// turns of the bend direction (F1, F6: `n = 1 / (2 C)`) than `nodes` per
+/// phase can resolve, naming the bend (and the nodes) that would do.
+pub fn check_resolvable(cfg: &Config, nodes: usize) -> Result<()> {
+    let cat = cfg.cat();
+    let b = cfg.max_bend();
+    let turns = 1.0 / (2.0 * twist_coefficient(&cat, b));
+    let most = 3.0 * nodes as f64 / NODES_PER_TURN;
+    if turns <= most {
+        return Ok(());
+    }
+    // C grows with the bend: bisect for the bend at which `most` turns do
+    let (mut lo, mut hi) = (b, std::f64::consts::PI * 0.99);
+    for _ in 0..60 {
+        let mid = 0.5 * (lo + hi);
+        if 1.0 / (2.0 * twist_coefficient(&cat, mid)) > most {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Err(crate::error::Error::Unreachable {
+        reason: format!(
+            "at a largest bend of {:.3} deg the flip needs about {turns:.0} turns of the bend direction (F1, F6), more than {nodes} nodes per phase resolve ({most:.0}); set limits.max_bend_deg to at least {:.2} (or free.nodes to at least {:.0})",
+            b.to_degrees(),
+            (hi.to_degrees() * 100.0).ceil() / 100.0,
+            (turns * NODES_PER_TURN / 3.0).ceil()
+        ),
+    })
+}
+
+/// Mesh-refinement check: the design re-optimised at twice the nodes per
+/// phase, warm-started from the coarse solution.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeshCheck {
+    pub nodes: usize,
+    pub status: ScpStatus,
+    pub scp_iterations: usize,
+    /// Dense peak of the refined design, N m.
+    pub peak_torque_nm: f64,
+    /// `(coarse - refined) / refined` dense peak.
+    pub relative_change: f64,
+}
+
+/// Re-optimises `r` at twice its nodes per phase (warm start: the coarse
+/// schedule sampled on the fine mesh).
+pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
+    let nodes = 2 * r.nodes;
+    let z0 = Transcription::new(3, nodes).sample(&r.plan);
+    let fine = design(cfg, &z0, None, nodes, |_| {})?;
+    let (peak, _) = crate::verify::analyze::peak_along(
+        cfg,
+        &fine.plan,
+        crate::verify::analyze::dense_samples(cfg),
+    );
+    Ok(MeshCheck {
+        nodes,
+        status: fine.res.status,
+        scp_iterations: fine.res.iterations.len(),
+        peak_torque_nm: peak,
+        relative_change: (r.peak_torque_nm - peak) / peak,
     })
 }
 
@@ -484,7 +867,8 @@ pub fn optimize(
     seed: Seed,
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
-    match seed {
+    check_resolvable(cfg, cfg.free.nodes)?;
+    let mut r = match seed {
         Seed::Phased => {
             let ph = crate::design::phased::optimize(cfg, |_| {})?;
             optimize_from(cfg, &ph.plan, seed.name(), cfg.free.nodes, observe)
@@ -496,5 +880,69 @@ pub fn optimize(
             cfg.free.nodes,
             observe,
         ),
+    }?;
+    r.mesh_check = Some(mesh_check(cfg, &r)?);
+    Ok(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn torque_hessian_matches_second_differences_of_the_inverse_dynamics() {
+        for joint in [crate::model::Joint::NoTwist, crate::model::Joint::Universal] {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+            let cfg = Config::load(
+                std::path::Path::new(path),
+                &[format!("cat.joint={}", joint.name())],
+            )
+            .unwrap();
+            let cat = cfg.cat();
+            let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
+            let y = [0.8, -1.3];
+            let g = weighted_torque_hessian(&cat, x, y);
+            let f = |x: [f64; 6]| {
+                let t = inverse_dynamics_at(&cat, x);
+                y[0] * t[0] + y[1] * t[1]
+            };
+            let h = 1e-4;
+            for i in 0..6 {
+                for j in 0..6 {
+                    let at = |si: f64, sj: f64| {
+                        let mut z = x;
+                        z[i] += si * h;
+                        z[j] += sj * h;
+                        f(z)
+                    };
+                    let fd = (at(1.0, 1.0) - at(1.0, -1.0) - at(-1.0, 1.0) + at(-1.0, -1.0))
+                        / (4.0 * h * h);
+                    assert!(
+                        (fd - g[i][j]).abs() < 1e-5 * (1.0 + fd.abs()),
+                        "{joint:?} ({i}, {j}): {fd} vs {}",
+                        g[i][j]
+                    );
+                }
+            }
+        }
+    }
+
+    fn inverse_dynamics_at(cat: &Cat, x: [f64; 6]) -> [f64; 2] {
+        crate::model::dynamics::inverse_dynamics(cat, [x[0], x[1]], [x[2], x[3]], [x[4], x[5]])
+    }
+
+    #[test]
+    fn psd_part_clips_negative_curvature_only() {
+        let a = nalgebra::SMatrix::<f64, 9, 9>::from_fn(|i, j| ((i * 7 + j * 3) % 5) as f64 - 2.0);
+        let sym = a + a.transpose();
+        let p = psd_part(sym);
+        let e = nalgebra::SymmetricEigen::new(p).eigenvalues;
+        assert!(e.iter().all(|&v| v > -1e-12));
+        // a PSD matrix is its own PSD part
+        let q = a * a.transpose();
+        assert!((psd_part(q) - q).norm() < 1e-10 * q.norm());
+        // and the clipped part is PSD with sym - p negative semidefinite
+        let n = nalgebra::SymmetricEigen::new(sym - p).eigenvalues;
+        assert!(n.iter().all(|&v| v < 1e-12));
     }
 }

@@ -15,9 +15,13 @@
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
 //! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
 //! halves when `rho < 0.1` and doubles when `rho > 0.5`.
-//! Stop: predicted decrease below `tolerance * phi` with `max |r| <= feasibility`
-//! (converged); the penalty grows tenfold when the model stalls while still
-//! infeasible; an iteration limit or a collapsed trust region end the run.
+//! Stop: criticality (the predicted decrease at unit radius relative to
+//! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
+//! that fell by less than `tolerance` (relative) per iteration on average
+//! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
+//! names the rule); the penalty grows tenfold when the
+//! model stalls while still infeasible; an iteration limit or a collapsed
+//! trust region (stalled) end the run.
 
 use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::error::{Error, Result};
@@ -60,6 +64,14 @@ pub trait ScpProblem {
     fn peak_limit(&self) -> Option<f64> {
         None
     }
+    /// Second-order information: a positive semidefinite approximation of
+    /// `sum_r y_r Hess f_r(z)` (`y` one multiplier per flattened term), as
+    /// upper-triangle triplets with a pattern that does not depend on `z` or
+    /// `y`. The default (none) makes the method sequential linear
+    /// programming; with it, the subproblem is an SQP step.
+    fn hessian(&self, _z: &[f64], _y: &[f64]) -> Triplets {
+        Vec::new()
+    }
 }
 
 /// Driver settings; defaults in each field's doc.
@@ -67,12 +79,16 @@ pub trait ScpProblem {
 pub struct ScpSettings {
     /// Iteration limit (default 150).
     pub max_iterations: usize,
-    /// Converged when the predicted decrease is below this fraction of the merit (default 1e-4).
+    /// Converged when the criticality (predicted decrease at unit trust radius
+    /// relative to the merit) is below this (default 1e-4).
     pub tolerance: f64,
     /// Largest `|r|` accepted as feasible (default 1e-6).
     pub feasibility: f64,
     /// Initial trust radius in scaled units (default 0.5).
     pub initial_radius: f64,
+    /// Iterations over which the merit must fall by `tolerance` (relative)
+    /// per iteration on average to keep going (default 10).
+    pub window: usize,
     /// Penalty weight relative to the initial peak (default 2): the exact L1
     /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
     /// model more curved and the steps shorter. It grows tenfold when needed.
@@ -86,6 +102,7 @@ impl Default for ScpSettings {
             tolerance: 1e-4,
             feasibility: 1e-6,
             initial_radius: 0.5,
+            window: 10,
             weight: 2.0,
         }
     }
@@ -108,7 +125,33 @@ pub struct ScpIteration {
     pub accepted: bool,
     /// Merit after the iteration (equal to `merit` when rejected).
     pub merit_after: f64,
+    /// Largest scaled component of the trial step `|dz_i| / scale_i`.
+    pub step: f64,
     pub solve_ms: f64,
+}
+
+impl ScpIteration {
+    /// First-order criticality: the model decrease at unit trust radius,
+    /// relative to the merit, bounded above by `predicted / min(radius, 1)`
+    /// (the model's optimal value is convex in the radius, so the predicted
+    /// decrease is concave in it). Unlike the raw predicted decrease it does
+    /// not vanish merely because the trust region has shrunk.
+    pub fn criticality(&self) -> f64 {
+        self.predicted.max(0.0) / self.merit.abs().max(1e-300) / self.radius.min(1.0)
+    }
+
+    /// The record with its peak-valued fields (merit, peak, decreases,
+    /// weight) multiplied by `unit`: problems solved in scaled units report
+    /// physical ones.
+    pub fn in_units(mut self, unit: f64) -> Self {
+        self.merit *= unit;
+        self.peak *= unit;
+        self.weight *= unit;
+        self.predicted *= unit;
+        self.actual *= unit;
+        self.merit_after *= unit;
+        self
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -120,6 +163,41 @@ pub enum ScpStatus {
     Stalled,
 }
 
+/// Why the user may trust the end point: the numbers the stopping rule
+/// looked at, at the last iteration.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct Certificate {
+    /// Largest scaled component of the last step taken (`|dz_i| / scale_i`).
+    pub step: f64,
+    /// Largest equality-constraint violation `max |r(z)|` at the end point.
+    pub constraint_violation: f64,
+    /// The method's optimality measure, [`ScpIteration::criticality`] of the
+    /// last iteration (zero exactly at a KKT point of the penalised problem;
+    /// converged below `tolerance`).
+    pub criticality: f64,
+    /// Trust-region radius at the end (scaled units).
+    pub radius: f64,
+    /// Penalty weight at the end, relative to the objective's scale.
+    pub weight: f64,
+    /// Which test ended a converged run.
+    pub rule: StopRule,
+}
+
+/// The test that declared convergence (both need `max |r| <= feasibility`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum StopRule {
+    /// Not converged.
+    #[default]
+    None,
+    /// Criticality below `tolerance`: a first-order point of the model.
+    Criticality,
+    /// The merit fell by less than `tolerance` (relative) per iteration on
+    /// average over the last `window` iterations: no further progress at
+    /// this tolerance.
+    Progress,
+}
+
 #[derive(Debug, Clone)]
 pub struct ScpResult {
     pub z: Vec<f64>,
@@ -127,6 +205,8 @@ pub struct ScpResult {
     pub peak: f64,
     pub infeasibility: f64,
     pub iterations: Vec<ScpIteration>,
+    pub certificate: Certificate,
+    pub warm: WarmStart,
 }
 
 fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
@@ -155,7 +235,9 @@ fn subproblem(
     scales: &[f64],
     radius: f64,
     w: f64,
-) -> ConicData {
+    phi: f64,
+    y: &[f64],
+) -> (ConicData, TermRows) {
     let n = p.dim();
     let m = lin.residual.len();
     let (t, np, nm) = (n, n + 1, n + 1 + m);
@@ -171,6 +253,8 @@ fn subproblem(
         p_diag[i] = 1e-9 / (scales[i] * scales[i]);
     }
     d.p_diag = Some(p_diag);
+    d.p_upper = p.hessian(z, y);
+    let mut term_rows: TermRows = vec![Vec::new(); lin.terms.len()];
     // linearised equalities with virtual control: r + J dz - nu+ + nu- = 0
     let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
     for &(r, c, v) in &lin.residual_jac {
@@ -197,7 +281,8 @@ fn subproblem(
                 for j in 0..dim {
                     let r = k * dim + j;
                     let row: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
-                    d.row(&row, lin.terms[r]);
+                    // s = f + J dz: the Lagrangian holds -z_row f
+                    term_rows[r].push((d.row(&row, lin.terms[r]), -1.0));
                 }
                 d.cone(Cone::Soc(dim + 1));
             }
@@ -206,10 +291,10 @@ fn subproblem(
             for r in 0..lin.terms.len() {
                 let mut up = jac[r].clone();
                 up.push((t, -1.0));
-                d.row(&up, -lin.terms[r]);
+                term_rows[r].push((d.row(&up, -lin.terms[r]), 1.0));
                 let mut down: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
                 down.push((t, -1.0));
-                d.row(&down, lin.terms[r]);
+                term_rows[r].push((d.row(&down, lin.terms[r]), -1.0));
             }
             d.cone(Cone::Nonneg(2 * lin.terms.len()));
         }
@@ -224,12 +309,19 @@ fn subproblem(
     }
     let mut rows = 2 * m + 2 * n;
     if let Some(lim) = p.peak_limit() {
-        d.row(&[(t, 1.0)], lim);
+        // dz = 0 is feasible with model value phi(z), so t <= phi(z) at the
+        // subproblem's optimum: a bound above 10 phi never binds, and a huge
+        // one (1e12) would only wreck the interior-point scaling
+        d.row(&[(t, 1.0)], lim.min(10.0 * phi));
         rows += 1;
     }
     d.cone(Cone::Nonneg(rows));
-    d
+    (d, term_rows)
 }
+
+/// For each flattened term, the subproblem rows it appears in and the sign
+/// with which the row's dual multiplies the term in the Lagrangian.
+type TermRows = Vec<Vec<(usize, f64)>>;
 
 /// Second-order correction at the trial point `z+ = z + dz`: the least
 /// scaled-norm `dc` with `J dc = (r + J dz) - r(z+)` (back onto the model's
@@ -277,12 +369,14 @@ fn iterate(
     iteration: usize,
     scales: &[f64],
     solvers: &mut Solvers,
+    y: &mut Vec<f64>,
 ) -> Result<(ScpIteration, Vec<f64>)> {
     let (phi, peak, inf) = merit(p, z, w);
     let lin = p.linearize(z);
-    let data = subproblem(p, z, &lin, scales, radius, w);
+    y.resize(lin.terms.len(), 0.0);
+    let (data, term_rows) = subproblem(p, z, &lin, scales, radius, w, phi, y);
     let clock = Instant::now();
-    let (st, x, _) = solve_reusing(&mut solvers.subproblem, &data)?;
+    let (st, x, obj) = solve_reusing(&mut solvers.subproblem, &data)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
     if !st.ok() {
         if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
@@ -298,8 +392,15 @@ fn iterate(
         });
     }
     let (n, m) = (p.dim(), lin.residual.len());
-    let model = x[n] + w * x[n + 1..n + 1 + 2 * m].iter().sum::<f64>();
-    let predicted = phi - model;
+    // the peak terms' multipliers, for the next subproblem's curvature
+    if let Some(sv) = &solvers.subproblem {
+        let dual = sv.duals();
+        for (yr, rows) in y.iter_mut().zip(&term_rows) {
+            *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+        }
+    }
+    // model value: t + w |nu|_1 + 1/2 dz' P dz (the solver's objective)
+    let predicted = phi - obj;
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let (mut phi_t, _, _) = merit(p, &trial, w);
     if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
@@ -319,6 +420,11 @@ fn iterate(
             }
         }
     }
+    let step = trial
+        .iter()
+        .zip(z)
+        .zip(scales)
+        .fold(0.0f64, |m, ((a, b), s)| m.max((a - b).abs() / s));
     let actual = phi - phi_t;
     let rho = if predicted > 0.0 {
         actual / predicted
@@ -338,6 +444,7 @@ fn iterate(
         rho,
         accepted,
         merit_after: if accepted { phi_t } else { phi },
+        step,
         solve_ms,
     };
     Ok((rec, trial))
@@ -349,18 +456,43 @@ pub fn solve(
     p: &dyn ScpProblem,
     z0: Vec<f64>,
     settings: &ScpSettings,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<ScpResult> {
+    solve_warm(p, z0, None, settings, observe)
+}
+
+/// What a finished solve hands to a neighbouring problem (continuation):
+/// its peak-term multipliers (the curvature of the first subproblem) and its
+/// final trust radius.
+#[derive(Debug, Clone, Default)]
+pub struct WarmStart {
+    pub multipliers: Vec<f64>,
+    pub radius: f64,
+}
+
+/// [`solve`] with the multipliers and radius of a neighbouring solve.
+pub fn solve_warm(
+    p: &dyn ScpProblem,
+    z0: Vec<f64>,
+    warm: Option<&WarmStart>,
+    settings: &ScpSettings,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<ScpResult> {
     let scales = p.scales();
     let mut z = z0;
     let (_, peak0, _) = merit(p, &z, 0.0);
     let mut w = settings.weight * peak0.max(1e-12);
-    let mut radius = settings.initial_radius;
+    let mut radius = warm.map_or(settings.initial_radius, |w| {
+        w.radius.clamp(1e-3, settings.initial_radius)
+    });
     let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
+    let mut y = warm.map_or_else(Vec::new, |w| w.multipliers.clone());
+    let mut window = Vec::new();
+    let mut rule = StopRule::None;
     for it in 0..settings.max_iterations {
-        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers)?;
+        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut y)?;
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
@@ -371,30 +503,53 @@ pub fn solve(
         } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
-        let (_, _, inf_now) = merit(p, &z, w);
-        if rec.predicted <= settings.tolerance * rec.merit.abs().max(1e-300) {
+        let (phi_now, _, inf_now) = merit(p, &z, w);
+        window.push(phi_now);
+        let critical = rec.criticality() <= settings.tolerance;
+        // the merit fell by less than `tolerance` (relative) per iteration,
+        // on average over the window
+        let slow = window.len() > settings.window
+            && window[window.len() - 1 - settings.window] - phi_now
+                <= settings.tolerance * settings.window as f64 * phi_now.abs();
+        if critical || slow {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
+                rule = if critical {
+                    StopRule::Criticality
+                } else {
+                    StopRule::Progress
+                };
                 break;
             }
             // stuck infeasible: the penalty is too weak
             w *= 10.0;
+            window.clear();
         }
         if radius < 1e-10 {
-            status = if inf_now <= settings.feasibility {
-                ScpStatus::Converged
-            } else {
-                ScpStatus::Stalled
-            };
+            status = ScpStatus::Stalled;
             break;
         }
     }
     let (_, peak, infeasibility) = merit(p, &z, w);
+    let last = iterations.last().copied();
+    let certificate = Certificate {
+        step: last.map_or(0.0, |l| l.step),
+        constraint_violation: infeasibility,
+        criticality: last.map_or(0.0, |l| l.criticality()),
+        radius,
+        weight: w / peak0.max(1e-12),
+        rule,
+    };
     Ok(ScpResult {
         z,
         status,
         peak,
         infeasibility,
         iterations,
+        certificate,
+        warm: WarmStart {
+            multipliers: y,
+            radius,
+        },
     })
 }

@@ -1,0 +1,114 @@
+//! Sweeps: continuation chunks, shards through the real binary, progress.
+
+use catflip::sweep::{CHUNK, Shard, progress_line};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn configs() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
+}
+
+fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into(),
+        String::from_utf8_lossy(&o.stderr).into(),
+    )
+}
+
+#[test]
+fn shards_partition_the_grid_into_whole_contiguous_chunks() {
+    for total in 0..50 {
+        for count in 1..8 {
+            let mut next = 0;
+            for index in 1..=count {
+                let r = Shard { index, count }.points(total);
+                assert_eq!(r.start, next, "{total} points, {index}/{count}");
+                assert!(r.start % CHUNK == 0 || r.start == total);
+                next = r.end;
+            }
+            assert_eq!(next, total, "{total} points in {count} shards");
+        }
+    }
+    for bad in ["0/3", "4/3", "3", "a/b", "1/0"] {
+        assert!(bad.parse::<Shard>().is_err(), "{bad}");
+    }
+    assert_eq!(
+        "2/5".parse::<Shard>().unwrap(),
+        Shard { index: 2, count: 5 }
+    );
+}
+
+#[test]
+fn progress_line_estimates_the_time_left_from_the_mean_time_per_point() {
+    // 10 of 40 points in 20 s: 2 s a point, 30 points left
+    let l = progress_line("fall.height", 10, 40, 20.0);
+    assert!(l.contains("10/40") && l.contains("ETA 60 s"), "{l}");
+    assert!(
+        l.contains(&format!("[{}{}]", "#".repeat(6), ".".repeat(18))),
+        "{l}"
+    );
+    assert!(progress_line("k", 0, 3, 0.0).contains("ETA -"));
+}
+
+/// The shards' CSVs, joined with one header, are byte for byte the
+/// single-machine CSV (continuation included: 11 points are two chunks).
+#[test]
+fn sharded_sweep_concatenates_into_the_single_machine_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let c = cfg.to_str().unwrap();
+    let common = [
+        "sweep",
+        c,
+        "--set-range",
+        "cat.radius=0.06:0.14:11",
+        "--methods",
+        "phased,free",
+        "--set",
+        "free.nodes=10",
+        "--set",
+        "phased.nodes=12",
+    ];
+    let mut args = common.to_vec();
+    args.extend(["--threads", "2", "--out", "full"]);
+    let (ok, _, err) = run(&args, dir.path());
+    assert!(ok, "{err}");
+    let full = std::fs::read_to_string(
+        dir.path()
+            .join("full/seed/sweep-cat_radius/sweep-cat_radius.csv"),
+    )
+    .unwrap();
+    assert_eq!(full.lines().count(), 12);
+    let mut joined = String::new();
+    for k in 1..=3 {
+        let mut args = common.to_vec();
+        let shard = format!("{k}/3");
+        args.extend(["--threads", "1", "--shard", &shard, "--out", "shards"]);
+        let (ok, _, err) = run(&args, dir.path());
+        assert!(ok, "{err}");
+        let part = std::fs::read_to_string(dir.path().join(format!(
+            "shards/seed/sweep-cat_radius.shard-{k}-of-3/sweep-cat_radius.shard-{k}-of-3.csv"
+        )))
+        .unwrap();
+        let skip = if k == 1 { 0 } else { 1 };
+        for line in part.lines().skip(skip) {
+            joined.push_str(line);
+            joined.push('\n');
+        }
+    }
+    assert_eq!(joined, full);
+    // every point converged or its failure recorded
+    for line in full.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let (status, error) = (cells[cells.len() - 2], cells[cells.len() - 1]);
+        assert!(!status.is_empty() || !error.is_empty(), "{line}");
+    }
+    let (ok, _, err) = run(&[&common[..], &["--shard", "4/3"]].concat(), dir.path());
+    assert!(!ok && err.contains("--shard"), "{err}");
+}
