@@ -29,7 +29,7 @@ fn shards_partition_the_grid_into_whole_contiguous_chunks() {
             for index in 1..=count {
                 let r = Shard { index, count }.points(total);
                 assert_eq!(r.start, next, "{total} points, {index}/{count}");
-                assert!(r.start % CHUNK == 0 || r.start == total);
+                assert!(r.start.is_multiple_of(CHUNK) || r.start == total);
                 next = r.end;
             }
             assert_eq!(next, total, "{total} points in {count} shards");
