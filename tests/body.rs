@@ -2,10 +2,8 @@
 //! own velocities, the relabelling symmetry, and identical halves as before.
 
 use catflip::Config;
-use catflip::design::analytic::analytic_plan;
 use catflip::design::phased::optimize;
-use catflip::design::plan::ShapePlan;
-use catflip::model::dynamics::{inverse_dynamics, kinetic_energy};
+use catflip::model::dynamics::kinetic_energy;
 use catflip::model::{Cat, Half};
 use nalgebra::{Matrix3, Rotation3, Vector3};
 
@@ -95,36 +93,7 @@ fn unequal_halves_zero_momentum_and_kinetic_energy_from_the_bodies() {
     }
 }
 
-#[test]
-fn unequal_halves_power_balance_along_a_schedule() {
-    for joint in ["no-twist", "universal"] {
-        let mut ov = UNEQUAL.to_vec();
-        let j = format!("cat.joint={joint}");
-        ov.push(&j);
-        let cfg = seed(&ov);
-        let cat = cfg.cat();
-        let p = analytic_plan(&cfg);
-        let b = p.phase_bounds();
-        let h = 1e-6;
-        for i in 0..3 {
-            for k in 1..10 {
-                let t = b[i] + (b[i + 1] - b[i]) * k as f64 / 10.0;
-                let e = |t: f64| {
-                    let s = p.state_in(i, t);
-                    kinetic_energy(&cat, s.q, s.qd)
-                };
-                let dtdt = (e(t + h) - e(t - h)) / (2.0 * h);
-                let s = p.state_in(i, t);
-                let tau = inverse_dynamics(&cat, s.q, s.qd, s.qdd);
-                let power = tau[0] * s.qd[0] + tau[1] * s.qd[1];
-                assert!(
-                    (dtdt - power).abs() < 1e-5 * (1.0 + power.abs()),
-                    "{joint} phase {i}: {dtdt} vs {power}"
-                );
-            }
-        }
-    }
-}
+// power balance with unequal halves: tests/foundation.rs, power_balance_dt_dt_equals_tau_dot_qdot
 
 #[test]
 fn identical_front_table_reproduces_the_symmetric_cat() {

@@ -114,8 +114,20 @@ fn f3_time_scaling_multiplies_torque_by_k_squared() {
 
 #[test]
 fn power_balance_dt_dt_equals_tau_dot_qdot() {
-    for joint in ["no-twist", "universal"] {
-        let cfg = seed(&[&format!("cat.joint={joint}")]);
+    // identical halves, and unequal ones (a heavy short rear, a long thin front)
+    let unequal = [
+        "cat.front.mass=0.4",
+        "cat.front.length=1.4",
+        "cat.front.radius=0.05",
+    ];
+    for (joint, front) in [
+        ("no-twist", &[][..]),
+        ("universal", &[][..]),
+        ("no-twist", &unequal[..]),
+        ("universal", &unequal[..]),
+    ] {
+        let j = format!("cat.joint={joint}");
+        let cfg = seed(&[&[j.as_str()][..], front].concat());
         let cat = cfg.cat();
         let p = analytic_plan(&cfg);
         let b = p.phase_bounds();
