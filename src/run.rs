@@ -513,7 +513,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         ("shape_path.svg", report::shape_path(&traces)),
     ];
     if !iterations.is_empty() {
-        figures.push(("convergence.svg", report::convergence(&iterations)));
+        figures.push((
+            "convergence.svg",
+            report::convergence(&iterations, cfg.design.objective),
+        ));
     }
     let mut notes = notes_early;
     let figures: Vec<(&str, String)> = figures
