@@ -104,6 +104,8 @@ impl FreeProblem {
                 }
             }
         }
+        let manoeuvre =
+            ((0..3).map(|p| z0[tr.duration(p)]).sum::<f64>() / time_unit).clamp(1e-3, 1.0);
         let mut scales = vec![0.0; tr.dim()];
         for p in 0..3 {
             for k in 0..nodes {
@@ -113,7 +115,9 @@ impl FreeProblem {
                     scales[tr.a(p, k) + j] = sa;
                 }
             }
-            scales[tr.duration(p)] = 0.1;
+            // a tenth of the start's manoeuvre (in units of the available
+            // time): slowing the whole problem down scales every step alike
+            scales[tr.duration(p)] = 0.1 * manoeuvre;
         }
         Self {
             cat,
@@ -121,7 +125,7 @@ impl FreeProblem {
             norm: cfg.norm(),
             time_unit,
             torque_unit,
-            min_phase: 0.02,
+            min_phase: 0.02 * manoeuvre,
             max_bend: cfg.limits.max_bend_deg.map(f64::to_radians),
             // without a torque-speed line, a limit above the cap can never bind
             max_torque: cfg
@@ -396,26 +400,29 @@ impl FreeProblem {
         (terms, limited)
     }
 
-    /// Physical rate continuity across the two junctions, in units of the
-    /// available time (radians): `q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1}`,
+    /// Physical rate continuity across the two junctions, in radians (the
+    /// rate jump times the two phases' mean duration, so that the residual
+    /// does not change when the whole manoeuvre is slowed down):
+    /// `m (q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1})`, `m = (T_p + T_{p+1}) / 2`,
     /// with its Jacobian.
     fn rate_continuity(&self, z: &[f64], row0: usize, jac: Option<&mut Triplets>) -> Vec<f64> {
         let tr = &self.tr;
         let n = tr.nodes;
-        let sc = 1.0;
         let mut r = Vec::with_capacity(4);
         let mut jac = jac;
         for p in 0..2 {
             let (ta, tb) = (z[tr.duration(p)], z[tr.duration(p + 1)]);
+            let m = 0.5 * (ta + tb);
             for j in 0..2 {
                 let (ia, ib) = (tr.v(p, n - 1) + j, tr.v(p + 1, 0) + j);
                 let row = row0 + r.len();
-                r.push(sc * (z[ia] / ta - z[ib] / tb));
+                let jump = z[ia] / ta - z[ib] / tb;
+                r.push(m * jump);
                 if let Some(jac) = jac.as_deref_mut() {
-                    jac.push((row, ia, sc / ta));
-                    jac.push((row, ib, -sc / tb));
-                    jac.push((row, tr.duration(p), -sc * z[ia] / (ta * ta)));
-                    jac.push((row, tr.duration(p + 1), sc * z[ib] / (tb * tb)));
+                    jac.push((row, ia, m / ta));
+                    jac.push((row, ib, -m / tb));
+                    jac.push((row, tr.duration(p), 0.5 * jump - m * z[ia] / (ta * ta)));
+                    jac.push((row, tr.duration(p + 1), 0.5 * jump + m * z[ib] / (tb * tb)));
                 }
             }
         }
