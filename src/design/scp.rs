@@ -680,8 +680,24 @@ pub fn solve_warm(
     let mut mult = warm.map_or_else(Multipliers::default, |w| w.multipliers.clone());
     let mut window = Vec::new();
     let mut rule = StopRule::None;
+    let mut failures = 0;
     for it in 0..settings.max_iterations {
-        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult)?;
+        let (rec, trial) = match iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult) {
+            Ok(x) => {
+                failures = 0;
+                x
+            }
+            // a subproblem the conic solver could not finish (numerical
+            // trouble) is a rejected step: a smaller trust region is a
+            // better-conditioned subproblem
+            Err(Error::Solver { .. }) if failures < 4 => {
+                failures += 1;
+                radius *= 0.25;
+                solvers.subproblem = None;
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
