@@ -150,6 +150,23 @@ impl RunResult {
     }
 }
 
+/// Whether a free-form design can answer the robot question: converged,
+/// inside the motor envelope at every written row, and flipping under the
+/// motor model within `simulate.flip_tolerance`.
+fn verified(cfg: &Config, fr: &crate::design::free::FreeResult) -> bool {
+    let margin = crate::design::envelope::usage_of(cfg, &fr.plan)
+        .min_margin
+        .unwrap_or(1.0);
+    fr.status == crate::design::scp::ScpStatus::Converged
+        && margin >= -1e-6
+        && crate::verify::simulate::misses_flip(
+            fr.flip_error_rad,
+            fr.tilt_deg,
+            cfg.simulate.flip_tolerance,
+        )
+        .is_none()
+}
+
 /// Why a verified design misses its targets, if it does: solver status,
 /// flip and tilt beyond `simulate.flip_tolerance`, limits broken.
 fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
@@ -356,6 +373,9 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     // the robot question first: when the motors cannot flip the cat in
     // this fall, no design at this height is attempted
     let mut answer = None;
+    let mut fastest_free: Option<crate::design::free::FreeResult> = None;
+    // the phased least height, when no phased schedule fits this fall
+    let mut phased_short: Option<f64> = None;
     if limited {
         progress(Progress::Stage {
             index: 2,
@@ -364,20 +384,48 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         });
         let clock = Instant::now();
         let a = crate::design::least_height::answer(cfg);
+        let a = match a {
+            // the free-form time design, seeded by the phased one, when it
+            // verifies (converged, inside the envelope, flips) and is shorter
+            Ok(Some(mut a)) => {
+                phased_short = (!a.possible).then_some(a.least_height_m);
+                let mut timed = cfg.clone();
+                timed.design.objective = crate::design::objective::Objective::Time;
+                if let Ok(fr) = crate::design::free::optimize_from(
+                    &timed,
+                    &a.schedule,
+                    "phased",
+                    cfg.free.nodes,
+                    |it| progress(Progress::Scp(it)),
+                ) && verified(cfg, &fr)
+                {
+                    a.improve_with(cfg, &fr);
+                    fastest_free = Some(fr);
+                }
+                Ok(Some(a))
+            }
+            other => other,
+        };
         stage_end(&mut progress, clock, a.as_ref().err());
         match a {
             Ok(Some(a)) => {
-                Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "least-height");
+                a.schedule.add_to(&mut output, "least-height");
                 answer = Some(a);
             }
             Ok(None) => {}
             Err(e) => notes_early.push(format!("The least drop height could not be found: {e}")),
         }
     }
-    let impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
+    let impossible = phased_short.map(|least| {
         format!(
-            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {:.3} m (least-height.csv)",
-            a.height_m, a.least_height_m
+            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
+            cfg.fall.height
+        )
+    });
+    let free_impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
+        format!(
+            "no schedule found fits the motors in the fall from {} m (fall.height); the {} time-optimal design needs at least {:.3} m (least-height.csv)",
+            a.height_m, a.method, a.least_height_m
         )
     });
     let skipped = |reason: &String| Error::Unreachable {
@@ -434,21 +482,25 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
     });
     let clock = Instant::now();
-    // seeded by the phased design, or by the analytic plan when that failed
+    // seeded by the phased design, or by the free-form least-time design
+    // when no phased one fits, or by the analytic plan when that failed
     let analytic_seed;
-    let (seed_plan, seed_name): (&dyn ShapePlan, &str) = match &phased {
-        Ok(ph) => (&ph.plan, "phased"),
-        Err(_) => {
+    let (seed_plan, seed_name): (&dyn ShapePlan, &str) = match (&phased, &fastest_free) {
+        (Ok(ph), _) => (&ph.plan, "phased"),
+        (Err(_), Some(fr)) => (&fr.plan, "free least-time"),
+        (Err(_), None) => {
             analytic_seed = crate::design::analytic::analytic_plan(cfg);
             (&analytic_seed, "analytic")
         }
     };
-    // always tried: the phased least height is an upper bound, and a
-    // free-form design may fit where no phased one does
-    let free =
-        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-            progress(Progress::Scp(it))
-        });
+    let free = match &free_impossible {
+        Some(r) => Err(skipped(r)),
+        None => {
+            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+                progress(Progress::Scp(it))
+            })
+        }
+    };
     match &free {
         Ok(fr) => {
             let fr_sched = Schedule::sample(&cat, &fr.plan, per);
@@ -521,7 +573,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         ("shape_path.svg", report::shape_path(&traces)),
     ];
     if !iterations.is_empty() {
-        figures.push(("convergence.svg", report::convergence(&iterations)));
+        figures.push((
+            "convergence.svg",
+            report::convergence(&iterations, cfg.design.objective),
+        ));
     }
     let mut notes = notes_early;
     let figures: Vec<(&str, String)> = figures
