@@ -90,7 +90,7 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     assert!(svg.contains("stall T = 1.4 N m") && svg.contains("no-load w0 = 5.969 rad/s"));
     // the torque figure draws the limits: the stall torque and T - k|w| along each method
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
-    assert!(torque.contains("stall torque 1.4 N m") && torque.contains("T - k|w|"));
+    assert!(torque.contains("torque limit 1.4 N m") && torque.contains("T - k|w|"));
 
     let polys = elements(&svg, "polygon", &["fill=\"#BBBBBB\""]);
     assert_eq!(polys.len(), 2, "one envelope per motor");

@@ -514,9 +514,9 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
                         BLACK.stroke_width(1),
                     ))
                     .map_err(perr)?;
-                    keys.push((format!("stall torque {l} N m"), Key::Level));
+                    keys.push((format!("torque limit {l} N m"), Key::Level));
                 }
-                (Some(l), None) => keys.push((format!("stall torque {l} N m (above)"), Key::Level)),
+                (Some(l), None) => keys.push((format!("torque limit {l} N m (above)"), Key::Level)),
                 _ => {}
             }
             legend(&side, &keys)?;
