@@ -190,7 +190,8 @@ def report(engine, summary, results, flip_tol, ff_tol):
             or (m.get("min_envelope_margin") is not None and m["min_envelope_margin"] < 0)
         if mode in flip_tol and abs(diff) > flip_tol[mode]:
             fails.append(f"{name}: {mode} replay flip differs by {diff:.3e} deg (> {flip_tol[mode]:g})")
-        if mode == "pd":
+        # the checked feedback replay (MuJoCo: pd; pyBullet: pd-x, its step error removed)
+        if mode in flip_tol:
             if abs(r["peak_nm"] - m["sim_peak_torque_nm"]) > 0.02 * m["sim_peak_torque_nm"]:
                 fails.append(f"{name}: PD replay peak torque {r['peak_nm']:.5f} vs catflip "
                              f"{m['sim_peak_torque_nm']:.5f} N m (> 2 %)")
