@@ -197,9 +197,9 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
             named.push((0.0, -t, format!("stall -T = {} N m", -t), 8, 4));
         }
         if let Some(w0) = motor.no_load_speed {
-            named.push((w0, 0.0, format!("no-load w0 = {w0} rad/s"), 6, 4));
+            named.push((w0, 0.0, format!("no-load w0 = {w0} rad/s"), 6, 16));
             if p.signed {
-                named.push((-w0, 0.0, format!("no-load -w0 = {} rad/s", -w0), 6, -18));
+                named.push((-w0, 0.0, format!("no-load -w0 = {} rad/s", -w0), 6, -32));
             }
         }
         for (w, s, label, dx, dy) in named {
