@@ -571,6 +571,15 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 r.seed
             );
             row(
+                &format!("objective ({})", r.objective.name()),
+                format!(
+                    "{:.6} {} (manoeuvre {:.4} s)",
+                    r.objective_value,
+                    r.objective.unit(),
+                    r.manoeuvre_time_s
+                ),
+            );
+            row(
                 "peak torque",
                 format!(
                     "{:.5} N m (at check points {:.5})",

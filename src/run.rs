@@ -7,7 +7,6 @@ use crate::design::least_height::HeightAnswer;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
-use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
 use crate::verify::analyze::analyze;
@@ -88,6 +87,9 @@ pub struct MethodNumbers {
     /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
     /// the envelope, negative violated; absent without limits).
     pub min_envelope_margin: Option<f64>,
+    /// `integral |tau|^2 dt` over the written rows, N^2 m^2 s (the energy
+    /// objective; the peak and the durations give the other two).
+    pub energy_n2m2s: f64,
     pub solve_time_s: f64,
     pub schedule_csv: String,
     pub schedule_json: String,
@@ -179,7 +181,10 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         n.tilt_deg,
         cfg.simulate.flip_tolerance,
     ));
+    // with a torque-speed line a braking torque may exceed the stall torque:
+    // the envelope margin below is the test then
     if let Some(lim) = cfg.limits.max_torque
+        && cfg.limits.no_load_speed.is_none()
         && n.peak_torque_nm > lim * (1.0 + 1e-6)
     {
         why.push(format!(
@@ -216,9 +221,12 @@ fn summarize(
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: std::result::Result<&SimReport, &Error>,
-    motor: MotorUse,
+    schedule: &Schedule,
     solve_time_s: f64,
 ) -> MethodSummary {
+    let motor = cfg
+        .motor()
+        .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)));
     let (bend, twist, durations) = path_numbers;
     let failed_sim;
     let (sim, sim_error) = match sim {
@@ -242,6 +250,7 @@ fn summarize(
         final_shape_error_rad: sim.final_shape_error_rad,
         max_speed_rad_s: motor.max_speed_rad_s,
         min_envelope_margin: motor.min_margin,
+        energy_n2m2s: schedule.torque_squared_integral(),
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
@@ -310,8 +319,6 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let cat = cfg.cat();
     let per = cfg.simulate.samples_per_phase;
     let mut output = Output::default();
-    let motor = cfg.motor();
-    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
     let mut methods = Vec::new();
     let mut traces = Vec::new();
     let mut tracks = Vec::new();
@@ -358,7 +365,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                     a.closed.phase_durations_s,
                 ),
                 a_sim.as_ref(),
-                usage(&a_sched),
+                &a_sched,
                 a_time,
             ));
             let failed_sim = SimReport::failed();
@@ -466,7 +473,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
                 Ok(ph_sim),
-                usage(&ph_sched),
+                &ph_sched,
                 ph.solve_time_s,
             ));
             traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
@@ -512,7 +519,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
                 Ok(&fr.sim),
-                usage(&fr_sched),
+                &fr_sched,
                 fr.solve_time_s,
             ));
             traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
@@ -691,10 +698,11 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
 }
 
 /// Columns of the comparison table (terminal and index.html).
-pub const TABLE_HEADER: [&str; 10] = [
+pub const TABLE_HEADER: [&str; 11] = [
     "method",
     "status",
     "peak N m",
+    "energy N2m2s",
     "bend deg",
     "durations s",
     "flip error rad",
@@ -735,6 +743,7 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
             let d = n.phase_durations_s;
             row.extend([
                 format!("{:.5}", n.peak_torque_nm),
+                format!("{:.4e}", n.energy_n2m2s),
                 format!("{:.2}", n.bend_deg),
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
                 small(n.flip_error_rad),
@@ -743,7 +752,7 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.3}", n.solve_time_s),
             ]);
         }
-        None => row.extend(std::iter::repeat_n("-".to_string(), 7)),
+        None => row.extend(std::iter::repeat_n("-".to_string(), 8)),
     }
     row.push(verdict);
     row

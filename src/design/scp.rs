@@ -8,13 +8,13 @@
 //! `z`). Each iteration linearises `f`, `g` and `r` about the current `z`, adds
 //! virtual controls `nu = nu+ - nu-` to the linearised equalities (penalised
 //! by `w |nu|_1`) and one elastic slack `sigma >= 0` to the limits
-//! (`|g + G dz| <= L + sigma`, penalised by `w sigma`), which keep every
+//! (`|g + G dz| / L <= 1 + sigma`, penalised by `w sigma`), which keep every
 //! subproblem feasible, bounds the step by a scaled trust region, and solves
 //! one conic program with Clarabel; the data pattern is the same every
 //! iteration, so the solver is updated in place.
 //!
 //! Steps are judged on the exact penalty
-//! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| - L))`:
+//! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| / L - 1))`:
 //! `rho = (phi(z) - phi(z + dz)) / (phi(z) - L(dz))` with `L` the subproblem's
 //! model value. When `rho < 0.75` a second-order correction (one more conic
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
@@ -276,16 +276,42 @@ fn cost_of(p: &dyn ScpProblem, z: &[f64], v: &Values) -> f64 {
 /// `(phi, cost, infeasibility)`: the exact penalty, the cost, and the
 /// largest violation (`max |r|`, and `max |g| / L - 1` for the limits).
 fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> (f64, f64, f64) {
-    let v = p.evaluate(z);
+    let v = evaluate(p, z);
     let cost = cost_of(p, z, &v);
     let l1: f64 = v.residual.iter().map(|x| x.abs()).sum();
     let mut inf = v.residual.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let mut over = 0.0;
-    if let Some(l) = p.limit() {
-        over = (peak_of(&v.limited, p.term_dim(), p.norm()) - l).max(0.0);
-        inf = inf.max(over / l);
+    if p.limit().is_some() {
+        over = (peak_of(&v.limited, p.term_dim(), p.norm()) - 1.0).max(0.0);
+        inf = inf.max(over);
     }
     (cost + w * (l1 + over), cost, inf)
+}
+
+/// The limited terms relative to the limit, `g / L` (bounded by 1): the
+/// penalty then weighs a relative violation against the cost, whatever the
+/// limit's size (a torque-speed line can make `L` many times the cost).
+fn relative(p: &dyn ScpProblem, limited: &mut [f64]) {
+    if let Some(l) = p.limit() {
+        limited.iter_mut().for_each(|x| *x /= l);
+    }
+}
+
+/// [`ScpProblem::evaluate`] with relative limited terms.
+fn evaluate(p: &dyn ScpProblem, z: &[f64]) -> Values {
+    let mut v = p.evaluate(z);
+    relative(p, &mut v.limited);
+    v
+}
+
+/// [`ScpProblem::linearize`] with relative limited terms.
+fn linearize(p: &dyn ScpProblem, z: &[f64]) -> Linearization {
+    let mut lin = p.linearize(z);
+    relative(p, &mut lin.limited);
+    if let Some(l) = p.limit() {
+        lin.limited_jac.iter_mut().for_each(|e| e.2 /= l);
+    }
+    lin
 }
 
 /// Rows of `norm(s) <= bound` for each term of `(values, jac)`, in the
@@ -369,7 +395,9 @@ fn subproblem(
     for i in 0..n {
         p_diag[i] = 1e-9 / (scales[i] * scales[i]);
     }
-    d.p_upper = p.hessian(z, y, u);
+    // the multipliers of the relative limits are L times the problem's
+    let u_abs: Vec<f64> = u.iter().map(|x| x / limit.unwrap_or(1.0)).collect();
+    d.p_upper = p.hessian(z, y, &u_abs);
     let mut constant = 0.0;
     match &cost {
         Cost::Peak => d.q[t] = 1.0,
@@ -430,9 +458,9 @@ fn subproblem(
     } else {
         Vec::new()
     };
-    // limits with elastic slack: |g + G dz| <= L + sigma
+    // limits with elastic slack, relative: |g + G dz| / L <= 1 + sigma
     let limit_rows = match limit {
-        Some(l) => {
+        Some(_) => {
             d.q[sigma] = w;
             norm_rows(
                 &mut d,
@@ -440,7 +468,7 @@ fn subproblem(
                 &lin.limited_jac,
                 dim,
                 p.norm(),
-                (&[(sigma, 1.0)], l),
+                (&[(sigma, 1.0)], 1.0),
             )
         }
         None => Vec::new(),
@@ -534,7 +562,7 @@ fn iterate(
     mult: &mut Multipliers,
 ) -> Result<(ScpIteration, Vec<f64>)> {
     let (phi, cost, inf) = merit(p, z, w);
-    let lin = p.linearize(z);
+    let lin = linearize(p, z);
     mult.terms.resize(lin.terms.len(), 0.0);
     mult.limited.resize(lin.limited.len(), 0.0);
     let (data, constant, term_rows, limit_rows) =
@@ -569,14 +597,19 @@ fn iterate(
     let (mut phi_t, _, _) = merit(p, &trial, w);
     if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
         // back onto the model's residual at the trial point, r + J dz = nu+ - nu-
-        let at = p.evaluate(&trial);
+        let at = evaluate(p, &trial);
         let rhs: Vec<f64> = (0..m)
             .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - at.residual[i])
             .collect();
         // with the terms' bounds first (t, L + sigma from the subproblem);
         // without them when that has no solution
         let bounded = p.cost() == Cost::Peak || p.limit().is_some();
-        let sigma = p.limit().map_or(0.0, |l| l + x[n + 1 + 2 * m]);
+        let sigma = 1.0
+            + if p.limit().is_some() {
+                x[n + 1 + 2 * m]
+            } else {
+                0.0
+            };
         let tries = [
             (true, &mut solvers.bounded_correction),
             (false, &mut solvers.correction),
