@@ -284,12 +284,17 @@ pub fn trace(
     let norm = cfg.norm();
     let b = plan.phase_bounds();
     let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
     for i in 0..3 {
         for k in 0..=per_phase {
             let tt = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
             t.push(tt);
-            q.push(plan.state_in(i, tt).q);
-            tau.push(norm.of(plan.torque_in(&cat, i, tt)));
+            let s = plan.state_in(i, tt);
+            q.push(s.q);
+            qd.push(s.qd);
+            let v = plan.torque_in(&cat, i, tt);
+            tau.push(norm.of(v));
+            tau_xy.push(v);
         }
     }
     MethodTrace {
@@ -297,6 +302,8 @@ pub fn trace(
         t,
         q,
         tau,
+        qd,
+        tau_xy,
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),
@@ -564,9 +571,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .unwrap_or_default();
     let mut figures = vec![
         ("angles.svg", report::angles(&traces)),
+        ("torque.svg", report::torque(&traces, &norm_name, &motor)),
         (
-            "torque.svg",
-            report::torque(&traces, &norm_name, cfg.limits.max_torque),
+            report::TORQUE_SPEED_SVG,
+            report::torque_speed(&traces, &motor),
         ),
         ("flip.svg", report::flip(&traces)),
         ("shape_path.svg", report::shape_path(&traces)),
