@@ -46,10 +46,11 @@ fn main() -> anyhow::Result<()> {
                 for seed in [Seed::Phased, Seed::Analytic] {
                     let clock = Instant::now();
                     let r = match seed {
-                        Seed::Phased => catflip::design::phased::optimize(&cfg, |_| {})
-                            .and_then(|ph| {
+                        Seed::Phased => {
+                            catflip::design::phased::optimize(&cfg, |_| {}).and_then(|ph| {
                                 optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
-                            }),
+                            })
+                        }
                         Seed::Analytic => optimize_from(
                             &cfg,
                             &catflip::design::analytic::analytic_plan(&cfg),
