@@ -1017,8 +1017,11 @@ fn inside_envelope(
             }
             solved.node_peak /= stretch * stretch;
         } else {
-            let lim = tight.limits.max_torque.expect("a torque limit");
-            tight.limits.max_torque = Some(lim * (1.0 + 1.5 * margin));
+            // |tau + k qd| <= T tightened as a whole: T and the no-load
+            // speed shrink together, k = T / w0 stays
+            let f = 1.0 + 1.5 * margin;
+            tight.limits.max_torque = tight.limits.max_torque.map(|t| t * f);
+            tight.limits.no_load_speed = tight.limits.no_load_speed.map(|w| w * f);
             let again = design(
                 &tight,
                 &solved.plan.z,
