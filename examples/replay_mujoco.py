@@ -8,6 +8,10 @@ Loads output/<name>/run/<name>.mjcf.xml and each output/<name>/run/<method>.mujo
 as catflip wrote them, steps MuJoCo at the model's time step (the CSV's), and
 holds each row's torque over its step: once feed-forward only, once
 feed-forward plus catflip's PD (gains and torque limit from the CSV header).
+With a torque-speed line on a universal joint the MJCF's actuators are DC
+motors (force = ctrl - k qd, ctrl limited to the stall torque) and the CSV's
+ctrl is the command tau + k qd; otherwise this script clips to the envelope
+at each step's start.
 Prints flip, tilt, final shape error and peak torque beside catflip's
 summary.json; exits non-zero on a mismatch. Also checks that the URDF loads in
 MuJoCo (universal joint) with the same masses and inertias.
@@ -21,7 +25,12 @@ import mujoco
 import numpy as np
 
 from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
-                           peak_of, quat_log, read_controls, report, right_jacobian)
+                           peak_of, quat_log, read_controls, reference, report, right_jacobian)
+
+
+def is_dc_motor(model):
+    """Whether the actuators are catflip's DC motors: force = ctrl - k qd (affine bias)."""
+    return model.nu > 0 and model.actuator_biastype[0] == mujoco.mjtBias.mjBIAS_AFFINE
 
 
 def replay(model, c, pd):
@@ -29,10 +38,34 @@ def replay(model, c, pd):
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)
     ball = model.jnt_type[1] == mujoco.mjtJoint.mjJNT_BALL
+    dc = is_dc_motor(model)
+    if dc != any(col.startswith("ctrl_cmd") for col in c["cols"]):
+        raise SystemExit("the controls' ctrl columns do not match the model's actuators "
+                         "(ctrl_cmd = DC-motor command, ctrl_tau = torque)")
     qa, va = model.jnt_qposadr[1], model.jnt_dofadr[1]
     rear = model.body("rear").id
     tracker = FlipTracker(data.xquat[rear].copy())
     pos, vel, ff = c["pick"]("qpos"), c["pick"]("qvel"), c["pick"]("ctrl")
+    peak = 0.0
+    # step index, its start time and feed-forward torque, for the control callback
+    stage = np.zeros(4)
+
+    def control(m, d):
+        k, t0 = int(stage[0]), stage[1]
+        q_ref, qd_ref = reference(pos, vel, k, (d.time - t0) / c["dt"], c["dt"])
+        q, qd = d.qpos[qa:qa + 2], d.qvel[va:va + 2]
+        tau = stage[2:] + c["kp"] * (q_ref - q) + c["kd"] * (qd_ref - qd)
+        d.ctrl[:] = tau + c["slope"] * qd
+
+    if dc and pd:
+        mujoco.set_mjcb_control(control)
+    try:
+        return run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff)
+    finally:
+        mujoco.set_mjcb_control(None)
+
+
+def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff):
     peak = 0.0
     for k in range(c["steps"]):
         if ball:
@@ -47,6 +80,21 @@ def replay(model, c, pd):
                 tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
             tau_v = limit_catflip_torque(tau_v, vd, c)
             data.ctrl[:] = np.linalg.solve(jr.T, tau_v)
+        elif dc:
+            # DC-motor actuators: force = clamp(ctrl, -T, T) - k qd, MuJoCo recomputing the
+            # back-EMF at every RK4 stage. Feed-forward only: the CSV's command, held.
+            # With feedback: catflip's controller, run at every integrator stage by the control
+            # callback: the held feed-forward torque plus PD on the planned state at that
+            # instant, ctrl = tau + k qd, so the motor gives catflip's clip at the stage's speed.
+            q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
+            ff_tau = ff[k] - c["slope"] * (pos[k + 1] - pos[k]) / c["dt"]
+            if pd:
+                stage[:] = [k, data.time, *ff_tau]
+                tau_v = limit_catflip_torque(
+                    ff_tau + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd), qd, c)
+            else:
+                data.ctrl[:] = ff[k]
+                tau_v = limit_catflip_torque(ff_tau, qd, c)
         else:
             q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
             tau_v = ff[k].copy()
@@ -88,8 +136,14 @@ def check_urdf(out, name, model, controls, mjcf_flips):
           + ", ".join(f"{u.body(i).name} {u.body_mass[i]:.6g} kg" for i in range(1, u.nbody)))
     spec = mujoco.MjSpec.from_file(str(path))
     spec.body("rear").add_freejoint()
-    for j in ("motor1", "motor2"):
-        spec.add_actuator(name=j, target=j, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+    for i, j in enumerate(("motor1", "motor2")):
+        a = spec.add_actuator(name=j, target=j, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        if is_dc_motor(model):
+            # the MJCF's DC motor, as it is
+            a.biastype = mujoco.mjtBias.mjBIAS_AFFINE
+            a.biasprm = model.actuator_biasprm[i]
+            a.ctrllimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            a.ctrlrange = model.actuator_ctrlrange[i]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
     # the rear and front cylinders touch at the joint and are not parent and child here
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT

@@ -80,6 +80,11 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
             "seed",
             &["limits.max_torque=2.5", "cat.joint=universal"][..],
         ),
+        // a torque-speed line on the no-twist joint's ball
+        (
+            "seed",
+            &["limits.max_torque=2.5", "limits.no_load_speed=8"][..],
+        ),
     ] {
         let cfg = config(name, set);
         let cat = cfg.cat();
@@ -194,9 +199,11 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
             .unwrap();
         let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
         assert!(close(opt.attribute("timestep").unwrap(), dt));
+        // a universal joint with a torque-speed line has DC motors (`general`)
+        let dc = torque_line && cat.joint == Joint::Universal;
         let motors: Vec<_> = doc
             .descendants()
-            .filter(|n| n.has_tag_name("motor"))
+            .filter(|n| n.has_tag_name(if dc { "general" } else { "motor" }))
             .collect();
         match cat.joint {
             // a ball has three degrees of freedom: one motor about each child axis
@@ -209,11 +216,25 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
             }
             Joint::Universal => assert_eq!(motors.len(), 2),
         }
-        if torque_line {
-            // MJCF motors cannot say a torque-speed line: no clipping range,
+        if dc {
+            // force = gain ctrl + biasprm . (0, length, velocity) = ctrl - k qd, the
+            // command limited to the stall torque: |tau + k qd| <= T
+            let (t, k) = (limit.unwrap(), cfg.motor().slope());
+            for m in &motors {
+                assert_eq!(m.attribute("biastype"), Some("affine"));
+                let b: Vec<&str> = m.attribute("biasprm").unwrap().split(' ').collect();
+                assert!(close(b[0], 0.0) && close(b[1], 0.0) && close(b[2], -k));
+                assert!(close(m.attribute("gainprm").unwrap(), 1.0));
+                let r: Vec<&str> = m.attribute("ctrlrange").unwrap().split(' ').collect();
+                assert!(close(r[0], -t) && close(r[1], t));
+                // braking beyond T is allowed: no force range
+                assert!(m.attribute("forcerange").is_none());
+            }
+        } else if torque_line {
+            // a ball's disc is not a box on its motors: no clipping range,
             // the header says so and the replays clip to the envelope
             assert!(motors.iter().all(|m| m.attribute("ctrlrange").is_none()));
-            assert!(mjcf.contains("no_load_speed") || mjcf.contains("torque-speed"));
+            assert!(mjcf.contains("torque-speed"));
         }
         for m in motors.iter().filter(|_| !torque_line) {
             match limit {
@@ -261,9 +282,16 @@ fn held_torques_carry_the_schedules_impulse() {
     .unwrap();
     let duration = s.rows.last().unwrap().t - s.rows[0].t;
     assert!((dt * steps as f64 - duration).abs() < 1e-12);
-    let i1 = cols.iter().position(|c| c == "ctrl_tau1").unwrap();
+    // the robot's servo has a torque-speed line: the MJCF's DC motors take the
+    // command tau + k qd, whose held impulse is the torque's plus k times the
+    // angle travelled
+    let k = num(&meta["motor_slope_nm_s"]);
+    assert!(k > 0.0);
+    let i1 = cols.iter().position(|c| c == "ctrl_cmd1").unwrap();
+    let iq = cols.iter().position(|c| c == "qpos_motor1").unwrap();
     for j in 0..2 {
-        let held: f64 = rows[..steps].iter().map(|r| r[i1 + j] * dt).sum();
+        let travel = rows[steps][iq + j] - rows[0][iq + j];
+        let held: f64 = rows[..steps].iter().map(|r| r[i1 + j] * dt).sum::<f64>() - k * travel;
         let exact: f64 = s
             .rows
             .windows(2)
@@ -276,7 +304,6 @@ fn held_torques_carry_the_schedules_impulse() {
         );
     }
     // positions are the schedule's at each step start
-    let iq = cols.iter().position(|c| c == "qpos_motor1").unwrap();
     let mid = rows[steps / 3][0];
     let want = catflip::design::plan::ShapePlan::state(&s, mid).q;
     assert!((rows[steps / 3][iq] - want[0]).abs() < 1e-12);

@@ -152,7 +152,8 @@ fn run_writes_a_complete_consistent_report() {
         assert!(
             texts.iter().any(|t| t.contains("time (s)")
                 || t.contains("iteration")
-                || t.contains("q1 (deg)")),
+                || t.contains("q1 (deg)")
+                || t.contains("(rad/s)")),
             "{name}: {texts:?}"
         );
     }

@@ -53,10 +53,14 @@ impl Simulator {
         }
     }
 
-    fn columns(self, joint: Joint) -> &'static str {
+    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::mjcf::dc_motor`]).
+    fn columns(self, joint: Joint, dc: bool) -> &'static str {
         match (self, joint) {
             (Simulator::Mujoco, Joint::NoTwist) => {
                 "t_s,qpos_w,qpos_x,qpos_y,qpos_z,qvel_x,qvel_y,qvel_z,ctrl_tau_x,ctrl_tau_y,ctrl_tau_z"
+            }
+            (Simulator::Mujoco, Joint::Universal) if dc => {
+                "t_s,qpos_motor1,qpos_motor2,qvel_motor1,qvel_motor2,ctrl_cmd1,ctrl_cmd2"
             }
             (Simulator::Mujoco, Joint::Universal) => {
                 "t_s,qpos_motor1,qpos_motor2,qvel_motor1,qvel_motor2,ctrl_tau1,ctrl_tau2"
@@ -185,7 +189,9 @@ pub struct ControlRow {
     pub pos: Vec<f64>,
     /// Planned joint velocity at `t`.
     pub vel: Vec<f64>,
-    /// Actuator torque held over `[t, t + dt]` (step average), N m; zero on the final row.
+    /// Actuator torque held over `[t, t + dt]` (step average), N m; zero on
+    /// the final row. With [`Controls::slope`] `k > 0` the DC motor's command
+    /// `tau + k qd`, both averaged over the step.
     pub torque: Vec<f64>,
 }
 
@@ -195,6 +201,9 @@ pub struct Controls {
     pub simulator: Simulator,
     pub joint: Joint,
     pub dt: f64,
+    /// `k` of a DC-motor actuator whose command is `tau + k qd` (0: the
+    /// torque columns are the torque).
+    pub slope: f64,
     /// `n + 1` rows: one per step, then the final planned state.
     pub rows: Vec<ControlRow>,
 }
@@ -205,6 +214,12 @@ impl Controls {
         let cat = cfg.cat();
         let b = plan.phase_bounds();
         let (dt, n) = time_step(b[3] - b[0], sim.target_step());
+        // MuJoCo's DC-motor actuators take the command tau + k qd
+        let slope = match (sim, super::mjcf::dc_motor(cfg)) {
+            (Simulator::Mujoco, Some(_)) => cfg.motor().slope(),
+            _ => 0.0,
+        };
+        let phase_of = |t: f64| (0..3).find(|&i| t <= b[i + 1]).unwrap_or(2);
         let rows = (0..=n)
             .map(|k| {
                 let t = if k == n { b[3] } else { b[0] + k as f64 * dt };
@@ -227,7 +242,16 @@ impl Controls {
                 let torque = if k == n {
                     vec![0.0; vel.len()]
                 } else {
-                    step_average(&cat, plan, t, (t + dt).min(b[3]))
+                    let t1 = (t + dt).min(b[3]);
+                    let mut u = step_average(&cat, plan, t, t1);
+                    if slope > 0.0 {
+                        // the DC motor's command: + k times the step's mean speed
+                        let (q0, q1) = (s.q, plan.state_in(phase_of(t1), t1).q);
+                        for j in 0..2 {
+                            u[j] += slope * (q1[j] - q0[j]) / (t1 - t);
+                        }
+                    }
+                    u
                 };
                 ControlRow {
                     t,
@@ -241,6 +265,7 @@ impl Controls {
             simulator: sim,
             joint: cat.joint,
             dt,
+            slope,
             rows,
         }
     }
@@ -266,6 +291,10 @@ impl Controls {
                 Joint::NoTwist =>
                     "# Ball joint: quaternion of the front half relative to the rear, velocity and torque\n\
                      # in the front half's frame; torque = J_r(v)^-T (tau1, tau2, tau3), tau3 holding the twist.\n",
+                Joint::Universal if self.slope > 0.0 =>
+                    "# Hinges motor1 (rear x) and motor2 (rotated y): catflip's q, q_dot. ctrl_cmd is the DC\n\
+                     # motors' command tau + k q_dot (k = motor_slope_nm_s, both averaged over the step): the\n\
+                     # MJCF's actuators give force = clamp(ctrl, -T, T) - k q_dot, catflip's motor model.\n",
                 Joint::Universal =>
                     "# Hinges motor1 (rear x) and motor2 (rotated y): catflip's q, q_dot, tau.\n",
             },
@@ -282,7 +311,7 @@ impl Controls {
                 crate::model::TorqueNorm::Euclidean => "euclidean",
                 crate::model::TorqueNorm::PerMotor => "per-motor",
             },
-            cols = self.simulator.columns(self.joint),
+            cols = self.simulator.columns(self.joint, self.slope > 0.0),
         );
         for r in &self.rows {
             s.push_str(&format!("{:.12}", r.t));

@@ -26,9 +26,17 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push_str(&format!("\n     Motor: stall torque {t} N m"));
         if m.slope() > 0.0 {
             s.push_str(&format!(
-                ", torque-speed line |tau + {k} w| <= {t} (not expressible here: apply it to the command)",
+                ", torque-speed line |tau + {k} w| <= {t}",
                 k = m.slope()
             ));
+            if cfg.cat.joint == Joint::Universal {
+                s.push_str(
+                    ": each motor is a DC motor, force = ctrl - k qd with ctrl (the voltage, in N m)
+     limited to the stall torque; the *.mujoco.csv ctrl is tau + k qd",
+                );
+            } else {
+                s.push_str(" (a disc in catflip's rotation-vector coordinates, not expressible here: apply it to the command)");
+            }
         }
         s.push('.');
     }
@@ -36,6 +44,26 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push_str(&format!("\n     Joint speed limit {w} rad/s."));
     }
     s
+}
+
+/// Attributes of a hinge's `<general>` actuator that is the linear DC motor
+/// `|tau + k qd| <= T` (universal joint with a torque-speed line): gain 1,
+/// affine bias `-k qd`, `ctrl` (the voltage in N m, `tau + k qd`) limited to
+/// `[-T, T]`. MuJoCo recomputes the bias at each RK4 stage, so a saturated
+/// motor follows `T - k qd` continuously as catflip's simulation does.
+/// `None` without a torque-speed line (a plain `<motor>` then says it all).
+pub(crate) fn dc_motor(cfg: &Config) -> Option<String> {
+    let m = cfg.motor();
+    let t = m.max_torque?;
+    if m.slope() == 0.0 || cfg.cat.joint != Joint::Universal {
+        return None;
+    }
+    Some(format!(
+        " gaintype=\"fixed\" gainprm=\"1\" biastype=\"affine\" biasprm=\"0 0 {nk}\" ctrllimited=\"true\" ctrlrange=\"{a} {b}\"",
+        nk = f(-m.slope()),
+        a = f(-t),
+        b = f(t)
+    ))
 }
 
 /// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
@@ -62,9 +90,14 @@ pub fn mjcf(cfg: &Config) -> String {
     let (joints, actuators) = match cfg.cat.joint {
         Joint::Universal => (
             "      <!-- universal joint: motor1 about the rear's x, then motor2 about the rotated y -->\n      <joint name=\"motor1\" type=\"hinge\" axis=\"1 0 0\"/>\n      <joint name=\"motor2\" type=\"hinge\" axis=\"0 1 0\"/>\n".to_string(),
-            format!(
-                "    <motor name=\"tau1\" joint=\"motor1\" gear=\"1\"{limit}/>\n    <motor name=\"tau2\" joint=\"motor2\" gear=\"1\"{limit}/>\n"
-            ),
+            match dc_motor(cfg) {
+                Some(dc) => format!(
+                    "    <!-- DC motors: force = ctrl - k qd (back-EMF), ctrl limited to the stall torque -->\n    <general name=\"tau1\" joint=\"motor1\"{dc}/>\n    <general name=\"tau2\" joint=\"motor2\"{dc}/>\n"
+                ),
+                None => format!(
+                    "    <motor name=\"tau1\" joint=\"motor1\" gear=\"1\"{limit}/>\n    <motor name=\"tau2\" joint=\"motor2\" gear=\"1\"{limit}/>\n"
+                ),
+            },
         ),
         Joint::NoTwist => (
             "      <!-- Kane & Scher no-twist joint as a ball: qpos is the quaternion of exp(hat(q1, q2, 0)),\n           qvel the relative rate in this (front) body's frame; the twist is held by the third motor -->\n      <joint name=\"spine\" type=\"ball\"/>\n".to_string(),

@@ -7,9 +7,13 @@
 //! legends sit in a column beside the plot, never over the data.
 
 pub mod animation;
+mod torque_speed;
+
+pub use torque_speed::{FILE as TORQUE_SPEED_SVG, caption, envelope, torque_speed};
 
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
+use crate::model::motor::Motor;
 use plotters::coord::Shift;
 use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
@@ -24,6 +28,10 @@ pub struct MethodTrace {
     pub q: Vec<[f64; 2]>,
     /// Joint torque in the peak norm, N m.
     pub tau: Vec<f64>,
+    /// Joint rates at the same instants, rad/s (the motors' speeds).
+    pub qd: Vec<[f64; 2]>,
+    /// Joint torque components at the same instants, N m.
+    pub tau_xy: Vec<[f64; 2]>,
     pub phase_bounds: Vec<f64>,
     /// Attitude about the initial spine from the forward simulation.
     pub flip_t: Vec<f64>,
@@ -261,6 +269,14 @@ enum Key {
     Level,
     /// The open circle around each curve's peak.
     Peak,
+    /// A filled region with its outline (the motor envelope).
+    Band,
+    /// A filled black dot (a named point).
+    Dot,
+    /// A dashed reference level (a speed limit).
+    DashedLevel,
+    /// Text alone, continuing the row above.
+    Note,
 }
 
 /// The legend column beside a plot.
@@ -305,6 +321,32 @@ fn legend(area: &Area, rows: &[(String, Key)]) -> Result<()> {
                 ))
                 .map_err(perr)?;
             }
+            Key::Band => {
+                area.draw(&Rectangle::new(
+                    [(x0, y - 7), (x1, y + 7)],
+                    RGBColor(0xbb, 0xbb, 0xbb).mix(0.35).filled(),
+                ))
+                .map_err(perr)?;
+                area.draw(&Rectangle::new(
+                    [(x0, y - 7), (x1, y + 7)],
+                    BLACK.stroke_width(2),
+                ))
+                .map_err(perr)?;
+            }
+            Key::Dot => {
+                area.draw(&Circle::new((22, y), 5, BLACK.filled()))
+                    .map_err(perr)?;
+            }
+            Key::DashedLevel => {
+                area.draw(&DashedPathElement::new(
+                    vec![(x0, y), (x1, y)],
+                    8,
+                    4,
+                    BLACK.stroke_width(1),
+                ))
+                .map_err(perr)?;
+            }
+            Key::Note => {}
         }
         area.draw_text(label, &text, (48, y - 7)).map_err(perr)?;
         y += 22;
@@ -388,7 +430,12 @@ pub fn angles(methods: &[MethodTrace]) -> Result<String> {
 /// seed's schedule (`analytic`) has its own panel: its peak is often
 /// an order of magnitude above the optimised ones and would flatten them.
 /// With a torque limit the limit is drawn (or named, when off the panel's scale).
-pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> Result<String> {
+/// With a torque-speed line the torque available at each instant depends on
+/// the speed: each method gets a thin line `T - k |qd|` in its colour, the
+/// torque its motors give in any direction at that instant's speed (a torque
+/// below it is inside the envelope; above it, only when braking).
+pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result<String> {
+    let limit = motor.max_torque;
     svg((1000, 760), |root| {
         let tmax = range(methods.iter().flat_map(|m| m.t.iter().copied())).1;
         let (seed, optimised): (Vec<&MethodTrace>, Vec<&MethodTrace>) =
@@ -431,6 +478,23 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> R
                     .map_err(perr)?;
                 }
                 phase_marks(&mut c, m, st, (0.0, ymax))?;
+                if let (Some(l), true) = (limit, motor.slope() > 0.0) {
+                    // drawn where it is on the panel's scale, in runs
+                    let avail =
+                        m.t.iter()
+                            .zip(&m.qd)
+                            .map(|(t, w)| (*t, (l - motor.slope() * motor.speed(*w)).max(0.0)));
+                    let mut run: Vec<(f64, f64)> = Vec::new();
+                    for p in avail.chain([(f64::NAN, f64::INFINITY)]) {
+                        if p.1 <= ymax {
+                            run.push(p);
+                        } else if !run.is_empty() {
+                            let pts = std::mem::take(&mut run);
+                            c.draw_series(LineSeries::new(pts, st.color.mix(0.6).stroke_width(1)))
+                                .map_err(perr)?;
+                        }
+                    }
+                }
                 let over = match limit {
                     Some(l) if p > l * (1.0 + 1e-9) => ", OVER LIMIT",
                     _ => "",
@@ -439,6 +503,10 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, limit: Option<f64>) -> R
             }
             keys.push(("peak of each curve".into(), Key::Peak));
             keys.push(boundary_key());
+            if limit.is_some() && motor.slope() > 0.0 {
+                keys.push(("thin: T - k|w| at the method's".into(), Key::Level));
+                keys.push(("speed (motoring limit)".into(), Key::Note));
+            }
             match (limit, lim_on_scale) {
                 (Some(l), Some(_)) => {
                     c.draw_series(LineSeries::new(
@@ -532,30 +600,33 @@ pub fn shape_path(methods: &[MethodTrace]) -> Result<String> {
 }
 
 /// SCP convergence: peak and infeasibility per iteration.
-pub fn convergence(iters: &[ScpIteration]) -> Result<String> {
+/// `objective` names what the SCP minimised (its [`Objective`](crate::design::objective::Objective)).
+pub fn convergence(
+    iters: &[ScpIteration],
+    objective: crate::design::objective::Objective,
+) -> Result<String> {
+    let title = format!("Free-form SCP: {} per iteration", objective.name());
+    let axis = format!("{} ({})", objective.name(), objective.unit());
     svg((1000, 700), |root| {
         let n = iters.len().max(2) as f64;
         let panels = root.split_evenly((2, 1));
         let (plot, side) = with_legend(&panels[0]);
-        let y = range(iters.iter().map(|i| i.peak));
-        let mut c = chart(
-            &plot,
-            "Free-form SCP: peak torque per iteration",
-            (0.0, n),
-            y,
-            ("iteration", "peak (N m)"),
-            true,
-        )?;
+        let y = range(iters.iter().map(|i| i.objective));
+        let mut c = chart(&plot, &title, (0.0, n), y, ("iteration", &axis), true)?;
         let st = style(1);
-        let pts: Vec<_> = iters.iter().map(|i| (i.iteration as f64, i.peak)).collect();
+        let pts: Vec<_> = iters
+            .iter()
+            .map(|i| (i.iteration as f64, i.objective))
+            .collect();
         line(&mut c, &pts, st, 0.0)?;
         let rejected = style(2);
-        c.draw_series(
-            iters
-                .iter()
-                .filter(|i| !i.accepted)
-                .map(|i| marker((i.iteration as f64, i.peak), Marker::Cross, rejected.color)),
-        )
+        c.draw_series(iters.iter().filter(|i| !i.accepted).map(|i| {
+            marker(
+                (i.iteration as f64, i.objective),
+                Marker::Cross,
+                rejected.color,
+            )
+        }))
         .map_err(perr)?;
         legend(
             &side,
@@ -740,7 +811,11 @@ pub fn index_html(
     }
     h.push_str(animation);
     for f in figures {
-        h.push_str(&format!("<div><img src=\"{f}\" alt=\"{f}\"></div>\n"));
+        h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));
+        if let Some(c) = caption(f) {
+            h.push_str(&format!("<figcaption>{}</figcaption>", esc(c)));
+        }
+        h.push_str("</figure>\n");
     }
     h.push_str("</body></html>\n");
     h

@@ -1,0 +1,94 @@
+//! Issue 11 item 1: the free-form optimiser on every bundled config, both
+//! norms, every objective and both seeds, with its status and certificate.
+//! Configs without motor limits get a torque limit for the `time` objective
+//! (1.5 times their phased peak, so that the least time is inside the fall).
+//! `cargo run --release --example convergence_matrix [-- CONFIG...]`
+use catflip::Config;
+use catflip::design::free::{Seed, optimize_from};
+use std::time::Instant;
+
+fn main() -> anyhow::Result<()> {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let mut names: Vec<String> = std::env::args().skip(1).collect();
+    if names.is_empty() {
+        names = ["seed", "domestic-cat", "robot-universal"]
+            .map(String::from)
+            .to_vec();
+    }
+    println!(
+        "{:<16} {:<10} {:<12} {:<9} {:>15} {:>12} {:>5} {:>9} {:>9} {:>9} {:>7}",
+        "config",
+        "norm",
+        "objective",
+        "seed",
+        "status",
+        "value",
+        "iters",
+        "crit",
+        "violation",
+        "margin",
+        "s"
+    );
+    for name in &names {
+        let path = format!("{root}/configs/{name}.toml");
+        for norm in ["euclidean", "per-motor"] {
+            for objective in ["peak-torque", "time", "energy"] {
+                let mut ov = vec![
+                    format!("limits.norm={norm}"),
+                    format!("design.objective={objective}"),
+                ];
+                let base = Config::load(std::path::Path::new(&path), &ov[..1])?;
+                if objective == "time" && !base.motor().is_limited() {
+                    let peak = catflip::design::phased::optimize(&base, |_| {})?.peak_torque_nm;
+                    ov.push(format!("limits.max_torque={}", 1.5 * peak));
+                }
+                let cfg = Config::load(std::path::Path::new(&path), &ov)?;
+                for seed in [Seed::Phased, Seed::Analytic] {
+                    let clock = Instant::now();
+                    let r = match seed {
+                        Seed::Phased => {
+                            catflip::design::phased::optimize(&cfg, |_| {}).and_then(|ph| {
+                                optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
+                            })
+                        }
+                        Seed::Analytic => optimize_from(
+                            &cfg,
+                            &catflip::design::analytic::analytic_plan(&cfg),
+                            "analytic",
+                            cfg.free.nodes,
+                            |_| {},
+                        ),
+                    };
+                    let s = clock.elapsed().as_secs_f64();
+                    match r {
+                        Ok(r) => {
+                            let margin = catflip::design::envelope::usage_of(&cfg, &r.plan)
+                                .min_margin
+                                .map_or("-".to_string(), |m| format!("{m:.1e}"));
+                            println!(
+                                "{:<16} {:<10} {:<12} {:<9} {:>15} {:>12.6} {:>5} {:>9.1e} {:>9.1e} {:>9} {:>7.2}",
+                                name,
+                                norm,
+                                objective,
+                                seed.name(),
+                                catflip::run::json_name(&r.status),
+                                r.objective_value,
+                                r.scp_iterations,
+                                r.certificate.criticality,
+                                r.certificate.constraint_violation,
+                                margin,
+                                s
+                            );
+                        }
+                        Err(e) => println!(
+                            "{name:<16} {norm:<10} {objective:<12} {:<9} {:>15} {e}",
+                            seed.name(),
+                            "error"
+                        ),
+                    }
+                }
+            }
+        }
+    }
+    Ok(())
+}

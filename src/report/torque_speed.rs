@@ -1,0 +1,259 @@
+//! The torque-speed figure motor sizing is done with: the motor envelope and
+//! each method's trajectory in the (speed, torque) plane.
+//!
+//! `per-motor`: one panel per motor, `(qd_i, tau_i)`, all four quadrants
+//! (motoring where torque and speed share a sign, braking where they do not).
+//! `euclidean`: the joint's one actuator pushes in any direction of the bend,
+//! so the panel shows the torque component along the motion, `tau . u` with
+//! `u = qd / |qd|`, against the speed `|qd|`: the disc `|tau + k qd| <= T`
+//! projects onto exactly the band `|tau . u + k |qd|| <= T` drawn (a point
+//! inside the band may still leave the disc through the sideways component;
+//! the table's margin is the exact check).
+
+use super::{
+    FONT, Key, MethodTrace, Style, chart, legend, line, perr, range, style_of, svg, with_legend,
+};
+use crate::error::Result;
+use crate::model::TorqueNorm;
+use crate::model::motor::Motor;
+use plotters::prelude::*;
+
+/// The file name of the figure.
+pub const FILE: &str = "torque_speed.svg";
+
+/// The index.html caption of a figure of `run`, by file name.
+pub fn caption(file: &str) -> Option<&'static str> {
+    Some(match file {
+        "angles.svg" => "Joint angles against time; dotted lines are the phase boundaries.",
+        "torque.svg" => {
+            "Joint torque against time with the stall torque; with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
+        }
+        FILE => {
+            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed."
+        }
+        "flip.svg" => {
+            "Rotation about the initial spine in the forward simulation (motor model applied)."
+        }
+        "shape_path.svg" => "The shape path in the (q1, q2) plane.",
+        "convergence.svg" => "Free-form SCP convergence.",
+        _ => return None,
+    })
+}
+
+/// One panel's samples: `(speed, torque)` per method.
+struct Panel {
+    title: String,
+    xdesc: &'static str,
+    ydesc: &'static str,
+    /// Whether the speed axis is signed (per motor) or a magnitude (Euclidean).
+    signed: bool,
+    curves: Vec<Vec<(f64, f64)>>,
+}
+
+fn panels(methods: &[MethodTrace], norm: TorqueNorm) -> Vec<Panel> {
+    match norm {
+        TorqueNorm::PerMotor => (0..2)
+            .map(|j| Panel {
+                title: format!("Motor {}: torque against speed", j + 1),
+                xdesc: "motor speed qd (rad/s)",
+                ydesc: "motor torque tau (N m)",
+                signed: true,
+                curves: methods
+                    .iter()
+                    .map(|m| {
+                        m.qd.iter()
+                            .zip(&m.tau_xy)
+                            .map(|(w, t)| (w[j], t[j]))
+                            .collect()
+                    })
+                    .collect(),
+            })
+            .collect(),
+        TorqueNorm::Euclidean => vec![Panel {
+            title: "Joint actuator: torque along the motion against speed".into(),
+            xdesc: "joint speed |qd| (rad/s)",
+            ydesc: "torque along the motion, tau . qd/|qd| (N m)",
+            signed: false,
+            curves: methods
+                .iter()
+                .map(|m| {
+                    m.qd.iter()
+                        .zip(&m.tau_xy)
+                        .map(|(w, t)| {
+                            let s = w[0].hypot(w[1]);
+                            // at rest every torque starts a motion: its own direction
+                            let along = if s > 1e-12 {
+                                (t[0] * w[0] + t[1] * w[1]) / s
+                            } else {
+                                t[0].hypot(t[1])
+                            };
+                            (s, along)
+                        })
+                        .collect()
+                })
+                .collect(),
+        }],
+    }
+}
+
+/// The envelope's closed polygon `(speed, torque)`: the band between
+/// `tau = -T - k w` and `tau = T - k w` for `|w| <= w_c`, `w_c` the speed limit
+/// or else the no-load speed (`w >= 0` only when `signed` is false).
+/// `None` without a torque limit.
+pub fn envelope(motor: &Motor, signed: bool) -> Option<Vec<(f64, f64)>> {
+    let t = motor.max_torque?;
+    let k = motor.slope();
+    let wc = motor.max_speed.or(motor.no_load_speed)?;
+    let w0 = if signed { -wc } else { 0.0 };
+    Some(vec![
+        (w0, t - k * w0),
+        (wc, t - k * wc),
+        (wc, -t - k * wc),
+        (w0, -t - k * w0),
+    ])
+}
+
+/// The torque-speed figure (see the module doc).
+pub fn torque_speed(methods: &[MethodTrace], motor: &Motor) -> Result<String> {
+    let panels = panels(methods, motor.norm);
+    let h = 560 * panels.len() as u32;
+    svg((1000, h), |root| {
+        for (area, p) in root.split_evenly((panels.len(), 1)).iter().zip(&panels) {
+            draw_panel(area, p, methods, motor)?;
+        }
+        Ok(())
+    })
+}
+
+fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Motor) -> Result<()> {
+    let (plot, side) = with_legend(area);
+    let k = motor.slope();
+    let poly = envelope(motor, p.signed);
+    // limits join the scale: the stall torque, the no-load and speed limits
+    let mut xs: Vec<f64> = p.curves.iter().flatten().map(|c| c.0).collect();
+    let mut ys: Vec<f64> = p.curves.iter().flatten().map(|c| c.1).collect();
+    for (w, t) in poly.iter().flatten() {
+        xs.push(*w);
+        ys.push(*t);
+    }
+    if let Some(t) = motor.max_torque {
+        ys.extend([t, -t]);
+    }
+    xs.extend(motor.max_speed.into_iter().chain(motor.no_load_speed));
+    if p.signed {
+        let r = xs.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        xs.push(-r);
+    } else {
+        xs.push(0.0);
+    }
+    let x = range(xs.into_iter());
+    let y = range(ys.into_iter().chain([0.0]));
+    let mut c = chart(&plot, &p.title, x, y, (p.xdesc, p.ydesc), false)?;
+    let grey = RGBColor(0x99, 0x99, 0x99);
+    // quadrant axes
+    c.draw_series([
+        PathElement::new(vec![(x.0, 0.0), (x.1, 0.0)], grey.stroke_width(1)),
+        PathElement::new(vec![(0.0, y.0), (0.0, y.1)], grey.stroke_width(1)),
+    ])
+    .map_err(perr)?;
+    let mut keys = Vec::new();
+    let text = |s: String, at: (f64, f64), dx: i32, dy: i32| {
+        EmptyElement::at(at) + Text::new(s, (dx, dy), (FONT, 13).into_font().color(&BLACK))
+    };
+    if let Some(t) = motor.max_torque {
+        // the band's lines beyond the closing speed: braking past no-load
+        for s in [t, -t] {
+            c.draw_series(DashedLineSeries::new(
+                [(x.0, s - k * x.0), (x.1, s - k * x.1)],
+                4,
+                4,
+                grey.stroke_width(1),
+            ))
+            .map_err(perr)?;
+        }
+        if let Some(poly) = &poly {
+            c.draw_series(std::iter::once(Polygon::new(
+                poly.clone(),
+                RGBColor(0xbb, 0xbb, 0xbb).mix(0.35).filled(),
+            )))
+            .map_err(perr)?;
+            let mut closed = poly.clone();
+            closed.push(poly[0]);
+            c.draw_series(std::iter::once(PathElement::new(
+                closed,
+                BLACK.stroke_width(2),
+            )))
+            .map_err(perr)?;
+        }
+        if k > 0.0 {
+            keys.push(("envelope |tau + k w| <= T".into(), Key::Band));
+            keys.push((format!("k = T / w0 = {k:.4} N m s"), Key::Note));
+        } else {
+            keys.push((format!("envelope |tau| <= T = {t} N m"), Key::Band));
+        }
+        // the named points: stall (rest, full torque) and no-load (no torque left)
+        let mut named = vec![(0.0, t, format!("stall T = {t} N m"), 8, -18)];
+        if p.signed {
+            named.push((0.0, -t, format!("stall -T = {} N m", -t), 8, 4));
+        }
+        if let Some(w0) = motor.no_load_speed {
+            named.push((w0, 0.0, format!("no-load w0 = {w0} rad/s"), 6, 16));
+            if p.signed {
+                named.push((-w0, 0.0, format!("no-load -w0 = {} rad/s", -w0), 6, -32));
+            }
+        }
+        for (w, s, label, dx, dy) in named {
+            c.draw_series(std::iter::once(Circle::new((w, s), 5, BLACK.filled())))
+                .map_err(perr)?;
+            c.draw_series(std::iter::once(text(label, (w, s), dx, dy)))
+                .map_err(perr)?;
+        }
+        keys.push(("stall / no-load point".into(), Key::Dot));
+    }
+    if let Some(wm) = motor.max_speed {
+        let at: &[f64] = if p.signed { &[wm, -wm] } else { &[wm] };
+        for &w in at {
+            c.draw_series(DashedLineSeries::new(
+                [(w, y.0), (w, y.1)],
+                8,
+                4,
+                BLACK.stroke_width(1),
+            ))
+            .map_err(perr)?;
+            c.draw_series(std::iter::once(text(
+                format!("max_speed {w} rad/s"),
+                (w, y.1),
+                4,
+                4,
+            )))
+            .map_err(perr)?;
+        }
+        keys.push((format!("max_speed {wm} rad/s"), Key::DashedLevel));
+    }
+    if motor.max_torque.is_none() && motor.max_speed.is_none() {
+        keys.push(("no motor limits configured".into(), Key::Note));
+    }
+    // quadrant names
+    let q = |s: &str, at: (f64, f64), dx: i32, dy: i32| text(s.into(), at, dx, dy);
+    let mut names = vec![
+        q("motoring", (x.1, y.1), -80, 24),
+        q("braking", (x.1, y.0), -70, -20),
+    ];
+    if p.signed {
+        names.push(q("braking", (x.0, y.1), 8, 24));
+        names.push(q("motoring", (x.0, y.0), 8, -20));
+    }
+    c.draw_series(names).map_err(perr)?;
+    for (i, (m, pts)) in methods.iter().zip(&p.curves).enumerate() {
+        let st: Style = style_of(&m.name, i);
+        line(&mut c, pts, st, i as f64 / methods.len() as f64)?;
+        let tp = pts.iter().fold(0.0f64, |a, p| a.max(p.1.abs()));
+        let wp = pts.iter().fold(0.0f64, |a, p| a.max(p.0.abs()));
+        keys.push((
+            format!("{} ({tp:.3} N m, {wp:.2} rad/s)", m.name),
+            Key::Line(st),
+        ));
+    }
+    keys.push(("(largest |torque|, |speed|)".into(), Key::Note));
+    legend(&side, &keys)
+}
