@@ -1,8 +1,10 @@
 //! Benchmark: the free-form design, seeding design included, median of
-//! several runs, with iteration counts, on the three cases of issue 11.
+//! several runs, with iteration counts, on the three cases of issue 11,
+//! from both seeds (phased, analytic).
 //! `cargo run --release --example bench_free [-- RUNS]` (default 5 runs).
 use catflip::Config;
 use catflip::design::free::{FreeResult, Seed};
+use catflip::design::plan::ShapePlan;
 use std::time::Instant;
 
 fn median(mut x: Vec<f64>) -> f64 {
@@ -15,16 +17,19 @@ fn median(mut x: Vec<f64>) -> f64 {
     }
 }
 
-/// The seeding (phased) design and the SCP, timed together, without the
-/// mesh check.
-fn design(cfg: &Config) -> anyhow::Result<(FreeResult, f64, f64)> {
+/// The seeding design (phased, or the analytic schedule, which costs
+/// nothing) and the SCP, timed together, without the mesh check.
+fn design(cfg: &Config, seed: Seed) -> anyhow::Result<(FreeResult, f64, f64)> {
     let t = Instant::now();
-    let phased = catflip::design::phased::optimize(cfg, |_| {})?;
+    let plan: Box<dyn ShapePlan> = match seed {
+        Seed::Phased => Box::new(catflip::design::phased::optimize(cfg, |_| {})?.plan),
+        Seed::Analytic => Box::new(catflip::design::analytic::analytic_plan(cfg)),
+    };
     let seed_s = t.elapsed().as_secs_f64();
     let r = catflip::design::free::optimize_from(
         cfg,
-        &phased.plan,
-        Seed::Phased.name(),
+        plan.as_ref(),
+        seed.name(),
         cfg.free.nodes,
         |_| {},
     )?;
@@ -45,29 +50,41 @@ fn main() -> anyhow::Result<()> {
         ("robot-universal", "robot-universal", "per-motor", 0.5),
     ];
     println!(
-        "{:<18} {:>9} {:>9} {:>9} {:>6} {:>11} {:>12} {:>10}",
-        "case", "median s", "seed s", "target s", "iters", "status", "peak N m", "criticality"
+        "{:<18} {:>8} {:>9} {:>9} {:>9} {:>6} {:>11} {:>12} {:>10}",
+        "case",
+        "seed",
+        "median s",
+        "seed s",
+        "target s",
+        "iters",
+        "status",
+        "peak N m",
+        "criticality"
     );
-    for (name, file, norm, target) in cases {
+    for ((name, file, norm, target), seed) in cases
+        .into_iter()
+        .flat_map(|c| [(c, Seed::Phased), (c, Seed::Analytic)])
+    {
         // the robot is issue 11's peak-torque case: its body under the servo's
         // stall torque alone (the torque-speed line is bench_objectives' subject)
         let path = format!("{root}/configs/{file}.toml");
         let text = std::fs::read_to_string(&path)?.replace("no_load_speed", "# no_load_speed");
         let cfg = Config::from_toml(&text, &path, &[format!("limits.norm={norm}")])?;
-        let (mut total, mut seed) = (Vec::new(), Vec::new());
+        let (mut total, mut seed_s) = (Vec::new(), Vec::new());
         let mut last = None;
         for _ in 0..runs {
-            let (r, s, t) = design(&cfg)?;
-            seed.push(s);
+            let (r, s, t) = design(&cfg, seed)?;
+            seed_s.push(s);
             total.push(t);
             last = Some(r);
         }
         let r = last.expect("at least one run");
         println!(
-            "{:<18} {:>9.3} {:>9.3} {:>9.1} {:>6} {:>11} {:>12.6} {:>10.1e}",
+            "{:<18} {:>8} {:>9.3} {:>9.3} {:>9.1} {:>6} {:>11} {:>12.6} {:>10.1e}",
             name,
+            seed.name(),
             median(total),
-            median(seed),
+            median(seed_s),
             target,
             r.scp_iterations,
             format!("{:?}", r.status),

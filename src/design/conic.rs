@@ -119,12 +119,21 @@ pub struct ConicSolver {
     p_nnz: usize,
 }
 
+/// Iterative-refinement stopping tolerance (relative and absolute) of the
+/// KKT solves (Clarabel's defaults: 1e-13 relative, 1e-12 absolute). The
+/// SCP's subproblems are accurate to ~1e-8 anyway; refining the KKT solves
+/// to 1e-10 cut the free-form design's instructions by 14 % (Euclidean) and
+/// 21 % (per-motor) with the same iterations and peaks to 1e-5 (issue 11).
+const REFINE_TOL: f64 = 1e-10;
+
 fn settings() -> DefaultSettings<f64> {
     DefaultSettingsBuilder::default()
         .verbose(false)
         .presolve_enable(false)
         .input_sparse_dropzeros(false)
         .max_iter(200)
+        .iterative_refinement_reltol(REFINE_TOL)
+        .iterative_refinement_abstol(REFINE_TOL)
         .build()
         .expect("valid Clarabel settings")
 }
