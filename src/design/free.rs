@@ -1058,13 +1058,17 @@ pub fn optimize_start(
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(cfg, solved.node_peak));
     }
+    let solved = inside_envelope(cfg, solved, nodes, &mut observe)?;
+    if solved.res.status == ScpStatus::Infeasible {
+        return Err(infeasible(cfg, solved.node_peak));
+    }
     let Solved {
         res,
         z_scaled,
         plan,
         attitude_error: att,
         node_peak,
-    } = inside_envelope(cfg, solved, nodes, &mut observe)?;
+    } = solved;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
     let cat = cfg.cat();
