@@ -51,7 +51,70 @@ use crate::model::motor::{Motor, MotorUse};
 use crate::model::{Cat, TorqueNorm};
 use crate::verify::analyze::{dense_samples, peak_along};
 use crate::verify::simulate::dynamic_cfg;
+use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
+
+/// Work done by the envelope programs of this process (all threads), for
+/// benchmarks: [`work`] reads it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Work {
+    /// Conic programs solved.
+    pub socps: usize,
+    /// Clarabel interior-point iterations, summed.
+    pub iterations: usize,
+    /// Wall time inside Clarabel (setup and solves), s.
+    pub solver_s: f64,
+}
+
+static SOCPS: AtomicUsize = AtomicUsize::new(0);
+static IPM_ITERATIONS: AtomicUsize = AtomicUsize::new(0);
+static SOLVER_NS: AtomicU64 = AtomicU64::new(0);
+
+/// The work counted so far; subtract two readings to time one design.
+pub fn work() -> Work {
+    Work {
+        socps: SOCPS.load(Ordering::Relaxed),
+        iterations: IPM_ITERATIONS.load(Ordering::Relaxed),
+        solver_s: SOLVER_NS.load(Ordering::Relaxed) as f64 * 1e-9,
+    }
+}
+
+impl std::ops::Sub for Work {
+    type Output = Work;
+    fn sub(self, o: Work) -> Work {
+        Work {
+            socps: self.socps - o.socps,
+            iterations: self.iterations - o.iterations,
+            solver_s: self.solver_s - o.solver_s,
+        }
+    }
+}
+
+/// [`solve_reusing`], counted in [`work`].
+fn counted_solve(
+    slot: &mut Option<ConicSolver>,
+    data: &ConicData,
+) -> Result<(SolveStatus, Vec<f64>, f64)> {
+    let t = Instant::now();
+    let out = solve_reusing(slot, data)?;
+    SOLVER_NS.fetch_add(t.elapsed().as_nanos() as u64, Ordering::Relaxed);
+    SOCPS.fetch_add(1, Ordering::Relaxed);
+    let it = slot.as_ref().map_or(0, |s| s.iterations() as usize);
+    IPM_ITERATIONS.fetch_add(it, Ordering::Relaxed);
+    if std::env::var_os("CATFLIP_TRACE").is_some() {
+        eprintln!(
+            "socp n={} m={} nnz={} it={} {:.1} ms status={:?} obj={:.6}",
+            data.n,
+            data.m(),
+            data.vals.len(),
+            it,
+            t.elapsed().as_secs_f64() * 1e3,
+            out.0,
+            out.2
+        );
+    }
+    Ok(out)
+}
 
 /// A linear expression: `(column, coefficient)` pairs.
 type Expr = Vec<(usize, f64)>;
@@ -414,6 +477,10 @@ impl EnvelopeProblem {
         twist: f64,
         shrink: f64,
     ) -> Result<EnvelopeDesign> {
+        // a new bend has new units and data ranges: a fresh solver
+        // equilibrates them (a reused one keeps the first bend's scaling,
+        // which at the extreme bends of a scan made Clarabel fail)
+        self.solver = None;
         let first = self.solve_from(cat, bend, twist, shrink, None)?;
         if first.timings.is_some() || self.budget.is_none() || self.motor.slope() == 0.0 {
             return Ok(first);
@@ -444,15 +511,52 @@ impl EnvelopeProblem {
         let paths = Path::phased(bend, twist);
         let cols = Cols::new(self.k, self.objective);
         let m0 = cat.straight_inertia();
-        // time unit: the budget, or the time to sweep the bend at the speed or
-        // torque limit, whichever is slower
+        // Units (the program's conditioning depends on them: with data of
+        // order one Clarabel needs about a third of the iterations). Time
+        // unit: the budget, or the time to sweep the path at the speed limit
+        // (the no-load speed counts as one) or torque limit, whichever is
+        // slower.
         let ts = self.budget.unwrap_or_else(|| {
             let len = bend * (2.0 + twist.abs());
-            let by_speed = self.motor.max_speed.map_or(0.0, |w| len / w);
+            let fastest = match (self.motor.max_speed, self.motor.no_load_speed) {
+                (Some(w), Some(w0)) => Some(w.min(w0)),
+                (w, w0) => w.or(w0),
+            };
+            let by_speed = fastest.map_or(0.0, |w| len / w);
             let by_torque = self.motor.max_torque.map_or(0.0, |t| (m0 * len / t).sqrt());
             by_speed.max(by_torque).max(1e-6)
         });
-        let nu = m0 / (ts * ts);
+        // path data per unit `M(0)`
+        let mut data: [Vec<PointData>; 3] = paths.each_ref().map(|path| {
+            (0..cols.points())
+                .map(|j| {
+                    let s = j as f64 * cols.ds() / 2.0;
+                    let (m, c) = path_coefficients(cat, path, s);
+                    PointData {
+                        m: m.map(|x| x / m0),
+                        c: c.map(|x| x / m0),
+                        dq: path.eval(s)[1],
+                    }
+                })
+                .collect()
+        });
+        // torque unit `nu`: the stall torque (the bound the design lives
+        // with), else the inertial torque of a path point at a typical
+        // phase's acceleration (36 / ts^2: a third of `ts`, bang-bang in `s`)
+        let nu = self.motor.max_torque.unwrap_or_else(|| {
+            let mut ms: Vec<f64> = data
+                .iter()
+                .flatten()
+                .map(|p| self.motor.norm.of(p.m))
+                .collect();
+            ms.sort_by(f64::total_cmp);
+            (36.0 * m0 * ms[ms.len() / 2] / (ts * ts)).max(1e-300)
+        });
+        let per_unit = m0 / (nu * ts * ts);
+        for p in data.iter_mut().flatten() {
+            p.m = p.m.map(|x| x * per_unit);
+            p.c = p.c.map(|x| x * per_unit);
+        }
         let lim = Scaled {
             torque: self.motor.max_torque.map(|t| shrink * t / nu),
             speed: self.motor.max_speed.map(|w| shrink * w * ts),
@@ -468,19 +572,22 @@ impl EnvelopeProblem {
                         .into(),
             });
         }
-        let data: [Vec<PointData>; 3] = paths.each_ref().map(|path| {
-            (0..cols.points())
-                .map(|j| {
-                    let s = j as f64 * cols.ds() / 2.0;
-                    let (m, c) = path_coefficients(cat, path, s);
-                    PointData {
-                        m: m.map(|x| x / m0),
-                        c: c.map(|x| x / m0),
-                        dq: path.eval(s)[1],
-                    }
-                })
-                .collect()
-        });
+        if std::env::var_os("CATFLIP_TRACE").is_some() {
+            let mm = data
+                .iter()
+                .flatten()
+                .map(|p| p.m[0].abs().max(p.m[1].abs()))
+                .fold(0.0, f64::max);
+            let mc = data
+                .iter()
+                .flatten()
+                .map(|p| p.c[0].abs().max(p.c[1].abs()))
+                .fold(0.0, f64::max);
+            eprintln!(
+                "bend {bend:.4} ts {ts:.4} torque {:?} slope {:.4} speed {:?} max|m| {mm:.4} max|c| {mc:.4}",
+                lim.torque, lim.slope, lim.speed
+            );
+        }
         let tangents = lim.torque.is_some() && lim.slope > 0.0;
         // first tangent of sqrt(beta) where the path runs at the no-load
         // speed: beyond it a motor can only brake, so this is where the line
@@ -502,7 +609,7 @@ impl EnvelopeProblem {
         let mut iterations = 0;
         for it in 0..40 {
             let prob = self.build(&data, &lim, &beta0);
-            let (status, x, obj) = solve_reusing(&mut self.solver, &prob)?;
+            let (status, x, obj) = counted_solve(&mut self.solver, &prob)?;
             iterations = it;
             if !status.ok() {
                 if out.is_none() {
