@@ -101,18 +101,6 @@ fn counted_solve(
     SOCPS.fetch_add(1, Ordering::Relaxed);
     let it = slot.as_ref().map_or(0, |s| s.iterations() as usize);
     IPM_ITERATIONS.fetch_add(it, Ordering::Relaxed);
-    if std::env::var_os("CATFLIP_TRACE").is_some() {
-        eprintln!(
-            "socp n={} m={} nnz={} it={} {:.1} ms status={:?} obj={:.6}",
-            data.n,
-            data.m(),
-            data.vals.len(),
-            it,
-            t.elapsed().as_secs_f64() * 1e3,
-            out.0,
-            out.2
-        );
-    }
     Ok(out)
 }
 
@@ -369,6 +357,7 @@ impl EnvelopeProblem {
         for p in 0..3 {
             for j in 0..np {
                 let pd = &data[p][j];
+                let rest = j == 0 || j == np - 1;
                 if let Some(w) = lim.speed {
                     // |q'| sqrt(beta) <= w, with |q'| in the motor norm
                     let g = self.motor.norm.of(pd.dq);
@@ -398,6 +387,10 @@ impl EnvelopeProblem {
                         let g = sign * lim.slope * pd.dq[comp];
                         let (cc, bb) = if g <= 0.0 {
                             (g, 0.0)
+                        } else if rest {
+                            // at rest the speed term is exactly zero (and a
+                            // tangent at beta0 ~ 0 would be ill-conditioned)
+                            (0.0, 0.0)
                         } else {
                             let b = beta0[p][j].max(1e-8);
                             rhs = -g * b.sqrt() / 2.0;
@@ -431,7 +424,11 @@ impl EnvelopeProblem {
                         for comp in 0..2 {
                             let g = lim.slope * pd.dq[comp];
                             let b = beta0[p][j].max(1e-8);
-                            let (bb, rhs) = (g / (2.0 * b.sqrt()), g * b.sqrt() / 2.0);
+                            let (bb, rhs) = if j == 0 || j == np - 1 {
+                                (0.0, 0.0)
+                            } else {
+                                (g / (2.0 * b.sqrt()), g * b.sqrt() / 2.0)
+                            };
                             let row =
                                 plus(scaled(&tau[comp], -1.0), scaled(&cols.beta_at(p, j), -bb));
                             d.row(&row, rhs);
@@ -576,22 +573,6 @@ impl EnvelopeProblem {
                     "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
                         .into(),
             });
-        }
-        if std::env::var_os("CATFLIP_TRACE").is_some() {
-            let mm = data
-                .iter()
-                .flatten()
-                .map(|p| p.m[0].abs().max(p.m[1].abs()))
-                .fold(0.0, f64::max);
-            let mc = data
-                .iter()
-                .flatten()
-                .map(|p| p.c[0].abs().max(p.c[1].abs()))
-                .fold(0.0, f64::max);
-            eprintln!(
-                "bend {bend:.4} ts {ts:.4} torque {:?} slope {:.4} speed {:?} max|m| {mm:.4} max|c| {mc:.4}",
-                lim.torque, lim.slope, lim.speed
-            );
         }
         let tangents = lim.torque.is_some() && lim.slope > 0.0;
         // first tangent of sqrt(beta) where the path runs at the no-load
@@ -760,12 +741,6 @@ fn verified_design(
             plan.durations = plan.durations.map(|x| x * ratio);
         }
         let margin = usage_of(cfg, &plan).min_margin.unwrap_or(1.0);
-        if std::env::var_os("CATFLIP_TRACE").is_some() {
-            eprintln!(
-                "verify bend {bend:.5} shrink {shrink:.6} budget {:?} margin {margin:.3e} value {:.6}",
-                problem.budget, d.value
-            );
-        }
         if margin < -1e-7 {
             shrink *= 1.0 + 1.2 * margin;
         } else if on_time {
@@ -898,5 +873,90 @@ fn unreachable_here(cfg: &Config) -> Error {
             ),
             None => "no phased schedule fits the motor envelope at any bend; widen phased.bend_min_deg / bend_max_deg or relax the limits".into(),
         },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The smallest exact envelope margin (the true torque-speed line, no
+    /// approximation) at every point of the program's grid.
+    fn margin_at_points(cat: &Cat, motor: &Motor, d: &EnvelopeDesign) -> f64 {
+        let paths = Path::phased(d.bend, d.twist);
+        let (timings, betas) = (d.timings.as_ref().unwrap(), d.point_betas.as_ref().unwrap());
+        let mut worst = f64::INFINITY;
+        for p in 0..3 {
+            let g = &timings[p];
+            let dur2 = d.durations[p].powi(2);
+            let np = betas[p].len();
+            for (j, &beta) in betas[p].iter().enumerate() {
+                let s = j as f64 / (np - 1) as f64;
+                let a = if j % 2 == 0 {
+                    g.a[j / 2]
+                } else {
+                    0.5 * (g.a[j / 2] + g.a[j / 2 + 1])
+                } / dur2;
+                let (m, c) = path_coefficients(cat, &paths[p], s);
+                let tau = [0, 1].map(|i| m[i] * a + c[i] * beta);
+                let dq = paths[p].eval(s)[1];
+                let qd = dq.map(|x| x * beta.sqrt());
+                worst = worst.min(motor.margin(tau, qd).unwrap());
+            }
+        }
+        worst
+    }
+
+    #[test]
+    fn tangent_iteration_is_conservative_and_closes_the_gap_to_the_line() {
+        // the robot's servo line, per motor: the time-optimal program must
+        // stay inside the true line at its points at every tangent iterate,
+        // improve from the first to the converged one, and end on the line
+        let text = std::fs::read_to_string(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/configs/robot-universal.toml"
+        ))
+        .unwrap();
+        let cfg = Config::from_toml(&text, "robot-universal.toml", &[]).unwrap();
+        let (cat, motor) = (cfg.cat(), cfg.motor());
+        assert!(motor.slope() > 0.0 && motor.norm == TorqueNorm::PerMotor);
+        let bend = 0.7;
+        let twist = twist_for(&cat, bend).unwrap();
+        let solve = |tol: f64| {
+            let mut p = EnvelopeProblem::new(20, motor, Objective::Time, None);
+            p.tangent_tol = tol;
+            p.solve(&cat, bend, twist, 1.0).unwrap()
+        };
+        // an infinite tolerance stops after the first program (tangent at
+        // the no-load speed)
+        let (first, converged) = (solve(f64::INFINITY), solve(1e-7));
+        assert_eq!(first.iterations, 0);
+        assert!(converged.iterations >= 2, "{}", converged.iterations);
+        let (m_first, m_conv) = (
+            margin_at_points(&cat, &motor, &first),
+            margin_at_points(&cat, &motor, &converged),
+        );
+        // conservative: the approximated line never lets a point outside the true one
+        assert!(m_first >= -1e-6 && m_conv >= -1e-6, "{m_first} {m_conv}");
+        // the gap closes: every update improves on the first program, and
+        // the converged timing is a fixed point (the tangent at its own
+        // speeds touches the line there, so restarting from it moves nothing)
+        assert!(
+            converged.value < first.value * (1.0 - 1e-4),
+            "converged {} s vs first {} s",
+            converged.value,
+            first.value
+        );
+        let mut again = EnvelopeProblem::new(20, motor, Objective::Time, None);
+        again.tangent_tol = f64::INFINITY;
+        let restart = again
+            .solve_from(&cat, bend, twist, 1.0, converged.point_betas.clone())
+            .unwrap();
+        assert!(
+            (restart.value - converged.value).abs() < 1e-5 * converged.value,
+            "restart {} s vs converged {} s",
+            restart.value,
+            converged.value
+        );
     }
 }
