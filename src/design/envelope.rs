@@ -12,18 +12,38 @@
 //! - torque `tau = m a + c beta` is linear; a torque bound is exact (per motor:
 //!   linear rows; Euclidean: a cone);
 //! - a speed limit `|q'| sqrt(beta) <= w` is `beta <= w^2 / |q'|^2`: linear, exact;
-//! - the torque-speed line `|tau + k q' sqrt(beta)| <= T` is NOT convex in
-//!   `beta` (`sqrt` is concave). Per motor, each side is one row
-//!   `+-tau_i + k q'_i sqrt(beta) (+-) <= T`: where the `sqrt(beta)` term enters
-//!   with a negative sign it is replaced by `c <= sqrt(beta)` (the time
-//!   model's own SOC variable; a lower bound, so conservative); where it enters
-//!   with a positive sign by its tangent at the previous iterate,
-//!   `(beta + beta0) / (2 sqrt(beta0))`, an upper bound of the concave `sqrt`,
-//!   so conservative too. The tangent point is updated until it stops moving
-//!   (a convex-concave procedure: every iterate after the first is inside the
-//!   envelope at the points, and the objective does not increase). For the
-//!   Euclidean disc the tangent enters inside the norm, which is exact at the
-//!   converged point only.
+//! - the torque-speed line `|tau + k q' sqrt(beta)| <= T` (`k = T / w0`,
+//!   `q' sqrt(beta)` the joint speed) is NOT convex in `beta`: `sqrt` is
+//!   concave. This is the ONLY approximation of the line, and it is made at
+//!   the grid points and midpoints only. Per motor `i`, each side
+//!   `sigma = +-1` is one row `sigma tau_i + g sqrt(beta) <= T` with
+//!   `g = sigma k q'_i`:
+//!   - `g <= 0` (braking side: the speed gives the motor torque back):
+//!     `sqrt(beta)` is replaced by the SOC variable `c <= sqrt(beta)` (the
+//!     time model's own); since `g c >= g sqrt(beta)` the row is at least as
+//!     tight as the line: conservative, with gap `|g| (sqrt(beta) - c)`.
+//!   - `g > 0` (motoring side: the speed eats the torque): `sqrt(beta)` is
+//!     replaced by its tangent at a point `beta0`,
+//!     `L(beta) = (beta + beta0) / (2 sqrt(beta0)) >= sqrt(beta)`:
+//!     conservative, with gap `g (sqrt(beta) - sqrt(beta0))^2 / (2 sqrt(beta0))`,
+//!     zero at `beta = beta0`. At the rest ends (`beta = 0`) the term is
+//!     dropped: exact.
+//!
+//!   So every program's solution is inside the true line at its points. The
+//!   first tangent is at the no-load speed (`beta0 = (w0 / |q'|)^2`, where the
+//!   line matters; at rest it still leaves `T / 2`); then `beta0` is set to
+//!   the last solution and the program solved again (a convex-concave
+//!   procedure): each solution is feasible for the next program, so the
+//!   objective never increases, and at the fixed point the tangent gap is
+//!   zero at the solution's own speeds. It stops when the objective moves by
+//!   less than [`EnvelopeProblem::tangent_tol`] (1e-5; 1e-3 while searching
+//!   the bend). If the first program is infeasible for a tight budget, the
+//!   tangent starts at the `time` design's speeds instead (which fits any
+//!   budget at least as long). The tests check the bound and the fixed point.
+//!   For the Euclidean disc the tangent enters inside the norm (each
+//!   component with its own sign), which is NOT a bound in general: there
+//!   the line holds exactly only at the converged point, and the dense check
+//!   below enforces it.
 //! - Between the points the torque is second-order accurate; every written
 //!   row is then checked, and if any leaves the envelope the limits are backed
 //!   off by the excess and the design solved again.
@@ -34,8 +54,10 @@
 //!   timing SOC model's `sum 2 ds / (c_k + c_{k+1})`.
 //!
 //! Units: the program is solved in a time unit `ts` (the fall time or an
-//! estimate) and the torque unit `M(0) / ts^2`, so its data are of order one
-//! whatever the size of the cat.
+//! estimate from the limits) and the torque unit `nu` (the stall torque, or a
+//! typical inertial torque without one), so its data are of order one
+//! whatever the size of the cat; each bend gets a fresh Clarabel solver so
+//! that its equilibration matches the bend's data.
 
 use crate::config::Config;
 use crate::design::analytic::plan as cosine_plan;
