@@ -18,7 +18,7 @@ fn main() -> anyhow::Result<()> {
         catflip::design::free::optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |it| {
             println!(
                 "  SCP {:3}: peak {:.5} N m, max |r| {:.1e}",
-                it.iteration, it.peak, it.infeasibility
+                it.iteration, it.objective, it.infeasibility
             )
         })?;
     println!(

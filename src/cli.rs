@@ -535,7 +535,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                         "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
                         it.iteration,
                         it.merit,
-                        it.peak,
+                        it.objective,
                         it.infeasibility,
                         it.radius,
                         it.rho,
@@ -569,6 +569,15 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 cfg.cat.joint.name(),
                 catflip::run::json_name(&r.status),
                 r.seed
+            );
+            row(
+                &format!("objective ({})", r.objective.name()),
+                format!(
+                    "{:.6} {} (manoeuvre {:.4} s)",
+                    r.objective_value,
+                    r.objective.unit(),
+                    r.manoeuvre_time_s
+                ),
             );
             row(
                 "peak torque",
@@ -664,7 +673,7 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
                 let _ = write!(
                     e,
                     "\r\x1b[2K      SCP iteration {:3}: peak {:.5} N m, max |r| {:.1e}, radius {:.1e}",
-                    it.iteration, it.peak, it.infeasibility, it.radius
+                    it.iteration, it.objective, it.infeasibility, it.radius
                 );
             }
             _ => {}

@@ -7,7 +7,6 @@ use crate::design::least_height::HeightAnswer;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
-use crate::model::motor::MotorUse;
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
 use crate::verify::analyze::analyze;
@@ -88,6 +87,9 @@ pub struct MethodNumbers {
     /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
     /// the envelope, negative violated; absent without limits).
     pub min_envelope_margin: Option<f64>,
+    /// `integral |tau|^2 dt` over the written rows, N^2 m^2 s (the energy
+    /// objective; the peak and the durations give the other two).
+    pub energy_n2m2s: f64,
     pub solve_time_s: f64,
     pub schedule_csv: String,
     pub schedule_json: String,
@@ -150,6 +152,23 @@ impl RunResult {
     }
 }
 
+/// Whether a free-form design can answer the robot question: converged,
+/// inside the motor envelope at every written row, and flipping under the
+/// motor model within `simulate.flip_tolerance`.
+fn verified(cfg: &Config, fr: &crate::design::free::FreeResult) -> bool {
+    let margin = crate::design::envelope::usage_of(cfg, &fr.plan)
+        .min_margin
+        .unwrap_or(1.0);
+    fr.status == crate::design::scp::ScpStatus::Converged
+        && margin >= -1e-6
+        && crate::verify::simulate::misses_flip(
+            fr.flip_error_rad,
+            fr.tilt_deg,
+            cfg.simulate.flip_tolerance,
+        )
+        .is_none()
+}
+
 /// Why a verified design misses its targets, if it does: solver status,
 /// flip and tilt beyond `simulate.flip_tolerance`, limits broken.
 fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
@@ -162,7 +181,10 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         n.tilt_deg,
         cfg.simulate.flip_tolerance,
     ));
+    // with a torque-speed line a braking torque may exceed the stall torque:
+    // the envelope margin below is the test then
     if let Some(lim) = cfg.limits.max_torque
+        && cfg.limits.no_load_speed.is_none()
         && n.peak_torque_nm > lim * (1.0 + 1e-6)
     {
         why.push(format!(
@@ -199,9 +221,12 @@ fn summarize(
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: std::result::Result<&SimReport, &Error>,
-    motor: MotorUse,
+    schedule: &Schedule,
     solve_time_s: f64,
 ) -> MethodSummary {
+    let motor = cfg
+        .motor()
+        .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)));
     let (bend, twist, durations) = path_numbers;
     let failed_sim;
     let (sim, sim_error) = match sim {
@@ -225,6 +250,7 @@ fn summarize(
         final_shape_error_rad: sim.final_shape_error_rad,
         max_speed_rad_s: motor.max_speed_rad_s,
         min_envelope_margin: motor.min_margin,
+        energy_n2m2s: schedule.torque_squared_integral(),
         solve_time_s,
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
@@ -286,8 +312,6 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     let cat = cfg.cat();
     let per = cfg.simulate.samples_per_phase;
     let mut output = Output::default();
-    let motor = cfg.motor();
-    let usage = |s: &Schedule| motor.usage(s.rows.iter().map(|r| (r.tau, r.qd)));
     let mut methods = Vec::new();
     let mut traces = Vec::new();
     let mut tracks = Vec::new();
@@ -334,7 +358,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                     a.closed.phase_durations_s,
                 ),
                 a_sim.as_ref(),
-                usage(&a_sched),
+                &a_sched,
                 a_time,
             ));
             let failed_sim = SimReport::failed();
@@ -349,6 +373,9 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     // the robot question first: when the motors cannot flip the cat in
     // this fall, no design at this height is attempted
     let mut answer = None;
+    let mut fastest_free: Option<crate::design::free::FreeResult> = None;
+    // the phased least height, when no phased schedule fits this fall
+    let mut phased_short: Option<f64> = None;
     if limited {
         progress(Progress::Stage {
             index: 2,
@@ -357,20 +384,48 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         });
         let clock = Instant::now();
         let a = crate::design::least_height::answer(cfg);
+        let a = match a {
+            // the free-form time design, seeded by the phased one, when it
+            // verifies (converged, inside the envelope, flips) and is shorter
+            Ok(Some(mut a)) => {
+                phased_short = (!a.possible).then_some(a.least_height_m);
+                let mut timed = cfg.clone();
+                timed.design.objective = crate::design::objective::Objective::Time;
+                if let Ok(fr) = crate::design::free::optimize_from(
+                    &timed,
+                    &a.schedule,
+                    "phased",
+                    cfg.free.nodes,
+                    |it| progress(Progress::Scp(it)),
+                ) && verified(cfg, &fr)
+                {
+                    a.improve_with(cfg, &fr);
+                    fastest_free = Some(fr);
+                }
+                Ok(Some(a))
+            }
+            other => other,
+        };
         stage_end(&mut progress, clock, a.as_ref().err());
         match a {
             Ok(Some(a)) => {
-                Schedule::sample(&cat, &a.plan, per).add_to(&mut output, "least-height");
+                a.schedule.add_to(&mut output, "least-height");
                 answer = Some(a);
             }
             Ok(None) => {}
             Err(e) => notes_early.push(format!("The least drop height could not be found: {e}")),
         }
     }
-    let impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
+    let impossible = phased_short.map(|least| {
         format!(
-            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {:.3} m (least-height.csv)",
-            a.height_m, a.least_height_m
+            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
+            cfg.fall.height
+        )
+    });
+    let free_impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
+        format!(
+            "no schedule found fits the motors in the fall from {} m (fall.height); the {} time-optimal design needs at least {:.3} m (least-height.csv)",
+            a.height_m, a.method, a.least_height_m
         )
     });
     let skipped = |reason: &String| Error::Unreachable {
@@ -411,7 +466,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
                 Ok(ph_sim),
-                usage(&ph_sched),
+                &ph_sched,
                 ph.solve_time_s,
             ));
             traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
@@ -427,21 +482,25 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         name: "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
     });
     let clock = Instant::now();
-    // seeded by the phased design, or by the analytic plan when that failed
+    // seeded by the phased design, or by the free-form least-time design
+    // when no phased one fits, or by the analytic plan when that failed
     let analytic_seed;
-    let (seed_plan, seed_name): (&dyn ShapePlan, &str) = match &phased {
-        Ok(ph) => (&ph.plan, "phased"),
-        Err(_) => {
+    let (seed_plan, seed_name): (&dyn ShapePlan, &str) = match (&phased, &fastest_free) {
+        (Ok(ph), _) => (&ph.plan, "phased"),
+        (Err(_), Some(fr)) => (&fr.plan, "free least-time"),
+        (Err(_), None) => {
             analytic_seed = crate::design::analytic::analytic_plan(cfg);
             (&analytic_seed, "analytic")
         }
     };
-    // always tried: the phased least height is an upper bound, and a
-    // free-form design may fit where no phased one does
-    let free =
-        crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-            progress(Progress::Scp(it))
-        });
+    let free = match &free_impossible {
+        Some(r) => Err(skipped(r)),
+        None => {
+            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
+                progress(Progress::Scp(it))
+            })
+        }
+    };
     match &free {
         Ok(fr) => {
             let fr_sched = Schedule::sample(&cat, &fr.plan, per);
@@ -453,7 +512,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
                 Ok(&fr.sim),
-                usage(&fr_sched),
+                &fr_sched,
                 fr.solve_time_s,
             ));
             traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
@@ -513,7 +572,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         ("shape_path.svg", report::shape_path(&traces)),
     ];
     if !iterations.is_empty() {
-        figures.push(("convergence.svg", report::convergence(&iterations)));
+        figures.push((
+            "convergence.svg",
+            report::convergence(&iterations, cfg.design.objective),
+        ));
     }
     let mut notes = notes_early;
     let figures: Vec<(&str, String)> = figures
@@ -628,10 +690,11 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
 }
 
 /// Columns of the comparison table (terminal and index.html).
-pub const TABLE_HEADER: [&str; 10] = [
+pub const TABLE_HEADER: [&str; 11] = [
     "method",
     "status",
     "peak N m",
+    "energy N2m2s",
     "bend deg",
     "durations s",
     "flip error rad",
@@ -672,6 +735,7 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
             let d = n.phase_durations_s;
             row.extend([
                 format!("{:.5}", n.peak_torque_nm),
+                format!("{:.4e}", n.energy_n2m2s),
                 format!("{:.2}", n.bend_deg),
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
                 small(n.flip_error_rad),
@@ -680,7 +744,7 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.3}", n.solve_time_s),
             ]);
         }
-        None => row.extend(std::iter::repeat_n("-".to_string(), 7)),
+        None => row.extend(std::iter::repeat_n("-".to_string(), 8)),
     }
     row.push(verdict);
     row

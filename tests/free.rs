@@ -4,7 +4,7 @@ use catflip::Config;
 use catflip::design::analytic::analytic_plan;
 use catflip::design::collocation::Transcription;
 use catflip::design::free::FreeProblem;
-use catflip::design::scp::ScpProblem;
+use catflip::design::scp::{Cost, ScpProblem, ScpStatus, Values};
 
 /// A bundled config. The robot's servo also has a torque-speed line, which
 /// only the envelope designs handle (tests/envelope.rs); here the robot is the
@@ -39,7 +39,8 @@ fn linearisation_matches_finite_differences_of_the_nonlinear_maps() {
         }
         let p = FreeProblem::new(&c, nodes, &z);
         let lin = p.linearize(&z);
-        let (terms, res) = p.evaluate(&z);
+        let v = p.evaluate(&z);
+        let (terms, res) = (v.terms, v.residual);
         for (a, b) in terms.iter().zip(&lin.terms) {
             assert!((a - b).abs() < 1e-10);
         }
@@ -54,7 +55,8 @@ fn linearisation_matches_finite_differences_of_the_nonlinear_maps() {
             zp[col] += h;
             let mut zm = z.clone();
             zm[col] -= h;
-            let ((tp, rp), (tm, rm)) = (p.evaluate(&zp), p.evaluate(&zm));
+            let (vp, vm) = (p.evaluate(&zp), p.evaluate(&zm));
+            let ((tp, rp), (tm, rm)) = ((vp.terms, vp.residual), (vm.terms, vm.residual));
             for r in 0..terms.len() {
                 let fd = (tp[r] - tm[r]) / (2.0 * h);
                 assert!(
@@ -75,11 +77,46 @@ fn linearisation_matches_finite_differences_of_the_nonlinear_maps() {
     }
 }
 
-/// A rest-to-rest double integrator (unit mass, move 1 m in 1 s) with least
-/// peak force, solved by the same transcription and SCP driver. Known optimum:
-/// bang-bang, |F| = 4 D / T^2 = 4 N, switching at mid-time.
+/// A rest-to-rest double integrator (unit mass, move D = 1 m), solved by
+/// the same transcription and SCP driver, with three objectives whose optima
+/// are known in closed form:
+/// - least peak force in T = 1 s: bang-bang, |F| = 4 D / T^2 = 4 N,
+///   switching at mid-time;
+/// - least time under |F| <= 1 N: bang-bang, T = 2 sqrt(D / F) = 2 s;
+/// - least `integral F^2 dt` in T = 1 s: F linear in time, 12 D^2 / T^3 = 12.
 struct DoubleIntegrator {
     tr: Transcription,
+    cost: Cost,
+    limit: Option<f64>,
+}
+
+impl DoubleIntegrator {
+    fn peak(tr: Transcription) -> Self {
+        Self {
+            tr,
+            cost: Cost::Peak,
+            limit: None,
+        }
+    }
+    /// The force at the nodes and its gradient in (a_k, T).
+    fn forces(&self, z: &[f64]) -> Vec<(f64, f64, f64)> {
+        let t = z[self.tr.duration(0)];
+        (0..self.tr.nodes)
+            .map(|k| {
+                let a = z[self.tr.a(0, k)];
+                (a / (t * t), 1.0 / (t * t), -2.0 * a / (t * t * t))
+            })
+            .collect()
+    }
+    /// Trapezoid weight of node `k` (normalised time).
+    fn weight(&self, k: usize) -> f64 {
+        let h = self.tr.h();
+        if k == 0 || k == self.tr.nodes - 1 {
+            h / 2.0
+        } else {
+            h
+        }
+    }
 }
 
 impl ScpProblem for DoubleIntegrator {
@@ -92,30 +129,51 @@ impl ScpProblem for DoubleIntegrator {
     fn norm(&self) -> catflip::model::TorqueNorm {
         catflip::model::TorqueNorm::PerMotor
     }
-    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
-        let t = z[self.tr.duration(0)];
-        let f = (0..self.tr.nodes)
-            .map(|k| z[self.tr.a(0, k)] / (t * t))
-            .collect();
-        (f, self.tr.defects(z, 0, None))
+    fn cost(&self) -> Cost {
+        self.cost.clone()
+    }
+    fn limit(&self) -> Option<f64> {
+        self.limit
+    }
+    fn evaluate(&self, z: &[f64]) -> Values {
+        let lin = self.linearize(z);
+        Values {
+            terms: lin.terms,
+            limited: lin.limited,
+            residual: lin.residual,
+        }
     }
     fn linearize(&self, z: &[f64]) -> catflip::design::scp::Linearization {
-        let (terms, _) = self.evaluate(z);
         let t = z[self.tr.duration(0)];
-        let mut tj = Vec::new();
-        for k in 0..self.tr.nodes {
-            tj.push((k, self.tr.a(0, k), 1.0 / (t * t)));
-            tj.push((
-                k,
-                self.tr.duration(0),
-                -2.0 * z[self.tr.a(0, k)] / (t * t * t),
-            ));
+        let (mut terms, mut tj, mut limited, mut lj) = (vec![], vec![], vec![], vec![]);
+        for (k, (f, da, dt)) in self.forces(z).into_iter().enumerate() {
+            let (a, d) = (self.tr.a(0, k), self.tr.duration(0));
+            match self.cost {
+                Cost::Peak => {
+                    tj.extend([(k, a, da), (k, d, dt)]);
+                    terms.push(f);
+                }
+                // sqrt(w T) F, whose square sums to integral F^2 dt
+                Cost::SumOfSquares => {
+                    let c = (self.weight(k) * t).sqrt();
+                    let dc = 0.5 * (self.weight(k) / t).sqrt();
+                    tj.extend([(k, a, c * da), (k, d, c * dt + dc * f)]);
+                    terms.push(c * f);
+                }
+                Cost::Linear(_) => {}
+            }
+            if self.limit.is_some() {
+                lj.extend([(k, a, da), (k, d, dt)]);
+                limited.push(f);
+            }
         }
         let mut rj = Vec::new();
         let residual = self.tr.defects(z, 0, Some(&mut rj));
         catflip::design::scp::Linearization {
             terms,
             terms_jac: tj,
+            limited,
+            limited_jac: lj,
             residual,
             residual_jac: rj,
         }
@@ -143,8 +201,15 @@ impl ScpProblem for DoubleIntegrator {
         fix(d, tr.v(0, 0), 0.0);
         fix(d, tr.q(0, n - 1), 1.0);
         fix(d, tr.v(0, n - 1), 0.0);
-        fix(d, tr.duration(0), 1.0);
+        if !matches!(self.cost, Cost::Linear(_)) {
+            fix(d, tr.duration(0), 1.0);
+        }
         d.cone(catflip::design::conic::Cone::Zero(rows));
+        if matches!(self.cost, Cost::Linear(_)) {
+            // the duration stays positive
+            d.row(&[(var(tr.duration(0)), -1.0)], z[tr.duration(0)] - 0.1);
+            d.cone(catflip::design::conic::Cone::Nonneg(1));
+        }
     }
     fn scales(&self) -> Vec<f64> {
         vec![1.0; self.dim()]
@@ -165,7 +230,7 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
             z[tr.a(0, k)] = 0.5 * w * w * (w * s).cos();
         }
         z[tr.duration(0)] = 1.0;
-        let p = DoubleIntegrator { tr };
+        let p = DoubleIntegrator::peak(tr);
         let r = catflip::design::scp::solve(
             &p,
             z,
@@ -181,15 +246,15 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
         // first-order-hold force needs one interval to switch: peak 4 / (1 - h/2)^2-ish above 4
         let h = 1.0 / (nodes - 1) as f64;
         assert!(
-            r.peak >= 4.0 - 1e-6 && r.peak < 4.0 * (1.0 + 2.5 * h),
+            r.objective >= 4.0 - 1e-6 && r.objective < 4.0 * (1.0 + 2.5 * h),
             "{nodes}: peak {}",
-            r.peak
+            r.objective
         );
         // bang-bang: saturated almost everywhere, one sign change
         let f: Vec<f64> = (0..nodes).map(|k| r.z[tr.a(0, k)]).collect();
         let saturated = f
             .iter()
-            .filter(|x| (x.abs() - r.peak).abs() < 1e-3 * r.peak)
+            .filter(|x| (x.abs() - r.objective).abs() < 1e-3 * r.objective)
             .count();
         assert!(saturated >= nodes - 3, "{nodes}: {f:?}");
         let changes = f
@@ -198,6 +263,80 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
             .count();
         assert!(changes <= 1, "{f:?}");
         assert!(r.infeasibility < 1e-6);
+    }
+}
+
+/// The cosine move (peak pi^2 / 2 = 4.93 N in 1 s) on `nodes` nodes.
+fn cosine_move(tr: &Transcription) -> Vec<f64> {
+    let mut z = vec![0.0; tr.dim()];
+    for k in 0..tr.nodes {
+        let s = k as f64 / (tr.nodes - 1) as f64;
+        let w = std::f64::consts::PI;
+        z[tr.q(0, k)] = 0.5 * (1.0 - (w * s).cos());
+        z[tr.v(0, k)] = 0.5 * w * (w * s).sin();
+        z[tr.a(0, k)] = 0.5 * w * w * (w * s).cos();
+    }
+    z[tr.duration(0)] = 1.0;
+    z
+}
+
+#[test]
+fn the_scp_machinery_finds_the_least_time_under_a_force_limit() {
+    // T = 2 sqrt(D / F) = 2 s; starting from the 1 s cosine move (which
+    // breaks the limit fivefold: the elastic slack keeps the steps feasible)
+    for nodes in [21, 41] {
+        let tr = Transcription::new(1, nodes);
+        let p = DoubleIntegrator {
+            tr,
+            cost: Cost::Linear(vec![(tr.duration(0), 1.0)]),
+            limit: Some(1.0),
+        };
+        let r = catflip::design::scp::solve(
+            &p,
+            cosine_move(&tr),
+            &catflip::design::scp::ScpSettings::default(),
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(r.status, ScpStatus::Converged, "{nodes} nodes");
+        let h = tr.h();
+        assert!(
+            r.objective >= 2.0 * (1.0 - 1e-6) && r.objective < 2.0 * (1.0 + 1.5 * h),
+            "{nodes}: time {}",
+            r.objective
+        );
+        assert!(r.infeasibility < 1e-6);
+    }
+}
+
+#[test]
+fn the_scp_machinery_finds_the_least_energy_move() {
+    // integral F^2 dt = 12 D^2 / T^3 with F linear in time; the trapezoid
+    // rule on the nodes overestimates the quadratic integrand by O(h^2)
+    for nodes in [21, 41] {
+        let tr = Transcription::new(1, nodes);
+        let p = DoubleIntegrator {
+            tr,
+            cost: Cost::SumOfSquares,
+            limit: None,
+        };
+        let r = catflip::design::scp::solve(
+            &p,
+            cosine_move(&tr),
+            &catflip::design::scp::ScpSettings::default(),
+            |_| {},
+        )
+        .unwrap();
+        assert_eq!(r.status, ScpStatus::Converged, "{nodes} nodes");
+        let h = tr.h();
+        assert!(
+            (r.objective - 12.0).abs() < 12.0 * 2.0 * h * h + 1e-6,
+            "{nodes}: energy {}",
+            r.objective
+        );
+        // the force is linear: F(0) = 6, F(1) = -6
+        let f0 = r.z[tr.a(0, 0)];
+        assert!((f0 - 6.0).abs() < 0.05 * 6.0, "{nodes}: F(0) = {f0}");
     }
 }
 

@@ -23,9 +23,11 @@
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
 use crate::design::conic::{Cone, ConicData};
+use crate::design::objective::Objective;
+use crate::design::plan::ShapePlan;
 use crate::design::scp::{
-    Certificate, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets,
-    WarmStart, solve_warm,
+    Certificate, Cost, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets,
+    Values, WarmStart, solve_warm,
 };
 use crate::error::Result;
 use crate::model::dynamics::{linearize_torque, torque_from};
@@ -38,6 +40,13 @@ use serde::Serialize;
 /// A torque check point: interval index, normalised `(q, q^, q^^)`, and the
 /// interpolation coefficients of `q`, `q^`, `q^^` on the interval's node values.
 type CheckPoint = (usize, [f64; 2], [f64; 2], [f64; 2], [[f64; 4]; 3]);
+
+/// Trust-region scale of the phase durations relative to the start's
+/// manoeuvre: the cost of the `time` objective is linear in them, so their
+/// steps are bounded by the trust region alone (0.3 took half the
+/// iterations of 0.1 on the seed's least-time problem, and no more on the
+/// peak problems).
+const DURATION_SCALE: f64 = 0.3;
 
 /// Magnus sub-steps per collocation interval.
 const SUB: usize = 2;
@@ -57,9 +66,29 @@ pub struct FreeProblem {
     /// Shortest phase, in units of the available time.
     pub min_phase: f64,
     pub max_bend: Option<f64>,
-    /// Torque limit in units of `torque_unit`.
+    /// Torque limit `T` in units of `torque_unit` (clamped, see [`LIMIT_CAP`]).
     pub max_torque: Option<f64>,
+    /// Slope of the torque-speed line in the problem's units: the limited
+    /// term is `tau + slope q^ / T_p` (physical `tau + k qd`).
+    pub slope: f64,
+    /// Hard joint-speed limit in units of the rate `q^` per unit duration.
+    pub max_speed: Option<f64>,
+    pub objective: Objective,
     scales: Vec<f64>,
+}
+
+/// A torque limit above this many torque units (`I_t / T^2`) is dropped
+/// (clamped to it with a torque-speed line): no schedule that flips the cat
+/// comes near it (the cosine schedule needs about 10), and a huge bound
+/// would only wreck the conic solver's scaling.
+pub const LIMIT_CAP: f64 = 1e4;
+
+/// One flattened torque row at a check point: its value and its gradient in
+/// the interval's eight node values and the phase duration.
+#[derive(Clone, Copy)]
+struct TorqueRow {
+    value: f64,
+    grad: [f64; 9],
 }
 
 impl FreeProblem {
@@ -82,6 +111,8 @@ impl FreeProblem {
                 }
             }
         }
+        let manoeuvre =
+            ((0..3).map(|p| z0[tr.duration(p)]).sum::<f64>() / time_unit).clamp(1e-3, 1.0);
         let mut scales = vec![0.0; tr.dim()];
         for p in 0..3 {
             for k in 0..nodes {
@@ -91,7 +122,9 @@ impl FreeProblem {
                     scales[tr.a(p, k) + j] = sa;
                 }
             }
-            scales[tr.duration(p)] = 0.1;
+            // a tenth of the start's manoeuvre (in units of the available
+            // time): slowing the whole problem down scales every step alike
+            scales[tr.duration(p)] = DURATION_SCALE * manoeuvre;
         }
         Self {
             cat,
@@ -99,16 +132,35 @@ impl FreeProblem {
             norm: cfg.norm(),
             time_unit,
             torque_unit,
-            min_phase: 0.02,
+            min_phase: 0.02 * manoeuvre,
             max_bend: cfg.limits.max_bend_deg.map(f64::to_radians),
-            max_torque: cfg.limits.max_torque.map(|l| l / torque_unit),
+            // without a torque-speed line, a limit above the cap can never bind
+            max_torque: cfg
+                .limits
+                .max_torque
+                .map(|l| l / torque_unit)
+                .filter(|&l| l < LIMIT_CAP || cfg.motor().slope() > 0.0)
+                .map(|l| l.min(LIMIT_CAP)),
+            slope: cfg.motor().slope() / (torque_unit * time_unit),
+            max_speed: cfg.limits.max_speed.map(|w| w * time_unit),
+            objective: cfg.design.objective,
             scales,
         }
     }
 
-    /// Number of flattened peak terms (two per check point).
-    pub fn terms_len(&self) -> usize {
+    /// Number of flattened torque rows (two per check point).
+    pub fn torques_len(&self) -> usize {
         3 * 2 * (2 * self.tr.nodes - 1)
+    }
+
+    /// The objective's unit in physical terms: N m (peak), s (time) or
+    /// N^2 m^2 s (energy).
+    pub fn objective_unit(&self) -> f64 {
+        match self.objective {
+            Objective::PeakTorque => self.torque_unit,
+            Objective::Time => self.time_unit,
+            Objective::Energy => self.torque_unit * self.torque_unit * self.time_unit,
+        }
     }
 
     /// Physical `z` (durations in s) to the problem's units.
@@ -230,43 +282,173 @@ impl FreeProblem {
         out
     }
 
-    fn torques(&self, z: &[f64]) -> Vec<f64> {
-        let mut out = Vec::with_capacity(12 * self.tr.nodes);
+    /// Simpson weights of one phase's check points (in [`Self::check_points`]
+    /// order) for `integral_0^1 f ds`.
+    fn quadrature(&self) -> Vec<f64> {
+        let h = self.tr.h();
+        let mut w = Vec::with_capacity(2 * self.tr.nodes - 1);
+        for k in 0..self.tr.nodes - 1 {
+            w.push(if k == 0 { h / 6.0 } else { h / 3.0 });
+            w.push(2.0 * h / 3.0);
+        }
+        w.push(h / 6.0);
+        w
+    }
+
+    /// The torque (in units of `torque_unit`) at every check point, phases
+    /// in order, with gradients when asked; the point's phase, interval,
+    /// rate `q^` and its interpolation coefficients, and quadrature weight.
+    fn torque_points(&self, z: &[f64], want_grad: bool) -> Vec<TorquePoint> {
+        let tr = &self.tr;
+        let it = self.cat.i_t();
+        let weights = self.quadrature();
+        let mut out = Vec::with_capacity(3 * (2 * tr.nodes - 1));
         for p in 0..3 {
-            let t2 = z[self.tr.duration(p)].powi(2) * self.cat.i_t();
-            for (_, q, v, a, _) in self.check_points(z, p) {
-                let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
-                out.extend(tau.iter().map(|x| x / t2));
+            let t = z[tr.duration(p)];
+            let (s2, s3) = (1.0 / (t * t * it), -2.0 / (t * t * t * it));
+            for ((k, q, v, a, coef), &weight) in self.check_points(z, p).into_iter().zip(&weights) {
+                let rows = if want_grad {
+                    // normalised-time inverse dynamics; physical torque = tau^ / T^2
+                    let lin = linearize_torque(&ShapeTerms::second(&self.cat, q), v, a);
+                    [0, 1].map(|i| {
+                        let mut grad = [0.0; 9];
+                        for l in 0..2 {
+                            for idx in 0..4 {
+                                grad[4 * l + idx] = (lin.d_q[i][l] * coef[0][idx]
+                                    + lin.d_qd[i][l] * coef[1][idx]
+                                    + lin.d_qdd[i][l] * coef[2][idx])
+                                    * s2;
+                            }
+                        }
+                        grad[8] = lin.tau[i] * s3;
+                        TorqueRow {
+                            value: lin.tau[i] * s2,
+                            grad,
+                        }
+                    })
+                } else {
+                    let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
+                    tau.map(|x| TorqueRow {
+                        value: x * s2,
+                        grad: [0.0; 9],
+                    })
+                };
+                out.push(TorquePoint {
+                    phase: p,
+                    interval: k,
+                    duration: t,
+                    rate: v,
+                    rate_coef: coef[1],
+                    weight,
+                    rows,
+                });
             }
         }
         out
     }
 
-    /// Physical rate continuity across the two junctions, in units of the
-    /// available time (radians): `q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1}`,
+    /// The torques at the check points, flattened.
+    fn torques(&self, z: &[f64]) -> Vec<f64> {
+        self.torque_points(z, false)
+            .iter()
+            .flat_map(|pt| pt.rows.iter().map(|r| r.value))
+            .collect()
+    }
+
+    /// The variables a point's gradient refers to: the interval's eight
+    /// node values (component 0 then 1) and the phase duration.
+    fn point_columns(&self, pt: &TorquePoint) -> [usize; 9] {
+        let mut cols = [0usize; 9];
+        for l in 0..2 {
+            let ic = self.tr.interval_columns(pt.phase, pt.interval, l);
+            cols[4 * l..4 * l + 4].copy_from_slice(&ic);
+        }
+        cols[8] = self.tr.duration(pt.phase);
+        cols
+    }
+
+    /// The cost's terms and the limited terms from the torque points, with
+    /// gradients (in the points' nine columns) when the points carry them.
+    /// Peak: the torque. Energy: `sqrt(w T_p) tau` (Simpson weight `w`), so
+    /// that the sum of squares is `integral |tau|^2 dt`. Time: none. Limited:
+    /// `tau + slope q^ / T_p` (the torque-speed line), when there is a limit.
+    fn terms_of(&self, pts: &[TorquePoint]) -> (Vec<TorqueRow>, Vec<TorqueRow>) {
+        let mut terms = Vec::new();
+        let mut limited = Vec::new();
+        for pt in pts {
+            let t = pt.duration;
+            for (i, row) in pt.rows.iter().enumerate() {
+                match self.objective {
+                    Objective::PeakTorque => terms.push(*row),
+                    Objective::Energy => {
+                        let c = (pt.weight * t).sqrt();
+                        let mut grad = row.grad.map(|g| c * g);
+                        grad[8] += row.value * 0.5 * (pt.weight / t).sqrt();
+                        terms.push(TorqueRow {
+                            value: c * row.value,
+                            grad,
+                        });
+                    }
+                    Objective::Time => {}
+                }
+                if self.max_torque.is_some() {
+                    let mut grad = row.grad;
+                    for idx in 0..4 {
+                        grad[4 * i + idx] += self.slope / t * pt.rate_coef[idx];
+                    }
+                    grad[8] -= self.slope * pt.rate[i] / (t * t);
+                    limited.push(TorqueRow {
+                        value: row.value + self.slope * pt.rate[i] / t,
+                        grad,
+                    });
+                }
+            }
+        }
+        (terms, limited)
+    }
+
+    /// Physical rate continuity across the two junctions, in radians (the
+    /// rate jump times the two phases' mean duration, so that the residual
+    /// does not change when the whole manoeuvre is slowed down):
+    /// `m (q^_{p,end} / T_p - q^_{p+1,0} / T_{p+1})`, `m = (T_p + T_{p+1}) / 2`,
     /// with its Jacobian.
     fn rate_continuity(&self, z: &[f64], row0: usize, jac: Option<&mut Triplets>) -> Vec<f64> {
         let tr = &self.tr;
         let n = tr.nodes;
-        let sc = 1.0;
         let mut r = Vec::with_capacity(4);
         let mut jac = jac;
         for p in 0..2 {
             let (ta, tb) = (z[tr.duration(p)], z[tr.duration(p + 1)]);
+            let m = 0.5 * (ta + tb);
             for j in 0..2 {
                 let (ia, ib) = (tr.v(p, n - 1) + j, tr.v(p + 1, 0) + j);
                 let row = row0 + r.len();
-                r.push(sc * (z[ia] / ta - z[ib] / tb));
+                let jump = z[ia] / ta - z[ib] / tb;
+                r.push(m * jump);
                 if let Some(jac) = jac.as_deref_mut() {
-                    jac.push((row, ia, sc / ta));
-                    jac.push((row, ib, -sc / tb));
-                    jac.push((row, tr.duration(p), -sc * z[ia] / (ta * ta)));
-                    jac.push((row, tr.duration(p + 1), sc * z[ib] / (tb * tb)));
+                    jac.push((row, ia, m / ta));
+                    jac.push((row, ib, -m / tb));
+                    jac.push((row, tr.duration(p), 0.5 * jump - m * z[ia] / (ta * ta)));
+                    jac.push((row, tr.duration(p + 1), 0.5 * jump + m * z[ib] / (tb * tb)));
                 }
             }
         }
         r
     }
+}
+
+/// The torque at one check point (see [`FreeProblem::torque_points`]).
+struct TorquePoint {
+    phase: usize,
+    interval: usize,
+    /// Phase duration (problem units).
+    duration: f64,
+    /// `q^` at the point and its coefficients on the interval's values.
+    rate: [f64; 2],
+    rate_coef: [f64; 4],
+    /// Simpson weight in normalised time.
+    weight: f64,
+    rows: [TorqueRow; 2],
 }
 
 /// `d tau_i / d(q, q^, q^^)` as one row of six.
@@ -339,7 +521,20 @@ impl ScpProblem for FreeProblem {
     /// values and the phase duration; the 9x9 Hessian of the interval's sum
     /// is clipped to its PSD part (the attitude's curvature is left to the
     /// driver's second-order correction).
-    fn hessian(&self, z: &[f64], y: &[f64]) -> Triplets {
+    fn hessian(&self, z: &[f64], y_terms: &[f64], u: &[f64]) -> Triplets {
+        // the torque's curvature, weighted by the multipliers of the rows it
+        // appears in: peak terms (peak cost) and limited terms (whose
+        // rate part is linear in q^; its 1/T_p curvature is left out)
+        let y: Vec<f64> = (0..self.torques_len())
+            .map(|r| {
+                let a = if self.objective == Objective::PeakTorque {
+                    y_terms.get(r).copied().unwrap_or(0.0)
+                } else {
+                    0.0
+                };
+                a + u.get(r).copied().unwrap_or(0.0)
+            })
+            .collect();
         let tr = &self.tr;
         let n = tr.nodes;
         let it = self.cat.i_t();
@@ -421,19 +616,30 @@ impl ScpProblem for FreeProblem {
     fn scales(&self) -> Vec<f64> {
         self.scales.clone()
     }
-    fn peak_limit(&self) -> Option<f64> {
+    fn limit(&self) -> Option<f64> {
         self.max_torque
     }
+    fn cost(&self) -> Cost {
+        match self.objective {
+            Objective::PeakTorque => Cost::Peak,
+            Objective::Energy => Cost::SumOfSquares,
+            Objective::Time => Cost::Linear((0..3).map(|p| (self.tr.duration(p), 1.0)).collect()),
+        }
+    }
 
-    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>) {
+    fn evaluate(&self, z: &[f64]) -> Values {
         let mut r = self.rate_continuity(z, 0, None);
         let (rf, _) = self.attitude(z, false);
         r.extend(Self::attitude_error(&rf).iter());
-        (self.torques(z), r)
+        let (terms, limited) = self.terms_of(&self.torque_points(z, false));
+        Values {
+            terms: terms.iter().map(|t| t.value).collect(),
+            limited: limited.iter().map(|t| t.value).collect(),
+            residual: r,
+        }
     }
 
     fn linearize(&self, z: &[f64]) -> Linearization {
-        let tr = &self.tr;
         let mut rj: Triplets = Vec::new();
         let mut residual = self.rate_continuity(z, 0, Some(&mut rj));
         let (rf, g) = self.attitude(z, true);
@@ -447,34 +653,24 @@ impl ScpProblem for FreeProblem {
                 rj.push((row0 + i, col, d[i]));
             }
         }
-        let mut terms = Vec::new();
-        let mut tj: Triplets = Vec::new();
-        for p in 0..3 {
-            let t = z[tr.duration(p)];
-            let it = self.cat.i_t();
-            let (s2, s3) = (1.0 / (t * t * it), -2.0 / (t * t * t * it));
-            for (k, q, v, a, coef) in self.check_points(z, p) {
-                // normalised-time inverse dynamics; physical torque = tau^ / T^2
-                let lin = linearize_torque(&ShapeTerms::second(&self.cat, q), v, a);
-                for i in 0..2 {
-                    let row = terms.len();
-                    terms.push(lin.tau[i] * s2);
-                    for l in 0..2 {
-                        let cols = tr.interval_columns(p, k, l);
-                        for (idx, col) in cols.into_iter().enumerate() {
-                            let g = lin.d_q[i][l] * coef[0][idx]
-                                + lin.d_qd[i][l] * coef[1][idx]
-                                + lin.d_qdd[i][l] * coef[2][idx];
-                            tj.push((row, col, g * s2));
-                        }
-                    }
-                    tj.push((row, tr.duration(p), lin.tau[i] * s3));
-                }
+        let pts = self.torque_points(z, true);
+        let (terms, limited) = self.terms_of(&pts);
+        // each point contributes two rows to each list, in point order
+        let flatten = |rows: &[TorqueRow]| {
+            let mut jac: Triplets = Vec::with_capacity(9 * rows.len());
+            for (r, row) in rows.iter().enumerate() {
+                let cols = self.point_columns(&pts[r / 2]);
+                jac.extend(cols.iter().zip(&row.grad).map(|(&c, &g)| (r, c, g)));
             }
-        }
+            (rows.iter().map(|t| t.value).collect::<Vec<_>>(), jac)
+        };
+        let (terms, tj) = flatten(&terms);
+        let (limited, lj) = flatten(&limited);
         Linearization {
             terms,
             terms_jac: tj,
+            limited,
+            limited_jac: lj,
             residual,
             residual_jac: rj,
         }
@@ -516,17 +712,75 @@ impl ScpProblem for FreeProblem {
         }
         zero += dz.len();
         d.cone(Cone::Zero(zero));
-        // total time within the fall; each phase at least min_phase
-        let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
-        let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
-        d.row(&durs, 1.0 - total);
+        // total time within the fall (unless the time is minimised); each
+        // phase at least min_phase
+        if self.objective != Objective::Time {
+            let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
+            let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+            d.row(&durs, 1.0 - total);
+        }
         for p in 0..3 {
             d.row(
                 &[(var(tr.duration(p)), -1.0)],
                 z[tr.duration(p)] - self.min_phase,
             );
         }
-        d.cone(Cone::Nonneg(4));
+        d.cone(Cone::Nonneg(
+            3 + usize::from(self.objective != Objective::Time),
+        ));
+        // speed limit |q^| <= w T_p everywhere: the rate is quadratic on an
+        // interval, so it lies in the convex hull of its Bernstein points
+        // q^_k, q^_k + h q^^_k / 2, q^_{k+1}; bounding them bounds it exactly
+        if let Some(w) = self.max_speed {
+            let h = tr.h();
+            let mut nonneg = 0;
+            for p in 0..3 {
+                let dur = tr.duration(p);
+                for k in 0..n {
+                    for mid in [false, true] {
+                        if mid && k == n - 1 {
+                            continue;
+                        }
+                        // the point: q^_k (+ h/2 q^^_k)
+                        let comp = |j: usize| {
+                            let mut e = vec![(var(tr.v(p, k) + j), -1.0)];
+                            let mut val = z[tr.v(p, k) + j];
+                            if mid {
+                                e.push((var(tr.a(p, k) + j), -h / 2.0));
+                                val += h / 2.0 * z[tr.a(p, k) + j];
+                            }
+                            (e, val)
+                        };
+                        match self.norm {
+                            TorqueNorm::Euclidean => {
+                                d.row(&[(var(dur), -w)], w * z[dur]);
+                                for j in 0..2 {
+                                    let (e, val) = comp(j);
+                                    d.row(&e, val);
+                                }
+                                d.cone(Cone::Soc(3));
+                            }
+                            TorqueNorm::PerMotor => {
+                                for j in 0..2 {
+                                    let (e, val) = comp(j);
+                                    // w (T + dT) - (v + dv) >= 0 and w (T + dT) + (v + dv) >= 0
+                                    let mut up: Vec<_> = e.iter().map(|&(c, x)| (c, -x)).collect();
+                                    up.push((var(dur), -w));
+                                    d.row(&up, w * z[dur] - val);
+                                    let mut down = e.clone();
+                                    down.push((var(dur), -w));
+                                    d.row(&down, w * z[dur] + val);
+                                    nonneg += 2;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+            if nonneg > 0 {
+                d.cone(Cone::Nonneg(nonneg));
+            }
+        }
         // bend limit |q| <= b_max at every node
         if let Some(b) = self.max_bend {
             for p in 0..3 {
@@ -547,6 +801,13 @@ impl ScpProblem for FreeProblem {
 pub struct FreeResult {
     pub mode: &'static str,
     pub status: ScpStatus,
+    pub objective: Objective,
+    /// The objective's value for the written schedule, in [`Objective::unit`]
+    /// (dense peak torque N m, manoeuvre time s, or `integral |tau|^2 dt`
+    /// N^2 m^2 s).
+    pub objective_value: f64,
+    /// Manoeuvre time of the schedule, s.
+    pub manoeuvre_time_s: f64,
     /// Dense inverse-dynamics peak along the reconstructed schedule, N m.
     pub peak_torque_nm: f64,
     /// Peak at the collocation nodes and interval midpoints (the SCP objective), N m.
@@ -621,17 +882,37 @@ pub fn optimize_from(
 
 /// An SCP solution before verification.
 struct Solved {
-    /// With `z` in physical units and peaks in N m.
+    /// With `z` in physical units and the objective in its physical unit.
     res: crate::design::scp::ScpResult,
     z_scaled: Vec<f64>,
     plan: CollocationPlan,
     attitude_error: f64,
+    /// Peak at the check points, N m.
+    node_peak: f64,
+}
+
+impl FreeProblem {
+    /// Whether a neighbour's multipliers fit this problem's rows.
+    fn multipliers_fit(&self, m: &crate::design::scp::Multipliers) -> bool {
+        let terms = if self.objective == Objective::Time {
+            0
+        } else {
+            self.torques_len()
+        };
+        let limited = if self.max_torque.is_some() {
+            self.torques_len()
+        } else {
+            0
+        };
+        m.terms.len() == terms && m.limited.len() == limited
+    }
 }
 
 /// The SCP from a start `z0` in physical units (durations in s) at `nodes`
 /// per phase: the durations are fitted into the available time (F3 time
-/// scaling of the same path) and the start is projected onto the exact
-/// constraints (ends at rest, continuity, defects, bend limit), so that every
+/// scaling of the same path; not for the `time` objective, which has no
+/// budget) and the start is projected onto the exact constraints (ends at
+/// rest, continuity, defects, bend and speed limits), so that every
 /// subproblem is feasible at `dz = 0`.
 fn design(
     cfg: &Config,
@@ -643,9 +924,20 @@ fn design(
     check_resolvable(cfg, nodes)?;
     let tr = Transcription::new(3, nodes);
     let problem = FreeProblem::new(cfg, nodes, z0);
+    if problem.objective == Objective::Time
+        && problem.max_torque.is_none()
+        && problem.max_speed.is_none()
+    {
+        return Err(crate::error::Error::Invalid {
+            key: "design.objective".into(),
+            value: "\"time\"".into(),
+            expected: "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
+                .into(),
+        });
+    }
     let mut z0 = problem.to_scaled(z0);
     let total: f64 = (0..3).map(|p| z0[tr.duration(p)]).sum();
-    if total > 1.0 {
+    if total > 1.0 && problem.objective != Objective::Time {
         for p in 0..3 {
             z0[tr.duration(p)] /= total;
         }
@@ -657,15 +949,17 @@ fn design(
         feasibility: cfg.free.attitude_tolerance,
         ..Default::default()
     };
-    let unit = problem.torque_unit;
-    let warm = warm.filter(|w| w.multipliers.len() == problem.terms_len());
+    let unit = problem.objective_unit();
+    let warm = warm.filter(|w| problem.multipliers_fit(&w.multipliers));
     let mut res = solve_warm(&problem, z0, warm, &settings, |it| {
         observe(&it.in_units(unit))
     })?;
     for it in res.iterations.iter_mut() {
         *it = it.in_units(unit);
     }
-    res.peak *= unit;
+    res.objective *= unit;
+    let node_peak = crate::design::scp::peak_of(&problem.torques(&res.z), 2, problem.norm)
+        * problem.torque_unit;
     let (rf, _) = problem.attitude(&res.z, false);
     let attitude_error = FreeProblem::attitude_error(&rf).norm();
     let z_scaled = std::mem::take(&mut res.z);
@@ -679,37 +973,107 @@ fn design(
         z_scaled,
         plan,
         attitude_error,
+        node_peak,
     })
 }
 
-/// Runs the SCP from a start `z0` in physical units (see [`design`]) and
-/// verifies the schedule by simulation.
+/// Makes the solution exact where the check points are not: the torque
+/// between check points may leave the envelope by the mesh's second-order
+/// error, so while a written row is outside it the manoeuvre is slowed
+/// down (the same path, F2: torque falls as `1 / s^2`, speed as `1 / s`),
+/// when the fall leaves room (always for `time`), or else the problem is
+/// solved again with the limit tightened by the excess. Returns the solution
+/// and the smallest margin.
+fn inside_envelope(
+    cfg: &Config,
+    mut solved: Solved,
+    nodes: usize,
+    observe: &mut dyn FnMut(&ScpIteration),
+) -> Result<Solved> {
+    let motor = cfg.motor();
+    if motor.max_torque.is_none() {
+        // the speed limit holds exactly (Bernstein bound)
+        return Ok(solved);
+    }
+    let tr = solved.plan.tr;
+    let mut tight = cfg.clone();
+    for _ in 0..8 {
+        let margin = crate::design::envelope::usage_of(cfg, &solved.plan)
+            .min_margin
+            .unwrap_or(1.0);
+        if margin >= -1e-7 {
+            break;
+        }
+        let stretch = 1.0 - 1.5 * margin;
+        let total: f64 = solved.plan.phase_bounds()[3];
+        let room = cfg.design.objective == Objective::Time
+            || total * stretch <= cfg.available_time() * (1.0 + 1e-12);
+        if room {
+            for p in 0..3 {
+                let i = tr.duration(p);
+                solved.plan.z[i] *= stretch;
+                solved.res.z[i] *= stretch;
+                solved.z_scaled[i] *= stretch;
+            }
+            solved.node_peak /= stretch * stretch;
+        } else {
+            let lim = tight.limits.max_torque.expect("a torque limit");
+            tight.limits.max_torque = Some(lim * (1.0 + 1.5 * margin));
+            let again = design(
+                &tight,
+                &solved.plan.z,
+                Some(&solved.res.warm),
+                nodes,
+                &mut *observe,
+            )?;
+            let mut iterations = std::mem::take(&mut solved.res.iterations);
+            let n0 = iterations.len();
+            iterations.extend(again.res.iterations.iter().map(|it| ScpIteration {
+                iteration: it.iteration + n0,
+                ..*it
+            }));
+            solved = again;
+            solved.res.iterations = iterations;
+        }
+    }
+    Ok(solved)
+}
+
+/// Runs the SCP from a start `z0` in physical units (see [`design`]), keeps
+/// the schedule inside the motor envelope (see [`inside_envelope`]) and
+/// verifies it by simulation.
 pub fn optimize_start(
     cfg: &Config,
     z0: &[f64],
     warm: Option<&WarmStart>,
     seed: &str,
     nodes: usize,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let start = std::time::Instant::now();
+    let solved = design(cfg, z0, warm, nodes, &mut observe)?;
+    if solved.res.status == ScpStatus::Infeasible {
+        return Err(infeasible(cfg, solved.node_peak));
+    }
     let Solved {
         res,
         z_scaled,
         plan,
         attitude_error: att,
-    } = design(cfg, z0, warm, nodes, observe)?;
+        node_peak,
+    } = inside_envelope(cfg, solved, nodes, &mut observe)?;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
-    let (peak, _) =
-        crate::verify::analyze::peak_along(cfg, &plan, crate::verify::analyze::dense_samples(cfg));
-    // a limit that the design breaks fails before any simulation is spent on it
-    crate::design::phased::check_limit(
-        cfg,
-        peak * cfg.available_time().powi(2),
-        peak,
-        "free-form design",
-    )?;
+    let cat = cfg.cat();
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let (peak, _) = crate::verify::analyze::peak_along(cfg, &plan, dense);
+    let time: f64 = plan.phase_bounds()[3];
+    let objective = cfg.design.objective;
+    let objective_value = match objective {
+        Objective::PeakTorque => peak,
+        Objective::Time => time,
+        Objective::Energy => crate::design::envelope::torque_squared_integral(&cat, &plan, dense),
+    };
     let sim = crate::verify::simulate::dynamic_cfg(cfg, &plan)?;
     let kin = crate::verify::simulate::kinematic_cfg(cfg, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
@@ -730,8 +1094,11 @@ pub fn optimize_start(
     Ok(FreeResult {
         mode: "free",
         status: res.status,
+        objective,
+        objective_value,
+        manoeuvre_time_s: time,
         peak_torque_nm: peak,
-        node_peak_torque_nm: res.peak,
+        node_peak_torque_nm: node_peak,
         bend_deg: bend.to_degrees(),
         theta_deg: 180.0 - bend.to_degrees(),
         twist_rad: twist,
@@ -756,6 +1123,30 @@ pub fn optimize_start(
         plan,
         sim,
     })
+}
+
+/// The error when the SCP cannot meet the motor limits in the fall: with a
+/// torque limit alone, F7's least height for the design's peak; otherwise
+/// the pointer to the `time` objective.
+fn infeasible(cfg: &Config, node_peak: f64) -> crate::error::Error {
+    let motor = cfg.motor();
+    if motor.no_load_speed.is_none()
+        && motor.max_speed.is_none()
+        && let Err(e) = crate::design::phased::check_limit(
+            cfg,
+            node_peak * cfg.available_time().powi(2),
+            node_peak,
+            "free-form design",
+        )
+    {
+        return e;
+    }
+    crate::error::Error::Unreachable {
+        reason: format!(
+            "the free-form design cannot keep inside the motor limits in the fall from {} m; `catflip run` (or design.objective = \"time\") gives the least drop height",
+            cfg.fall.height
+        ),
+    }
 }
 
 /// Continuation: the free-form design for `cfg` started from a neighbouring

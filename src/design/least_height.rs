@@ -6,7 +6,7 @@
 
 use crate::config::Config;
 use crate::design::objective::Objective;
-use crate::design::path::PhasedPlan;
+use crate::design::plan::Schedule;
 use crate::error::Result;
 use serde::Serialize;
 
@@ -17,18 +17,21 @@ pub struct HeightAnswer {
     pub possible: bool,
     /// The configured drop height, m.
     pub height_m: f64,
-    /// The least drop height found for the motors, m: the phased `time`
-    /// design's (an upper bound on the true least height).
+    /// The least drop height found for the motors, m: the better of the
+    /// phased and free-form `time` designs (an upper bound on the true least
+    /// height).
     pub least_height_m: f64,
     /// The shortest manoeuvre inside the motor envelope, s.
     pub least_time_s: f64,
-    /// Which design settles the answer (`phased` for the least height; `free`
-    /// when a verified free-form schedule fits although no phased one does).
+    /// Which design settles the answer: the one with the least height
+    /// (`phased` or `free`), or `free` when a verified free-form schedule
+    /// fits although no phased one does.
     pub method: &'static str,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
+    /// The least-height schedule.
     #[serde(skip)]
-    pub plan: PhasedPlan,
+    pub schedule: Schedule,
 }
 
 /// Answers the question when the motors are limited (`None` otherwise: an
@@ -48,11 +51,25 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
         least_time_s: r.manoeuvre_time_s,
         method: "phased",
         flip_error_rad: r.flip_error_rad,
-        plan: r.plan,
+        schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     }))
 }
 
 impl HeightAnswer {
+    /// Takes a verified free-form `time` design (`fr`: converged, inside
+    /// the envelope, flipping) when it is shorter than the answer's.
+    pub fn improve_with(&mut self, cfg: &Config, fr: &crate::design::free::FreeResult) {
+        if fr.manoeuvre_time_s >= self.least_time_s {
+            return;
+        }
+        self.least_time_s = fr.manoeuvre_time_s;
+        self.least_height_m = crate::design::envelope::height_for(cfg, fr.manoeuvre_time_s);
+        self.possible = self.least_height_m <= cfg.fall.height * (1.0 + 1e-9);
+        self.method = "free";
+        self.flip_error_rad = fr.flip_error_rad;
+        self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
+    }
+
     /// One plain sentence for the terminal and the report.
     pub fn sentence(&self) -> String {
         if self.possible && self.least_height_m > self.height_m {
@@ -62,13 +79,13 @@ impl HeightAnswer {
             )
         } else if self.possible {
             format!(
-                "The flip is possible from {} m: the motors need at most {:.3} m ({:.4} s of manoeuvre, phased time-optimal schedule in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s
+                "The flip is possible from {} m: the motors need at most {:.3} m ({:.4} s of manoeuvre, the {} time-optimal schedule in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s, self.method
             )
         } else {
             format!(
-                "The flip is NOT possible from {} m with these motors: from {:.3} m it is ({:.4} s of manoeuvre, the phased time-optimal schedule in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s
+                "The flip is NOT possible from {} m with these motors: from {:.3} m it is ({:.4} s of manoeuvre, the {} time-optimal schedule in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s, self.method
             )
         }
     }

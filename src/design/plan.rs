@@ -116,6 +116,18 @@ impl Schedule {
         self.rows.iter().map(|r| norm.of(r.tau)).fold(0.0, f64::max)
     }
 
+    /// `integral |tau|^2 dt` over the rows (trapezoid; a junction's two rows
+    /// bound a zero-length interval), N^2 m^2 s: the energy objective.
+    pub fn torque_squared_integral(&self) -> f64 {
+        self.rows
+            .windows(2)
+            .map(|w| {
+                let sq = |r: &Row| r.tau[0] * r.tau[0] + r.tau[1] * r.tau[1];
+                0.5 * (w[1].t - w[0].t) * (sq(&w[0]) + sq(&w[1]))
+            })
+            .sum()
+    }
+
     /// The schedule as JSON: `{"rows": [{"t_s", "phase", "q_rad", "qd_rad_s",
     /// "qdd_rad_s2", "tau_nm"}, ...]}`, the same rows as the CSV.
     pub fn to_json(&self) -> String {

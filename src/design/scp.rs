@@ -1,15 +1,20 @@
-//! Successive convexification for least-peak problems.
+//! Successive convexification for least-peak, least-squares and linear
+//! objectives under nonlinear equalities and norm limits.
 //!
-//! A problem is: minimise `max_k |f_k(z)|` (Euclidean or per-component norm)
-//! subject to nonlinear equalities `r(z) = 0` and exact convex constraints
-//! (linear rows and second-order cones on affine functions of `z`). Each
-//! iteration linearises `f` and `r` about the current `z`, adds virtual
-//! controls `nu = nu+ - nu-` to the linearised equalities (penalised by `w |nu|_1`,
-//! which keeps every subproblem feasible), bounds the step by a scaled trust
-//! region, and solves one conic program with Clarabel; the data pattern is the
-//! same every iteration, so the solver is updated in place.
+//! A problem is: minimise a [`Cost`] (`max_k |f_k(z)|`, `sum_k |f_k(z)|^2` or
+//! `c' z`; Euclidean or per-component norm of each term) subject to nonlinear
+//! equalities `r(z) = 0`, nonlinear limits `|g_k(z)| <= L` and exact convex
+//! constraints (linear rows and second-order cones on affine functions of
+//! `z`). Each iteration linearises `f`, `g` and `r` about the current `z`, adds
+//! virtual controls `nu = nu+ - nu-` to the linearised equalities (penalised
+//! by `w |nu|_1`) and one elastic slack `sigma >= 0` to the limits
+//! (`|g + G dz| / L <= 1 + sigma`, penalised by `w sigma`), which keep every
+//! subproblem feasible, bounds the step by a scaled trust region, and solves
+//! one conic program with Clarabel; the data pattern is the same every
+//! iteration, so the solver is updated in place.
 //!
-//! Steps are judged on the exact penalty `phi(z) = max_k |f_k(z)| + w |r(z)|_1`:
+//! Steps are judged on the exact penalty
+//! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| / L - 1))`:
 //! `rho = (phi(z) - phi(z + dz)) / (phi(z) - L(dz))` with `L` the subproblem's
 //! model value. When `rho < 0.75` a second-order correction (one more conic
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
@@ -23,7 +28,7 @@
 //! model stalls while still infeasible; an iteration limit or a collapsed
 //! trust region (stalled) end the run.
 
-use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::design::conic::{Cone, ConicData, ConicSolver, solve_reusing};
 use crate::error::{Error, Result};
 use crate::model::TorqueNorm;
 use serde::Serialize;
@@ -33,6 +38,30 @@ use std::time::Instant;
 /// depend on `z` (emit zeros too), so the conic pattern stays fixed.
 pub type Triplets = Vec<(usize, usize, f64)>;
 
+/// What a problem minimises.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Cost {
+    /// `max_k |f_k(z)|`, through an epigraph variable.
+    Peak,
+    /// `sum_k |f_k(z)|^2`, modelled by Gauss-Newton `|f + J dz|^2` (a convex
+    /// quadratic, exact for affine terms).
+    SumOfSquares,
+    /// `c' z`, as sparse `(column, coefficient)`; the terms are unused.
+    Linear(Vec<(usize, f64)>),
+}
+
+/// Values at one point, without derivatives (merit evaluation).
+#[derive(Debug, Clone, Default)]
+pub struct Values {
+    /// `f_k(z)`, each of length `term_dim`, flattened (the cost's terms).
+    pub terms: Vec<f64>,
+    /// `g_k(z)`, each of length `term_dim`, flattened (limited by
+    /// [`ScpProblem::limit`]).
+    pub limited: Vec<f64>,
+    /// `r(z)`.
+    pub residual: Vec<f64>,
+}
+
 /// Values and Jacobians at one point.
 #[derive(Debug, Clone, Default)]
 pub struct Linearization {
@@ -40,36 +69,45 @@ pub struct Linearization {
     pub terms: Vec<f64>,
     /// Jacobian of the flattened terms.
     pub terms_jac: Triplets,
+    /// `g_k(z)` and its Jacobian.
+    pub limited: Vec<f64>,
+    pub limited_jac: Triplets,
     /// `r(z)`.
     pub residual: Vec<f64>,
     pub residual_jac: Triplets,
 }
 
-/// A least-peak problem the driver can convexify.
+/// A problem the driver can convexify.
 pub trait ScpProblem {
     /// Number of decision variables.
     fn dim(&self) -> usize;
-    /// Length of each peak term `f_k`.
+    /// Length of each term `f_k` and `g_k`.
     fn term_dim(&self) -> usize;
+    /// The norm of each term (cost and limits).
     fn norm(&self) -> TorqueNorm;
-    /// `(terms, residual)` without derivatives (merit evaluation).
-    fn evaluate(&self, z: &[f64]) -> (Vec<f64>, Vec<f64>);
+    /// What is minimised (default: the peak of the terms).
+    fn cost(&self) -> Cost {
+        Cost::Peak
+    }
+    fn evaluate(&self, z: &[f64]) -> Values;
     fn linearize(&self, z: &[f64]) -> Linearization;
     /// Adds the exact convex constraints in the step `dz = x[var(i)]`,
     /// i.e. in `z + dz`. The rows must have a fixed pattern.
     fn add_constraints(&self, data: &mut ConicData, z: &[f64], var: &dyn Fn(usize) -> usize);
     /// Trust-region scale of each variable (the radius is in these units).
     fn scales(&self) -> Vec<f64>;
-    /// Optional hard bound on the peak.
-    fn peak_limit(&self) -> Option<f64> {
+    /// The bound `L` on each limited term's norm `|g_k(z)|` (none: no limits).
+    fn limit(&self) -> Option<f64> {
         None
     }
     /// Second-order information: a positive semidefinite approximation of
-    /// `sum_r y_r Hess f_r(z)` (`y` one multiplier per flattened term), as
-    /// upper-triangle triplets with a pattern that does not depend on `z` or
-    /// `y`. The default (none) makes the method sequential linear
-    /// programming; with it, the subproblem is an SQP step.
-    fn hessian(&self, _z: &[f64], _y: &[f64]) -> Triplets {
+    /// `sum_r y_r Hess f_r(z) + sum_r u_r Hess g_r(z)` (`y` one multiplier
+    /// per flattened term of a peak cost, zero otherwise; `u` one per
+    /// flattened limited term), as upper-triangle triplets with a pattern
+    /// that does not depend on `z`, `y` or `u`. The default (none) makes the
+    /// method sequential linear programming (Gauss-Newton for a
+    /// sum-of-squares cost); with it, the subproblem is an SQP step.
+    fn hessian(&self, _z: &[f64], _y: &[f64], _u: &[f64]) -> Triplets {
         Vec::new()
     }
 }
@@ -114,8 +152,10 @@ pub struct ScpIteration {
     pub iteration: usize,
     /// Merit before the step.
     pub merit: f64,
-    pub peak: f64,
-    /// `max |r|` before the step.
+    /// The cost before the step (peak, sum of squares or `c' z`).
+    pub objective: f64,
+    /// Largest violation before the step: `max |r|` and the limits'
+    /// `max |g| / L - 1`.
     pub infeasibility: f64,
     pub radius: f64,
     pub weight: f64,
@@ -140,12 +180,12 @@ impl ScpIteration {
         self.predicted.max(0.0) / self.merit.abs().max(1e-300) / self.radius.min(1.0)
     }
 
-    /// The record with its peak-valued fields (merit, peak, decreases,
+    /// The record with its cost-valued fields (merit, objective, decreases,
     /// weight) multiplied by `unit`: problems solved in scaled units report
     /// physical ones.
     pub fn in_units(mut self, unit: f64) -> Self {
         self.merit *= unit;
-        self.peak *= unit;
+        self.objective *= unit;
         self.weight *= unit;
         self.predicted *= unit;
         self.actual *= unit;
@@ -161,6 +201,9 @@ pub enum ScpStatus {
     IterationLimit,
     /// The trust region shrank to nothing without converging.
     Stalled,
+    /// The constraints stayed violated while the penalty weight grew a
+    /// millionfold: no point meets them near here (locally infeasible).
+    Infeasible,
 }
 
 /// Why the user may trust the end point: the numbers the stopping rule
@@ -202,14 +245,16 @@ pub enum StopRule {
 pub struct ScpResult {
     pub z: Vec<f64>,
     pub status: ScpStatus,
-    pub peak: f64,
+    /// The cost at the end point.
+    pub objective: f64,
     pub infeasibility: f64,
     pub iterations: Vec<ScpIteration>,
     pub certificate: Certificate,
     pub warm: WarmStart,
 }
 
-fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
+/// Largest norm over the terms (each of length `d`).
+pub fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
     terms
         .chunks(d)
         .map(|f| match norm {
@@ -219,15 +264,111 @@ fn peak_of(terms: &[f64], d: usize, norm: TorqueNorm) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> (f64, f64, f64) {
-    let (terms, r) = p.evaluate(z);
-    let peak = peak_of(&terms, p.term_dim(), p.norm());
-    let l1: f64 = r.iter().map(|x| x.abs()).sum();
-    let inf = r.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    (peak + w * l1, peak, inf)
+/// The cost of `p` at `z` from its values.
+fn cost_of(p: &dyn ScpProblem, z: &[f64], v: &Values) -> f64 {
+    match p.cost() {
+        Cost::Peak => peak_of(&v.terms, p.term_dim(), p.norm()),
+        Cost::SumOfSquares => v.terms.iter().map(|x| x * x).sum(),
+        Cost::Linear(c) => c.iter().map(|&(i, a)| a * z[i]).sum(),
+    }
 }
 
-/// The convex subproblem at `z`: variables `[dz, t, nu+, nu-]`.
+/// `(phi, cost, infeasibility)`: the exact penalty, the cost, and the
+/// largest violation (`max |r|`, and `max |g| / L - 1` for the limits).
+fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> (f64, f64, f64) {
+    let v = evaluate(p, z);
+    let cost = cost_of(p, z, &v);
+    let l1: f64 = v.residual.iter().map(|x| x.abs()).sum();
+    let mut inf = v.residual.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut over = 0.0;
+    if p.limit().is_some() {
+        over = (peak_of(&v.limited, p.term_dim(), p.norm()) - 1.0).max(0.0);
+        inf = inf.max(over);
+    }
+    (cost + w * (l1 + over), cost, inf)
+}
+
+/// The limited terms relative to the limit, `g / L` (bounded by 1): the
+/// penalty then weighs a relative violation against the cost, whatever the
+/// limit's size (a torque-speed line can make `L` many times the cost).
+fn relative(p: &dyn ScpProblem, limited: &mut [f64]) {
+    if let Some(l) = p.limit() {
+        limited.iter_mut().for_each(|x| *x /= l);
+    }
+}
+
+/// [`ScpProblem::evaluate`] with relative limited terms.
+fn evaluate(p: &dyn ScpProblem, z: &[f64]) -> Values {
+    let mut v = p.evaluate(z);
+    relative(p, &mut v.limited);
+    v
+}
+
+/// [`ScpProblem::linearize`] with relative limited terms.
+fn linearize(p: &dyn ScpProblem, z: &[f64]) -> Linearization {
+    let mut lin = p.linearize(z);
+    relative(p, &mut lin.limited);
+    if let Some(l) = p.limit() {
+        lin.limited_jac.iter_mut().for_each(|e| e.2 /= l);
+    }
+    lin
+}
+
+/// Rows of `norm(s) <= bound` for each term of `(values, jac)`, in the
+/// subproblem's form `s = values + J dz`: one SOC per term (Euclidean) or
+/// two linear rows per component (per motor). `bound` is the variable(s)
+/// and constant on the bound side, e.g. `t` or `L + sigma`. Returns, for
+/// each flattened term, the rows and signs with which their duals multiply
+/// the term in the Lagrangian.
+fn norm_rows(
+    d: &mut ConicData,
+    values: &[f64],
+    jac: &Triplets,
+    dim: usize,
+    norm: TorqueNorm,
+    bound: (&[(usize, f64)], f64),
+) -> TermRows {
+    let mut rows_of: TermRows = vec![Vec::new(); values.len()];
+    let mut jr: Vec<Vec<(usize, f64)>> = vec![Vec::new(); values.len()];
+    for &(r, c, v) in jac {
+        jr[r].push((c, v));
+    }
+    let (bvars, bconst) = bound;
+    let neg =
+        |row: &[(usize, f64)]| -> Vec<(usize, f64)> { row.iter().map(|&(c, v)| (c, -v)).collect() };
+    match norm {
+        TorqueNorm::Euclidean => {
+            for k in 0..values.len() / dim {
+                d.row(&neg(bvars), bconst);
+                for j in 0..dim {
+                    let r = k * dim + j;
+                    // s = f + J dz: the Lagrangian holds -z_row f
+                    rows_of[r].push((d.row(&neg(&jr[r]), values[r]), -1.0));
+                }
+                d.cone(Cone::Soc(dim + 1));
+            }
+        }
+        TorqueNorm::PerMotor => {
+            for r in 0..values.len() {
+                let mut up = jr[r].clone();
+                up.extend(neg(bvars));
+                rows_of[r].push((d.row(&up, bconst - values[r]), 1.0));
+                let mut down = neg(&jr[r]);
+                down.extend(neg(bvars));
+                rows_of[r].push((d.row(&down, bconst + values[r]), -1.0));
+            }
+            d.cone(Cone::Nonneg(2 * values.len()));
+        }
+    }
+    rows_of
+}
+
+/// The convex subproblem at `z`: variables `[dz, t, nu+, nu-, sigma]` (`t`
+/// the peak epigraph, zero for other costs; `sigma` the limits' elastic
+/// slack, present when the problem has limits). Returns the data, the
+/// model's constant (`cost(z)` for costs without an epigraph), and the rows
+/// of the terms and of the limited terms.
+#[allow(clippy::too_many_arguments)]
 fn subproblem(
     p: &dyn ScpProblem,
     z: &[f64],
@@ -235,14 +376,16 @@ fn subproblem(
     scales: &[f64],
     radius: f64,
     w: f64,
-    phi: f64,
     y: &[f64],
-) -> (ConicData, TermRows) {
+    u: &[f64],
+) -> (ConicData, f64, TermRows, TermRows) {
     let n = p.dim();
     let m = lin.residual.len();
+    let limit = p.limit();
     let (t, np, nm) = (n, n + 1, n + 1 + m);
-    let mut d = ConicData::new(n + 1 + 2 * m);
-    d.q[t] = 1.0;
+    let sigma = n + 1 + 2 * m;
+    let mut d = ConicData::new(n + 1 + 2 * m + usize::from(limit.is_some()));
+    let cost = p.cost();
     for i in 0..m {
         d.q[np + i] = w;
         d.q[nm + i] = w;
@@ -252,9 +395,40 @@ fn subproblem(
     for i in 0..n {
         p_diag[i] = 1e-9 / (scales[i] * scales[i]);
     }
+    // the multipliers of the relative limits are L times the problem's
+    let u_abs: Vec<f64> = u.iter().map(|x| x / limit.unwrap_or(1.0)).collect();
+    d.p_upper = p.hessian(z, y, &u_abs);
+    let mut constant = 0.0;
+    match &cost {
+        Cost::Peak => d.q[t] = 1.0,
+        Cost::Linear(c) => {
+            for &(i, a) in c {
+                d.q[i] += a;
+                constant += a * z[i];
+            }
+        }
+        Cost::SumOfSquares => {
+            // |f + J dz|^2 = |f|^2 + 2 f'J dz + dz' J'J dz: P = 2 J'J
+            constant = lin.terms.iter().map(|x| x * x).sum();
+            let mut jr: Vec<Vec<(usize, f64)>> = vec![Vec::new(); lin.terms.len()];
+            for &(r, c, v) in &lin.terms_jac {
+                jr[r].push((c, v));
+                d.q[c] += 2.0 * lin.terms[r] * v;
+            }
+            for row in &jr {
+                for &(a, va) in row {
+                    for &(b, vb) in row {
+                        if a < b {
+                            d.p_upper.push((a, b, 2.0 * va * vb));
+                        } else if a == b {
+                            p_diag[a] += 2.0 * va * vb;
+                        }
+                    }
+                }
+            }
+        }
+    }
     d.p_diag = Some(p_diag);
-    d.p_upper = p.hessian(z, y);
-    let mut term_rows: TermRows = vec![Vec::new(); lin.terms.len()];
     // linearised equalities with virtual control: r + J dz - nu+ + nu- = 0
     let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
     for &(r, c, v) in &lin.residual_jac {
@@ -265,58 +439,53 @@ fn subproblem(
         row.push((nm + i, 1.0));
         d.row(&row, -lin.residual[i]);
     }
-    d.cone(Cone::Zero(m));
+    if cost != Cost::Peak {
+        // no epigraph: t = 0
+        d.row(&[(t, 1.0)], 0.0);
+    }
+    d.cone(Cone::Zero(m + usize::from(cost != Cost::Peak)));
     p.add_constraints(&mut d, z, &|i| i);
-    // peak epigraph
     let dim = p.term_dim();
-    let nterms = lin.terms.len() / dim;
-    let mut jac: Vec<Vec<(usize, f64)>> = vec![Vec::new(); lin.terms.len()];
-    for &(r, c, v) in &lin.terms_jac {
-        jac[r].push((c, v));
-    }
-    match p.norm() {
-        TorqueNorm::Euclidean => {
-            for k in 0..nterms {
-                d.row(&[(t, -1.0)], 0.0);
-                for j in 0..dim {
-                    let r = k * dim + j;
-                    let row: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
-                    // s = f + J dz: the Lagrangian holds -z_row f
-                    term_rows[r].push((d.row(&row, lin.terms[r]), -1.0));
-                }
-                d.cone(Cone::Soc(dim + 1));
-            }
+    let term_rows = if cost == Cost::Peak {
+        norm_rows(
+            &mut d,
+            &lin.terms,
+            &lin.terms_jac,
+            dim,
+            p.norm(),
+            (&[(t, 1.0)], 0.0),
+        )
+    } else {
+        Vec::new()
+    };
+    // limits with elastic slack, relative: |g + G dz| / L <= 1 + sigma
+    let limit_rows = match limit {
+        Some(_) => {
+            d.q[sigma] = w;
+            norm_rows(
+                &mut d,
+                &lin.limited,
+                &lin.limited_jac,
+                dim,
+                p.norm(),
+                (&[(sigma, 1.0)], 1.0),
+            )
         }
-        TorqueNorm::PerMotor => {
-            for r in 0..lin.terms.len() {
-                let mut up = jac[r].clone();
-                up.push((t, -1.0));
-                term_rows[r].push((d.row(&up, -lin.terms[r]), 1.0));
-                let mut down: Vec<_> = jac[r].iter().map(|&(c, v)| (c, -v)).collect();
-                down.push((t, -1.0));
-                term_rows[r].push((d.row(&down, lin.terms[r]), -1.0));
-            }
-            d.cone(Cone::Nonneg(2 * lin.terms.len()));
-        }
-    }
-    // nu >= 0, trust region, peak limit
+        None => Vec::new(),
+    };
+    // nu >= 0, sigma >= 0, trust region
     for i in 0..2 * m {
         d.row(&[(np + i, -1.0)], 0.0);
+    }
+    if limit.is_some() {
+        d.row(&[(sigma, -1.0)], 0.0);
     }
     for i in 0..n {
         d.row(&[(i, 1.0)], radius * scales[i]);
         d.row(&[(i, -1.0)], radius * scales[i]);
     }
-    let mut rows = 2 * m + 2 * n;
-    if let Some(lim) = p.peak_limit() {
-        // dz = 0 is feasible with model value phi(z), so t <= phi(z) at the
-        // subproblem's optimum: a bound above 10 phi never binds, and a huge
-        // one (1e12) would only wreck the interior-point scaling
-        d.row(&[(t, 1.0)], lim.min(10.0 * phi));
-        rows += 1;
-    }
-    d.cone(Cone::Nonneg(rows));
-    (d, term_rows)
+    d.cone(Cone::Nonneg(2 * m + usize::from(limit.is_some()) + 2 * n));
+    (d, constant, term_rows, limit_rows)
 }
 
 /// For each flattened term, the subproblem rows it appears in and the sign
@@ -327,13 +496,17 @@ type TermRows = Vec<Vec<(usize, f64)>>;
 /// scaled-norm `dc` with `J dc = (r + J dz) - r(z+)` (back onto the model's
 /// prediction of the residual) that keeps the exact constraints. This undoes
 /// the curvature of `r` (here the attitude's, a holonomy that is quadratic in
-/// the path) that would otherwise force tiny trust regions.
+/// the path) that would otherwise force tiny trust regions. With `bounds`,
+/// the terms at `z+` are also brought back under the model's bounds,
+/// `|f(z+) + F dc| <= t` (peak cost) and `|g(z+) + G dc| <= L + sigma`
+/// (limits), the same curvature effect on the norm rows.
 fn correction(
     p: &dyn ScpProblem,
     z_trial: &[f64],
     lin: &Linearization,
     target_minus_actual: &[f64],
     scales: &[f64],
+    bounds: Option<(&Values, f64, f64)>,
 ) -> ConicData {
     let n = p.dim();
     let m = target_minus_actual.len();
@@ -348,6 +521,22 @@ fn correction(
     }
     d.cone(Cone::Zero(m));
     p.add_constraints(&mut d, z_trial, &|i| i);
+    if let Some((at, t, l)) = bounds {
+        let dim = p.term_dim();
+        if p.cost() == Cost::Peak {
+            norm_rows(&mut d, &at.terms, &lin.terms_jac, dim, p.norm(), (&[], t));
+        }
+        if !at.limited.is_empty() {
+            norm_rows(
+                &mut d,
+                &at.limited,
+                &lin.limited_jac,
+                dim,
+                p.norm(),
+                (&[], l),
+            );
+        }
+    }
     d
 }
 
@@ -356,6 +545,7 @@ fn correction(
 struct Solvers {
     subproblem: Option<ConicSolver>,
     correction: Option<ConicSolver>,
+    bounded_correction: Option<ConicSolver>,
 }
 
 /// One SCP iteration at `z`: linearise, solve the convex subproblem, try a
@@ -369,22 +559,18 @@ fn iterate(
     iteration: usize,
     scales: &[f64],
     solvers: &mut Solvers,
-    y: &mut Vec<f64>,
+    mult: &mut Multipliers,
 ) -> Result<(ScpIteration, Vec<f64>)> {
-    let (phi, peak, inf) = merit(p, z, w);
-    let lin = p.linearize(z);
-    y.resize(lin.terms.len(), 0.0);
-    let (data, term_rows) = subproblem(p, z, &lin, scales, radius, w, phi, y);
+    let (phi, cost, inf) = merit(p, z, w);
+    let lin = linearize(p, z);
+    mult.terms.resize(lin.terms.len(), 0.0);
+    mult.limited.resize(lin.limited.len(), 0.0);
+    let (data, constant, term_rows, limit_rows) =
+        subproblem(p, z, &lin, scales, radius, w, &mult.terms, &mult.limited);
     let clock = Instant::now();
     let (st, x, obj) = solve_reusing(&mut solvers.subproblem, &data)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
     if !st.ok() {
-        if st == SolveStatus::Infeasible && p.peak_limit().is_some() {
-            return Err(Error::Unreachable {
-                reason: "the convexified problem has no solution within limits.max_torque: raise the limit or fall.height"
-                    .into(),
-            });
-        }
         return Err(Error::Solver {
             what: format!("SCP subproblem {iteration}"),
             status: format!("{st:?}"),
@@ -392,31 +578,57 @@ fn iterate(
         });
     }
     let (n, m) = (p.dim(), lin.residual.len());
-    // the peak terms' multipliers, for the next subproblem's curvature
+    // the terms' and limits' multipliers, for the next subproblem's curvature
     if let Some(sv) = &solvers.subproblem {
         let dual = sv.duals();
-        for (yr, rows) in y.iter_mut().zip(&term_rows) {
-            *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+        for (v, rows) in [
+            (&mut mult.terms, &term_rows),
+            (&mut mult.limited, &limit_rows),
+        ] {
+            for (yr, rows) in v.iter_mut().zip(rows) {
+                *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+            }
         }
     }
-    // model value: t + w |nu|_1 + 1/2 dz' P dz (the solver's objective)
-    let predicted = phi - obj;
+    // model value: the cost's constant plus the solver's objective
+    // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
+    let predicted = phi - (constant + obj);
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let (mut phi_t, _, _) = merit(p, &trial, w);
     if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
         // back onto the model's residual at the trial point, r + J dz = nu+ - nu-
-        let (_, r_trial) = p.evaluate(&trial);
+        let at = evaluate(p, &trial);
         let rhs: Vec<f64> = (0..m)
-            .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - r_trial[i])
+            .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - at.residual[i])
             .collect();
-        let cd = correction(p, &trial, &lin, &rhs, scales);
-        if let Ok((cs, dc, _)) = solve_reusing(&mut solvers.correction, &cd)
-            && cs.ok()
-        {
-            let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
-            let (phi_c, _, _) = merit(p, &corrected, w);
-            if phi_c < phi_t {
-                (trial, phi_t) = (corrected, phi_c);
+        // with the terms' bounds first (t, L + sigma from the subproblem);
+        // without them when that has no solution
+        let bounded = p.cost() == Cost::Peak || p.limit().is_some();
+        let sigma = 1.0
+            + if p.limit().is_some() {
+                x[n + 1 + 2 * m]
+            } else {
+                0.0
+            };
+        let tries = [
+            (true, &mut solvers.bounded_correction),
+            (false, &mut solvers.correction),
+        ];
+        for (with_bounds, slot) in tries {
+            if with_bounds && !bounded {
+                continue;
+            }
+            let bounds = with_bounds.then_some((&at, x[n], sigma));
+            let cd = correction(p, &trial, &lin, &rhs, scales, bounds);
+            if let Ok((cs, dc, _)) = solve_reusing(slot, &cd)
+                && cs.ok()
+            {
+                let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
+                let (phi_c, _, _) = merit(p, &corrected, w);
+                if phi_c < phi_t {
+                    (trial, phi_t) = (corrected, phi_c);
+                }
+                break;
             }
         }
     }
@@ -435,7 +647,7 @@ fn iterate(
     let rec = ScpIteration {
         iteration,
         merit: phi,
-        peak,
+        objective: cost,
         infeasibility: inf,
         radius,
         weight: w,
@@ -461,12 +673,20 @@ pub fn solve(
     solve_warm(p, z0, None, settings, observe)
 }
 
+/// Multipliers of the terms of a peak cost and of the limited terms (the
+/// curvature of the next subproblem).
+#[derive(Debug, Clone, Default)]
+pub struct Multipliers {
+    pub terms: Vec<f64>,
+    pub limited: Vec<f64>,
+}
+
 /// What a finished solve hands to a neighbouring problem (continuation):
-/// its peak-term multipliers (the curvature of the first subproblem) and its
-/// final trust radius.
+/// its multipliers (the curvature of the first subproblem) and its final
+/// trust radius.
 #[derive(Debug, Clone, Default)]
 pub struct WarmStart {
-    pub multipliers: Vec<f64>,
+    pub multipliers: Multipliers,
     pub radius: f64,
 }
 
@@ -480,19 +700,37 @@ pub fn solve_warm(
 ) -> Result<ScpResult> {
     let scales = p.scales();
     let mut z = z0;
-    let (_, peak0, _) = merit(p, &z, 0.0);
-    let mut w = settings.weight * peak0.max(1e-12);
+    // the penalty's scale: the cost at the start (at least the limit)
+    let (_, cost0, _) = merit(p, &z, 0.0);
+    let scale = cost0.abs().max(p.limit().unwrap_or(0.0)).max(1e-12);
+    let mut w = settings.weight * scale;
     let mut radius = warm.map_or(settings.initial_radius, |w| {
         w.radius.clamp(1e-3, settings.initial_radius)
     });
     let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
-    let mut y = warm.map_or_else(Vec::new, |w| w.multipliers.clone());
+    let mut mult = warm.map_or_else(Multipliers::default, |w| w.multipliers.clone());
     let mut window = Vec::new();
     let mut rule = StopRule::None;
+    let mut failures = 0;
     for it in 0..settings.max_iterations {
-        let (rec, trial) = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut y)?;
+        let (rec, trial) = match iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult) {
+            Ok(x) => {
+                failures = 0;
+                x
+            }
+            // a subproblem the conic solver could not finish (numerical
+            // trouble) is a rejected step: a smaller trust region is a
+            // better-conditioned subproblem
+            Err(Error::Solver { .. }) if failures < 4 => {
+                failures += 1;
+                radius *= 0.25;
+                solvers.subproblem = None;
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
@@ -524,31 +762,35 @@ pub fn solve_warm(
             // stuck infeasible: the penalty is too weak
             w *= 10.0;
             window.clear();
+            if w > 1e6 * settings.weight * scale {
+                status = ScpStatus::Infeasible;
+                break;
+            }
         }
         if radius < 1e-10 {
             status = ScpStatus::Stalled;
             break;
         }
     }
-    let (_, peak, infeasibility) = merit(p, &z, w);
+    let (_, objective, infeasibility) = merit(p, &z, w);
     let last = iterations.last().copied();
     let certificate = Certificate {
         step: last.map_or(0.0, |l| l.step),
         constraint_violation: infeasibility,
         criticality: last.map_or(0.0, |l| l.criticality()),
         radius,
-        weight: w / peak0.max(1e-12),
+        weight: w / scale,
         rule,
     };
     Ok(ScpResult {
         z,
         status,
-        peak,
+        objective,
         infeasibility,
         iterations,
         certificate,
         warm: WarmStart {
-            multipliers: y,
+            multipliers: mult,
             radius,
         },
     })

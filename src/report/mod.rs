@@ -532,30 +532,33 @@ pub fn shape_path(methods: &[MethodTrace]) -> Result<String> {
 }
 
 /// SCP convergence: peak and infeasibility per iteration.
-pub fn convergence(iters: &[ScpIteration]) -> Result<String> {
+/// `objective` names what the SCP minimised (its [`Objective`](crate::design::objective::Objective)).
+pub fn convergence(
+    iters: &[ScpIteration],
+    objective: crate::design::objective::Objective,
+) -> Result<String> {
+    let title = format!("Free-form SCP: {} per iteration", objective.name());
+    let axis = format!("{} ({})", objective.name(), objective.unit());
     svg((1000, 700), |root| {
         let n = iters.len().max(2) as f64;
         let panels = root.split_evenly((2, 1));
         let (plot, side) = with_legend(&panels[0]);
-        let y = range(iters.iter().map(|i| i.peak));
-        let mut c = chart(
-            &plot,
-            "Free-form SCP: peak torque per iteration",
-            (0.0, n),
-            y,
-            ("iteration", "peak (N m)"),
-            true,
-        )?;
+        let y = range(iters.iter().map(|i| i.objective));
+        let mut c = chart(&plot, &title, (0.0, n), y, ("iteration", &axis), true)?;
         let st = style(1);
-        let pts: Vec<_> = iters.iter().map(|i| (i.iteration as f64, i.peak)).collect();
+        let pts: Vec<_> = iters
+            .iter()
+            .map(|i| (i.iteration as f64, i.objective))
+            .collect();
         line(&mut c, &pts, st, 0.0)?;
         let rejected = style(2);
-        c.draw_series(
-            iters
-                .iter()
-                .filter(|i| !i.accepted)
-                .map(|i| marker((i.iteration as f64, i.peak), Marker::Cross, rejected.color)),
-        )
+        c.draw_series(iters.iter().filter(|i| !i.accepted).map(|i| {
+            marker(
+                (i.iteration as f64, i.objective),
+                Marker::Cross,
+                rejected.color,
+            )
+        }))
         .map_err(perr)?;
         legend(
             &side,

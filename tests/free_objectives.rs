@@ -1,0 +1,95 @@
+//! Free-form designs for every objective inside the motor envelope, against
+//! F7, time scaling, the motor model and the phased designs.
+
+use catflip::Config;
+use catflip::design::envelope::{height_for, usage_of};
+use catflip::design::free::{FreeResult, optimize_from};
+
+fn seed(overrides: &[&str]) -> Config {
+    let text =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
+    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    Config::from_toml(&text, "seed.toml", &ov).unwrap()
+}
+
+/// The free-form design seeded by the phased design of the same objective
+/// (the mesh check left out).
+fn free(cfg: &Config) -> FreeResult {
+    let phased = catflip::design::phased::optimize(cfg, |_| {}).unwrap();
+    let r = optimize_from(cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+    assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
+    r
+}
+
+#[test]
+fn free_time_with_a_torque_limit_alone_is_f7() {
+    // F7 for the free-form optimum: the least-peak design P at the fall time
+    // T_f gives T_min = T_f sqrt(P / tau_max) (F3 time scaling of one path);
+    // the time design must find it
+    let tau_max = 1.0;
+    let open = seed(&[]);
+    let peak = free(&open);
+    let t_fall = open.available_time();
+    let t_f7 = t_fall * (peak.peak_torque_nm / tau_max).sqrt();
+    let timed = free(&seed(&[
+        "design.objective=time",
+        &format!("limits.max_torque={tau_max}"),
+    ]));
+    let rel = (timed.manoeuvre_time_s - t_f7) / t_f7;
+    assert!(
+        rel.abs() < 5e-3,
+        "time {} vs F7 {t_f7}",
+        timed.manoeuvre_time_s
+    );
+    let (h, h_f7) = (
+        height_for(&open, timed.manoeuvre_time_s),
+        0.5 * open.fall.gravity * t_f7 * t_f7,
+    );
+    assert!((h - h_f7).abs() < 1e-2 * h_f7, "{h} vs {h_f7}");
+    assert!(timed.peak_torque_nm <= tau_max * (1.0 + 1e-6));
+}
+
+#[test]
+fn free_time_with_a_speed_limit_alone_scales_as_one_over_the_limit() {
+    let t = |w: f64| {
+        free(&seed(&[
+            "design.objective=time",
+            &format!("limits.max_speed={w}"),
+        ]))
+        .manoeuvre_time_s
+    };
+    let (a, b) = (t(5.0), t(10.0));
+    assert!((a / b - 2.0).abs() < 1e-2, "{a} / {b} = {}", a / b);
+}
+
+#[test]
+fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design() {
+    // a DC motor line (1 N m stall, 8 rad/s no load) that binds for every objective
+    for objective in ["peak-torque", "time", "energy"] {
+        let cfg = seed(&[
+            &format!("design.objective={objective}"),
+            "limits.max_torque=1",
+            "limits.no_load_speed=8",
+        ]);
+        let phased = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
+        let r = optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+        assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
+        let margin = usage_of(&cfg, &r.plan).min_margin.unwrap();
+        assert!(margin >= -1e-6, "{objective}: margin {margin}");
+        // the dynamic simulation applies the motor model (clipped torque)
+        assert!(
+            r.flip_error_rad.abs() < 1e-3,
+            "{objective}: flip error {}",
+            r.flip_error_rad
+        );
+        assert!(
+            r.objective_value <= phased.objective_value * (1.0 + 1e-6),
+            "{objective}: free {} vs phased {}",
+            r.objective_value,
+            phased.objective_value
+        );
+        if objective != "time" {
+            assert!(r.manoeuvre_time_s <= cfg.available_time() * (1.0 + 1e-9));
+        }
+    }
+}
