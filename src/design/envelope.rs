@@ -815,12 +815,14 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
     let spacing = (hi - lo) / (scan.len().max(2) - 1) as f64;
     let tol = cfg.phased.bend_tol_deg.to_radians();
     let mut best = search(&cat, &mut coarse, scan, tol, &mut record)?;
+    let mut fastest_bend = None;
     if !best.value.is_finite() && budget.is_some() {
         // a budget close to the least time leaves a narrow band of feasible
         // bends that the scan can miss: look around the time-optimal bend
         let mut timed = EnvelopeProblem::new(coarse.k, cfg.motor(), Objective::Time, None);
         timed.tangent_tol = COARSE_TANGENT_TOL;
         let fastest = search(&cat, &mut timed, bend_scan(cfg, lo, hi), tol, |_| {})?;
+        fastest_bend = fastest.value.is_finite().then_some(fastest.bend);
         let around: Vec<f64> = (-3..=3)
             .map(|i| (fastest.bend + spacing * i as f64 / 6.0).clamp(lo, hi))
             .collect();
@@ -832,7 +834,7 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
         None
     };
     let Some((design, plan)) = found else {
-        return Err(unreachable_here(cfg));
+        return Err(unreachable_here(cfg, fastest_bend));
     };
     let solve_time = start.elapsed().as_secs_f64();
     let time: f64 = plan.durations.iter().sum();
@@ -878,13 +880,26 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
 
 /// The error when nothing fits the envelope in the fall: it names the least
 /// drop height (the `time` design) when that can be found.
-fn unreachable_here(cfg: &Config) -> Error {
+///
+/// `fastest_bend`: the `time` design's bend when the search already found it
+/// (the same search `optimize` would run for `time`, so only its verified
+/// design at that bend is left to do).
+fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
     let mut timed = cfg.clone();
     timed.design.objective = Objective::Time;
-    let least = (cfg.design.objective != Objective::Time)
-        .then(|| optimize(&timed, |_| {}).ok())
-        .flatten()
-        .map(|r| height_for(cfg, r.manoeuvre_time_s));
+    let least_time = if cfg.design.objective == Objective::Time {
+        None
+    } else if let Some(bend) = fastest_bend {
+        let mut problem =
+            EnvelopeProblem::new(cfg.phased.nodes, cfg.motor(), Objective::Time, None);
+        verified_design(&timed, &mut problem, bend)
+            .ok()
+            .flatten()
+            .map(|(_, plan)| plan.durations.iter().sum::<f64>())
+    } else {
+        optimize(&timed, |_| {}).ok().map(|r| r.manoeuvre_time_s)
+    };
+    let least = least_time.map(|t| height_for(cfg, t));
     Error::Unreachable {
         reason: match least {
             Some(h) => format!(
