@@ -272,6 +272,11 @@ impl ConicSolver {
         (SolveStatus::from_clarabel(s.status), s.x.clone(), s.obj_val)
     }
 
+    /// Interior-point iterations of the last solve.
+    pub fn iterations(&self) -> u32 {
+        self.solver.solution.iterations
+    }
+
     /// The dual solution `z` of the last solve (one per row; the
     /// Lagrangian is `q'x + z'(A x - b)`).
     pub fn duals(&self) -> &[f64] {
