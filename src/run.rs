@@ -571,10 +571,13 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .unwrap_or_default();
     let mut figures = vec![
         ("angles.svg", report::angles(&traces)),
-        ("torque.svg", report::torque(&traces, &norm_name, &motor)),
+        (
+            "torque.svg",
+            report::torque(&traces, &norm_name, &cfg.motor()),
+        ),
         (
             report::TORQUE_SPEED_SVG,
-            report::torque_speed(&traces, &motor),
+            report::torque_speed(&traces, &cfg.motor()),
         ),
         ("flip.svg", report::flip(&traces)),
         ("shape_path.svg", report::shape_path(&traces)),
