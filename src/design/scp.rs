@@ -714,6 +714,7 @@ pub fn solve_warm(
     let mut window = Vec::new();
     let mut rule = StopRule::None;
     let mut failures = 0;
+    let mut nearly = 0;
     for it in 0..settings.max_iterations {
         let (rec, trial) = match iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult) {
             Ok(x) => {
@@ -759,13 +760,21 @@ pub fn solve_warm(
                 };
                 break;
             }
-            // stuck infeasible: the penalty is too weak
-            w *= 10.0;
-            window.clear();
-            if w > 1e6 * settings.weight * scale {
-                status = ScpStatus::Infeasible;
-                break;
+            // nearly feasible at a critical point: the next steps remove a
+            // small violation at this weight (raising it would only shrink
+            // the steps); stuck infeasible otherwise: the penalty is too weak
+            nearly += 1;
+            if inf_now > 100.0 * settings.feasibility || nearly > 3 {
+                w *= 10.0;
+                window.clear();
+                nearly = 0;
+                if w > 1e6 * settings.weight * scale {
+                    status = ScpStatus::Infeasible;
+                    break;
+                }
             }
+        } else {
+            nearly = 0;
         }
         if radius < 1e-10 {
             status = ScpStatus::Stalled;
