@@ -170,6 +170,10 @@ impl std::str::FromStr for Shard {
     }
 }
 
+/// Keys that change only the fall (its duration), not the cat, the motors or
+/// the design: the phased peak design is the same path at every value.
+const FALL_ONLY: [&str; 3] = ["fall.height", "fall.gravity", "fall.margin"];
+
 /// One sweep point; `warm` is the previous point's free-form design in the
 /// same chunk (continuation), and the point's own free-form design is
 /// returned for the next.
@@ -178,6 +182,7 @@ fn point(
     value: f64,
     methods: Methods,
     warm: Option<&FreeResult>,
+    mut phased_warm: Option<&mut Option<(f64, crate::design::phased::PhasedResult)>>,
 ) -> (SweepPoint, Option<FreeResult>) {
     let mut p = SweepPoint {
         value,
@@ -204,13 +209,32 @@ fn point(
     if methods.phased || methods.free {
         // within a chunk the free-form design continues from its neighbour
         // and needs no phased seed
-        let ph = if methods.phased || warm.is_none() {
+        let reuse = phased_warm
+            .as_deref()
+            .and_then(|w| w.as_ref())
+            .filter(|_| !cfg.uses_envelope());
+        let ph = if let Some((t_prev, prev)) = reuse {
+            // a sweep of the fall alone (height, gravity, margin): the same
+            // path, slowed down (F2, F3), so the neighbour's peak design
+            // scales by (T_prev / T)^2 and flips the same
+            let mut r = prev.clone();
+            let k = (t_prev / cfg.available_time()).powi(2);
+            r.peak_torque_nm *= k;
+            r.socp_peak_torque_nm *= k;
+            r.objective_value *= k;
+            Ok(r)
+        } else if methods.phased || warm.is_none() {
             crate::design::phased::optimize(&cfg, |_| {})
         } else {
             Err(Error::Unreachable {
                 reason: "not computed".into(),
             })
         };
+        if let (Ok(r), Some(slot)) = (&ph, phased_warm.as_deref_mut())
+            && slot.is_none()
+        {
+            *slot = Some((cfg.available_time(), r.clone()));
+        }
         match &ph {
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
@@ -375,9 +399,15 @@ pub fn sweep_shard(
                         break;
                     }
                     let mut warm: Option<FreeResult> = None;
+                    // a sweep of the fall alone reuses the chunk's first
+                    // phased design (F3 time scaling)
+                    let mut phased_warm = None;
                     for i in chunks[c].clone() {
+                        let slot = FALL_ONLY
+                            .contains(&spec.key.as_str())
+                            .then_some(&mut phased_warm);
                         let (p, fr) = match &configs[i] {
-                            Ok(cfg) => point(cfg, values[i], methods, warm.as_ref()),
+                            Ok(cfg) => point(cfg, values[i], methods, warm.as_ref(), slot),
                             Err(e) => (
                                 SweepPoint {
                                     value: values[i],

@@ -114,3 +114,53 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     let (ok, _, err) = run(&[&common[..], &["--shard", "4/3"]].concat(), dir.path());
     assert!(!ok && err.contains("--shard"), "{err}");
 }
+
+/// A sweep of the drop height reuses each chunk's first phased design,
+/// scaled by F3: its peaks must be the phased designs computed afresh at
+/// every height.
+#[test]
+fn a_height_sweep_scales_the_phased_design_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let c = cfg.to_str().unwrap();
+    let args = [
+        "sweep",
+        c,
+        "--set-range",
+        "fall.height=1:9:9",
+        "--methods",
+        "phased",
+        "--set",
+        "phased.nodes=12",
+        "--out",
+        "out",
+    ];
+    let (ok, _, err) = run(&args, dir.path());
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(
+        dir.path()
+            .join("out/seed/sweep-fall_height/sweep-fall_height.csv"),
+    )
+    .unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = head.iter().position(|h| *h == "phased_peak_nm").unwrap();
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let h: f64 = cells[0].parse().unwrap();
+        let swept: f64 = cells[col].parse().unwrap();
+        let direct = catflip::design::phased::optimize(
+            &catflip::Config::load(
+                &cfg,
+                &["phased.nodes=12".into(), format!("fall.height={h}")],
+            )
+            .unwrap(),
+            |_| {},
+        )
+        .unwrap()
+        .peak_torque_nm;
+        assert!(
+            (swept - direct).abs() < 1e-6 * direct,
+            "h = {h}: swept {swept} vs direct {direct}"
+        );
+    }
+}
