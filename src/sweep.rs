@@ -182,7 +182,7 @@ fn point(
     value: f64,
     methods: Methods,
     warm: Option<&FreeResult>,
-    mut phased_warm: Option<&mut Option<(f64, crate::design::phased::PhasedResult)>>,
+    phased_warm: Option<&mut Option<(f64, crate::design::phased::PhasedResult)>>,
 ) -> (SweepPoint, Option<FreeResult>) {
     let mut p = SweepPoint {
         value,
@@ -230,7 +230,7 @@ fn point(
                 reason: "not computed".into(),
             })
         };
-        if let (Ok(r), Some(slot)) = (&ph, phased_warm.as_deref_mut())
+        if let (Ok(r), Some(slot)) = (&ph, phased_warm)
             && slot.is_none()
         {
             *slot = Some((cfg.available_time(), r.clone()));
