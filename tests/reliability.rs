@@ -330,6 +330,14 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(summary["methods"], v["methods"]);
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     assert!(html.contains("FAILED: the flip is impossible") && html.contains("FLAGGED"));
+    // the answer comes from the free-form least-time design, which fits the
+    // fall and keeps the limit on every written row
+    let ans = &v["answer"];
+    assert_eq!(ans["possible"], true, "{ans}");
+    assert_eq!(ans["method"], "free", "{ans}");
+    assert!(ans["least_height_m"].as_f64().unwrap() <= 12.0, "{ans}");
+    let (lpeak, _) = csv_peak(&std::fs::read_to_string(base.join("least-height.csv")).unwrap());
+    assert!(lpeak <= 0.5 * (1.0 + 1e-6), "{lpeak}");
 }
 
 #[test]

@@ -27,6 +27,10 @@ pub struct HeightAnswer {
     /// (`phased` or `free`), or `free` when a verified free-form schedule
     /// fits although no phased one does.
     pub method: &'static str,
+    /// The status of that design's solver (`solved`, `converged`, or e.g.
+    /// `iteration-limit` for a verified free-form schedule that is not
+    /// proven the shortest).
+    pub status: String,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
     /// The least-height schedule.
@@ -50,6 +54,7 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
         least_height_m: least,
         least_time_s: r.manoeuvre_time_s,
         method: "phased",
+        status: crate::run::json_name(&r.status),
         flip_error_rad: r.flip_error_rad,
         schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     }))
@@ -66,12 +71,25 @@ impl HeightAnswer {
         self.least_height_m = crate::design::envelope::height_for(cfg, fr.manoeuvre_time_s);
         self.possible = self.least_height_m <= cfg.fall.height * (1.0 + 1e-9);
         self.method = "free";
+        self.status = crate::run::json_name(&fr.status);
         self.flip_error_rad = fr.flip_error_rad;
         self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
     }
 
     /// One plain sentence for the terminal and the report.
     pub fn sentence(&self) -> String {
+        let proven = matches!(
+            self.status.as_str(),
+            "solved" | "almost-solved" | "converged"
+        );
+        let what = if proven {
+            format!("the {} time-optimal schedule", self.method)
+        } else {
+            format!(
+                "the {} time design, verified but not proven shortest ({})",
+                self.method, self.status
+            )
+        };
         if self.possible && self.least_height_m > self.height_m {
             format!(
                 "The flip is possible from {} m: the {} design fits the motors, although the phased least-height design needs {:.3} m.",
@@ -79,13 +97,13 @@ impl HeightAnswer {
             )
         } else if self.possible {
             format!(
-                "The flip is possible from {} m: the motors need at most {:.3} m ({:.4} s of manoeuvre, the {} time-optimal schedule in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s, self.method
+                "The flip is possible from {} m: the motors need at most {:.3} m ({:.4} s of manoeuvre, {what} in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s
             )
         } else {
             format!(
-                "The flip is NOT possible from {} m with these motors: from {:.3} m it is ({:.4} s of manoeuvre, the {} time-optimal schedule in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s, self.method
+                "The flip is NOT possible from {} m with these motors: from {:.3} m it is ({:.4} s of manoeuvre, {what} in least-height.csv).",
+                self.height_m, self.least_height_m, self.least_time_s
             )
         }
     }
