@@ -13,6 +13,28 @@ pub trait Scored {
     fn score(&self) -> f64;
 }
 
+/// Evaluates every bend of `scan` (sorted here); returns the best bend's
+/// bracket `(left neighbour, best, right neighbour)` and its design.
+fn scan_best<D: Scored>(
+    scan: &mut [f64],
+    eval: &mut impl FnMut(f64) -> Result<D>,
+) -> Result<(f64, f64, f64, D)> {
+    scan.sort_by(f64::total_cmp);
+    let mut designs = Vec::with_capacity(scan.len());
+    for &x in scan.iter() {
+        designs.push(eval(x)?);
+    }
+    let best = (0..scan.len())
+        .min_by(|&i, &j| designs[i].score().total_cmp(&designs[j].score()))
+        .expect("a non-empty scan");
+    Ok((
+        scan[best.saturating_sub(1)],
+        scan[best],
+        scan[(best + 1).min(scan.len() - 1)],
+        designs.swap_remove(best),
+    ))
+}
+
 /// Evaluates every bend of `scan` (sorted here), then refines the best
 /// bracket to `tol` rad; returns the best design seen.
 pub fn scan_then_golden<D: Scored>(
@@ -20,19 +42,7 @@ pub fn scan_then_golden<D: Scored>(
     tol: f64,
     mut eval: impl FnMut(f64) -> Result<D>,
 ) -> Result<D> {
-    scan.sort_by(f64::total_cmp);
-    let mut designs = Vec::with_capacity(scan.len());
-    for &x in &scan {
-        designs.push(eval(x)?);
-    }
-    let best = (0..scan.len())
-        .min_by(|&i, &j| designs[i].score().total_cmp(&designs[j].score()))
-        .expect("a non-empty scan");
-    let (mut a, mut b) = (
-        scan[best.saturating_sub(1)],
-        scan[(best + 1).min(scan.len() - 1)],
-    );
-    let mut best_d = designs.swap_remove(best);
+    let (mut a, _, mut b, mut best_d) = scan_best(&mut scan, &mut eval)?;
     if !best_d.score().is_finite() {
         return Ok(best_d);
     }
@@ -72,20 +82,7 @@ pub fn scan_then_brent<D: Scored>(
     tol: f64,
     mut eval: impl FnMut(f64) -> Result<D>,
 ) -> Result<D> {
-    scan.sort_by(f64::total_cmp);
-    let mut designs = Vec::with_capacity(scan.len());
-    for &x in &scan {
-        designs.push(eval(x)?);
-    }
-    let best = (0..scan.len())
-        .min_by(|&i, &j| designs[i].score().total_cmp(&designs[j].score()))
-        .expect("a non-empty scan");
-    let (mut a, mut b) = (
-        scan[best.saturating_sub(1)],
-        scan[(best + 1).min(scan.len() - 1)],
-    );
-    let mut x = scan[best];
-    let mut best_d = designs.swap_remove(best);
+    let (mut a, mut x, mut b, mut best_d) = scan_best(&mut scan, &mut eval)?;
     let mut fx = best_d.score();
     if !fx.is_finite() || b - a <= tol {
         return Ok(best_d);
