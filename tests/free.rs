@@ -91,13 +91,6 @@ struct DoubleIntegrator {
 }
 
 impl DoubleIntegrator {
-    fn peak(tr: Transcription) -> Self {
-        Self {
-            tr,
-            cost: Cost::Peak,
-            limit: None,
-        }
-    }
     /// The force at the nodes and its gradient in (a_k, T).
     fn forces(&self, z: &[f64]) -> Vec<(f64, f64, f64)> {
         let t = z[self.tr.duration(0)];
@@ -219,25 +212,7 @@ impl ScpProblem for DoubleIntegrator {
 #[test]
 fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
     for nodes in [21, 41] {
-        let tr = Transcription::new(1, nodes);
-        let mut z = vec![0.0; tr.dim()];
-        // seed: the smooth cosine move, peak pi^2 / 2 = 4.93 N
-        for k in 0..nodes {
-            let s = k as f64 / (nodes - 1) as f64;
-            let w = std::f64::consts::PI;
-            z[tr.q(0, k)] = 0.5 * (1.0 - (w * s).cos());
-            z[tr.v(0, k)] = 0.5 * w * (w * s).sin();
-            z[tr.a(0, k)] = 0.5 * w * w * (w * s).cos();
-        }
-        z[tr.duration(0)] = 1.0;
-        let p = DoubleIntegrator::peak(tr);
-        let r = catflip::design::scp::solve(
-            &p,
-            z,
-            &catflip::design::scp::ScpSettings::default(),
-            |_| {},
-        )
-        .unwrap();
+        let (tr, r) = solve_move(nodes, Cost::Peak, None);
         assert_eq!(
             r.status,
             catflip::design::scp::ScpStatus::Converged,
@@ -266,6 +241,25 @@ fn the_scp_machinery_finds_the_bang_bang_optimum_of_a_double_integrator() {
     }
 }
 
+/// The double-integrator move on `nodes` nodes for a cost and limit, solved
+/// by the SCP driver from the cosine move.
+fn solve_move(
+    nodes: usize,
+    cost: Cost,
+    limit: Option<f64>,
+) -> (Transcription, catflip::design::scp::ScpResult) {
+    let tr = Transcription::new(1, nodes);
+    let p = DoubleIntegrator { tr, cost, limit };
+    let r = catflip::design::scp::solve(
+        &p,
+        cosine_move(&tr),
+        &catflip::design::scp::ScpSettings::default(),
+        |_| {},
+    )
+    .unwrap();
+    (tr, r)
+}
+
 /// The cosine move (peak pi^2 / 2 = 4.93 N in 1 s) on `nodes` nodes.
 fn cosine_move(tr: &Transcription) -> Vec<f64> {
     let mut z = vec![0.0; tr.dim()];
@@ -285,19 +279,8 @@ fn the_scp_machinery_finds_the_least_time_under_a_force_limit() {
     // T = 2 sqrt(D / F) = 2 s; starting from the 1 s cosine move (which
     // breaks the limit fivefold: the elastic slack keeps the steps feasible)
     for nodes in [21, 41] {
-        let tr = Transcription::new(1, nodes);
-        let p = DoubleIntegrator {
-            tr,
-            cost: Cost::Linear(vec![(tr.duration(0), 1.0)]),
-            limit: Some(1.0),
-        };
-        let r = catflip::design::scp::solve(
-            &p,
-            cosine_move(&tr),
-            &catflip::design::scp::ScpSettings::default(),
-            |_| {},
-        )
-        .unwrap();
+        let duration = Transcription::new(1, nodes).duration(0);
+        let (tr, r) = solve_move(nodes, Cost::Linear(vec![(duration, 1.0)]), Some(1.0));
         assert_eq!(r.status, ScpStatus::Converged, "{nodes} nodes");
         let h = tr.h();
         assert!(
@@ -314,19 +297,7 @@ fn the_scp_machinery_finds_the_least_energy_move() {
     // integral F^2 dt = 12 D^2 / T^3 with F linear in time; the trapezoid
     // rule on the nodes overestimates the quadratic integrand by O(h^2)
     for nodes in [21, 41] {
-        let tr = Transcription::new(1, nodes);
-        let p = DoubleIntegrator {
-            tr,
-            cost: Cost::SumOfSquares,
-            limit: None,
-        };
-        let r = catflip::design::scp::solve(
-            &p,
-            cosine_move(&tr),
-            &catflip::design::scp::ScpSettings::default(),
-            |_| {},
-        )
-        .unwrap();
+        let (tr, r) = solve_move(nodes, Cost::SumOfSquares, None);
         assert_eq!(r.status, ScpStatus::Converged, "{nodes} nodes");
         let h = tr.h();
         assert!(
