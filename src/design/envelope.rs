@@ -710,17 +710,7 @@ pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
 
 /// `integral |tau|^2 dt` along a plan (trapezoid on `per_phase` samples a phase), N^2 m^2 s.
 pub fn torque_squared_integral(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize) -> f64 {
-    let b = plan.phase_bounds();
-    let mut sum = 0.0;
-    for i in 0..3 {
-        let h = (b[i + 1] - b[i]) / per_phase as f64;
-        for k in 0..=per_phase {
-            let tau = plan.torque_in(cat, i, b[i] + h * k as f64);
-            let w = if k == 0 || k == per_phase { 0.5 } else { 1.0 };
-            sum += w * h * (tau[0] * tau[0] + tau[1] * tau[1]);
-        }
-    }
-    sum
+    Schedule::sample(cat, plan, per_phase).torque_squared_integral()
 }
 
 /// Least drop height for a manoeuvre of `time` seconds, m.
