@@ -115,8 +115,11 @@ pub struct SweepPoint {
 }
 
 /// Points per continuation chunk (fixed, so results do not depend on the
-/// number of threads or shards).
-pub const CHUNK: usize = 8;
+/// number of threads or shards). Ten: a chunk's first point costs about
+/// three continued ones, and the 40-point sweeps of issue 11 split into
+/// four chunks, two per core on a 2-core machine (eight left one core with
+/// three of five chunks: 60 % of the two cores used).
+pub const CHUNK: usize = 10;
 
 /// `K/N`: the K-th (1-based) of N disjoint slices of a sweep's grid.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -182,7 +185,9 @@ fn point(
     value: f64,
     methods: Methods,
     warm: Option<&FreeResult>,
+    before: Option<&FreeResult>,
     phased_warm: Option<&mut Option<(f64, crate::design::phased::PhasedResult)>>,
+    bends: &mut Vec<f64>,
 ) -> (SweepPoint, Option<FreeResult>) {
     let mut p = SweepPoint {
         value,
@@ -224,7 +229,18 @@ fn point(
             r.objective_value *= k;
             Ok(r)
         } else if methods.phased || warm.is_none() {
-            crate::design::phased::optimize(&cfg, |_| {})
+            // the chunk's previous bends predict this one's (continuation)
+            let hint = bends.last().map(|&last| {
+                crate::design::phased::BendHint::from_neighbours(
+                    last,
+                    bends.len().checked_sub(2).map(|i| bends[i]),
+                )
+            });
+            let r = crate::design::phased::optimize_near(&cfg, hint, |_| {});
+            if let Ok(r) = &r {
+                bends.push(r.bend_deg.to_radians());
+            }
+            r
         } else {
             Err(Error::Unreachable {
                 reason: "not computed".into(),
@@ -255,7 +271,7 @@ fn point(
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, |_| {}),
+                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, before, |_| {}),
                 (Ok(ph), None) => crate::design::free::optimize_from(
                     &cfg,
                     &ph.plan,
@@ -398,16 +414,28 @@ pub fn sweep_shard(
                     if c >= chunks.len() {
                         break;
                     }
+                    // the chunk's last two free-form designs, when they are
+                    // consecutive points (the secant predictor)
                     let mut warm: Option<FreeResult> = None;
+                    let mut before: Option<FreeResult> = None;
                     // a sweep of the fall alone reuses the chunk's first
                     // phased design (F3 time scaling)
                     let mut phased_warm = None;
+                    let mut bends = Vec::new();
                     for i in chunks[c].clone() {
                         let slot = FALL_ONLY
                             .contains(&spec.key.as_str())
                             .then_some(&mut phased_warm);
                         let (p, fr) = match &configs[i] {
-                            Ok(cfg) => point(cfg, values[i], methods, warm.as_ref(), slot),
+                            Ok(cfg) => point(
+                                cfg,
+                                values[i],
+                                methods,
+                                warm.as_ref(),
+                                before.as_ref(),
+                                slot,
+                                &mut bends,
+                            ),
                             Err(e) => (
                                 SweepPoint {
                                     value: values[i],
@@ -417,9 +445,12 @@ pub fn sweep_shard(
                                 None,
                             ),
                         };
-                        // a failed point leaves the last good design as the start
+                        // a failed point leaves the last good design as the
+                        // start (and no secant: its neighbour is two steps away)
                         if fr.is_some() {
-                            warm = fr;
+                            before = std::mem::replace(&mut warm, fr);
+                        } else {
+                            before = None;
                         }
                         results.lock().unwrap()[i] = Some(p);
                         progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());

@@ -164,3 +164,55 @@ fn a_height_sweep_scales_the_phased_design_exactly() {
         );
     }
 }
+
+#[test]
+fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_optimum() {
+    // the radius changes the cat: each point's phased design is a local
+    // search from the chunk's previous bends; it must find the optimum the
+    // full scan finds at that radius (to the bend tolerance, where the peak
+    // is flat: 1e-4)
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml");
+    let args = [
+        "sweep",
+        cfg.to_str().unwrap(),
+        "--set-range",
+        "cat.radius=0.04:0.2:6",
+        "--methods",
+        "phased",
+        "--set",
+        "phased.nodes=12",
+        "--out",
+        "out",
+    ];
+    let (ok, _, err) = run(&args, dir.path());
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(
+        dir.path()
+            .join("out/seed/sweep-cat_radius/sweep-cat_radius.csv"),
+    )
+    .unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = head.iter().position(|h| *h == "phased_peak_nm").unwrap();
+    let bend = head.iter().position(|h| *h == "phased_bend_deg").unwrap();
+    let mut bends = Vec::new();
+    for line in csv.lines().skip(1) {
+        let cells: Vec<&str> = line.split(',').collect();
+        let r: f64 = cells[0].parse().unwrap();
+        let swept: f64 = cells[col].parse().unwrap();
+        let direct = catflip::design::phased::optimize(
+            &catflip::Config::load(&cfg, &["phased.nodes=12".into(), format!("cat.radius={r}")])
+                .unwrap(),
+            |_| {},
+        )
+        .unwrap();
+        assert!(
+            (swept - direct.peak_torque_nm).abs() < 1e-4 * direct.peak_torque_nm,
+            "r = {r}: swept {swept} vs direct {}",
+            direct.peak_torque_nm
+        );
+        bends.push(cells[bend].parse::<f64>().unwrap());
+    }
+    // the optimum moves with the radius (the local search had to follow it)
+    assert!(bends.windows(2).all(|w| w[1] > w[0] + 1.0), "{bends:?}");
+}

@@ -82,7 +82,67 @@ pub fn scan_then_brent<D: Scored>(
     tol: f64,
     mut eval: impl FnMut(f64) -> Result<D>,
 ) -> Result<D> {
-    let (mut a, mut x, mut b, mut best_d) = scan_best(&mut scan, &mut eval)?;
+    let (a, x, b, best_d) = scan_best(&mut scan, &mut eval)?;
+    brent(a, x, b, best_d, tol, eval)
+}
+
+/// A local search for a sweep, where the neighbouring point's best bend
+/// predicts this one's: evaluates `center` and `center +- step`, steps
+/// outward (doubling) while the best bend is at the bracket's edge and
+/// inside `[lo, hi]`, then refines the bracket with Brent's method. Returns
+/// `None` when no bend of the bracket is possible (the caller scans the
+/// whole range instead).
+pub fn bracket_then_brent<D: Scored>(
+    center: f64,
+    step: f64,
+    (lo, hi): (f64, f64),
+    tol: f64,
+    mut eval: impl FnMut(f64) -> Result<D>,
+) -> Result<Option<D>> {
+    let center = center.clamp(lo, hi);
+    let step = step.max(tol);
+    let (a, b) = ((center - step).max(lo), (center + step).min(hi));
+    let mut pa = (a, eval(a)?);
+    let mut pm = (center, eval(center)?);
+    let mut pb = (b, eval(b)?);
+    let mut width = step;
+    for _ in 0..40 {
+        let f = |p: &(f64, D)| p.1.score();
+        if !(f(&pa).is_finite() || f(&pm).is_finite() || f(&pb).is_finite()) {
+            return Ok(None);
+        }
+        width *= 2.0;
+        if f(&pa) < f(&pm) && pa.0 > lo {
+            // the minimum lies below a: shift the bracket down
+            let x = (pa.0 - width).max(lo);
+            let new = (x, eval(x)?);
+            pb = std::mem::replace(&mut pm, std::mem::replace(&mut pa, new));
+        } else if f(&pb) < f(&pm) && pb.0 < hi {
+            let x = (pb.0 + width).min(hi);
+            let new = (x, eval(x)?);
+            pa = std::mem::replace(&mut pm, std::mem::replace(&mut pb, new));
+        } else {
+            break;
+        }
+    }
+    let (fa, fm, fb) = (pa.1.score(), pm.1.score(), pb.1.score());
+    if fa < fm || fb < fm {
+        // decreasing to an end of the range: the end is the best bend
+        return Ok(Some(if fa <= fb { pa.1 } else { pb.1 }));
+    }
+    brent(pa.0, pm.0, pb.0, pm.1, tol, eval).map(Some)
+}
+
+/// Brent's method on the bracket `a < x < b` whose best bend so far is `x`
+/// (with design `best_d`), to `tol` wide.
+fn brent<D: Scored>(
+    mut a: f64,
+    mut x: f64,
+    mut b: f64,
+    mut best_d: D,
+    tol: f64,
+    mut eval: impl FnMut(f64) -> Result<D>,
+) -> Result<D> {
     let mut fx = best_d.score();
     if !fx.is_finite() || b - a <= tol {
         return Ok(best_d);
@@ -188,6 +248,50 @@ mod tests {
         assert!((best.0 - 0.83).abs() < 2e-6, "{}", best.0);
         let best = scan_then_brent(scan, 1e-6, f).unwrap();
         assert!((best.0 - 0.83).abs() < 2e-6, "{}", best.0);
+    }
+
+    #[test]
+    fn a_bracket_follows_the_minimum_from_a_poor_hint_and_stops_at_the_range_end() {
+        let minimum = 0.7318;
+        let f = |x: f64| {
+            Ok(S(
+                x,
+                (x - minimum).powi(2) + 0.3 * (x - minimum).powi(4) + 1.0,
+            ))
+        };
+        // a hint 0.5 away with a 0.05 bracket: the bracket walks to it
+        let best = bracket_then_brent(0.2, 0.05, (0.1, 3.0), 1e-5, f)
+            .unwrap()
+            .unwrap();
+        assert!((best.0 - minimum).abs() < 1e-5, "{}", best.0);
+        // a good hint needs fewer evaluations than the scan and Brent
+        let near = {
+            let mut k = 0;
+            bracket_then_brent(0.74, 0.02, (0.1, 3.0), 1e-5, |x: f64| {
+                k += 1;
+                Ok(S(x, (x - minimum).powi(2) + 1.0))
+            })
+            .unwrap()
+            .unwrap();
+            k
+        };
+        let mut k = 0;
+        let scan: Vec<f64> = (0..12).map(|i| 0.1 + 2.9 * i as f64 / 11.0).collect();
+        scan_then_brent(scan, 1e-5, |x: f64| {
+            k += 1;
+            Ok(S(x, (x - minimum).powi(2) + 1.0))
+        })
+        .unwrap();
+        assert!(near < k, "bracket {near} vs scan {k} evaluations");
+        // decreasing to the range's end: the end
+        let end = bracket_then_brent(2.5, 0.1, (0.1, 3.0), 1e-5, |x: f64| Ok(S(x, -x)))
+            .unwrap()
+            .unwrap();
+        assert_eq!(end.0, 3.0);
+        // nothing possible in the bracket: the caller scans
+        let none = bracket_then_brent(1.0, 0.1, (0.1, 3.0), 1e-5, |x: f64| Ok(S(x, f64::INFINITY)))
+            .unwrap();
+        assert!(none.is_none());
     }
 
     #[test]

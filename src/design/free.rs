@@ -30,7 +30,7 @@ use crate::design::scp::{
     Values, WarmStart, solve_warm,
 };
 use crate::error::Result;
-use crate::model::dynamics::{linearize_torque, torque_from};
+use crate::model::dynamics::{christoffel, linearize_torque, torque_from};
 use crate::model::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
 use crate::model::{Cat, ShapeTerms, TorqueNorm};
 use crate::verify::simulate::SimReport;
@@ -475,22 +475,28 @@ fn torque_gradients(cat: &Cat, x: &[f64; 6], terms: Option<&ShapeTerms>) -> [[f6
     })
 }
 
-/// `sum_i y_i Hess tau_i` in `(q, q^, q^^)`: central differences of the
-/// exact gradients (the rate and acceleration blocks are polynomial, so
-/// exact up to rounding), symmetrised.
-fn weighted_torque_hessian(cat: &Cat, x: [f64; 6], y: [f64; 2]) -> [[f64; 6]; 6] {
+/// `sum_i y_i Hess tau_i` in `(q, q^, q^^)`, from the structure of the
+/// inverse dynamics `tau_i = M_ij(q) a_j + c_ijk(q) v_j v_k`: the rate block is
+/// the exact `c_ilk + c_ikl`, the acceleration blocks with rate and
+/// acceleration are zero, and the rows in `q` (hence, by symmetry, the
+/// mixed blocks) are central differences of the exact gradients in `q`
+/// alone (the shape terms' third derivatives are not formed). `base` holds
+/// the shape terms at `q`.
+fn weighted_torque_hessian(
+    cat: &Cat,
+    base: &ShapeTerms,
+    x: [f64; 6],
+    y: [f64; 2],
+) -> [[f64; 6]; 6] {
     let mut g = [[0.0; 6]; 6];
-    let base = ShapeTerms::second(cat, [x[0], x[1]]);
-    for m in 0..6 {
+    for m in 0..2 {
         let h = 1e-5 * (1.0 + x[m].abs());
         let (mut xp, mut xm) = (x, x);
         xp[m] += h;
         xm[m] -= h;
-        // the shape terms depend on q only
-        let reuse = if m < 2 { None } else { Some(&base) };
         let (gp, gm) = (
-            torque_gradients(cat, &xp, reuse),
-            torque_gradients(cat, &xm, reuse),
+            torque_gradients(cat, &xp, None),
+            torque_gradients(cat, &xm, None),
         );
         for c in 0..6 {
             g[m][c] = (0..2)
@@ -498,11 +504,18 @@ fn weighted_torque_hessian(cat: &Cat, x: [f64; 6], y: [f64; 2]) -> [[f64; 6]; 6]
                 .sum();
         }
     }
-    for a in 0..6 {
-        for b in a + 1..6 {
-            let v = 0.5 * (g[a][b] + g[b][a]);
-            g[a][b] = v;
-            g[b][a] = v;
+    // the q rows give the mixed blocks; their own 2x2 block is symmetrised
+    let v = 0.5 * (g[0][1] + g[1][0]);
+    (g[0][1], g[1][0]) = (v, v);
+    for m in 0..2 {
+        for c in 2..6 {
+            g[c][m] = g[m][c];
+        }
+    }
+    let ch = christoffel(base);
+    for l in 0..2 {
+        for k in 0..2 {
+            g[2 + l][2 + k] = (0..2).map(|i| y[i] * (ch[i][l][k] + ch[i][k][l])).sum();
         }
     }
     g
@@ -555,9 +568,10 @@ impl ScpProblem for FreeProblem {
                     continue;
                 }
                 let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
-                let g6 = weighted_torque_hessian(&self.cat, x, w);
-                let gr = torque_gradients(&self.cat, &x, None);
-                let tau = torque_from(&ShapeTerms::first(&self.cat, q), v, a);
+                let base = ShapeTerms::second(&self.cat, q);
+                let g6 = weighted_torque_hessian(&self.cat, &base, x, w);
+                let gr = torque_gradients(&self.cat, &x, Some(&base));
+                let tau = torque_from(&base, v, a);
                 // C: local inputs (kind, component) from the interval's 8 values (component, idx)
                 let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
                 for kind in 0..3 {
@@ -618,6 +632,9 @@ impl ScpProblem for FreeProblem {
     }
     fn limit(&self) -> Option<f64> {
         self.max_torque
+    }
+    fn limited_are_terms(&self) -> bool {
+        self.objective == Objective::PeakTorque && self.slope == 0.0
     }
     fn cost(&self) -> Cost {
         match self.objective {
@@ -1160,16 +1177,27 @@ fn infeasible(cfg: &Config, node_peak: f64) -> crate::error::Error {
 /// design `prev` (another point of a sweep). The start is `prev`'s solution
 /// in dimensionless units, so a change of drop height, margin or gravity
 /// (F3) starts exactly at the optimum, and a change of the cat or limits
-/// starts next to it.
+/// starts next to it. With the design `before` `prev` (one grid step
+/// further back) the start is the secant predictor `2 prev - before`,
+/// which moves it along the solution path as well.
 pub fn continue_from(
     cfg: &Config,
     prev: &FreeResult,
+    before: Option<&FreeResult>,
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let nodes = cfg.free.nodes;
     let tr = Transcription::new(3, nodes);
     let mut z0 = if prev.nodes == nodes {
-        prev.z_scaled.clone()
+        match before.filter(|b| b.nodes == nodes) {
+            Some(b) => prev
+                .z_scaled
+                .iter()
+                .zip(&b.z_scaled)
+                .map(|(p, b)| 2.0 * p - b)
+                .collect(),
+            None => prev.z_scaled.clone(),
+        }
     } else {
         let mut z = tr.sample(&prev.plan);
         let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
@@ -1299,7 +1327,7 @@ mod tests {
             let cat = cfg.cat();
             let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
             let y = [0.8, -1.3];
-            let g = weighted_torque_hessian(&cat, x, y);
+            let g = weighted_torque_hessian(&cat, &ShapeTerms::second(&cat, [x[0], x[1]]), x, y);
             let f = |x: [f64; 6]| {
                 let t = inverse_dynamics_at(&cat, x);
                 y[0] * t[0] + y[1] * t[1]

@@ -5,12 +5,14 @@
 //! phase SOCP ([`crate::design::timing`]). The best split is `T_i ~ sqrt(p_i)` and the
 //! phased peak is `(sum_i sqrt(p_i))^2 / T^2`. The bend is then searched by a
 //! coarse scan (which includes the one-turn bend of F6 and the config's bend)
-//! and golden-section refinement inside the best bracket: derivative-free, so
-//! it stays correct where the objective has kinks (a phase taking over the peak).
+//! and Brent refinement inside the best bracket: derivative-free, so it stays
+//! correct where the objective has kinks (a phase taking over the peak; Brent
+//! falls back to golden steps there). In a sweep a neighbour's bend predicts
+//! this point's ([`BendHint`]), and a local bracket replaces the scan.
 
 use crate::config::Config;
 use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
-use crate::design::bend_search::{Scored, scan_then_golden};
+use crate::design::bend_search::{Scored, bracket_then_brent, scan_then_brent};
 use crate::design::conic::SolveStatus;
 use crate::design::objective::Objective;
 use crate::design::path::{Path, PhasedPlan, Timing};
@@ -240,11 +242,34 @@ impl Scored for BendDesign {
     }
 }
 
-/// Bend search: scan (with the one-turn and the config's bend), then golden
-/// section in the best bracket.
+/// Where a neighbouring design (a sweep's previous point) puts the best
+/// bend: the local search starts there, `step` either side.
+#[derive(Debug, Clone, Copy)]
+pub struct BendHint {
+    pub bend: f64,
+    pub step: f64,
+}
+
+impl BendHint {
+    /// The prediction from the last two points' bends (linear
+    /// extrapolation), or from the last alone; the bracket is as wide as
+    /// the last change, and at least a degree.
+    pub fn from_neighbours(last: f64, before: Option<f64>) -> Self {
+        let change = before.map_or(0.0, |b| last - b);
+        BendHint {
+            bend: last + change,
+            step: change.abs().max(1f64.to_radians()),
+        }
+    }
+}
+
+/// Bend search: scan (with the one-turn and the config's bend), then Brent
+/// refinement in the best bracket; with a `hint`, a bracket around it
+/// instead of the scan (the scan when no bend of the bracket is possible).
 pub fn search_bend(
     cfg: &Config,
     problem: &mut TimingProblem,
+    hint: Option<BendHint>,
     mut observe: impl FnMut(&BendEvaluation),
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
     let cat = cfg.cat();
@@ -263,9 +288,14 @@ pub fn search_bend(
         evals.push(e);
         Ok(d)
     };
-    let xs = bend_scan(cfg, lo, hi);
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    let best_d = scan_then_golden(xs, tol, |b| eval(b, &mut evals))?;
+    if let Some(h) = hint
+        && let Some(d) = bracket_then_brent(h.bend, h.step, (lo, hi), tol, |b| eval(b, &mut evals))?
+    {
+        return Ok((d, evals));
+    }
+    let xs = bend_scan(cfg, lo, hi);
+    let best_d = scan_then_brent(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
 }
 
@@ -292,12 +322,23 @@ pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Resul
 
 /// The phased optimiser: bend search, optimal split, reconstruction, verification.
 pub fn optimize(cfg: &Config, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    optimize_near(cfg, None, observe)
+}
+
+/// [`optimize`] with the bend search started at a neighbour's bend (a
+/// sweep's continuation; see [`search_bend`]). The motor-envelope design
+/// ignores the hint.
+pub fn optimize_near(
+    cfg: &Config,
+    hint: Option<BendHint>,
+    observe: impl FnMut(&BendEvaluation),
+) -> Result<PhasedResult> {
     if cfg.uses_envelope() {
         return crate::design::envelope::optimize(cfg, observe);
     }
     let start = Instant::now();
     let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
-    let (design, evals) = search_bend(cfg, &mut problem, observe)?;
+    let (design, evals) = search_bend(cfg, &mut problem, hint, observe)?;
     let solve_time = start.elapsed().as_secs_f64();
     finish(cfg, design, evals, solve_time)
 }

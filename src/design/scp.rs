@@ -100,6 +100,13 @@ pub trait ScpProblem {
     fn limit(&self) -> Option<f64> {
         None
     }
+    /// Whether the limited terms are the peak cost's terms themselves (a
+    /// torque limit without a torque-speed line): the limit is then one row
+    /// on the epigraph, `t <= L (1 + sigma)`, instead of a copy of every
+    /// term's rows (default: no).
+    fn limited_are_terms(&self) -> bool {
+        false
+    }
     /// Second-order information: a positive semidefinite approximation of
     /// `sum_r y_r Hess f_r(z) + sum_r u_r Hess g_r(z)` (`y` one multiplier
     /// per flattened term of a peak cost, zero otherwise; `u` one per
@@ -167,17 +174,28 @@ pub struct ScpIteration {
     pub merit_after: f64,
     /// Largest scaled component of the trial step `|dz_i| / scale_i`.
     pub step: f64,
+    /// Whether the trust region bounded the subproblem's step (its largest
+    /// scaled component at the radius); when not, the model's minimum lies
+    /// inside it.
+    pub bounded: bool,
     pub solve_ms: f64,
 }
 
 impl ScpIteration {
     /// First-order criticality: the model decrease at unit trust radius,
-    /// relative to the merit, bounded above by `predicted / min(radius, 1)`
-    /// (the model's optimal value is convex in the radius, so the predicted
-    /// decrease is concave in it). Unlike the raw predicted decrease it does
-    /// not vanish merely because the trust region has shrunk.
+    /// relative to the merit. When the trust region bounded the step it is
+    /// bounded above by `predicted / min(radius, 1)` (the model's optimal
+    /// value is convex in the radius, so the predicted decrease is concave
+    /// in it), which does not vanish merely because the trust region has
+    /// shrunk; when it did not, the model's minimum is inside the region and
+    /// a larger radius predicts no more: it is `predicted` itself.
     pub fn criticality(&self) -> f64 {
-        self.predicted.max(0.0) / self.merit.abs().max(1e-300) / self.radius.min(1.0)
+        let per_radius = if self.bounded {
+            self.radius.min(1.0)
+        } else {
+            1.0
+        };
+        self.predicted.max(0.0) / self.merit.abs().max(1e-300) / per_radius
     }
 
     /// The record with its cost-valued fields (merit, objective, decreases,
@@ -460,6 +478,14 @@ fn subproblem(
     };
     // limits with elastic slack, relative: |g + G dz| / L <= 1 + sigma
     let limit_rows = match limit {
+        Some(l) if p.limited_are_terms() && cost == Cost::Peak => {
+            // |f + F dz| <= t <= L (1 + sigma): the limit's multiplier
+            // reaches the terms through t
+            d.q[sigma] = w;
+            d.row(&[(t, 1.0), (sigma, -l)], l);
+            d.cone(Cone::Nonneg(1));
+            Vec::new()
+        }
         Some(_) => {
             d.q[sigma] = w;
             norm_rows(
@@ -526,7 +552,9 @@ fn correction(
         if p.cost() == Cost::Peak {
             norm_rows(&mut d, &at.terms, &lin.terms_jac, dim, p.norm(), (&[], t));
         }
-        if !at.limited.is_empty() {
+        // limits that are the terms are held by `t`, which is at most the limit
+        let held_by_t = p.limited_are_terms() && p.cost() == Cost::Peak;
+        if !at.limited.is_empty() && !held_by_t {
             norm_rows(
                 &mut d,
                 &at.limited,
@@ -593,6 +621,10 @@ fn iterate(
     // model value: the cost's constant plus the solver's objective
     // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
     let predicted = phi - (constant + obj);
+    let bounded = x[..n]
+        .iter()
+        .zip(scales)
+        .any(|(d, s)| d.abs() >= 0.99 * radius * s);
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let (mut phi_t, _, _) = merit(p, &trial, w);
     if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
@@ -657,6 +689,7 @@ fn iterate(
         accepted,
         merit_after: if accepted { phi_t } else { phi },
         step,
+        bounded,
         solve_ms,
     };
     Ok((rec, trial))
@@ -803,4 +836,41 @@ pub fn solve_warm(
             radius,
         },
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(predicted: f64, radius: f64, bounded: bool) -> ScpIteration {
+        ScpIteration {
+            iteration: 0,
+            merit: 2.0,
+            objective: 2.0,
+            infeasibility: 0.0,
+            radius,
+            weight: 1.0,
+            predicted,
+            actual: predicted,
+            rho: 1.0,
+            accepted: true,
+            merit_after: 2.0 - predicted,
+            step: radius,
+            bounded,
+            solve_ms: 0.0,
+        }
+    }
+
+    #[test]
+    fn criticality_scales_by_the_radius_only_when_the_trust_region_bound_the_step() {
+        // bounded: the decrease at unit radius is at most predicted / radius
+        assert!((record(1e-4, 0.01, true).criticality() - 5e-3).abs() < 1e-15);
+        // the model's minimum inside the region: a larger one predicts no more
+        assert!((record(1e-4, 0.01, false).criticality() - 5e-5).abs() < 1e-15);
+        // radii above 1 never shrink it
+        assert_eq!(
+            record(1e-4, 8.0, true).criticality(),
+            record(1e-4, 8.0, false).criticality()
+        );
+    }
 }
