@@ -733,9 +733,18 @@ pub fn solve_warm(
 ) -> Result<ScpResult> {
     let scales = p.scales();
     let mut z = z0;
-    // the penalty's scale: the cost at the start (at least the limit)
+    // the penalty's scale: the cost at the start; for a peak cost at least
+    // the limit, which is in the cost's unit (a torque-speed line can make
+    // it many times the cost). A time or energy cost has another unit: there
+    // the limit's size (torque) said nothing about the multipliers, and a
+    // weight hundreds of times the cost made the merit all penalty (the
+    // domestic cat's least time took 150 iterations instead of 53)
     let (_, cost0, _) = merit(p, &z, 0.0);
-    let scale = cost0.abs().max(p.limit().unwrap_or(0.0)).max(1e-12);
+    let scale = match p.cost() {
+        Cost::Peak => cost0.abs().max(p.limit().unwrap_or(0.0)),
+        Cost::Linear(_) | Cost::SumOfSquares => cost0.abs(),
+    }
+    .max(1e-12);
     let mut w = settings.weight * scale;
     let mut radius = warm.map_or(settings.initial_radius, |w| {
         w.radius.clamp(1e-3, settings.initial_radius)
