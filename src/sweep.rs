@@ -177,8 +177,11 @@ impl std::str::FromStr for Shard {
 /// the design: the phased peak design is the same path at every value.
 const FALL_ONLY: [&str; 3] = ["fall.height", "fall.gravity", "fall.margin"];
 
-/// One sweep point; `warm` is the previous point's free-form design in the
-/// same chunk (continuation), and the point's own free-form design is
+/// One sweep point; `warm` is the last free-form design in the same chunk
+/// (continuation) and `before` the one at the point before it, when both
+/// points are consecutive (the secant predictor); `bends` the chunk's
+/// solved phased bends so far, consecutive (the bend search's hint), to
+/// which this point's is added. The point's own free-form design is
 /// returned for the next.
 fn point(
     cfg: &Config,
@@ -237,8 +240,13 @@ fn point(
                 )
             });
             let r = crate::design::phased::optimize_near(&cfg, hint, |_| {});
-            if let Ok(r) = &r {
-                bends.push(r.bend_deg.to_radians());
+            // only a solved design at the point just before predicts this
+            // one: after a failure the next point scans afresh
+            match &r {
+                Ok(r) if r.status == crate::design::conic::SolveStatus::Solved => {
+                    bends.push(r.bend_deg.to_radians())
+                }
+                _ => bends.clear(),
             }
             r
         } else {
@@ -422,6 +430,7 @@ pub fn sweep_shard(
                     // phased design (F3 time scaling)
                     let mut phased_warm = None;
                     let mut bends = Vec::new();
+                    let mut last_ok = false;
                     for i in chunks[c].clone() {
                         let slot = FALL_ONLY
                             .contains(&spec.key.as_str())
@@ -436,21 +445,35 @@ pub fn sweep_shard(
                                 slot,
                                 &mut bends,
                             ),
-                            Err(e) => (
-                                SweepPoint {
-                                    value: values[i],
-                                    error: Some(e.to_string()),
-                                    ..Default::default()
-                                },
-                                None,
-                            ),
+                            Err(e) => {
+                                bends.clear();
+                                (
+                                    SweepPoint {
+                                        value: values[i],
+                                        error: Some(e.to_string()),
+                                        ..Default::default()
+                                    },
+                                    None,
+                                )
+                            }
                         };
                         // a failed point leaves the last good design as the
-                        // start (and no secant: its neighbour is two steps away)
-                        if fr.is_some() {
-                            before = std::mem::replace(&mut warm, fr);
-                        } else {
-                            before = None;
+                        // start, and no secant until two consecutive points
+                        // have designs again
+                        match fr {
+                            Some(fr) => {
+                                before = if last_ok {
+                                    warm.replace(fr)
+                                } else {
+                                    warm = Some(fr);
+                                    None
+                                };
+                                last_ok = true;
+                            }
+                            None => {
+                                before = None;
+                                last_ok = false;
+                            }
                         }
                         results.lock().unwrap()[i] = Some(p);
                         progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());

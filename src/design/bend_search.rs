@@ -1,9 +1,10 @@
 //! The one-dimensional search over the bend that every phased design uses:
-//! a coarse scan, then golden-section refinement inside the best bracket.
-//! Derivative-free, so it stays correct where the objective has kinks (a
-//! phase taking over the peak); it assumes unimodality inside that bracket.
-//! The refinement is golden section or Brent's method (fewer evaluations
-//! where the objective is smooth).
+//! a coarse scan, then refinement inside the best bracket (golden section or
+//! Brent's method, which needs fewer evaluations where the objective is
+//! smooth); or, in a sweep, a local bracket around the neighbours' bend
+//! ([`bracket_then_brent`]). Derivative-free, so it stays correct where the
+//! objective has kinks (a phase taking over the peak); it assumes
+//! unimodality inside the bracket.
 
 use crate::error::Result;
 
@@ -127,13 +128,19 @@ pub fn bracket_then_brent<D: Scored>(
     }
     let (fa, fm, fb) = (pa.1.score(), pm.1.score(), pb.1.score());
     if fa < fm || fb < fm {
-        // decreasing to an end of the range: the end is the best bend
-        return Ok(Some(if fa <= fb { pa.1 } else { pb.1 }));
+        // falling towards an end of the range: the minimum lies between
+        // that end and the middle bend (Brent from the end, as after a scan)
+        return if fa <= fb {
+            brent(pa.0, pa.0, pm.0, pa.1, tol, eval)
+        } else {
+            brent(pm.0, pb.0, pb.0, pb.1, tol, eval)
+        }
+        .map(Some);
     }
     brent(pa.0, pm.0, pb.0, pm.1, tol, eval).map(Some)
 }
 
-/// Brent's method on the bracket `a < x < b` whose best bend so far is `x`
+/// Brent's method on the bracket `a <= x <= b` whose best bend so far is `x`
 /// (with design `best_d`), to `tol` wide.
 fn brent<D: Scored>(
     mut a: f64,
@@ -283,6 +290,14 @@ mod tests {
         })
         .unwrap();
         assert!(near < k, "bracket {near} vs scan {k} evaluations");
+        // a minimum near the range's end, reached by walking the bracket
+        // there: refined, not the end itself
+        let near_end = bracket_then_brent(0.3, 0.02, (0.1, 3.0), 1e-5, |x: f64| {
+            Ok(S(x, (x - 0.12).powi(2)))
+        })
+        .unwrap()
+        .unwrap();
+        assert!((near_end.0 - 0.12).abs() < 1e-5, "{}", near_end.0);
         // decreasing to the range's end: the end
         let end = bracket_then_brent(2.5, 0.1, (0.1, 3.0), 1e-5, |x: f64| Ok(S(x, -x)))
             .unwrap()

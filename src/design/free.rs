@@ -1184,20 +1184,37 @@ pub fn continue_from(
     cfg: &Config,
     prev: &FreeResult,
     before: Option<&FreeResult>,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let nodes = cfg.free.nodes;
     let tr = Transcription::new(3, nodes);
-    let mut z0 = if prev.nodes == nodes {
-        match before.filter(|b| b.nodes == nodes) {
-            Some(b) => prev
-                .z_scaled
-                .iter()
-                .zip(&b.z_scaled)
-                .map(|(p, b)| 2.0 * p - b)
-                .collect(),
-            None => prev.z_scaled.clone(),
+    // the secant from two converged designs on this mesh, its durations
+    // kept to at least half the last's; the plain start if it fails
+    let converged = |r: &FreeResult| r.nodes == nodes && r.status == ScpStatus::Converged;
+    if let Some(b) = before.filter(|b| converged(b) && converged(prev)) {
+        let mut z: Vec<f64> = prev
+            .z_scaled
+            .iter()
+            .zip(&b.z_scaled)
+            .map(|(p, b)| 2.0 * p - b)
+            .collect();
+        for p in 0..3 {
+            let i = tr.duration(p);
+            z[i] = z[i].max(0.5 * prev.z_scaled[i]) * cfg.available_time();
         }
+        if let Ok(r) = optimize_start(
+            cfg,
+            &z,
+            Some(&prev.warm),
+            "continuation",
+            nodes,
+            &mut observe,
+        ) {
+            return Ok(r);
+        }
+    }
+    let mut z0 = if prev.nodes == nodes {
+        prev.z_scaled.clone()
     } else {
         let mut z = tr.sample(&prev.plan);
         let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();

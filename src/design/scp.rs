@@ -111,7 +111,9 @@ pub trait ScpProblem {
     /// `sum_r y_r Hess f_r(z) + sum_r u_r Hess g_r(z)` (`y` one multiplier
     /// per flattened term of a peak cost, zero otherwise; `u` one per
     /// flattened limited term), as upper-triangle triplets with a pattern
-    /// that does not depend on `z`, `y` or `u`. The default (none) makes the
+    /// that does not depend on `z`, `y` or `u` (with
+    /// [`ScpProblem::limited_are_terms`], `u` is zero and `y` carries the
+    /// limit's multiplier through the epigraph). The default (none) makes the
     /// method sequential linear programming (Gauss-Newton for a
     /// sum-of-squares cost); with it, the subproblem is an SQP step.
     fn hessian(&self, _z: &[f64], _y: &[f64], _u: &[f64]) -> Triplets {
@@ -134,7 +136,8 @@ pub struct ScpSettings {
     /// Iterations over which the merit must fall by `tolerance` (relative)
     /// per iteration on average to keep going (default 10).
     pub window: usize,
-    /// Penalty weight relative to the initial peak (default 2): the exact L1
+    /// Penalty weight relative to the initial cost (for a peak cost at least
+    /// the limit, which has its unit) (default 2): the exact L1
     /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
     /// model more curved and the steps shorter. It grows tenfold when needed.
     pub weight: f64,
@@ -617,6 +620,11 @@ fn iterate(
                 *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
             }
         }
+        if limit_rows.is_empty() {
+            // no rows of their own (none, or held by `t`): the terms'
+            // multipliers carry the limit, and a neighbour's must not linger
+            mult.limited.fill(0.0);
+        }
     }
     // model value: the cost's constant plus the solver's objective
     // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
@@ -635,7 +643,7 @@ fn iterate(
             .collect();
         // with the terms' bounds first (t, L + sigma from the subproblem);
         // without them when that has no solution
-        let bounded = p.cost() == Cost::Peak || p.limit().is_some();
+        let has_bounds = p.cost() == Cost::Peak || p.limit().is_some();
         let sigma = 1.0
             + if p.limit().is_some() {
                 x[n + 1 + 2 * m]
@@ -647,7 +655,7 @@ fn iterate(
             (false, &mut solvers.correction),
         ];
         for (with_bounds, slot) in tries {
-            if with_bounds && !bounded {
+            if with_bounds && !has_bounds {
                 continue;
             }
             let bounds = with_bounds.then_some((&at, x[n], sigma));
