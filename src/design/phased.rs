@@ -265,7 +265,8 @@ impl BendHint {
 
 /// Bend search: scan (with the one-turn and the config's bend), then Brent
 /// refinement in the best bracket; with a `hint`, a bracket around it
-/// instead of the scan (the scan when no bend of the bracket is possible).
+/// instead of the scan (the scan when no bend of the bracket is possible,
+/// one fails, or the one-turn or the config's bend is better).
 pub fn search_bend(
     cfg: &Config,
     problem: &mut TimingProblem,
@@ -289,12 +290,24 @@ pub fn search_bend(
         Ok(d)
     };
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    if let Some(h) = hint
-        && let Some(d) = bracket_then_brent(h.bend, h.step, (lo, hi), tol, |b| eval(b, &mut evals))?
-    {
-        return Ok((d, evals));
-    }
     let xs = bend_scan(cfg, lo, hi);
+    // the bracket's best, unless a bend of it fails, none is possible, or
+    // one of the bends the scan always tries (one turn, F6, and the
+    // config's) beats it: another basin, so the scan
+    if let Some(h) = hint
+        && let Ok(Some(d)) =
+            bracket_then_brent(h.bend, h.step, (lo, hi), tol, |b| eval(b, &mut evals))
+    {
+        let mut beaten = false;
+        for &b in &xs[cfg.phased.scan_points..] {
+            if let Ok(other) = eval(b, &mut evals) {
+                beaten |= other.unit_peak() < d.unit_peak();
+            }
+        }
+        if !beaten {
+            return Ok((d, evals));
+        }
+    }
     let best_d = scan_then_brent(xs, tol, |b| eval(b, &mut evals))?;
     Ok((best_d, evals))
 }
