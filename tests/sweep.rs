@@ -115,19 +115,18 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     assert!(!ok && err.contains("--shard"), "{err}");
 }
 
-/// A sweep of the drop height reuses each chunk's first phased design,
-/// scaled by F3: its peaks must be the phased designs computed afresh at
-/// every height.
-#[test]
-fn a_height_sweep_scales_the_phased_design_exactly() {
+/// A phased sweep of `key` over `range` (12 nodes per phase) on the seed:
+/// per point `(value, swept peak, swept bend, peak designed afresh at that
+/// value)`.
+fn phased_sweep_against_fresh_designs(key: &str, range: &str) -> Vec<(f64, f64, f64, f64)> {
     let dir = tempfile::tempdir().unwrap();
     let cfg = configs().join("seed.toml");
-    let c = cfg.to_str().unwrap();
+    let set_range = format!("{key}={range}");
     let args = [
         "sweep",
-        c,
+        cfg.to_str().unwrap(),
         "--set-range",
-        "fall.height=1:9:9",
+        &set_range,
         "--methods",
         "phased",
         "--set",
@@ -137,27 +136,38 @@ fn a_height_sweep_scales_the_phased_design_exactly() {
     ];
     let (ok, _, err) = run(&args, dir.path());
     assert!(ok, "{err}");
-    let csv = std::fs::read_to_string(
-        dir.path()
-            .join("out/seed/sweep-fall_height/sweep-fall_height.csv"),
-    )
-    .unwrap();
+    let name = format!("sweep-{}", key.replace('.', "_"));
+    let csv =
+        std::fs::read_to_string(dir.path().join(format!("out/seed/{name}/{name}.csv"))).unwrap();
     let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let col = head.iter().position(|h| *h == "phased_peak_nm").unwrap();
-    for line in csv.lines().skip(1) {
-        let cells: Vec<&str> = line.split(',').collect();
-        let h: f64 = cells[0].parse().unwrap();
-        let swept: f64 = cells[col].parse().unwrap();
-        let direct = catflip::design::phased::optimize(
-            &catflip::Config::load(
-                &cfg,
-                &["phased.nodes=12".into(), format!("fall.height={h}")],
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let (peak, bend) = (col("phased_peak_nm"), col("phased_bend_deg"));
+    csv.lines()
+        .skip(1)
+        .map(|line| {
+            let cells: Vec<f64> = line
+                .split(',')
+                .map(|c| c.parse().unwrap_or(f64::NAN))
+                .collect();
+            let value = cells[0];
+            let fresh = catflip::design::phased::optimize(
+                &catflip::Config::load(&cfg, &["phased.nodes=12".into(), format!("{key}={value}")])
+                    .unwrap(),
+                |_| {},
             )
-            .unwrap(),
-            |_| {},
-        )
-        .unwrap()
-        .peak_torque_nm;
+            .unwrap()
+            .peak_torque_nm;
+            (value, cells[peak], cells[bend], fresh)
+        })
+        .collect()
+}
+
+/// A sweep of the drop height reuses each chunk's first phased design,
+/// scaled by F3: its peaks must be the phased designs computed afresh at
+/// every height.
+#[test]
+fn a_height_sweep_scales_the_phased_design_exactly() {
+    for (h, swept, _, direct) in phased_sweep_against_fresh_designs("fall.height", "1:9:9") {
         assert!(
             (swept - direct).abs() < 1e-6 * direct,
             "h = {h}: swept {swept} vs direct {direct}"
@@ -171,48 +181,14 @@ fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_opt
     // search from the chunk's previous bends; it must find the optimum the
     // full scan finds at that radius (to the bend tolerance, where the peak
     // is flat: 1e-4)
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml");
-    let args = [
-        "sweep",
-        cfg.to_str().unwrap(),
-        "--set-range",
-        "cat.radius=0.04:0.2:6",
-        "--methods",
-        "phased",
-        "--set",
-        "phased.nodes=12",
-        "--out",
-        "out",
-    ];
-    let (ok, _, err) = run(&args, dir.path());
-    assert!(ok, "{err}");
-    let csv = std::fs::read_to_string(
-        dir.path()
-            .join("out/seed/sweep-cat_radius/sweep-cat_radius.csv"),
-    )
-    .unwrap();
-    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
-    let col = head.iter().position(|h| *h == "phased_peak_nm").unwrap();
-    let bend = head.iter().position(|h| *h == "phased_bend_deg").unwrap();
-    let mut bends = Vec::new();
-    for line in csv.lines().skip(1) {
-        let cells: Vec<&str> = line.split(',').collect();
-        let r: f64 = cells[0].parse().unwrap();
-        let swept: f64 = cells[col].parse().unwrap();
-        let direct = catflip::design::phased::optimize(
-            &catflip::Config::load(&cfg, &["phased.nodes=12".into(), format!("cat.radius={r}")])
-                .unwrap(),
-            |_| {},
-        )
-        .unwrap();
+    let points = phased_sweep_against_fresh_designs("cat.radius", "0.04:0.2:6");
+    for &(r, swept, _, direct) in &points {
         assert!(
-            (swept - direct.peak_torque_nm).abs() < 1e-4 * direct.peak_torque_nm,
-            "r = {r}: swept {swept} vs direct {}",
-            direct.peak_torque_nm
+            (swept - direct).abs() < 1e-4 * direct,
+            "r = {r}: swept {swept} vs direct {direct}"
         );
-        bends.push(cells[bend].parse::<f64>().unwrap());
     }
     // the optimum moves with the radius (the local search had to follow it)
+    let bends: Vec<f64> = points.iter().map(|p| p.2).collect();
     assert!(bends.windows(2).all(|w| w[1] > w[0] + 1.0), "{bends:?}");
 }

@@ -1,7 +1,6 @@
 //! The one-dimensional search over the bend that every phased design uses:
-//! a coarse scan, then refinement inside the best bracket (golden section or
-//! Brent's method, which needs fewer evaluations where the objective is
-//! smooth); or, in a sweep, a local bracket around the neighbours' bend
+//! a coarse scan, then Brent refinement inside the best bracket; or, in a
+//! sweep, a local bracket around the neighbours' bend
 //! ([`bracket_then_brent`]). Derivative-free, so it stays correct where the
 //! objective has kinks (a phase taking over the peak); it assumes
 //! unimodality inside the bracket.
@@ -37,46 +36,10 @@ fn scan_best<D: Scored>(
 }
 
 /// Evaluates every bend of `scan` (sorted here), then refines the best
-/// bracket to `tol` rad; returns the best design seen.
-pub fn scan_then_golden<D: Scored>(
-    mut scan: Vec<f64>,
-    tol: f64,
-    mut eval: impl FnMut(f64) -> Result<D>,
-) -> Result<D> {
-    let (mut a, _, mut b, mut best_d) = scan_best(&mut scan, &mut eval)?;
-    if !best_d.score().is_finite() {
-        return Ok(best_d);
-    }
-    let g = (5f64.sqrt() - 1.0) / 2.0;
-    let mut x1 = b - g * (b - a);
-    let mut x2 = a + g * (b - a);
-    let mut d1 = eval(x1)?;
-    let mut d2 = eval(x2)?;
-    while b - a > tol {
-        if d1.score() <= d2.score() {
-            b = x2;
-            (x2, d2) = (x1, d1);
-            x1 = b - g * (b - a);
-            d1 = eval(x1)?;
-        } else {
-            a = x1;
-            (x1, d1) = (x2, d2);
-            x2 = a + g * (b - a);
-            d2 = eval(x2)?;
-        }
-    }
-    for d in [d1, d2] {
-        if d.score() < best_d.score() {
-            best_d = d;
-        }
-    }
-    Ok(best_d)
-}
-
-/// Like [`scan_then_golden`], but refines the best bracket with Brent's
-/// method (parabolic steps through the three best bends, a golden step when
-/// the parabola is not trusted), so a smooth objective needs about half the
-/// evaluations; kinks and impossible bends fall back to golden steps.
+/// bracket with Brent's method (parabolic steps through the three best
+/// bends, a golden step when the parabola is not trusted), so a smooth
+/// objective needs about half the evaluations of golden section; kinks and
+/// impossible bends fall back to golden steps.
 /// Stops when the bracket around the best bend is `tol` wide.
 pub fn scan_then_brent<D: Scored>(
     mut scan: Vec<f64>,
@@ -229,6 +192,43 @@ fn brent<D: Scored>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Golden-section refinement after the same scan: the reference Brent
+    /// is measured against.
+    fn scan_then_golden<D: Scored>(
+        mut scan: Vec<f64>,
+        tol: f64,
+        mut eval: impl FnMut(f64) -> Result<D>,
+    ) -> Result<D> {
+        let (mut a, _, mut b, mut best_d) = scan_best(&mut scan, &mut eval)?;
+        if !best_d.score().is_finite() {
+            return Ok(best_d);
+        }
+        let g = (5f64.sqrt() - 1.0) / 2.0;
+        let mut x1 = b - g * (b - a);
+        let mut x2 = a + g * (b - a);
+        let mut d1 = eval(x1)?;
+        let mut d2 = eval(x2)?;
+        while b - a > tol {
+            if d1.score() <= d2.score() {
+                b = x2;
+                (x2, d2) = (x1, d1);
+                x1 = b - g * (b - a);
+                d1 = eval(x1)?;
+            } else {
+                a = x1;
+                (x1, d1) = (x2, d2);
+                x2 = a + g * (b - a);
+                d2 = eval(x2)?;
+            }
+        }
+        for d in [d1, d2] {
+            if d.score() < best_d.score() {
+                best_d = d;
+            }
+        }
+        Ok(best_d)
+    }
 
     struct S(f64, f64);
     impl Scored for S {

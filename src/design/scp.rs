@@ -384,6 +384,12 @@ fn norm_rows(
     rows_of
 }
 
+/// Whether the limit is the one epigraph row `t <= L (1 + sigma)` (see
+/// [`ScpProblem::limited_are_terms`]) rather than rows of its own.
+fn held_by_epigraph(p: &dyn ScpProblem) -> bool {
+    p.limited_are_terms() && p.cost() == Cost::Peak
+}
+
 /// The convex subproblem at `z`: variables `[dz, t, nu+, nu-, sigma]` (`t`
 /// the peak epigraph, zero for other costs; `sigma` the limits' elastic
 /// slack, present when the problem has limits). Returns the data, the
@@ -481,7 +487,7 @@ fn subproblem(
     };
     // limits with elastic slack, relative: |g + G dz| / L <= 1 + sigma
     let limit_rows = match limit {
-        Some(l) if p.limited_are_terms() && cost == Cost::Peak => {
+        Some(l) if held_by_epigraph(p) => {
             // |f + F dz| <= t <= L (1 + sigma): the limit's multiplier
             // reaches the terms through t
             d.q[sigma] = w;
@@ -556,8 +562,7 @@ fn correction(
             norm_rows(&mut d, &at.terms, &lin.terms_jac, dim, p.norm(), (&[], t));
         }
         // limits that are the terms are held by `t`, which is at most the limit
-        let held_by_t = p.limited_are_terms() && p.cost() == Cost::Peak;
-        if !at.limited.is_empty() && !held_by_t {
+        if !at.limited.is_empty() && !held_by_epigraph(p) {
             norm_rows(
                 &mut d,
                 &at.limited,
