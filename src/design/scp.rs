@@ -28,7 +28,7 @@
 //! model stalls while still infeasible; an iteration limit or a collapsed
 //! trust region (stalled) end the run.
 
-use crate::design::conic::{Cone, ConicData, ConicSolver, solve_reusing};
+use crate::design::conic::{Cone, ConicData, ConicSettings, ConicSolver, solve_reusing_with};
 use crate::error::{Error, Result};
 use crate::model::TorqueNorm;
 use serde::Serialize;
@@ -296,9 +296,16 @@ fn cost_of(p: &dyn ScpProblem, z: &[f64], v: &Values) -> f64 {
 
 /// `(phi, cost, infeasibility)`: the exact penalty, the cost, and the
 /// largest violation (`max |r|`, and `max |g| / L - 1` for the limits).
-fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> (f64, f64, f64) {
-    let v = evaluate(p, z);
-    let cost = cost_of(p, z, &v);
+fn merit(p: &dyn ScpProblem, z: &[f64], w: f64) -> Merit {
+    merit_of(p, z, &evaluate(p, z), w)
+}
+
+/// `(phi, cost, infeasibility)` of [`merit`].
+type Merit = (f64, f64, f64);
+
+/// [`merit`] from the values at `z` (evaluated once, used twice).
+fn merit_of(p: &dyn ScpProblem, z: &[f64], v: &Values, w: f64) -> Merit {
+    let cost = cost_of(p, z, v);
     let l1: f64 = v.residual.iter().map(|x| x.abs()).sum();
     let mut inf = v.residual.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let mut over = 0.0;
@@ -596,15 +603,16 @@ fn iterate(
     scales: &[f64],
     solvers: &mut Solvers,
     mult: &mut Multipliers,
-) -> Result<(ScpIteration, Vec<f64>)> {
-    let (phi, cost, inf) = merit(p, z, w);
+    here: Merit,
+) -> Result<(ScpIteration, Vec<f64>, Merit)> {
+    let (phi, cost, inf) = here;
     let lin = linearize(p, z);
     mult.terms.resize(lin.terms.len(), 0.0);
     mult.limited.resize(lin.limited.len(), 0.0);
     let (data, constant, term_rows, limit_rows) =
         subproblem(p, z, &lin, scales, radius, w, &mult.terms, &mult.limited);
     let clock = Instant::now();
-    let (st, x, obj) = solve_reusing(&mut solvers.subproblem, &data)?;
+    let (st, x, obj) = solve_reusing_with(&mut solvers.subproblem, &data, ConicSettings::MODEL)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
     if !st.ok() {
         return Err(Error::Solver {
@@ -639,10 +647,10 @@ fn iterate(
         .zip(scales)
         .any(|(d, s)| d.abs() >= 0.99 * radius * s);
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
-    let (mut phi_t, _, _) = merit(p, &trial, w);
-    if predicted > 0.0 && phi - phi_t < 0.75 * predicted {
+    let at = evaluate(p, &trial);
+    let mut there = merit_of(p, &trial, &at, w);
+    if predicted > 0.0 && phi - there.0 < 0.75 * predicted {
         // back onto the model's residual at the trial point, r + J dz = nu+ - nu-
-        let at = evaluate(p, &trial);
         let rhs: Vec<f64> = (0..m)
             .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - at.residual[i])
             .collect();
@@ -665,13 +673,13 @@ fn iterate(
             }
             let bounds = with_bounds.then_some((&at, x[n], sigma));
             let cd = correction(p, &trial, &lin, &rhs, scales, bounds);
-            if let Ok((cs, dc, _)) = solve_reusing(slot, &cd)
+            if let Ok((cs, dc, _)) = solve_reusing_with(slot, &cd, ConicSettings::MODEL)
                 && cs.ok()
             {
                 let corrected: Vec<f64> = trial.iter().zip(&dc).map(|(a, b)| a + b).collect();
-                let (phi_c, _, _) = merit(p, &corrected, w);
-                if phi_c < phi_t {
-                    (trial, phi_t) = (corrected, phi_c);
+                let at_c = merit(p, &corrected, w);
+                if at_c.0 < there.0 {
+                    (trial, there) = (corrected, at_c);
                 }
                 break;
             }
@@ -682,7 +690,7 @@ fn iterate(
         .zip(z)
         .zip(scales)
         .fold(0.0f64, |m, ((a, b), s)| m.max((a - b).abs() / s));
-    let actual = phi - phi_t;
+    let actual = phi - there.0;
     let rho = if predicted > 0.0 {
         actual / predicted
     } else {
@@ -700,12 +708,12 @@ fn iterate(
         actual,
         rho,
         accepted,
-        merit_after: if accepted { phi_t } else { phi },
+        merit_after: if accepted { there.0 } else { phi },
         step,
         bounded,
         solve_ms,
     };
-    Ok((rec, trial))
+    Ok((rec, trial, there))
 }
 
 /// The driver: runs [`iterate`] from `z0`, owns the trust radius, the penalty
@@ -770,8 +778,11 @@ pub fn solve_warm(
     let mut rule = StopRule::None;
     let mut failures = 0;
     let mut nearly = 0;
+    // the merit at z for the weight w, kept across iterations
+    let mut here = merit(p, &z, w);
     for it in 0..settings.max_iterations {
-        let (rec, trial) = match iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult) {
+        let step = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult, here);
+        let (rec, trial, there) = match step {
             Ok(x) => {
                 failures = 0;
                 x
@@ -790,14 +801,14 @@ pub fn solve_warm(
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
-            z = trial;
+            (z, here) = (trial, there);
         }
         if rec.rho < 0.1 {
             radius *= 0.5;
         } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
-        let (phi_now, _, inf_now) = merit(p, &z, w);
+        let (phi_now, _, inf_now) = here;
         window.push(phi_now);
         let critical = rec.criticality() <= settings.tolerance;
         // the merit fell by less than `tolerance` (relative) per iteration,
@@ -821,6 +832,7 @@ pub fn solve_warm(
             nearly += 1;
             if inf_now > 100.0 * settings.feasibility || nearly > 3 {
                 w *= 10.0;
+                here = merit(p, &z, w);
                 window.clear();
                 nearly = 0;
                 if w > 1e6 * settings.weight * scale {
@@ -836,7 +848,7 @@ pub fn solve_warm(
             break;
         }
     }
-    let (_, objective, infeasibility) = merit(p, &z, w);
+    let (_, objective, infeasibility) = here;
     let last = iterations.last().copied();
     let certificate = Certificate {
         step: last.map_or(0.0, |l| l.step),
