@@ -154,6 +154,13 @@ impl ConicSettings {
         refine: false,
         gap_tolerance: 1e-7,
     };
+
+    /// A search that only ranks candidates (the phased bend search), whose
+    /// winner is solved again with the defaults: no refinement.
+    pub const SEARCH: Self = Self {
+        refine: false,
+        gap_tolerance: 1e-8,
+    };
 }
 
 /// Iterative-refinement stopping tolerance (relative and absolute) of the

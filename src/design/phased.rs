@@ -277,8 +277,9 @@ pub fn search_bend(
     let t = cfg.available_time();
     let (lo, hi) = bend_range(cfg)?;
     let mut evals = Vec::new();
+    let mut search = problem.for_search();
     let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
-        let d = design_at(&cat, problem, b)?;
+        let d = design_at(&cat, &mut search, b)?;
         let e = BendEvaluation {
             bend_deg: b.to_degrees(),
             value: d.unit_peak() / (t * t),
@@ -305,11 +306,12 @@ pub fn search_bend(
             }
         }
         if !beaten {
-            return Ok((d, evals));
+            return Ok((design_at(&cat, problem, d.bend)?, evals));
         }
     }
     let best_d = scan_then_brent(xs, tol, |b| eval(b, &mut evals))?;
-    Ok((best_d, evals))
+    // the search's winner, solved to Clarabel's defaults (the certificate)
+    Ok((design_at(&cat, problem, best_d.bend)?, evals))
 }
 
 /// F7: least drop height at which `unit_peak / T^2 <= tau_max`, m.

@@ -17,7 +17,9 @@
 //! `beta = beta_k + ds (3 a_k + a_{k+1}) / 4`: the torque is then continuous
 //! and the bound holds between points to second order in `ds`.
 
-use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
+use crate::design::conic::{
+    Cone, ConicData, ConicSettings, ConicSolver, SolveStatus, solve_reusing_with,
+};
 use crate::design::path::{GridTiming, Path};
 use crate::error::{Error, Result};
 use crate::model::dynamics::christoffel;
@@ -39,6 +41,7 @@ pub struct PhaseTiming {
 pub struct TimingProblem {
     k: usize,
     norm: TorqueNorm,
+    settings: ConicSettings,
     solver: Option<ConicSolver>,
 }
 
@@ -92,7 +95,18 @@ impl TimingProblem {
         Self {
             k,
             norm,
+            settings: ConicSettings::default(),
             solver: None,
+        }
+    }
+
+    /// The same problem solved for a search ([`ConicSettings::SEARCH`]): its
+    /// values rank bends; the chosen one is solved again by [`Self::new`]'s.
+    pub fn for_search(&self) -> Self {
+        Self {
+            settings: ConicSettings::SEARCH,
+            solver: None,
+            ..*self
         }
     }
 
@@ -189,7 +203,7 @@ impl TimingProblem {
     /// Solves the phase along `path` in unit time.
     pub fn solve(&mut self, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
         let data = self.build(cat, path);
-        let (status, x, _) = solve_reusing(&mut self.solver, &data)?;
+        let (status, x, _) = solve_reusing_with(&mut self.solver, &data, self.settings)?;
         if !status.ok() {
             return Err(Error::Solver {
                 what: format!("path-timing SOCP ({} intervals)", self.k),
