@@ -19,7 +19,8 @@
 //! model value. When `rho < 0.75` a second-order correction (one more conic
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
 //! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
-//! halves when `rho < 0.1` and doubles when `rho > 0.5`.
+//! falls to half the model's step when `rho < 0.1` and doubles when
+//! `rho > 0.5`.
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
@@ -177,6 +178,9 @@ pub struct ScpIteration {
     pub merit_after: f64,
     /// Largest scaled component of the trial step `|dz_i| / scale_i`.
     pub step: f64,
+    /// Largest scaled component of the subproblem's step (before the
+    /// correction).
+    pub model_step: f64,
     /// Whether the trust region bounded the subproblem's step (its largest
     /// scaled component at the radius); when not, the model's minimum lies
     /// inside it.
@@ -642,10 +646,11 @@ fn iterate(
     // model value: the cost's constant plus the solver's objective
     // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
     let predicted = phi - (constant + obj);
-    let bounded = x[..n]
+    let model_step = x[..n]
         .iter()
         .zip(scales)
-        .any(|(d, s)| d.abs() >= 0.99 * radius * s);
+        .fold(0.0f64, |m, (d, s)| m.max(d.abs() / s));
+    let bounded = model_step >= 0.99 * radius;
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let at = evaluate(p, &trial);
     let mut there = merit_of(p, &trial, &at, w);
@@ -710,6 +715,7 @@ fn iterate(
         accepted,
         merit_after: if accepted { there.0 } else { phi },
         step,
+        model_step,
         bounded,
         solve_ms,
     };
@@ -804,7 +810,12 @@ pub fn solve_warm(
             (z, here) = (trial, there);
         }
         if rec.rho < 0.1 {
-            radius *= 0.5;
+            // half the model's step: a radius still above an interior
+            // step would only give the same step again (the seed's
+            // per-motor design from the phased seed rejected one step
+            // eight times, radius 8 down to 0.03); a vanishing step (no
+            // predicted decrease) cuts it a hundredfold at most
+            radius = 0.5 * radius.min(rec.model_step.max(0.01 * radius));
         } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
@@ -890,6 +901,7 @@ mod tests {
             accepted: true,
             merit_after: 2.0 - predicted,
             step: radius,
+            model_step: radius,
             bounded,
             solve_ms: 0.0,
         }
