@@ -22,7 +22,7 @@ fn median(mut x: Vec<f64>) -> f64 {
 fn design(cfg: &Config, seed: Seed) -> anyhow::Result<(FreeResult, f64, f64)> {
     let t = Instant::now();
     let plan: Box<dyn ShapePlan> = match seed {
-        Seed::Phased => Box::new(catflip::design::phased::optimize(cfg, |_| {})?.plan),
+        Seed::Phased => Box::new(catflip::design::phased::seed_plan(cfg)?),
         Seed::Analytic => Box::new(catflip::design::analytic::analytic_plan(cfg)),
     };
     let seed_s = t.elapsed().as_secs_f64();

@@ -1313,8 +1313,8 @@ pub fn optimize(
     check_resolvable(cfg, cfg.free.nodes)?;
     let mut r = match seed {
         Seed::Phased => {
-            let ph = crate::design::phased::optimize(cfg, |_| {})?;
-            optimize_from(cfg, &ph.plan, seed.name(), cfg.free.nodes, observe)
+            let plan = crate::design::phased::seed_plan(cfg)?;
+            optimize_from(cfg, &plan, seed.name(), cfg.free.nodes, observe)
         }
         Seed::Analytic => optimize_from(
             cfg,

@@ -358,6 +358,19 @@ pub fn optimize_near(
     finish(cfg, design, evals, solve_time)
 }
 
+/// The phased design's schedule alone, as a seed for the free-form design:
+/// the bend search and the optimal split, without [`finish`]'s dense peak,
+/// comparison and verifying simulation (a third of [`optimize`]'s time on
+/// the seed config), which the free-form design does for its own result.
+pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
+    if cfg.uses_envelope() {
+        return Ok(crate::design::envelope::optimize(cfg, |_| {})?.plan);
+    }
+    let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
+    let (design, _) = search_bend(cfg, &mut problem, None, |_| {})?;
+    Ok(design.plan(design.durations(cfg.available_time())))
+}
+
 /// Reconstruction, comparison and verification of a chosen design.
 pub fn finish(
     cfg: &Config,
