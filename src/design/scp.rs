@@ -961,4 +961,64 @@ mod tests {
             record(1e-4, 8.0, false).criticality()
         );
     }
+
+    /// Two unknowns, two residuals: `r0 = z0` (well conditioned) and
+    /// `r1 = g z1` with a vanishing gain `g` (the tilt at a design).
+    struct Degenerate {
+        gain: f64,
+    }
+
+    impl ScpProblem for Degenerate {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn term_dim(&self) -> usize {
+            1
+        }
+        fn norm(&self) -> TorqueNorm {
+            TorqueNorm::Euclidean
+        }
+        fn cost(&self) -> Cost {
+            Cost::Linear(Vec::new())
+        }
+        fn evaluate(&self, z: &[f64]) -> Values {
+            Values {
+                residual: vec![z[0], self.gain * z[1]],
+                ..Default::default()
+            }
+        }
+        fn linearize(&self, z: &[f64]) -> Linearization {
+            Linearization {
+                residual: self.evaluate(z).residual,
+                residual_jac: vec![(0, 0, 1.0), (1, 1, self.gain)],
+                ..Default::default()
+            }
+        }
+        fn add_constraints(&self, _: &mut ConicData, _: &[f64], _: &dyn Fn(usize) -> usize) {}
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0, 1.0]
+        }
+    }
+
+    #[test]
+    fn the_correction_removes_well_conditioned_residuals_and_leaves_degenerate_ones() {
+        // the model's residual misses by 0.1 along r0 and by 1e-6 along r1:
+        // a hard correction would move z1 by 1e-6 / gain = 10 (scaled)
+        let p = Degenerate { gain: 1e-7 };
+        let z = [0.0, 0.0];
+        let lin = p.linearize(&z);
+        let d = correction(&p, &z, &lin, &[0.1, 1e-6], &p.scales(), None);
+        let (st, x, _) = ConicSolver::new(&d).unwrap().solve();
+        assert!(st.ok(), "{st:?}");
+        assert!((x[0] - 0.1).abs() < 1e-6, "r0 removed: dc0 = {}", x[0]);
+        assert!(x[1].abs() < 1e-3, "r1 left alone: dc1 = {}", x[1]);
+        // with a gain the weight can afford, r1 is removed too
+        let p = Degenerate { gain: 1.0 };
+        let d = correction(&p, &z, &p.linearize(&z), &[0.1, 0.2], &p.scales(), None);
+        let (_, x, _) = ConicSolver::new(&d).unwrap().solve();
+        assert!(
+            (x[0] - 0.1).abs() < 1e-6 && (x[1] - 0.2).abs() < 1e-6,
+            "{x:?}"
+        );
+    }
 }
