@@ -146,7 +146,7 @@ impl Default for ConicSettings {
 impl ConicSettings {
     /// The SCP's subproblems and corrections: models of the problem, whose
     /// predicted decrease needs ~1e-6 of the merit. Without refinement and
-    /// with a 1e-7 gap, the 16 SCP runs of the issue-11 suite (three
+    /// with a 1e-7 gap, the 16 SCP runs of `examples/bench_scp_suite` (three
     /// configs, both norms, both seeds, and the seed at 30 and 50 nodes)
     /// took 427 SCP iterations instead of 481 and 38 % fewer instructions
     /// than with the defaults; every run converged, to peaks within 0.3 %.

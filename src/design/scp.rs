@@ -540,11 +540,11 @@ type TermRows = Vec<Vec<(usize, f64)>>;
 
 /// Weight of the correction's slacks against its scaled step `|dc|^2 / 2`.
 /// A residual component along a direction of scaled gain `s` is removed
-/// while it is below about `W s^2 / 2`: all of it where the constraints are
+/// while it is below about `W s^2`: all of it where the constraints are
 /// well conditioned (`s ~ 0.5`), none along the attitude's tilt, whose
 /// first-order gain all but vanishes at the designs (`s ~ 1e-7`; a hard
 /// correction took a huge step there, or 70 to 200 interior-point
-/// iterations to find none). Over the 16-run suite of issue 11 the elastic
+/// iterations to find none). Over `examples/bench_scp_suite` the elastic
 /// correction took 386 SCP iterations instead of 417 and 10 % fewer
 /// instructions (weights 1 to 100 all gave 386 to 391).
 const CORRECTION_SLACK_WEIGHT: f64 = 10.0;
