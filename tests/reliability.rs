@@ -338,6 +338,29 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert!(ans["least_height_m"].as_f64().unwrap() <= 12.0, "{ans}");
     let (lpeak, _) = csv_peak(&std::fs::read_to_string(base.join("least-height.csv")).unwrap());
     assert!(lpeak <= 0.5 * (1.0 + 1e-6), "{lpeak}");
+    // the time designs start from the phased schedule and from the analytic
+    // one: the answer is no longer than the analytic seed's design alone
+    let (code, out, err) = run(
+        &[
+            "optimize",
+            seed().to_str().unwrap(),
+            "--mode",
+            "free",
+            "--seed",
+            "analytic",
+            "--set",
+            "limits.max_torque=0.5",
+            "--set",
+            "design.objective=time",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let alone: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let alone = alone["manoeuvre_time_s"].as_f64().unwrap();
+    let least = ans["least_time_s"].as_f64().unwrap();
+    assert!(least <= alone * (1.0 + 1e-9), "{least} vs {alone}");
 }
 
 #[test]
