@@ -138,15 +138,16 @@ pub struct BendEvaluation {
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
     let twist = twist_for(cat, bend)?;
     let paths = Path::phased(bend, twist);
-    let fold = problem.solve(cat, &paths[0])?;
-    let twist_phase = problem.solve(cat, &paths[1])?;
-    let unfold = match cat.joint {
-        Joint::NoTwist => PhaseTiming {
-            timing: fold.timing.reversed(),
-            ..fold.clone()
-        },
-        Joint::Universal => problem.solve(cat, &paths[2])?,
+    let solved = match cat.joint {
+        Joint::NoTwist => problem.solve_all(cat, &[&paths[0], &paths[1]])?,
+        Joint::Universal => problem.solve_all(cat, &[&paths[0], &paths[1], &paths[2]])?,
     };
+    let mut solved = solved.into_iter();
+    let (fold, twist_phase) = (solved.next().unwrap(), solved.next().unwrap());
+    let unfold = solved.next().unwrap_or_else(|| PhaseTiming {
+        timing: fold.timing.reversed(),
+        ..fold.clone()
+    });
     Ok(BendDesign {
         bend,
         twist,

@@ -37,12 +37,19 @@ pub struct PhaseTiming {
     pub status: SolveStatus,
 }
 
-/// The phase SOCP on a fixed grid; its solver is reused across paths and bends.
+/// The phase SOCP on a fixed grid; its solvers (one per phase solved at
+/// once) are reused across paths and bends.
 pub struct TimingProblem {
+    socp: PhaseSocp,
+    solvers: Vec<Option<ConicSolver>>,
+}
+
+/// The grid, norm and solver settings of the phase SOCP.
+#[derive(Debug, Clone, Copy)]
+struct PhaseSocp {
     k: usize,
     norm: TorqueNorm,
     settings: ConicSettings,
-    solver: Option<ConicSolver>,
 }
 
 struct Index {
@@ -93,10 +100,12 @@ impl TimingProblem {
     /// `k` grid intervals; `norm` picks SOC rows (Euclidean) or linear rows (per motor).
     pub fn new(k: usize, norm: TorqueNorm) -> Self {
         Self {
-            k,
-            norm,
-            settings: ConicSettings::default(),
-            solver: None,
+            socp: PhaseSocp {
+                k,
+                norm,
+                settings: ConicSettings::default(),
+            },
+            solvers: Vec::new(),
         }
     }
 
@@ -104,12 +113,46 @@ impl TimingProblem {
     /// values rank bends; the chosen one is solved again by [`Self::new`]'s.
     pub fn for_search(&self) -> Self {
         Self {
-            settings: ConicSettings::SEARCH,
-            solver: None,
-            ..*self
+            socp: PhaseSocp {
+                settings: ConicSettings::SEARCH,
+                ..self.socp
+            },
+            solvers: Vec::new(),
         }
     }
 
+    /// Solves the phase along `path` in unit time.
+    pub fn solve(&mut self, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
+        Ok(self.solve_all(cat, &[path])?.remove(0))
+    }
+
+    /// Solves the phases along `paths` in unit time, each on its own thread:
+    /// the phases of a bend are independent SOCPs (a bend's two or three
+    /// SOCPs take the time of the longest on two cores).
+    pub fn solve_all(&mut self, cat: &Cat, paths: &[&Path]) -> Result<Vec<PhaseTiming>> {
+        if self.solvers.len() < paths.len() {
+            self.solvers.resize_with(paths.len(), || None);
+        }
+        let socp = self.socp;
+        let (first, rest) = self.solvers.split_at_mut(1);
+        std::thread::scope(|scope| {
+            let others: Vec<_> = paths[1..]
+                .iter()
+                .zip(rest.iter_mut())
+                .map(|(&path, slot)| scope.spawn(move || socp.solve(slot, cat, path)))
+                .collect();
+            let mut out = vec![socp.solve(&mut first[0], cat, paths[0])];
+            out.extend(
+                others
+                    .into_iter()
+                    .map(|h| h.join().expect("a phase SOCP thread panicked")),
+            );
+            out.into_iter().collect()
+        })
+    }
+}
+
+impl PhaseSocp {
     fn build(&self, cat: &Cat, path: &Path) -> ConicData {
         let k = self.k;
         let ix = Index { k };
@@ -200,10 +243,10 @@ impl TimingProblem {
         d
     }
 
-    /// Solves the phase along `path` in unit time.
-    pub fn solve(&mut self, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
+    /// Solves the phase along `path` in unit time with the solver in `slot`.
+    fn solve(&self, slot: &mut Option<ConicSolver>, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
         let data = self.build(cat, path);
-        let (status, x, _) = solve_reusing_with(&mut self.solver, &data, self.settings)?;
+        let (status, x, _) = solve_reusing_with(slot, &data, self.settings)?;
         if !status.ok() {
             return Err(Error::Solver {
                 what: format!("path-timing SOCP ({} intervals)", self.k),
