@@ -351,6 +351,8 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
             "--set",
             "limits.max_torque=0.5",
             "--set",
+            "fall.height=12",
+            "--set",
             "design.objective=time",
             "--json",
         ],

@@ -149,7 +149,9 @@ impl ConicSettings {
     /// with a 1e-7 gap, the 16 SCP runs of `examples/bench_scp_suite` (three
     /// configs, both norms, both seeds, and the seed at 30 and 50 nodes)
     /// took 427 SCP iterations instead of 481 and 38 % fewer instructions
-    /// than with the defaults; every run converged, to peaks within 0.3 %.
+    /// than with the defaults; every run converged, to peaks within 0.3 %
+    /// (measured when chosen, before the later trust-region and correction
+    /// rules).
     pub const MODEL: Self = Self {
         refine: false,
         gap_tolerance: 1e-7,

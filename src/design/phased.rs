@@ -117,7 +117,9 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     })
 }
 
-/// One evaluation of the bend search, as reported to an observer.
+/// One evaluation of the bend search, as reported to an observer: at the
+/// search's accuracy ([`ConicSettings::SEARCH`](crate::design::conic::ConicSettings::SEARCH),
+/// within about 1e-6 of the certified value the chosen bend is solved to).
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct BendEvaluation {
     pub bend_deg: f64,
@@ -307,12 +309,17 @@ pub fn search_bend(
             }
         }
         if !beaten {
-            return Ok((design_at(&cat, problem, d.bend)?, evals));
+            return Ok((certified(&cat, problem, d), evals));
         }
     }
     let best_d = scan_then_brent(xs, tol, |b| eval(b, &mut evals))?;
-    // the search's winner, solved to Clarabel's defaults (the certificate)
-    Ok((design_at(&cat, problem, best_d.bend)?, evals))
+    Ok((certified(&cat, problem, best_d), evals))
+}
+
+/// The search's winner solved again to Clarabel's defaults (the
+/// certificate); the search's own solution if that solve fails.
+fn certified(cat: &Cat, problem: &mut TimingProblem, found: BendDesign) -> BendDesign {
+    design_at(cat, problem, found.bend).unwrap_or(found)
 }
 
 /// F7: least drop height at which `unit_peak / T^2 <= tau_max`, m.
@@ -363,6 +370,9 @@ pub fn optimize_near(
 /// the bend search and the optimal split, without [`finish`]'s dense peak,
 /// comparison and verifying simulation (a third of [`optimize`]'s time on
 /// the seed config), which the free-form design does for its own result.
+/// Nor does it check `limits.max_torque` ([`check_limit`]): a seed above the
+/// limit still starts a free-form design, which meets the limit or reports
+/// the least height itself.
 pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
     if cfg.uses_envelope() {
         return Ok(crate::design::envelope::optimize(cfg, |_| {})?.plan);

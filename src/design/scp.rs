@@ -654,12 +654,6 @@ fn iterate(
     let clock = Instant::now();
     let (st, x, obj) = solve_reusing_with(&mut solvers.subproblem, &data, ConicSettings::MODEL)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
-    if std::env::var("IPM").is_ok() {
-        eprintln!(
-            "sub ipm {}",
-            solvers.subproblem.as_ref().unwrap().iterations()
-        );
-    }
     if !st.ok() {
         return Err(Error::Solver {
             what: format!("SCP subproblem {iteration}"),
@@ -855,9 +849,14 @@ pub fn solve_warm(
             // half the model's step: a radius still above an interior
             // step would only give the same step again (the seed's
             // per-motor design from the phased seed rejected one step
-            // eight times, radius 8 down to 0.03); a vanishing step (no
-            // predicted decrease) cuts it a hundredfold at most
-            radius = 0.5 * radius.min(rec.model_step.max(0.01 * radius));
+            // eight times, radius 8 down to 0.03); half the radius when
+            // the model predicted no decrease (its step says nothing), and
+            // at most a twentieth of it
+            radius *= if rec.predicted > 0.0 {
+                0.5 * (rec.model_step / radius).clamp(0.1, 1.0)
+            } else {
+                0.5
+            };
         } else if rec.rho > 0.5 {
             radius = (radius * 2.0).min(1e3);
         }
@@ -1008,14 +1007,18 @@ mod tests {
         let z = [0.0, 0.0];
         let lin = p.linearize(&z);
         let d = correction(&p, &z, &lin, &[0.1, 1e-6], &p.scales(), None);
-        let (st, x, _) = ConicSolver::new(&d).unwrap().solve();
+        let (st, x, _) = ConicSolver::with_settings(&d, ConicSettings::MODEL)
+            .unwrap()
+            .solve();
         assert!(st.ok(), "{st:?}");
         assert!((x[0] - 0.1).abs() < 1e-6, "r0 removed: dc0 = {}", x[0]);
         assert!(x[1].abs() < 1e-3, "r1 left alone: dc1 = {}", x[1]);
         // with a gain the weight can afford, r1 is removed too
         let p = Degenerate { gain: 1.0 };
         let d = correction(&p, &z, &p.linearize(&z), &[0.1, 0.2], &p.scales(), None);
-        let (_, x, _) = ConicSolver::new(&d).unwrap().solve();
+        let (_, x, _) = ConicSolver::with_settings(&d, ConicSettings::MODEL)
+            .unwrap()
+            .solve();
         assert!(
             (x[0] - 0.1).abs() < 1e-6 && (x[1] - 0.2).abs() < 1e-6,
             "{x:?}"

@@ -130,6 +130,9 @@ impl TimingProblem {
     /// the phases of a bend are independent SOCPs (a bend's two or three
     /// SOCPs take the time of the longest on two cores).
     pub fn solve_all(&mut self, cat: &Cat, paths: &[&Path]) -> Result<Vec<PhaseTiming>> {
+        if paths.is_empty() {
+            return Ok(Vec::new());
+        }
         if self.solvers.len() < paths.len() {
             self.solvers.resize_with(paths.len(), || None);
         }
