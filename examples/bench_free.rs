@@ -4,7 +4,6 @@
 //! `cargo run --release --example bench_free [-- RUNS]` (default 5 runs).
 use catflip::Config;
 use catflip::design::free::{FreeResult, Seed};
-use catflip::design::plan::ShapePlan;
 use std::time::Instant;
 
 fn median(mut x: Vec<f64>) -> f64 {
@@ -21,10 +20,7 @@ fn median(mut x: Vec<f64>) -> f64 {
 /// nothing) and the SCP, timed together, without the mesh check.
 fn design(cfg: &Config, seed: Seed) -> anyhow::Result<(FreeResult, f64, f64)> {
     let t = Instant::now();
-    let plan: Box<dyn ShapePlan> = match seed {
-        Seed::Phased => Box::new(catflip::design::phased::seed_plan(cfg)?),
-        Seed::Analytic => Box::new(catflip::design::analytic::analytic_plan(cfg)),
-    };
+    let plan = seed.plan(cfg)?;
     let seed_s = t.elapsed().as_secs_f64();
     let r = catflip::design::free::optimize_from(
         cfg,

@@ -8,7 +8,7 @@
 //! correction weight) were chosen on its totals. Each config's torque-speed
 //! line is left out (issue 11's peak-torque cases: the stall torque alone).
 use catflip::Config;
-use catflip::design::plan::ShapePlan;
+use catflip::design::free::Seed;
 use std::time::Instant;
 
 fn main() -> anyhow::Result<()> {
@@ -16,14 +16,14 @@ fn main() -> anyhow::Result<()> {
     let mut cases = Vec::new();
     for file in ["seed", "domestic-cat", "robot-universal"] {
         for norm in ["euclidean", "per-motor"] {
-            for seed in ["phased", "analytic"] {
+            for seed in [Seed::Phased, Seed::Analytic] {
                 cases.push((file, norm, None, seed));
             }
         }
     }
     for norm in ["euclidean", "per-motor"] {
         for nodes in [30, 50] {
-            cases.push(("seed", norm, Some(nodes), "analytic"));
+            cases.push(("seed", norm, Some(nodes), Seed::Analytic));
         }
     }
     println!(
@@ -37,15 +37,13 @@ fn main() -> anyhow::Result<()> {
         let cfg = Config::from_toml(&text, &path, &[format!("limits.norm={norm}")])?;
         let nodes = nodes.unwrap_or(cfg.free.nodes);
         let t = Instant::now();
-        let plan: Box<dyn ShapePlan> = if seed == "phased" {
-            Box::new(catflip::design::phased::seed_plan(&cfg)?)
-        } else {
-            Box::new(catflip::design::analytic::analytic_plan(&cfg))
-        };
-        let r = catflip::design::free::optimize_from(&cfg, plan.as_ref(), seed, nodes, |_| {})?;
+        let plan = seed.plan(&cfg)?;
+        let r =
+            catflip::design::free::optimize_from(&cfg, plan.as_ref(), seed.name(), nodes, |_| {})?;
         let s = t.elapsed().as_secs_f64();
         println!(
-            "{file:<16} {norm:<10} {nodes:>5} {seed:<8} {:>10} {:>6} {:>10.6} {s:>7.2}",
+            "{file:<16} {norm:<10} {nodes:>5} {:<8} {:>10} {:>6} {:>10.6} {s:>7.2}",
+            seed.name(),
             format!("{:?}", r.status),
             r.scp_iterations,
             r.peak_torque_nm

@@ -399,7 +399,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             // the free-form time design from the phased schedule and from
             // the analytic one (a local method: each seed can end in another
             // optimum; on the robot 0.771 s and 0.752 s), the shortest that
-            // verifies (converged, inside the envelope, flips), when shorter
+            // verifies (see `verified`), when shorter than the phased one
             Ok(Some(mut a)) => {
                 phased_short = (!a.possible).then_some(a.least_height_m);
                 let mut timed = cfg.clone();

@@ -460,21 +460,10 @@ pub fn sweep_shard(
                         // a failed point leaves the last good design as the
                         // start, and no secant until two consecutive points
                         // have designs again
-                        match fr {
-                            Some(fr) => {
-                                before = if last_ok {
-                                    warm.replace(fr)
-                                } else {
-                                    warm = Some(fr);
-                                    None
-                                };
-                                last_ok = true;
-                            }
-                            None => {
-                                before = None;
-                                last_ok = false;
-                            }
-                        }
+                        let produced = fr.is_some();
+                        let last = fr.and_then(|fr| warm.replace(fr));
+                        before = last.filter(|_| last_ok);
+                        last_ok = produced;
                         results.lock().unwrap()[i] = Some(p);
                         progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
                     }

@@ -883,6 +883,15 @@ impl Seed {
             Seed::Analytic => "analytic",
         }
     }
+
+    /// The seed's schedule: the phased design's ([`crate::design::phased::seed_plan`])
+    /// or the analytic cosine schedule (which costs nothing).
+    pub fn plan(self, cfg: &Config) -> Result<Box<dyn crate::design::plan::ShapePlan>> {
+        Ok(match self {
+            Seed::Phased => Box::new(crate::design::phased::seed_plan(cfg)?),
+            Seed::Analytic => Box::new(crate::design::analytic::analytic_plan(cfg)),
+        })
+    }
 }
 
 /// Runs the SCP from a seed plan at `nodes` per phase.
@@ -1311,19 +1320,8 @@ pub fn optimize(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     check_resolvable(cfg, cfg.free.nodes)?;
-    let mut r = match seed {
-        Seed::Phased => {
-            let plan = crate::design::phased::seed_plan(cfg)?;
-            optimize_from(cfg, &plan, seed.name(), cfg.free.nodes, observe)
-        }
-        Seed::Analytic => optimize_from(
-            cfg,
-            &crate::design::analytic::analytic_plan(cfg),
-            seed.name(),
-            cfg.free.nodes,
-            observe,
-        ),
-    }?;
+    let plan = seed.plan(cfg)?;
+    let mut r = optimize_from(cfg, plan.as_ref(), seed.name(), cfg.free.nodes, observe)?;
     r.mesh_check = Some(mesh_check(cfg, &r)?);
     Ok(r)
 }

@@ -181,14 +181,17 @@ pub struct ScpIteration {
     /// Largest scaled component of the subproblem's step (before the
     /// correction).
     pub model_step: f64,
-    /// Whether the trust region bounded the subproblem's step (its largest
-    /// scaled component at the radius); when not, the model's minimum lies
-    /// inside it.
-    pub bounded: bool,
     pub solve_ms: f64,
 }
 
 impl ScpIteration {
+    /// Whether the trust region bounded the subproblem's step (its largest
+    /// scaled component at the radius); when not, the model's minimum lies
+    /// inside it.
+    pub fn bounded(&self) -> bool {
+        self.model_step >= 0.99 * self.radius
+    }
+
     /// First-order criticality: the model decrease at unit trust radius,
     /// relative to the merit. When the trust region bounded the step it is
     /// bounded above by `predicted / min(radius, 1)` (the model's optimal
@@ -197,7 +200,7 @@ impl ScpIteration {
     /// shrunk; when it did not, the model's minimum is inside the region and
     /// a larger radius predicts no more: it is `predicted` itself.
     pub fn criticality(&self) -> f64 {
-        let per_radius = if self.bounded {
+        let per_radius = if self.bounded() {
             self.radius.min(1.0)
         } else {
             1.0
@@ -686,7 +689,6 @@ fn iterate(
         .iter()
         .zip(scales)
         .fold(0.0f64, |m, (d, s)| m.max(d.abs() / s));
-    let bounded = model_step >= 0.99 * radius;
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let at = evaluate(p, &trial);
     let mut there = merit_of(p, &trial, &at, w);
@@ -752,7 +754,6 @@ fn iterate(
         merit_after: if accepted { there.0 } else { phi },
         step,
         model_step,
-        bounded,
         solve_ms,
     };
     Ok((rec, trial, there))
@@ -942,8 +943,8 @@ mod tests {
             accepted: true,
             merit_after: 2.0 - predicted,
             step: radius,
-            model_step: radius,
-            bounded,
+            // at the radius when bounded, inside it when not
+            model_step: if bounded { radius } else { 0.5 * radius },
             solve_ms: 0.0,
         }
     }
