@@ -365,6 +365,37 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
     }
 }
 
+/// The free-form design's phased seed is a coarse search (20 path points per
+/// phase, the bend to half a degree, no certified re-solve): it must lead to
+/// the optimum the certified phased design leads to.
+#[test]
+fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
+    for norm in ["euclidean", "per-motor"] {
+        let c = cfg("seed", &[&format!("limits.norm={norm}")]);
+        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+        let certified =
+            catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
+                .unwrap();
+        let coarse =
+            catflip::design::free::optimize(&c, catflip::design::free::Seed::Phased, |_| {})
+                .unwrap();
+        for r in [&certified, &coarse] {
+            assert_eq!(
+                r.status,
+                catflip::design::scp::ScpStatus::Converged,
+                "{norm}"
+            );
+        }
+        let rel = coarse.peak_torque_nm / certified.peak_torque_nm - 1.0;
+        assert!(
+            rel.abs() < 2e-3,
+            "{norm}: {} vs {} ({rel:+.2e})",
+            coarse.peak_torque_nm,
+            certified.peak_torque_nm
+        );
+    }
+}
+
 /// Issue 11's quality anchor: exact-Hessian IPOPT on a Hermite-Simpson
 /// transcription with 120 intervals finds 0.31637 N m for the seed with the
 /// per-motor norm. At the default 40 nodes per phase catflip's dense peak is

@@ -528,6 +528,84 @@ fn psd_part(h: nalgebra::SMatrix<f64, 9, 9>) -> nalgebra::SMatrix<f64, 9, 9> {
     e.eigenvectors * nalgebra::SMatrix::<f64, 9, 9>::from_diagonal(&d) * e.eigenvectors.transpose()
 }
 
+/// Multipliers below this fraction of the largest carry no curvature into
+/// the SCP's model ([`FreeProblem::hessian`]).
+const NEGLIGIBLE_MULTIPLIER: f64 = 1e-6;
+
+impl FreeProblem {
+    /// Phase `p`'s share of [`ScpProblem::hessian`]: `y` holds its check
+    /// points' multipliers (two per point); those at most `cut` are skipped.
+    /// Every interval's block is emitted (zeros too: a fixed pattern).
+    fn phase_hessian(&self, z: &[f64], p: usize, y: &[f64], cut: f64) -> Triplets {
+        let tr = &self.tr;
+        let n = tr.nodes;
+        let it = self.cat.i_t();
+        let t = z[tr.duration(p)];
+        let (s2, s3, s4) = (
+            1.0 / (t * t * it),
+            -2.0 / (t * t * t * it),
+            6.0 / (t.powi(4) * it),
+        );
+        let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
+        for ((k, q, v, a, coef), w) in self.check_points(z, p).into_iter().zip(y.chunks(2)) {
+            let w = [w[0], w[1]];
+            if w[0].abs().max(w[1].abs()) <= cut {
+                continue;
+            }
+            let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
+            let base = ShapeTerms::second(&self.cat, q);
+            let g6 = weighted_torque_hessian(&self.cat, &base, x, w);
+            let gr = torque_gradients(&self.cat, &x, Some(&base));
+            let tau = torque_from(&base, v, a);
+            // C: local inputs (kind, component) from the interval's 8 values (component, idx)
+            let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
+            for kind in 0..3 {
+                for l in 0..2 {
+                    for idx in 0..4 {
+                        c[(2 * kind + l, 4 * l + idx)] = coef[kind][idx];
+                    }
+                }
+            }
+            let g = nalgebra::SMatrix::<f64, 6, 6>::from_fn(|i, j| g6[i][j]);
+            let hx = c.transpose() * g * c * s2;
+            let grad6 =
+                nalgebra::SVector::<f64, 6>::from_fn(|i, _| w[0] * gr[0][i] + w[1] * gr[1][i]);
+            let gx = c.transpose() * grad6 * s3;
+            let b = &mut blocks[k];
+            for i in 0..8 {
+                for j in 0..8 {
+                    b[(i, j)] += hx[(i, j)];
+                }
+                b[(i, 8)] += gx[i];
+                b[(8, i)] += gx[i];
+            }
+            b[(8, 8)] += (w[0] * tau[0] + w[1] * tau[1]) * s4;
+        }
+        let mut out = Vec::with_capacity((n - 1) * 45);
+        for (k, b) in blocks.into_iter().enumerate() {
+            let b = if b == nalgebra::SMatrix::<f64, 9, 9>::zeros() {
+                b
+            } else {
+                psd_part(b)
+            };
+            let mut cols = [0usize; 9];
+            for l in 0..2 {
+                let ic = tr.interval_columns(p, k, l);
+                cols[4 * l..4 * l + 4].copy_from_slice(&ic);
+            }
+            cols[8] = tr.duration(p);
+            for i in 0..9 {
+                for j in 0..9 {
+                    if cols[i] <= cols[j] {
+                        out.push((cols[i], cols[j], b[(i, j)]));
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
 impl ScpProblem for FreeProblem {
     /// Curvature of the peak terms, interval by interval: each check point's
     /// `y . tau / (I_t T_p^2)` is a function of its interval's eight node
@@ -548,74 +626,14 @@ impl ScpProblem for FreeProblem {
                 a + u.get(r).copied().unwrap_or(0.0)
             })
             .collect();
-        let tr = &self.tr;
-        let n = tr.nodes;
-        let it = self.cat.i_t();
-        let mut out = Vec::with_capacity(3 * (n - 1) * 45);
-        let mut row = 0;
-        for p in 0..3 {
-            let t = z[tr.duration(p)];
-            let (s2, s3, s4) = (
-                1.0 / (t * t * it),
-                -2.0 / (t * t * t * it),
-                6.0 / (t.powi(4) * it),
-            );
-            let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
-            for (k, q, v, a, coef) in self.check_points(z, p) {
-                let w = [y[row], y[row + 1]];
-                row += 2;
-                if w == [0.0, 0.0] {
-                    continue;
-                }
-                let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
-                let base = ShapeTerms::second(&self.cat, q);
-                let g6 = weighted_torque_hessian(&self.cat, &base, x, w);
-                let gr = torque_gradients(&self.cat, &x, Some(&base));
-                let tau = torque_from(&base, v, a);
-                // C: local inputs (kind, component) from the interval's 8 values (component, idx)
-                let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
-                for kind in 0..3 {
-                    for l in 0..2 {
-                        for idx in 0..4 {
-                            c[(2 * kind + l, 4 * l + idx)] = coef[kind][idx];
-                        }
-                    }
-                }
-                let g = nalgebra::SMatrix::<f64, 6, 6>::from_fn(|i, j| g6[i][j]);
-                let hx = c.transpose() * g * c * s2;
-                let grad6 =
-                    nalgebra::SVector::<f64, 6>::from_fn(|i, _| w[0] * gr[0][i] + w[1] * gr[1][i]);
-                let gx = c.transpose() * grad6 * s3;
-                let b = &mut blocks[k];
-                for i in 0..8 {
-                    for j in 0..8 {
-                        b[(i, j)] += hx[(i, j)];
-                    }
-                    b[(i, 8)] += gx[i];
-                    b[(8, i)] += gx[i];
-                }
-                b[(8, 8)] += (w[0] * tau[0] + w[1] * tau[1]) * s4;
-            }
-            for (k, b) in blocks.into_iter().enumerate() {
-                let b = psd_part(b);
-                let mut cols = [0usize; 9];
-                for l in 0..2 {
-                    let ic = tr.interval_columns(p, k, l);
-                    for idx in 0..4 {
-                        cols[4 * l + idx] = ic[idx];
-                    }
-                }
-                cols[8] = tr.duration(p);
-                for i in 0..9 {
-                    for j in 0..9 {
-                        if cols[i] <= cols[j] {
-                            out.push((cols[i], cols[j], b[(i, j)]));
-                        }
-                    }
-                }
-            }
-        }
-        out
+        // an interior-point dual of an inactive row is tiny, not zero: its
+        // curvature is left out (a third of the work; the same iterations
+        // and peaks on examples/bench_scp_suite)
+        let cut = NEGLIGIBLE_MULTIPLIER * y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let rows = y.len() / 3;
+        (0..3)
+            .flat_map(|p| self.phase_hessian(z, p, &y[p * rows..(p + 1) * rows], cut))
+            .collect()
     }
 
     fn dim(&self) -> usize {

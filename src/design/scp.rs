@@ -20,7 +20,7 @@
 //! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
 //! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
 //! falls to half the model's step when `rho < 0.1` and doubles when
-//! `rho > 0.5`.
+//! `rho > 0.5`, except right after a rejected step.
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
@@ -823,6 +823,7 @@ pub fn solve_warm(
     let mut nearly = 0;
     // the merit at z for the weight w, kept across iterations
     let mut here = merit(p, &z, w);
+    let mut last_rejected = false;
     for it in 0..settings.max_iterations {
         let step = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult, here);
         let (rec, trial, there) = match step {
@@ -858,9 +859,15 @@ pub fn solve_warm(
             } else {
                 0.5
             };
-        } else if rec.rho > 0.5 {
+        } else if rec.rho > 0.5 && !last_rejected {
+            // not right after a rejection: the radius that was just cut
+            // would be doubled back to one that failed (the seed's
+            // per-motor design from the phased seed alternated 0.125 /
+            // 0.25 three times); over examples/bench_scp_suite 364
+            // iterations instead of 387
             radius = (radius * 2.0).min(1e3);
         }
+        last_rejected = !rec.accepted;
         let (phi_now, _, inf_now) = here;
         window.push(phi_now);
         let critical = rec.criticality() <= settings.tolerance;
