@@ -26,7 +26,8 @@
 //! that fell by less than `tolerance` (relative) per iteration on average
 //! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
 //! names the rule); the penalty grows tenfold when the
-//! model stalls while still infeasible; an iteration limit or a collapsed
+//! model stalls while still infeasible (and, for a linear cost, when the
+//! violation stagnates, see [`ScpSettings::stagnation`]); an iteration limit or a collapsed
 //! trust region (stalled) end the run.
 
 use crate::design::conic::{Cone, ConicData, ConicSettings, ConicSolver, solve_reusing_with};
@@ -142,6 +143,19 @@ pub struct ScpSettings {
     /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
     /// model more curved and the steps shorter. It grows tenfold when needed.
     pub weight: f64,
+    /// For a linear cost (least time): iterations over which a violation
+    /// that fell by less than a fifth while the cost moved by less than 1 %
+    /// raises the penalty tenfold, at most twice (default 5; 0: never).
+    /// The cost has no curvature, so near the optimum it barely moves while
+    /// a weight below the constraints' multipliers settles on an infeasible
+    /// minimum of the merit: the robot's least-time designs crawled 40
+    /// iterations at a violation of 2e-4 before the criticality rule
+    /// raised the weight. Over `examples/convergence_matrix` the twelve
+    /// least-time designs took 469 iterations instead of 546, and the
+    /// robot's least drop height fell from 3.560 to 3.531 m; on peak and
+    /// energy costs the rule cost iterations (energy 25 to 35), so they
+    /// keep the criticality rule alone.
+    pub stagnation: usize,
 }
 
 impl Default for ScpSettings {
@@ -153,6 +167,7 @@ impl Default for ScpSettings {
             initial_radius: 0.5,
             window: 10,
             weight: 2.0,
+            stagnation: 5,
         }
     }
 }
@@ -821,6 +836,7 @@ pub fn solve_warm(
     let mut rule = StopRule::None;
     let mut failures = 0;
     let mut nearly = 0;
+    let mut stagnant: Vec<(f64, f64)> = Vec::new();
     // the merit at z for the weight w, kept across iterations
     let mut here = merit(p, &z, w);
     let mut last_rejected = false;
@@ -870,6 +886,25 @@ pub fn solve_warm(
         last_rejected = !rec.accepted;
         let (phi_now, _, inf_now) = here;
         window.push(phi_now);
+        // (violation, cost) after each iteration at this weight
+        stagnant.push((inf_now, here.1));
+        let k = settings.stagnation;
+        if k > 0
+            && matches!(p.cost(), Cost::Linear(_))
+            && stagnant.len() > k
+            && inf_now > settings.feasibility
+            && w < 50.0 * settings.weight * scale
+        {
+            let (inf_then, cost_then) = stagnant[stagnant.len() - 1 - k];
+            if inf_now > 0.8 * inf_then && (here.1 - cost_then).abs() < 1e-2 * here.1.abs() {
+                w *= 10.0;
+                here = merit(p, &z, w);
+                window.clear();
+                stagnant.clear();
+                nearly = 0;
+                continue;
+            }
+        }
         let critical = rec.criticality() <= settings.tolerance;
         // the merit fell by less than `tolerance` (relative) per iteration,
         // on average over the window
@@ -894,6 +929,7 @@ pub fn solve_warm(
                 w *= 10.0;
                 here = merit(p, &z, w);
                 window.clear();
+                stagnant.clear();
                 nearly = 0;
                 if w > 1e6 * settings.weight * scale {
                     status = ScpStatus::Infeasible;
@@ -1005,6 +1041,67 @@ mod tests {
         fn scales(&self) -> Vec<f64> {
             vec![1.0, 1.0]
         }
+    }
+
+    /// Least "time" on a circle: maximise `z0` with `z0^2 + z1^2 = 1`
+    /// (optimum `z0 = 1`, multiplier 1/2), a linear cost.
+    struct Circle;
+
+    impl ScpProblem for Circle {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn term_dim(&self) -> usize {
+            1
+        }
+        fn norm(&self) -> TorqueNorm {
+            TorqueNorm::Euclidean
+        }
+        fn cost(&self) -> Cost {
+            Cost::Linear(vec![(0, -1.0)])
+        }
+        fn evaluate(&self, z: &[f64]) -> Values {
+            Values {
+                residual: vec![z[0] * z[0] + z[1] * z[1] - 1.0],
+                ..Default::default()
+            }
+        }
+        fn linearize(&self, z: &[f64]) -> Linearization {
+            Linearization {
+                residual: self.evaluate(z).residual,
+                residual_jac: vec![(0, 0, 2.0 * z[0]), (0, 1, 2.0 * z[1])],
+                ..Default::default()
+            }
+        }
+        fn add_constraints(&self, _: &mut ConicData, _: &[f64], _: &dyn Fn(usize) -> usize) {}
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0, 1.0]
+        }
+    }
+
+    #[test]
+    fn a_penalty_below_the_multiplier_is_raised_when_a_linear_costs_violation_stagnates() {
+        // weight 0.1 x |cost| = 0.06 < 1/2: the merit -z0 + w |z0^2 + z1^2 - 1|
+        // is least at z0 = 1 / (2 w), far outside the circle
+        let solve_with = |stagnation| {
+            let settings = ScpSettings {
+                weight: 0.1,
+                stagnation,
+                ..Default::default()
+            };
+            solve(&Circle, vec![0.6, 0.8], &settings, |_| {}).unwrap()
+        };
+        let (with, without) = (solve_with(5), solve_with(0));
+        for r in [&with, &without] {
+            assert_eq!(r.status, ScpStatus::Converged);
+            assert!((r.z[0] - 1.0).abs() < 1e-5, "{:?}", r.z);
+        }
+        assert!(
+            with.iterations.len() < without.iterations.len(),
+            "{} vs {} iterations",
+            with.iterations.len(),
+            without.iterations.len()
+        );
     }
 
     #[test]
