@@ -398,9 +398,9 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         let a = match a {
             // the free-form time design from the phased schedule and from
             // the analytic one (a local method: each seed can end in another
-            // optimum; on the robot 0.770 s and 0.748 s), the shortest that
+            // optimum; on the robot 0.776 s and 0.750 s), the shortest that
             // verifies (see `verified`), when shorter than the phased one;
-            // the two run at once (on the robot's run, 14 s -> 10 s)
+            // the two run at once (the robot's run: 12.4-13.7 s -> 8.5-9.5 s)
             Ok(Some(mut a)) => {
                 phased_short = (!a.possible).then_some(a.least_height_m);
                 let mut timed = cfg.clone();

@@ -379,7 +379,7 @@ pub fn optimize_near(
     finish(cfg, design, evals, solve_time)
 }
 
-/// Path points per phase of the free-form design's phased seed: the free-form
+/// Grid intervals per phase of the free-form design's phased seed: the free-form
 /// design resamples the plan on its own mesh and optimises every node, so
 /// the seed needs the shape of the schedule, not its certified peak. 20
 /// instead of 40 cut the seed's time by half on the seed config and 40 %
@@ -398,8 +398,10 @@ pub const SEED_BEND_TOL_DEG: f64 = 0.5;
 /// Nor does it check `limits.max_torque` ([`check_limit`]): a seed above the
 /// limit still starts a free-form design, which meets the limit or reports
 /// the least height itself. It is a start, not a certificate: at most
-/// [`SEED_NODES`] path points per phase, the bend to [`SEED_BEND_TOL_DEG`],
-/// and the search's accuracy.
+/// [`SEED_NODES`] grid intervals per phase, the bend to
+/// [`SEED_BEND_TOL_DEG`], and the search's accuracy (a config with a motor
+/// envelope gets the whole envelope design, whose torque-speed line needs
+/// its own iteration).
 pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
     if cfg.uses_envelope() {
         return Ok(crate::design::envelope::optimize(cfg, |_| {})?.plan);
