@@ -423,10 +423,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                         cfg.free.nodes,
                         |it| progress(Progress::Scp(it)),
                     );
-                    (
-                        phased,
-                        analytic.join().expect("the free-form thread panicked"),
-                    )
+                    let analytic = analytic
+                        .join()
+                        .unwrap_or_else(|e| std::panic::resume_unwind(e));
+                    (phased, analytic)
                 });
                 for fr in [from_phased, from_analytic].into_iter().flatten() {
                     if verified(cfg, &fr)

@@ -355,15 +355,16 @@ impl FreeProblem {
             .collect()
     }
 
-    /// The variables a point's gradient refers to: the interval's eight
+    /// The variables a torque on interval `k` of phase `p` depends on (a
+    /// point's gradient, an interval's Hessian block): the interval's eight
     /// node values (component 0 then 1) and the phase duration.
-    fn point_columns(&self, pt: &TorquePoint) -> [usize; 9] {
+    fn interval_columns(&self, p: usize, k: usize) -> [usize; 9] {
         let mut cols = [0usize; 9];
         for l in 0..2 {
-            let ic = self.tr.interval_columns(pt.phase, pt.interval, l);
+            let ic = self.tr.interval_columns(p, k, l);
             cols[4 * l..4 * l + 4].copy_from_slice(&ic);
         }
-        cols[8] = self.tr.duration(pt.phase);
+        cols[8] = self.tr.duration(p);
         cols
     }
 
@@ -588,12 +589,7 @@ impl FreeProblem {
             } else {
                 psd_part(b)
             };
-            let mut cols = [0usize; 9];
-            for l in 0..2 {
-                let ic = tr.interval_columns(p, k, l);
-                cols[4 * l..4 * l + 4].copy_from_slice(&ic);
-            }
-            cols[8] = tr.duration(p);
+            let cols = self.interval_columns(p, k);
             for i in 0..9 {
                 for j in 0..9 {
                     if cols[i] <= cols[j] {
@@ -694,7 +690,7 @@ impl ScpProblem for FreeProblem {
         let flatten = |rows: &[TorqueRow]| {
             let mut jac: Triplets = Vec::with_capacity(9 * rows.len());
             for (r, row) in rows.iter().enumerate() {
-                let cols = self.point_columns(&pts[r / 2]);
+                let cols = self.interval_columns(pts[r / 2].phase, pts[r / 2].interval);
                 jac.extend(cols.iter().zip(&row.grad).map(|(&c, &g)| (r, c, g)));
             }
             (rows.iter().map(|t| t.value).collect::<Vec<_>>(), jac)

@@ -645,6 +645,11 @@ fn correction(
     d
 }
 
+/// Largest scaled component `|d_i| / scale_i` of a step.
+fn scaled_max(d: impl Iterator<Item = f64>, scales: &[f64]) -> f64 {
+    d.zip(scales).fold(0.0, |m, (d, s)| m.max(d.abs() / s))
+}
+
 /// Fixed-pattern Clarabel solvers reused across iterations.
 #[derive(Default)]
 struct Solvers {
@@ -704,10 +709,7 @@ fn iterate(
     // model value: the cost's constant plus the solver's objective
     // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
     let predicted = phi - (constant + obj);
-    let model_step = x[..n]
-        .iter()
-        .zip(scales)
-        .fold(0.0f64, |m, (d, s)| m.max(d.abs() / s));
+    let model_step = scaled_max(x[..n].iter().copied(), scales);
     let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
     let at = evaluate(p, &trial);
     let mut there = merit_of(p, &trial, &at, w);
@@ -747,11 +749,7 @@ fn iterate(
             }
         }
     }
-    let step = trial
-        .iter()
-        .zip(z)
-        .zip(scales)
-        .fold(0.0f64, |m, ((a, b), s)| m.max((a - b).abs() / s));
+    let step = scaled_max(trial.iter().zip(z).map(|(a, b)| a - b), scales);
     let actual = phi - there.0;
     let rho = if predicted > 0.0 {
         actual / predicted
@@ -906,13 +904,6 @@ pub fn solve_warm(
                 let (inf_then, cost_then) = stagnant[stagnant.len() - 1 - k];
                 inf_now > 0.8 * inf_then && (here.1 - cost_then).abs() < 1e-2 * here.1.abs()
             };
-        if stagnates {
-            w *= 10.0;
-            here = merit(p, &z, w);
-            window.clear();
-            stagnant.clear();
-            nearly = 0;
-        }
         let critical = !stagnates && rec.criticality() <= settings.tolerance;
         // the merit fell by less than `tolerance` (relative) per iteration,
         // on average over the window
@@ -920,6 +911,7 @@ pub fn solve_warm(
             && window.len() > settings.window
             && window[window.len() - 1 - settings.window] - phi_now
                 <= settings.tolerance * settings.window as f64 * phi_now.abs();
+        let mut raise = stagnates;
         if critical || slow {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
@@ -934,19 +926,20 @@ pub fn solve_warm(
             // small violation at this weight (raising it would only shrink
             // the steps); stuck infeasible otherwise: the penalty is too weak
             nearly += 1;
-            if inf_now > 100.0 * settings.feasibility || nearly > 3 {
-                w *= 10.0;
-                here = merit(p, &z, w);
-                window.clear();
-                stagnant.clear();
-                nearly = 0;
-                if w > 1e6 * settings.weight * scale {
-                    status = ScpStatus::Infeasible;
-                    break;
-                }
-            }
+            raise = inf_now > 100.0 * settings.feasibility || nearly > 3;
         } else {
             nearly = 0;
+        }
+        if raise {
+            w *= 10.0;
+            here = merit(p, &z, w);
+            window.clear();
+            stagnant.clear();
+            nearly = 0;
+            if w > 1e6 * settings.weight * scale {
+                status = ScpStatus::Infeasible;
+                break;
+            }
         }
         if radius < 1e-10 {
             status = ScpStatus::Stalled;
@@ -1014,13 +1007,14 @@ mod tests {
         );
     }
 
-    /// Two unknowns, two residuals: `r0 = z0` (well conditioned) and
-    /// `r1 = g z1` with a vanishing gain `g` (the tilt at a design).
-    struct Degenerate {
-        gain: f64,
+    /// A two-unknown problem with a linear cost and residuals `r(z)` with
+    /// their Jacobian, for the driver's and the correction's tests.
+    struct Toy {
+        cost: Vec<(usize, f64)>,
+        r: fn(&[f64]) -> (Vec<f64>, Triplets),
     }
 
-    impl ScpProblem for Degenerate {
+    impl ScpProblem for Toy {
         fn dim(&self) -> usize {
             2
         }
@@ -1031,60 +1025,52 @@ mod tests {
             TorqueNorm::Euclidean
         }
         fn cost(&self) -> Cost {
-            Cost::Linear(Vec::new())
+            Cost::Linear(self.cost.clone())
         }
         fn evaluate(&self, z: &[f64]) -> Values {
             Values {
-                residual: vec![z[0], self.gain * z[1]],
+                residual: (self.r)(z).0,
                 ..Default::default()
             }
         }
         fn linearize(&self, z: &[f64]) -> Linearization {
+            let (residual, residual_jac) = (self.r)(z);
             Linearization {
-                residual: self.evaluate(z).residual,
-                residual_jac: vec![(0, 0, 1.0), (1, 1, self.gain)],
+                residual,
+                residual_jac,
                 ..Default::default()
             }
         }
         fn add_constraints(&self, _: &mut ConicData, _: &[f64], _: &dyn Fn(usize) -> usize) {}
         fn scales(&self) -> Vec<f64> {
             vec![1.0, 1.0]
+        }
+    }
+
+    /// Two residuals: `r0 = z0` (well conditioned) and `r1 = g z1` with a
+    /// vanishing gain `g` (the tilt at a design: 1e-7), or a unit one.
+    fn degenerate(tiny_gain: bool) -> Toy {
+        Toy {
+            cost: Vec::new(),
+            r: if tiny_gain {
+                |z| (vec![z[0], 1e-7 * z[1]], vec![(0, 0, 1.0), (1, 1, 1e-7)])
+            } else {
+                |z| (vec![z[0], z[1]], vec![(0, 0, 1.0), (1, 1, 1.0)])
+            },
         }
     }
 
     /// Least "time" on a circle: maximise `z0` with `z0^2 + z1^2 = 1`
     /// (optimum `z0 = 1`, multiplier 1/2), a linear cost.
-    struct Circle;
-
-    impl ScpProblem for Circle {
-        fn dim(&self) -> usize {
-            2
-        }
-        fn term_dim(&self) -> usize {
-            1
-        }
-        fn norm(&self) -> TorqueNorm {
-            TorqueNorm::Euclidean
-        }
-        fn cost(&self) -> Cost {
-            Cost::Linear(vec![(0, -1.0)])
-        }
-        fn evaluate(&self, z: &[f64]) -> Values {
-            Values {
-                residual: vec![z[0] * z[0] + z[1] * z[1] - 1.0],
-                ..Default::default()
-            }
-        }
-        fn linearize(&self, z: &[f64]) -> Linearization {
-            Linearization {
-                residual: self.evaluate(z).residual,
-                residual_jac: vec![(0, 0, 2.0 * z[0]), (0, 1, 2.0 * z[1])],
-                ..Default::default()
-            }
-        }
-        fn add_constraints(&self, _: &mut ConicData, _: &[f64], _: &dyn Fn(usize) -> usize) {}
-        fn scales(&self) -> Vec<f64> {
-            vec![1.0, 1.0]
+    fn circle() -> Toy {
+        Toy {
+            cost: vec![(0, -1.0)],
+            r: |z| {
+                (
+                    vec![z[0] * z[0] + z[1] * z[1] - 1.0],
+                    vec![(0, 0, 2.0 * z[0]), (0, 1, 2.0 * z[1])],
+                )
+            },
         }
     }
 
@@ -1098,7 +1084,7 @@ mod tests {
                 stagnation,
                 ..Default::default()
             };
-            solve(&Circle, vec![0.6, 0.8], &settings, |_| {}).unwrap()
+            solve(&circle(), vec![0.6, 0.8], &settings, |_| {}).unwrap()
         };
         let (with, without) = (solve_with(5), solve_with(0));
         for r in [&with, &without] {
@@ -1117,7 +1103,7 @@ mod tests {
     fn the_correction_removes_well_conditioned_residuals_and_leaves_degenerate_ones() {
         // the model's residual misses by 0.1 along r0 and by 1e-6 along r1:
         // a hard correction would move z1 by 1e-6 / gain = 10 (scaled)
-        let p = Degenerate { gain: 1e-7 };
+        let p = degenerate(true);
         let z = [0.0, 0.0];
         let lin = p.linearize(&z);
         let d = correction(&p, &z, &lin, &[0.1, 1e-6], &p.scales(), None);
@@ -1128,7 +1114,7 @@ mod tests {
         assert!((x[0] - 0.1).abs() < 1e-6, "r0 removed: dc0 = {}", x[0]);
         assert!(x[1].abs() < 1e-3, "r1 left alone: dc1 = {}", x[1]);
         // with a gain the weight can afford, r1 is removed too
-        let p = Degenerate { gain: 1.0 };
+        let p = degenerate(false);
         let d = correction(&p, &z, &p.linearize(&z), &[0.1, 0.2], &p.scales(), None);
         let (_, x, _) = ConicSolver::with_settings(&d, ConicSettings::MODEL)
             .unwrap()
