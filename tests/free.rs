@@ -18,6 +18,16 @@ fn cfg(name: &str, overrides: &[&str]) -> Config {
     Config::from_toml(&text, &p, &ov).unwrap()
 }
 
+/// The seed config with `norm`, and its free-form design seeded by the
+/// certified phased design, at the config's nodes.
+fn seed_from_certified_phased(norm: &str) -> (Config, catflip::design::free::FreeResult) {
+    let c = cfg("seed", &[&format!("limits.norm={norm}")]);
+    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+    let r = catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
+        .unwrap();
+    (c, r)
+}
+
 fn dense(trip: &[(usize, usize, f64)], rows: usize, cols: usize) -> Vec<Vec<f64>> {
     let mut d = vec![vec![0.0; cols]; rows];
     for &(r, c, v) in trip {
@@ -371,11 +381,7 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
 #[test]
 fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
     for norm in ["euclidean", "per-motor"] {
-        let c = cfg("seed", &[&format!("limits.norm={norm}")]);
-        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let certified =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
-                .unwrap();
+        let (c, certified) = seed_from_certified_phased(norm);
         let coarse =
             catflip::design::free::optimize(&c, catflip::design::free::Seed::Phased, |_| {})
                 .unwrap();
@@ -568,10 +574,7 @@ fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
 #[test]
 fn the_certificate_backs_the_status() {
     for norm in ["euclidean", "per-motor"] {
-        let c = cfg("seed", &[&format!("limits.norm={norm}")]);
-        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let r =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        let (c, r) = seed_from_certified_phased(norm);
         assert_eq!(
             r.status,
             catflip::design::scp::ScpStatus::Converged,
