@@ -539,7 +539,13 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                         it.infeasibility,
                         it.radius,
                         it.rho,
-                        if it.accepted { "ok" } else { "rej" },
+                        if it.accepted {
+                            "ok"
+                        } else if it.tentative {
+                            "try"
+                        } else {
+                            "rej"
+                        },
                         it.solve_ms
                     );
                 }

@@ -132,7 +132,7 @@ pub struct DesignConfig {
 pub struct LimitsConfig {
     /// N m, largest joint torque the motors can give (default: none).
     pub max_torque: Option<f64>,
-    /// Degrees, largest bend the optimisers may use (default: none; 175 in practice).
+    /// Degrees, largest bend the optimisers may use (default: none: the free-form design is then unbounded, while the phased design's bend search stops at 175).
     pub max_bend_deg: Option<f64>,
     /// Peak norm: `euclidean` or `per-motor` (default: euclidean for no-twist, per-motor for universal).
     pub norm: Option<TorqueNorm>,
@@ -580,7 +580,8 @@ impl Config {
         }
     }
 
-    /// Largest bend the optimisers may use, rad.
+    /// Largest bend the phased design may use (and the free-form design's
+    /// mesh must resolve), rad: the limit, or 175 deg without one.
     pub fn max_bend(&self) -> f64 {
         self.limits.max_bend_deg.unwrap_or(175.0).to_radians()
     }

@@ -1,6 +1,6 @@
 //! The report page in a real headless Chromium: it renders, its script runs
 //! without errors, and the animation advances. Ignored by default because it
-//! needs `chromium`; `.ci/run` installs it and runs `cargo test --release -- --ignored`.
+//! needs `chromium`; `.ci/run` installs it and runs `cargo test --release --test browser -- --ignored`.
 
 use std::path::Path;
 use std::process::Command;

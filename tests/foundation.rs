@@ -1,4 +1,4 @@
-//! Physics facts of MODEL.md section 4 checked on the library.
+//! Physics facts of docs/model.md section 6 checked on the library.
 
 use catflip::Config;
 use catflip::design::analytic::{analytic_plan, closed_forms, plan, turns_theta, yy_inertia_and_c};

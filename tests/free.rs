@@ -322,6 +322,31 @@ fn the_scp_machinery_finds_the_least_energy_move() {
 }
 
 #[test]
+fn an_unmoved_cat_is_half_a_turn_from_the_flip_and_a_hopeless_limit_fails() {
+    // the attitude residual of the straight, unmoving shape is the whole
+    // half turn (a log that returned zero at exactly pi once let the SCP
+    // "converge" on it when the torque limit made flipping costly)
+    let c = cfg("seed", &[]);
+    let nodes = 6;
+    let tr = Transcription::new(3, nodes);
+    let mut z = tr.sample(&analytic_plan(&c));
+    for p in 0..3 {
+        for k in 0..nodes {
+            z[tr.node(p, k)..tr.node(p, k) + Transcription::PER_NODE].fill(0.0);
+        }
+    }
+    let p = FreeProblem::new(&c, nodes, &z);
+    let r = p.evaluate(&z).residual;
+    let att = &r[r.len() - 3..];
+    let norm = att.iter().map(|x| x * x).sum::<f64>().sqrt();
+    assert!((norm - std::f64::consts::PI).abs() < 1e-12, "{att:?}");
+    // and a limit far below any flip's peak is a failure, not a design
+    let c = cfg("seed", &["limits.max_torque=0.01"]);
+    let e = catflip::design::free::optimize(&c, catflip::design::free::Seed::Phased, |_| {});
+    assert!(e.is_err(), "{:?}", e.map(|r| (r.status, r.flip_error_rad)));
+}
+
+#[test]
 fn accepted_scp_steps_never_increase_the_penalised_objective() {
     let c = cfg("seed", &[]);
     let mut seen = 0;
@@ -342,6 +367,55 @@ fn accepted_scp_steps_never_increase_the_penalised_objective() {
     .unwrap();
     assert!(seen > 5);
     assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
+}
+
+#[test]
+fn a_tentative_step_stands_only_if_the_next_lowers_the_merit_below_its_start() {
+    // the seed's per-motor design from the analytic seed takes tentative
+    // steps (the watchdog); check the driver's rule on its record
+    let c = cfg("seed", &["limits.norm=per-motor"]);
+    let plan = catflip::design::free::Seed::Analytic.plan(&c).unwrap();
+    let r =
+        catflip::design::free::optimize_from(&c, plan.as_ref(), "analytic", c.free.nodes, |_| {})
+            .unwrap();
+    assert_eq!(r.status, ScpStatus::Converged);
+    let it = &r.iterations;
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(1.0);
+    let mut tentative = 0;
+    let mut armed = true;
+    for (i, t) in it.iter().enumerate() {
+        if !t.tentative {
+            armed |= t.accepted;
+            continue;
+        }
+        tentative += 1;
+        assert!(
+            armed,
+            "iteration {i}: tentative again before an accepted step"
+        );
+        assert!(!t.accepted && t.rho < 0.1, "iteration {i}: {t:?}");
+        let Some(next) = it.get(i + 1) else { break };
+        // the next step starts at the tentative point
+        assert!(close(next.merit, t.merit - t.actual), "iteration {i}");
+        assert!(!next.tentative);
+        if next.accepted {
+            assert!(
+                next.merit_after <= t.merit - 0.1 * t.predicted,
+                "iteration {}: kept at {} against {} - 0.1 {}",
+                i + 1,
+                next.merit_after,
+                t.merit,
+                t.predicted
+            );
+        } else {
+            // undone: the anchor again, with a smaller radius, and disarmed
+            let again = &it[i + 2];
+            assert!(close(again.merit, t.merit), "iteration {}", i + 2);
+            assert!(again.radius < t.radius);
+            armed = false;
+        }
+    }
+    assert!(tentative > 0, "no tentative step to check");
 }
 
 #[test]

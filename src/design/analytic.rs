@@ -1,5 +1,5 @@
 //! The seed's closed forms and its cosine schedule, errata corrected
-//! (MODEL.md section 5), evaluated with the true dynamics elsewhere.
+//! (docs/model.md section 7), evaluated with the true dynamics elsewhere.
 
 use crate::config::Config;
 use crate::design::path::{Path, PhasedPlan, Timing};

@@ -7,7 +7,7 @@
 //! physical rates are `q_dot = q^ / T_p`, `q_ddot = q^^ / T_p^2`.
 //!
 //! Why normalised time: the defects become linear (exact constraints, no
-//! penalty), the attitude depends on the path only (MODEL.md F2) and so not on
+//! penalty), the attitude depends on the path only (docs/model.md F2) and so not on
 //! the durations, and the duration enters the torque only as `1 / T_p^2` (F3).
 //!
 //! Scheme: first-order-hold acceleration. `q^^` is linear on each interval of

@@ -3,15 +3,19 @@
 //!
 //! Decision variables: `q, dq/ds, d2q/ds2` at `N` nodes in each of the three
 //! phases (normalised time `s`) and the three phase durations
-//! ([`Transcription`], first-order-hold acceleration). Objective: peak joint
-//! torque at the nodes and interval midpoints, `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact
-//! inverse dynamics in normalised time (F3). Exact constraints: straight and
-//! at rest at both ends, continuity of `q` across phases, total time within the
-//! fall, optional bend limit. Penalised equalities (virtual control): the
-//! collocation defects (linear, so their model is exact and a seed that does
-//! not satisfy them is still a feasible start), continuity of the physical rate
-//! across phases (`q^_p / T_p = q^_{p+1} / T_{p+1}`) and the final-attitude
-//! error `log(Rz(pi)' R_A(T))` (flip and tilt together, on SO(3)).
+//! ([`Transcription`], first-order-hold acceleration). Objective
+//! (`design.objective`): the peak joint torque at the nodes and interval
+//! midpoints, `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact inverse
+//! dynamics in normalised time (F3); the manoeuvre time (sum of the
+//! durations); or the energy `integral |tau|^2 dt` (Simpson weights). Exact
+//! constraints (linear rows and cones of the subproblem): straight and at rest
+//! at both ends, continuity of `q` across phases, the collocation defects
+//! (linear), total time within the fall (not for `time`), each phase at least
+//! a minimum, and the optional speed and bend limits. Nonlinear limit: the
+//! torque (with the torque-speed line) at the check points. Penalised
+//! equalities (virtual control): continuity of the physical rate across
+//! phases (`q^_p / T_p = q^_{p+1} / T_{p+1}`) and the final-attitude error
+//! `log(Rz(pi)' R_A(T))` (flip and tilt together, on SO(3)).
 //!
 //! The attitude map integrates `dR_A/ds = R_A hat(w^)`, `w^ = -A(q) q^`, along
 //! the interpolant with the fourth-order Magnus method (two Gauss points, `S`
@@ -122,8 +126,8 @@ impl FreeProblem {
                     scales[tr.a(p, k) + j] = sa;
                 }
             }
-            // a tenth of the start's manoeuvre (in units of the available
-            // time): slowing the whole problem down scales every step alike
+            // DURATION_SCALE of the start's manoeuvre (in units of the
+            // available time): slowing the whole problem down scales every step alike
             scales[tr.duration(p)] = DURATION_SCALE * manoeuvre;
         }
         Self {
@@ -1022,8 +1026,7 @@ fn design(
 /// error, so while a written row is outside it the manoeuvre is slowed
 /// down (the same path, F2: torque falls as `1 / s^2`, speed as `1 / s`),
 /// when the fall leaves room (always for `time`), or else the problem is
-/// solved again with the limit tightened by the excess. Returns the solution
-/// and the smallest margin.
+/// solved again with the limit tightened by the excess.
 fn inside_envelope(
     cfg: &Config,
     mut solved: Solved,

@@ -61,8 +61,9 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
 }
 
 impl HeightAnswer {
-    /// Takes a verified free-form `time` design (`fr`: converged, inside
-    /// the envelope, flipping) when it is shorter than the answer's.
+    /// Takes a verified free-form `time` design (`fr`: inside the envelope
+    /// and flipping; `run` also passes designs that stopped at the
+    /// iteration limit) when it is shorter than the answer's.
     pub fn improve_with(&mut self, cfg: &Config, fr: &crate::design::free::FreeResult) {
         if fr.manoeuvre_time_s >= self.least_time_s {
             return;

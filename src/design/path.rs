@@ -1,4 +1,4 @@
-//! The seed's family of shape paths (MODEL.md F5): fold in a plane, twist at
+//! The seed's family of shape paths (docs/model.md F5): fold in a plane, twist at
 //! constant bend, unfold in a plane; and the rest-to-rest timings that run
 //! along them. A phased plan is three (path, timing, duration) triples.
 

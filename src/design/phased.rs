@@ -1,4 +1,4 @@
-//! The certified least-peak-torque fold / twist / unfold design (MODEL.md F5).
+//! The certified least-peak-torque fold / twist / unfold design (docs/model.md F5).
 //!
 //! For a bend `b` each phase is a rest-to-rest traversal of a fixed path, so
 //! its least peak in time `T_i` is `p_i(b) / T_i^2` (F3) with `p_i` from the

@@ -17,10 +17,13 @@
 //! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| / L - 1))`:
 //! `rho = (phi(z) - phi(z + dz)) / (phi(z) - L(dz))` with `L` the subproblem's
 //! model value. When `rho < 0.75` a second-order correction (one more conic
-//! solve, see [`correction`]) is tried and kept if it lowers `phi`. Accepted
-//! when `rho > 0.1` (so an accepted step never increases `phi`); the radius
-//! falls to half the model's step when `rho < 0.1` and doubles when
-//! `rho > 0.5`, except right after a rejected step.
+//! solve, or two when the bounded one fails, see [`correction`]) is tried
+//! and kept if it lowers `phi`. Accepted when `rho > 0.1` (so an accepted
+//! step never increases `phi`); the radius falls to half the model's step
+//! when `rho < 0.1` and doubles when `rho > 0.5`, except right after a
+//! rejected step. For a peak cost a step that would be rejected is first
+//! taken tentatively (the watchdog, [`ScpSettings::watchdog`]): the next
+//! step must then lower `phi` below the point before it, or both are undone.
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
@@ -160,6 +163,22 @@ pub struct ScpSettings {
     /// the rule cost iterations (energy 25 to 35), so they keep the
     /// criticality rule alone.
     pub stagnation: usize,
+    /// The watchdog (default on): a step the merit would reject is taken
+    /// once, tentatively, and the next step from there must bring the merit
+    /// below the point before it by a tenth of that point's predicted
+    /// decrease; otherwise both are undone and the radius is cut as for a
+    /// rejection. The merit's kinks (the peak's active set, the attitude's
+    /// curvature) reject steps that the next linearisation would complete.
+    /// Over `examples/bench_scp_suite` 309 SCP iterations instead of 375,
+    /// all converged, with 10 of the 16 peaks lower (the seed's per-motor
+    /// design from the analytic seed 0.32165 instead of 0.32553 N m, the
+    /// domestic cat's 1.5345 instead of 1.5624) and none more than 0.1 %
+    /// higher. Peak costs only: on the time and energy costs of
+    /// `examples/convergence_matrix` it cost iterations (energy 25 to 45,
+    /// the robot's least time 35 to 62). Re-armed only by an accepted step:
+    /// armed after every step, the robot's impossible 2 m peak design ran
+    /// to the iteration limit instead of failing with its least height.
+    pub watchdog: bool,
 }
 
 impl Default for ScpSettings {
@@ -172,6 +191,7 @@ impl Default for ScpSettings {
             window: 10,
             weight: 2.0,
             stagnation: 5,
+            watchdog: true,
         }
     }
 }
@@ -193,7 +213,11 @@ pub struct ScpIteration {
     pub actual: f64,
     pub rho: f64,
     pub accepted: bool,
-    /// Merit after the iteration (equal to `merit` when rejected).
+    /// A step the merit rejected, taken tentatively (the watchdog, see
+    /// [`ScpSettings::watchdog`]): the next iteration starts from its trial
+    /// point and is judged against this one's start.
+    pub tentative: bool,
+    /// Merit after the iteration (equal to `merit` when rejected or tentative).
     pub merit_after: f64,
     /// Largest scaled component of the trial step `|dz_i| / scale_i`.
     pub step: f64,
@@ -768,6 +792,7 @@ fn iterate(
         actual,
         rho,
         accepted,
+        tentative: false,
         merit_after: if accepted { there.0 } else { phi },
         step,
         model_step,
@@ -785,6 +810,16 @@ pub fn solve(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<ScpResult> {
     solve_warm(p, z0, None, settings, observe)
+}
+
+/// The point before a tentative step (the watchdog).
+struct Anchor {
+    z: Vec<f64>,
+    merit: Merit,
+    /// Its model's predicted decrease.
+    predicted: f64,
+    /// The radius had its step been rejected.
+    cut: f64,
 }
 
 /// Multipliers of the terms of a peak cost and of the limited terms (the
@@ -843,9 +878,12 @@ pub fn solve_warm(
     // the merit at z for the weight w, kept across iterations
     let mut here = merit(p, &z, w);
     let mut last_rejected = false;
+    // the watchdog's point before a tentative step (see ScpSettings::watchdog)
+    let mut anchor: Option<Anchor> = None;
+    let mut armed = true;
     for it in 0..settings.max_iterations {
         let step = iterate(p, &z, radius, w, it, &scales, &mut solvers, &mut mult, here);
-        let (rec, trial, there) = match step {
+        let (mut rec, trial, there) = match step {
             Ok(x) => {
                 failures = 0;
                 x
@@ -862,23 +900,60 @@ pub fn solve_warm(
             }
             Err(e) => return Err(e),
         };
+        // the radius after a rejection: half the model's step (a radius
+        // still above an interior step would only give the same step again;
+        // the seed's per-motor design from the phased seed rejected one step
+        // eight times, radius 8 down to 0.03); half the radius when the
+        // model predicted no decrease (its step says nothing), and at most
+        // a twentieth of it
+        let cut = |rec: &ScpIteration| {
+            rec.radius
+                * if rec.predicted > 0.0 {
+                    0.5 * (rec.model_step / rec.radius).clamp(0.1, 1.0)
+                } else {
+                    0.5
+                }
+        };
+        let mut undone = false;
+        if let Some(a) = anchor.take() {
+            // the step after a tentative one: judged against the anchor
+            rec.accepted = rec.predicted > 0.0 && a.merit.0 - there.0 >= 0.1 * a.predicted;
+            rec.merit_after = if rec.accepted { there.0 } else { rec.merit };
+            if !rec.accepted {
+                // both undone; the radius cut as for the anchor's rejection
+                (z, here, radius) = (a.z, a.merit, a.cut);
+                undone = true;
+                armed = false;
+            }
+        } else if settings.watchdog
+            && p.cost() == Cost::Peak
+            && armed
+            && rec.predicted > 0.0
+            && rec.rho < 0.1
+        {
+            rec.tentative = true;
+            observe(&rec);
+            iterations.push(rec);
+            anchor = Some(Anchor {
+                z: std::mem::replace(&mut z, trial),
+                merit: std::mem::replace(&mut here, there),
+                predicted: rec.predicted,
+                cut: cut(&rec),
+            });
+            continue;
+        }
         observe(&rec);
         iterations.push(rec);
         if rec.accepted {
             (z, here) = (trial, there);
+            armed = true;
+        }
+        if undone {
+            last_rejected = true;
+            continue;
         }
         if rec.rho < 0.1 {
-            // half the model's step: a radius still above an interior
-            // step would only give the same step again (the seed's
-            // per-motor design from the phased seed rejected one step
-            // eight times, radius 8 down to 0.03); half the radius when
-            // the model predicted no decrease (its step says nothing), and
-            // at most a twentieth of it
-            radius *= if rec.predicted > 0.0 {
-                0.5 * (rec.model_step / radius).clamp(0.1, 1.0)
-            } else {
-                0.5
-            };
+            radius = cut(&rec);
         } else if rec.rho > 0.5 && !last_rejected {
             // not right after a rejection: the radius that was just cut
             // would be doubled back to one that failed (the seed's
@@ -946,6 +1021,10 @@ pub fn solve_warm(
             break;
         }
     }
+    if let Some(a) = anchor {
+        // the iteration limit ended the run on a tentative step
+        (z, here) = (a.z, a.merit);
+    }
     let (_, objective, infeasibility) = here;
     let last = iterations.last().copied();
     let certificate = Certificate {
@@ -986,6 +1065,7 @@ mod tests {
             actual: predicted,
             rho: 1.0,
             accepted: true,
+            tentative: false,
             merit_after: 2.0 - predicted,
             step: radius,
             // at the radius when bounded, inside it when not

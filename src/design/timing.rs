@@ -1,6 +1,6 @@
 //! Least-peak-torque timing of one rest-to-rest phase along a fixed path:
 //! a second-order cone program in the path-timing variables (Verscheure et
-//! al., IEEE TAC 2009; MODEL.md F5), peak torque minimised under a unit time
+//! al., IEEE TAC 2009; docs/model.md F5), peak torque minimised under a unit time
 //! budget instead of time under a torque bound.
 //!
 //! Along `q(s)`, `s` in `[0, 1]`: `q_dot = q' s_dot`, `q_ddot = q' s_ddot + q'' s_dot^2`,

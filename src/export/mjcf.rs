@@ -107,7 +107,7 @@ pub fn mjcf(cfg: &Config) -> String {
         ),
     };
     format!(
-        r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);
+        r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in catflip's docs/model.md;
      SI units, angles in rad. Time step {dt:.9e} s = the manoeuvre time / an integer, the
      step of catflip's *.mujoco.csv controls (torque held over each step).{motor_note} -->
 <mujoco model="{name}">

@@ -3,7 +3,7 @@
 //! joint positions, velocities and actuator torques at the simulator's time
 //! step, so that a schedule replays unedited.
 //!
-//! Frames follow MODEL.md: the rear half A's frame sits at its centre of mass
+//! Frames follow docs/model.md: the rear half A's frame sits at its centre of mass
 //! with `z` towards the joint at `(0, 0, l/2)`; the front half B's centre of
 //! mass is `l/2` beyond the joint along its own `z`. `universal`: motor 1
 //! about A's `x`, then motor 2 about the rotated `y` (`R = Rx(q1) Ry(q2)`).

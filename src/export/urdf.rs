@@ -72,7 +72,7 @@ pub fn urdf(cfg: &Config) -> String {
         speed,
     );
     let mut s = format!(
-        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in the model (MODEL.md);\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}; with a torque-speed line, the most\n     it allows, when braking at the speed limit), velocity = its speed limit (else 1000).{note} -->\n<robot name=\"{name}\">\n",
+        "<?xml version=\"1.0\"?>\n<!-- catflip: {name} ({joint} joint). Masses and inertias as in catflip's docs/model.md;\n     SI units, angles in rad. pyBullet: load with flags=p.URDF_USE_INERTIA_FROM_FILE, or it\n     recomputes the inertias from the collision cylinders (wrong for this model); set the\n     links' linearDamping and angularDamping to 0 (pyBullet's default is 0.04).\n     Joint effort = the config's torque limit ({lim}; with a torque-speed line, the most\n     it allows, when braking at the speed limit), velocity = its speed limit (else 1000).{note} -->\n<robot name=\"{name}\">\n",
         name = cfg.name,
         joint = cfg.cat.joint.name(),
         lim = torque_limit(cfg)

@@ -1,5 +1,5 @@
 //! Shape dynamics of the reduced Lagrangian `T = 1/2 q_dot' M(q) q_dot`
-//! (MODEL.md section 3).
+//! (docs/model.md section 3).
 //!
 //! `tau_i = sum_j M_ij q_ddot_j + sum_jk c_ijk q_dot_j q_dot_k` with the
 //! Christoffel symbols of the first kind `c_ijk = dM_ij/dq_k - 1/2 dM_jk/dq_i`.

@@ -30,7 +30,7 @@ use nalgebra::{Const, U1};
 use num_dual::{Derivative, Dual2SVec64, DualSVec64};
 use serde::{Deserialize, Serialize};
 
-/// How the two halves are joined (MODEL.md section 2).
+/// How the two halves are joined (docs/model.md section 2).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Joint {
@@ -49,7 +49,7 @@ impl Joint {
     }
 }
 
-/// Which norm of the joint torque vector is the "peak" (MODEL.md section 3).
+/// Which norm of the joint torque vector is the "peak" (docs/model.md section 4).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TorqueNorm {

@@ -98,7 +98,12 @@ pub fn exp(v: &Vector3<f64>) -> Matrix3<f64> {
     *Rotation3::new(*v).matrix()
 }
 
-/// Rotation vector of `r`, accurate near the identity (atan2 of sine and cosine parts).
+/// Rotation vector of `r`: the angle from atan2 of the sine and cosine
+/// parts (accurate near the identity); near a half turn, where the sine part
+/// vanishes, the axis comes from the symmetric part `(r + r')/2 - c I =
+/// (1 - c) a a'` and only its sign from the sine part. (nalgebra's
+/// `scaled_axis` returns zero at exactly pi: the unmoved cat measured as a
+/// perfect flip, and an SCP that "converged" on it without moving.)
 pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
     let v = 0.5
         * Vector3::new(
@@ -107,13 +112,22 @@ pub fn log(r: &Matrix3<f64>) -> Vector3<f64> {
             r[(1, 0)] - r[(0, 1)],
         );
     let (s, c) = (v.norm(), 0.5 * (r.trace() - 1.0));
+    let theta = s.atan2(c);
     if c < -0.9 {
-        return Rotation3::from_matrix_unchecked(*r).scaled_axis();
+        let b = 0.5 * (r + r.transpose()) - c * Matrix3::identity();
+        let k = (0..3)
+            .max_by(|&i, &j| b[(i, i)].total_cmp(&b[(j, j)]))
+            .expect("three columns");
+        let mut a: Vector3<f64> = b.column(k) / (b[(k, k)] * (1.0 - c)).sqrt();
+        if a.dot(&v) < 0.0 {
+            a = -a;
+        }
+        return a * theta;
     }
     if s < 1e-300 {
         return v;
     }
-    v * (s.atan2(c) / s)
+    v * (theta / s)
 }
 
 /// Right Jacobian of SO(3): `exp(v + dv) = exp(v) exp(J_r(v) dv)` to first order.
@@ -139,6 +153,7 @@ pub fn right_jacobian_inv(v: &Vector3<f64>) -> Matrix3<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::PI;
 
     #[test]
     fn flip_and_tilt_of_known_rotations() {
@@ -182,6 +197,24 @@ mod tests {
             ));
         }
         assert!((tr.flip() + last).abs() < 1e-9);
+    }
+
+    #[test]
+    fn log_inverts_exp_up_to_and_at_a_half_turn() {
+        let axis = Vector3::new(0.3, -0.8, 0.52).normalize();
+        for angle in [0.0, 1e-9, 0.7, 2.0, 2.9, PI - 1e-3, PI - 1e-9] {
+            let v = axis * angle;
+            let back = log(&exp(&v));
+            assert!((back - v).norm() < 1e-9, "{angle}: {back:?} vs {v:?}");
+        }
+        // exactly a half turn: the axis up to its sign, the angle pi
+        for a in [Vector3::z(), axis] {
+            let back = log(&exp(&(a * PI)));
+            assert!((back.norm() - PI).abs() < 1e-12, "{back:?}");
+            assert!(back.normalize().cross(&a).norm() < 1e-7, "{back:?}");
+        }
+        let half = Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0));
+        assert!((log(&half).norm() - PI).abs() < 1e-15);
     }
 
     #[test]

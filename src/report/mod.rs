@@ -620,14 +620,19 @@ pub fn convergence(
             .collect();
         line(&mut c, &pts, st, 0.0)?;
         let rejected = style(2);
-        c.draw_series(iters.iter().filter(|i| !i.accepted).map(|i| {
-            marker(
-                (i.iteration as f64, i.objective),
-                Marker::Cross,
-                rejected.color,
+        let tentative = style(3);
+        for (keep, shape, st) in [
+            (false, Marker::Cross, rejected),
+            (true, Marker::Circle, tentative),
+        ] {
+            c.draw_series(
+                iters
+                    .iter()
+                    .filter(|i| !i.accepted && i.tentative == keep)
+                    .map(|i| marker((i.iteration as f64, i.objective), shape, st.color)),
             )
-        }))
-        .map_err(perr)?;
+            .map_err(perr)?;
+        }
         legend(
             &side,
             &[
@@ -637,6 +642,13 @@ pub fn convergence(
                     Key::Mark(Style {
                         marker: Marker::Cross,
                         ..rejected
+                    }),
+                ),
+                (
+                    "tentative step (watchdog)".into(),
+                    Key::Mark(Style {
+                        marker: Marker::Circle,
+                        ..tentative
                     }),
                 ),
             ],
