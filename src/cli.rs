@@ -9,6 +9,22 @@ use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
+/// `println!` that ends the program quietly when stdout is a closed pipe
+/// (`catflip ... --json | head`), as ripgrep does, instead of panicking;
+/// the files were already written.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
+            if e.kind() == std::io::ErrorKind::BrokenPipe {
+                std::process::exit(0);
+            }
+            eprintln!("error: writing to stdout: {e}");
+            std::process::exit(1);
+        }
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "catflip",
@@ -180,7 +196,7 @@ pub fn run() -> Result<Status> {
 }
 
 fn row(label: &str, value: String) {
-    println!("  {label:<34} {value}");
+    say!("  {label:<34} {value}");
 }
 
 fn cmd_analyze(c: &Common) -> Result<Status> {
@@ -206,11 +222,11 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     // the analysis is what was asked: a miss is flagged in it, not a partial result
     flag("the seed's schedule", reason);
     if c.json {
-        println!("{json}");
+        say!("{json}");
         return Ok(Status::Ok);
     }
     let cf = &a.closed;
-    println!("catflip analyze: {} ({} joint)", a.name, a.joint);
+    say!("catflip analyze: {} ({} joint)", a.name, a.joint);
     row(
         "fall time",
         format!(
@@ -274,7 +290,7 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
 }
 
 fn print_sim(title: &str, r: &SimReport) {
-    println!("{title}");
+    say!("{title}");
     row(
         "flip",
         format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
@@ -359,12 +375,17 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
         if let Some(r) = reason {
             v["reason"] = r.into();
         }
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         print_sim(
             &format!(
-                "catflip simulate: {} ({source}, dynamic, feed-forward + PD)",
-                cfg.name
+                "catflip simulate: {} ({source}, dynamic, {})",
+                cfg.name,
+                if cfg.simulate.pd {
+                    "feed-forward + PD"
+                } else {
+                    "feed-forward only"
+                }
             ),
             &report,
         );
@@ -397,7 +418,7 @@ fn write_design(
     out.add(format!("{stem}.json"), json.clone());
     let written = publisher.publish(out)?;
     if c.json {
-        println!("{json}");
+        say!("{json}");
         return Ok(None);
     }
     Ok(Some(written))
@@ -478,7 +499,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             else {
                 return Ok(status_of(partial));
             };
-            println!(
+            say!(
                 "catflip optimize --mode phased: {} ({} joint), status {}",
                 cfg.name,
                 cfg.cat.joint.name(),
@@ -569,7 +590,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
             else {
                 return Ok(status_of(partial));
             };
-            println!(
+            say!(
                 "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
                 cfg.name,
                 cfg.cat.joint.name(),
@@ -701,12 +722,12 @@ fn cmd_run(c: &Common) -> Result<Status> {
     };
     let written = publisher.publish(r.output)?;
     if c.json {
-        println!("{}", serde_json::to_string_pretty(&r.summary)?);
+        say!("{}", serde_json::to_string_pretty(&r.summary)?);
         return Ok(status);
     }
     let s = &r.summary;
-    println!();
-    println!(
+    say!();
+    say!(
         "catflip run: {} ({} joint, peak norm {})",
         s.name,
         s.joint,
@@ -733,14 +754,14 @@ fn cmd_run(c: &Common) -> Result<Status> {
                 None => c.to_string(),
             })
             .collect();
-        println!("  {}", parts.join("  "));
+        say!("  {}", parts.join("  "));
     };
     line(header.iter().map(|h| h.to_string()).collect());
     for row in rows {
         line(row);
     }
     let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
-    println!(
+    say!(
         "  free-form / phased peak {}, phased / analytic {}; {} SCP iterations at {} nodes per phase",
         show(s.free_over_phased),
         show(s.phased_over_analytic),
@@ -748,9 +769,9 @@ fn cmd_run(c: &Common) -> Result<Status> {
         s.nodes
     );
     if let Some(a) = &s.answer {
-        println!("  {}", a.sentence());
+        say!("  {}", a.sentence());
     }
-    println!(
+    say!(
         "  report: {} ({} files)",
         dir.join("index.html").display(),
         written.len()
@@ -821,6 +842,17 @@ fn cmd_sweep(
         })
         .collect();
     let key = format!("{key}{}", shard.suffix());
+    if shard.points(spec.count).is_empty() {
+        // a job array wider than the grid: legitimate, but worth a word
+        eprintln!(
+            "warning: shard {}/{} holds no points: shards take whole continuation chunks of {} points, and the {} points make {}; use at most that many shards",
+            shard.index,
+            shard.count,
+            catflip::sweep::CHUNK,
+            spec.count,
+            spec.count.div_ceil(catflip::sweep::CHUNK)
+        );
+    }
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     // a live bar on a terminal, plain lines otherwise
     let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -870,23 +902,27 @@ fn cmd_sweep(
         );
     }
     if c.json {
-        println!("{}", serde_json::to_string_pretty(&points)?);
+        say!("{}", serde_json::to_string_pretty(&points)?);
         return Ok(status_of(partial));
     }
-    println!(
+    say!(
         "catflip sweep: {} over {} ({} points, {threads} at a time)",
         cfg.name,
         spec.key,
         points.len()
     );
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
-    println!(
+    say!(
         "  {:>12} {:>12} {:>12} {:>12} {:>12}",
-        spec.key, "analytic N m", "phased N m", "free N m", "least h (m)"
+        spec.key,
+        "analytic N m",
+        "phased N m",
+        "free N m",
+        "least h (m)"
     );
     for p in &points {
         let h = p.least_height_free_m.or(p.least_height_phased_m);
-        println!(
+        say!(
             "  {:>12.5} {:>12} {:>12} {:>12} {:>12}{}",
             p.value,
             show(p.analytic_peak_nm),
@@ -947,7 +983,7 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
         );
     }
     for w in publisher.publish(out)? {
-        println!("wrote {}", w.display());
+        say!("wrote {}", w.display());
     }
     Ok(Status::Ok)
 }

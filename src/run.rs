@@ -671,7 +671,17 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             summary.nodes
         ),
     );
-    notes.insert(1, "Flip and tilt come from the dynamic forward simulation of each schedule (feed-forward torque plus PD tracking, torque clipped to the motor envelope).".into());
+    notes.insert(
+        1,
+        format!(
+            "Flip and tilt come from the dynamic forward simulation of each schedule ({}, torque clipped to the motor envelope).",
+            if cfg.simulate.pd {
+                "feed-forward torque plus PD tracking"
+            } else {
+                "feed-forward torque only, simulate.pd = false"
+            }
+        ),
+    );
     if let Some(a) = &summary.answer {
         notes.insert(0, a.sentence());
     }

@@ -94,6 +94,32 @@ fn simulate_replays_a_written_schedule() {
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert!(v["flip_error_rad"].as_f64().unwrap().abs() < 1e-6, "{out}");
     assert!(v["momentum_drift_nms"].as_f64().unwrap() < 1e-12);
+    // from another height it is refused, with the height that fits it
+    let replay = |height: &str| {
+        let set = format!("fall.height={height}");
+        run(
+            &[
+                "simulate",
+                cfg.to_str().unwrap(),
+                "--set",
+                &set,
+                "--schedule",
+                sched.to_str().unwrap(),
+            ],
+            dir.path(),
+        )
+    };
+    let o = replay("7.5");
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    let fits = err
+        .split("--set fall.height=")
+        .nth(1)
+        .and_then(|s| s.split('`').next())
+        .unwrap_or_else(|| panic!("no height in: {err}"));
+    let h: f64 = fits.parse().unwrap();
+    assert!((h - 10.0).abs() < 1e-6, "{err}");
+    assert!(replay(fits).status.success());
 }
 
 #[test]
@@ -293,5 +319,40 @@ fn optimize_free_reports_iterations_and_nodes() {
         dir.path()
             .join("output/seed/optimize-free/free.csv")
             .exists()
+    );
+}
+
+#[test]
+fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
+    // `catflip simulate ... | head`: the reader is gone before catflip prints
+    let dir = tempfile::tempdir().unwrap();
+    let mut child = bin()
+        .args(["simulate"])
+        .arg(configs().join("seed.toml"))
+        .args(["--set", "simulate.pd=false", "--out"])
+        .arg(dir.path())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let o = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{:?}: {err}", o.status);
+    assert!(!err.contains("panicked"), "{err}");
+    // with the pipe open, the table says what was simulated
+    let o = run(
+        &[
+            "simulate",
+            configs().join("seed.toml").to_str().unwrap(),
+            "--set",
+            "simulate.pd=false",
+        ],
+        dir.path(),
+    );
+    let (out, _) = text(&o);
+    assert!(
+        out.lines().next().unwrap().contains("feed-forward only"),
+        "{out}"
     );
 }

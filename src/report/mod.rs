@@ -795,6 +795,8 @@ pub fn index_html(
         "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}",
         "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right;white-space:nowrap}",
         "th{background:#eee}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}",
+        // the verdict (a sentence when flagged) wraps inside the page width
+        "td:last-child,th:last-child{white-space:normal;text-align:left;min-width:12em}",
         ".warn{border-left:4px solid #b00;padding:2px 8px;background:#fee}",
         "#views{display:flex;flex-wrap:wrap;gap:12px}.view h3{margin:4px 0}",
         ".view canvas{border:1px solid #bbb;cursor:grab;touch-action:none}",
