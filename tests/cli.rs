@@ -356,3 +356,31 @@ fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
         "{out}"
     );
 }
+
+#[test]
+fn a_phased_seed_that_cannot_fit_is_not_reported_as_the_least_height() {
+    // from 4 m the robot's phased family needs 5.66 m, while `run` flips it
+    // from about 3.5 m with a free-form design: the phased seed's height is
+    // no answer for the free-form design
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("robot-universal.toml");
+    let o = run(
+        &[
+            "optimize",
+            cfg.to_str().unwrap(),
+            "--mode",
+            "free",
+            "--set",
+            "fall.height=4",
+        ],
+        dir.path(),
+    );
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(!err.contains("flip is impossible"), "{err}");
+    assert!(
+        err.contains("phased seed") && err.contains("--seed analytic"),
+        "{err}"
+    );
+    assert!(!dir.path().join("output").exists());
+}

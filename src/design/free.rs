@@ -1337,7 +1337,14 @@ pub fn optimize(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     check_resolvable(cfg, cfg.free.nodes)?;
-    let plan = seed.plan(cfg)?;
+    let plan = match seed.plan(cfg) {
+        // the phased family's least height is not the free-form design's:
+        // say so rather than pass it on as the answer
+        Err(crate::error::Error::Unreachable { reason }) => {
+            return Err(crate::error::Error::SeedUnfit { reason });
+        }
+        r => r?,
+    };
     let mut r = optimize_from(cfg, plan.as_ref(), seed.name(), cfg.free.nodes, observe)?;
     r.mesh_check = Some(mesh_check(cfg, &r)?);
     Ok(r)
