@@ -630,8 +630,9 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<
                 row(
                     "mesh check (N vs 2N)",
                     format!(
-                        "{:.5} N m at {} nodes per phase ({:+.2} %), {:?}",
-                        m.peak_torque_nm,
+                        "{:.5} {} at {} nodes per phase ({:+.2} %), {:?}",
+                        m.objective_value,
+                        r.objective.unit(),
                         m.nodes,
                         100.0 * m.relative_change,
                         m.status

@@ -308,7 +308,7 @@ fn point(
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m =
                         limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
-                    p.free_status = Some(format!("{:?}", fr.status));
+                    p.free_status = Some(crate::run::json_name(&fr.status));
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),

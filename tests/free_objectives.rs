@@ -31,10 +31,11 @@ fn free_time_with_a_torque_limit_alone_is_f7() {
     let peak = free(&open);
     let t_fall = open.available_time();
     let t_f7 = t_fall * (peak.peak_torque_nm / tau_max).sqrt();
-    let timed = free(&seed(&[
+    let timed_cfg = seed(&[
         "design.objective=time",
         &format!("limits.max_torque={tau_max}"),
-    ]));
+    ]);
+    let timed = free(&timed_cfg);
     let rel = (timed.manoeuvre_time_s - t_f7) / t_f7;
     assert!(
         rel.abs() < 5e-3,
@@ -47,6 +48,15 @@ fn free_time_with_a_torque_limit_alone_is_f7() {
     );
     assert!((h - h_f7).abs() < 1e-2 * h_f7, "{h} vs {h_f7}");
     assert!(timed.peak_torque_nm <= tau_max * (1.0 + 1e-6));
+    // the mesh check compares the objective, here the time (the peak sits
+    // at the limit, 1 N m, about 10 % from this time in s)
+    let m = catflip::design::free::mesh_check(&timed_cfg, &timed).unwrap();
+    assert!(
+        (m.objective_value - timed.manoeuvre_time_s).abs() < 2e-2 * timed.manoeuvre_time_s,
+        "{m:?}"
+    );
+    let change = (timed.objective_value - m.objective_value) / m.objective_value;
+    assert!((m.relative_change - change).abs() < 1e-12, "{m:?}");
 }
 
 #[test]

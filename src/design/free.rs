@@ -1114,16 +1114,8 @@ pub fn optimize_start(
     } = solved;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
-    let cat = cfg.cat();
-    let dense = crate::verify::analyze::dense_samples(cfg);
-    let (peak, _) = crate::verify::analyze::peak_along(cfg, &plan, dense);
-    let time: f64 = plan.phase_bounds()[3];
     let objective = cfg.design.objective;
-    let objective_value = match objective {
-        Objective::PeakTorque => peak,
-        Objective::Time => time,
-        Objective::Energy => crate::design::envelope::torque_squared_integral(&cat, &plan, dense),
-    };
+    let (peak, objective_value) = dense_objective(cfg, &plan);
     let sim = crate::verify::simulate::dynamic_cfg(cfg, &plan)?;
     let kin = crate::verify::simulate::kinematic_cfg(cfg, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
@@ -1146,7 +1138,7 @@ pub fn optimize_start(
         status: res.status,
         objective,
         objective_value,
-        manoeuvre_time_s: time,
+        manoeuvre_time_s: plan.phase_bounds()[3],
         peak_torque_nm: peak,
         node_peak_torque_nm: node_peak,
         bend_deg: bend.to_degrees(),
@@ -1297,6 +1289,22 @@ pub fn check_resolvable(cfg: &Config, nodes: usize) -> Result<()> {
     })
 }
 
+/// The dense inverse-dynamics peak of a schedule, N m, and the objective's
+/// value for it (in [`Objective::unit`]): the peak, the manoeuvre time, or
+/// `integral |tau|^2 dt`.
+fn dense_objective(cfg: &Config, plan: &dyn ShapePlan) -> (f64, f64) {
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let (peak, _) = crate::verify::analyze::peak_along(cfg, plan, dense);
+    let value = match cfg.design.objective {
+        Objective::PeakTorque => peak,
+        Objective::Time => plan.phase_bounds()[3],
+        Objective::Energy => {
+            crate::design::envelope::torque_squared_integral(&cfg.cat(), plan, dense)
+        }
+    };
+    (peak, value)
+}
+
 /// Mesh-refinement check: the design re-optimised at twice the nodes per
 /// phase, warm-started from the coarse solution.
 #[derive(Debug, Clone, Serialize)]
@@ -1306,7 +1314,10 @@ pub struct MeshCheck {
     pub scp_iterations: usize,
     /// Dense peak of the refined design, N m.
     pub peak_torque_nm: f64,
-    /// `(coarse - refined) / refined` dense peak.
+    /// The objective's value for the refined design, in its unit (the
+    /// peak, the manoeuvre time in s, or `integral |tau|^2 dt`).
+    pub objective_value: f64,
+    /// `(coarse - refined) / refined` of the objective's value.
     pub relative_change: f64,
 }
 
@@ -1316,17 +1327,14 @@ pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = Transcription::new(3, nodes).sample(&r.plan);
     let fine = design(cfg, &z0, None, nodes, |_| {})?;
-    let (peak, _) = crate::verify::analyze::peak_along(
-        cfg,
-        &fine.plan,
-        crate::verify::analyze::dense_samples(cfg),
-    );
+    let (peak, value) = dense_objective(cfg, &fine.plan);
     Ok(MeshCheck {
         nodes,
         status: fine.res.status,
         scp_iterations: fine.res.iterations.len(),
         peak_torque_nm: peak,
-        relative_change: (r.peak_torque_nm - peak) / peak,
+        objective_value: value,
+        relative_change: (r.objective_value - value) / value,
     })
 }
 
