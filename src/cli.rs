@@ -101,9 +101,9 @@ enum Command {
         common: Common,
         #[arg(long, value_enum, default_value = "phased")]
         mode: Mode,
-        /// Seed of the free-form optimiser.
-        #[arg(long, value_enum, default_value = "phased")]
-        seed: SeedArg,
+        /// Seed of the free-form optimiser (default: phased; only with `--mode free`).
+        #[arg(long, value_enum)]
+        seed: Option<SeedArg>,
         /// Print each iteration (bend evaluations, SCP iterations).
         #[arg(long)]
         verbose: bool,
@@ -462,7 +462,14 @@ fn design_flags(cfg: &Config, status: &str, flip_error_rad: f64, tilt_deg: f64) 
     (!why.is_empty()).then(|| why.join("; "))
 }
 
-fn cmd_optimize(c: &Common, mode: Mode, seed: SeedArg, verbose: bool) -> Result<Status> {
+fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) -> Result<Status> {
+    if matches!(mode, Mode::Phased) && seed.is_some() {
+        return Err(catflip::Error::Usage(
+            "--seed applies to --mode free (the phased design has no seed); add --mode free or leave --seed out".into(),
+        )
+        .into());
+    }
+    let seed = seed.unwrap_or(SeedArg::Phased);
     let cfg = load(c)?;
     let set = match mode {
         Mode::Phased => "optimize-phased",

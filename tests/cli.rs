@@ -183,6 +183,16 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
     }
     let o = run(&["analyze", "no-such.toml"], dir.path());
     assert!(!o.status.success() && text(&o).1.contains("no-such.toml"));
+    // a seed for the phased design, which has none, is refused, not ignored
+    let seed_cfg = configs().join("seed.toml");
+    let o = run(
+        &["optimize", seed_cfg.to_str().unwrap(), "--seed", "analytic"],
+        dir.path(),
+    );
+    let (_, err) = text(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("--mode free"), "{err}");
+    assert!(!dir.path().join("output").exists());
     // a broken schedule names the file, the line and the column
     let cfg = configs().join("seed.toml");
     let sched = dir.path().join("s.csv");
