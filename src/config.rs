@@ -580,6 +580,22 @@ impl Config {
         }
     }
 
+    /// The motor limits the config sets, as the keys a user would change
+    /// (`limits.max_torque, limits.no_load_speed`), for messages.
+    pub fn envelope_keys(&self) -> String {
+        let l = &self.limits;
+        [
+            ("limits.max_torque", l.max_torque.is_some()),
+            ("limits.no_load_speed", l.no_load_speed.is_some()),
+            ("limits.max_speed", l.max_speed.is_some()),
+        ]
+        .iter()
+        .filter(|(_, set)| *set)
+        .map(|(k, _)| *k)
+        .collect::<Vec<_>>()
+        .join(", ")
+    }
+
     /// Largest bend the phased design may use (and the free-form design's
     /// mesh must resolve), rad: the limit, or 175 deg without one.
     pub fn max_bend(&self) -> f64 {
@@ -685,6 +701,21 @@ gravity = 9.8
         assert_eq!(c.cat.joint, Joint::Universal);
         assert_eq!(c.analytic.theta_deg, 60.0);
         assert!((c.fall_time() - (20.0f64 / 9.8).sqrt()).abs() < 1e-15);
+    }
+
+    #[test]
+    fn messages_name_only_the_limits_the_config_sets() {
+        let with = |ov: &[&str]| {
+            let ov: Vec<String> = ov.iter().map(|s| s.to_string()).collect();
+            Config::from_toml(SEED, "t", &ov).unwrap().envelope_keys()
+        };
+        assert_eq!(with(&[]), "");
+        assert_eq!(with(&["limits.max_torque=1"]), "limits.max_torque");
+        assert_eq!(
+            with(&["limits.max_torque=1", "limits.no_load_speed=6"]),
+            "limits.max_torque, limits.no_load_speed"
+        );
+        assert_eq!(with(&["limits.max_speed=3"]), "limits.max_speed");
     }
 
     #[test]

@@ -202,7 +202,8 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         && !why.iter().any(|w| w.contains("limits.max_torque"))
     {
         why.push(format!(
-            "leaves the motor envelope (smallest margin {m:.3}; limits.max_torque, limits.no_load_speed, limits.max_speed)"
+            "leaves the motor envelope (smallest margin {m:.3}; {})",
+            cfg.envelope_keys()
         ));
     }
     if let Some(b) = cfg.limits.max_bend_deg
@@ -308,6 +309,12 @@ pub fn trace(
         tau,
         qd,
         tau_xy,
+        peak_nm: crate::verify::analyze::peak_along(
+            cfg,
+            plan,
+            crate::verify::analyze::dense_samples(cfg),
+        )
+        .0,
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),

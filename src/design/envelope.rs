@@ -893,8 +893,9 @@ fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
     Error::Unreachable {
         reason: match least {
             Some(h) => format!(
-                "no {} schedule fits the motor envelope (limits.max_torque, no_load_speed, max_speed) in the {:.4} s fall from {} m; drop the cat from at least {h:.3} m (fall.height) or use stronger or faster motors",
+                "no {} schedule fits the motor envelope ({}) in the {:.4} s fall from {} m; drop the cat from at least {h:.3} m (fall.height) or use stronger or faster motors",
                 cfg.design.objective.name(),
+                cfg.envelope_keys(),
                 cfg.available_time(),
                 cfg.fall.height
             ),
