@@ -204,11 +204,24 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let reason = catflip::verify::simulate::misses_flip(
+    let margin = cfg
+        .motor()
+        .usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
+        .min_margin;
+    let mut why: Vec<String> = catflip::verify::simulate::misses_flip(
         a.flip_error_rad,
         a.tilt_deg,
         cfg.simulate.flip_tolerance,
-    );
+    )
+    .into_iter()
+    .collect();
+    why.extend(catflip::run::limits_broken(
+        &cfg,
+        a.peak_torque_nm,
+        a.closed.bend_deg,
+        margin,
+    ));
+    let reason = (!why.is_empty()).then(|| why.join("; "));
     let mut v = serde_json::to_value(&a)?;
     v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
     if let Some(r) = &reason {

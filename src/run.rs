@@ -185,21 +185,38 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         n.tilt_deg,
         cfg.simulate.flip_tolerance,
     ));
+    why.extend(limits_broken(
+        cfg,
+        n.peak_torque_nm,
+        n.bend_deg,
+        n.min_envelope_margin,
+    ));
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// Which of the config's limits a schedule breaks: its dense peak torque,
+/// largest bend (deg) and smallest margin inside the motor envelope.
+pub fn limits_broken(
+    cfg: &Config,
+    peak_torque_nm: f64,
+    bend_deg: f64,
+    envelope_margin: Option<f64>,
+) -> Vec<String> {
+    let mut why = Vec::new();
     // with a torque-speed line a braking torque may exceed the stall torque:
     // the envelope margin below is the test then
     if let Some(lim) = cfg.limits.max_torque
         && cfg.limits.no_load_speed.is_none()
-        && n.peak_torque_nm > lim * (1.0 + 1e-6)
+        && peak_torque_nm > lim * (1.0 + 1e-6)
     {
         why.push(format!(
-            "needs {:.4} N m, above limits.max_torque = {lim} N m",
-            n.peak_torque_nm
+            "needs {peak_torque_nm:.4} N m, above limits.max_torque = {lim} N m"
         ));
     }
     // the envelope also holds the speed limits; a torque already named is not repeated
-    if let Some(m) = n.min_envelope_margin
+    if let Some(m) = envelope_margin
         && m < -1e-6
-        && !why.iter().any(|w| w.contains("limits.max_torque"))
+        && why.is_empty()
     {
         why.push(format!(
             "leaves the motor envelope (smallest margin {m:.3}; {})",
@@ -207,14 +224,13 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         ));
     }
     if let Some(b) = cfg.limits.max_bend_deg
-        && n.bend_deg > b * (1.0 + 1e-6)
+        && bend_deg > b * (1.0 + 1e-6)
     {
         why.push(format!(
-            "bends {:.2} deg, above limits.max_bend_deg = {b} deg",
-            n.bend_deg
+            "bends {bend_deg:.2} deg, above limits.max_bend_deg = {b} deg"
         ));
     }
-    (!why.is_empty()).then(|| why.join("; "))
+    why
 }
 
 /// A method's line; `sim` is its dynamic simulation, or why that failed

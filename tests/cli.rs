@@ -70,6 +70,25 @@ fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
         peak <= jp * (1.0 + 1e-9) && peak > 0.99 * jp,
         "{peak} vs {jp}"
     );
+    assert_eq!(v["verdict"], "ok");
+    // a torque limit below the schedule's peak is flagged in the analysis
+    let limited = run_json(
+        &[
+            "analyze",
+            cfg.to_str().unwrap(),
+            "--set",
+            "limits.max_torque=1",
+            "--out",
+            "limited",
+        ],
+        dir.path(),
+    );
+    assert_eq!(limited["verdict"], "flagged");
+    let reason = limited["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("limits.max_torque") && reason.contains(&format!("{jp:.4}")),
+        "{reason}"
+    );
 }
 
 #[test]
