@@ -9,18 +9,24 @@ use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
 
-/// `println!` that ends the program quietly when stdout is a closed pipe
-/// (`catflip ... --json | head`), as ripgrep does, instead of panicking;
-/// the files were already written.
+/// Set once stdout turned out to be a closed pipe: later lines are dropped.
+static STDOUT_GONE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// `println!` that stops printing, instead of panicking, when stdout is a
+/// closed pipe (`catflip ... --json | head`); the command still finishes
+/// and exits with its own status (3 partial, 4 impossible), which a
+/// `pipefail` script needs.
 macro_rules! say {
     ($($t:tt)*) => {{
         use std::io::Write as _;
-        if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
-            if e.kind() == std::io::ErrorKind::BrokenPipe {
-                std::process::exit(0);
+        use std::sync::atomic::Ordering;
+        if !STDOUT_GONE.load(Ordering::Relaxed) {
+            if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
+                if e.kind() != std::io::ErrorKind::BrokenPipe {
+                    eprintln!("error: writing to stdout: {e}");
+                }
+                STDOUT_GONE.store(true, Ordering::Relaxed);
             }
-            eprintln!("error: writing to stdout: {e}");
-            std::process::exit(1);
         }
     }};
 }
@@ -204,10 +210,7 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let margin = cfg
-        .motor()
-        .usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
-        .min_margin;
+    let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
     let mut why: Vec<String> = catflip::verify::simulate::misses_flip(
         a.flip_error_rad,
         a.tilt_deg,
@@ -219,7 +222,8 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
         &cfg,
         a.peak_torque_nm,
         a.closed.bend_deg,
-        margin,
+        Some(usage.max_speed_rad_s),
+        usage.min_margin,
     ));
     let reason = (!why.is_empty()).then(|| why.join("; "));
     let mut v = serde_json::to_value(&a)?;

@@ -38,7 +38,7 @@ pub enum Error {
     /// The phased seed of a free-form design is impossible where the
     /// free-form design may not be.
     #[error(
-        "the phased seed does not fit: {reason}; the free-form design may fit from lower: `--seed analytic` starts it without the phased design, and `catflip run` finds the least drop height"
+        "the phased seed does not fit: {reason}; the free-form design may still fit: `--seed analytic` starts it without the phased design, and `catflip run` finds the least drop height"
     )]
     SeedUnfit { reason: String },
     #[error("every method failed: {0}")]

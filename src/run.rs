@@ -189,17 +189,20 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         cfg,
         n.peak_torque_nm,
         n.bend_deg,
+        Some(n.max_speed_rad_s),
         n.min_envelope_margin,
     ));
     (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// Which of the config's limits a schedule breaks: its dense peak torque,
-/// largest bend (deg) and smallest margin inside the motor envelope.
+/// largest bend (deg), fastest joint speed and smallest margin inside the
+/// motor envelope.
 pub fn limits_broken(
     cfg: &Config,
     peak_torque_nm: f64,
     bend_deg: f64,
+    max_speed_rad_s: Option<f64>,
     envelope_margin: Option<f64>,
 ) -> Vec<String> {
     let mut why = Vec::new();
@@ -213,7 +216,15 @@ pub fn limits_broken(
             "needs {peak_torque_nm:.4} N m, above limits.max_torque = {lim} N m"
         ));
     }
-    // the envelope also holds the speed limits; a torque already named is not repeated
+    if let (Some(w), Some(s)) = (cfg.limits.max_speed, max_speed_rad_s)
+        && s > w * (1.0 + 1e-6)
+    {
+        why.push(format!(
+            "moves at {s:.4} rad/s, above limits.max_speed = {w} rad/s"
+        ));
+    }
+    // the envelope holds both (and the torque-speed line); a limit already
+    // named is not repeated
     if let Some(m) = envelope_margin
         && m < -1e-6
         && why.is_empty()
@@ -304,6 +315,8 @@ pub fn trace(
     let cat = cfg.cat();
     let norm = cfg.norm();
     let b = plan.phase_bounds();
+    let (peak, _) =
+        crate::verify::analyze::peak_along(cfg, plan, crate::verify::analyze::dense_samples(cfg));
     let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
     let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
     for i in 0..3 {
@@ -325,12 +338,10 @@ pub fn trace(
         tau,
         qd,
         tau_xy,
-        peak_nm: crate::verify::analyze::peak_along(
-            cfg,
-            plan,
-            crate::verify::analyze::dense_samples(cfg),
-        )
-        .0,
+        peak_nm: peak,
+        over_limit: limits_broken(cfg, peak, 0.0, None, None)
+            .iter()
+            .any(|w| w.contains("limits.max_torque")),
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),

@@ -263,7 +263,7 @@ fn point(
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
                     "phased",
-                    &format!("{:?}", ph.status),
+                    &crate::run::json_name(&ph.status),
                     ph.flip_error_rad,
                     ph.tilt_deg,
                     &cfg,
@@ -299,7 +299,7 @@ fn point(
                 Ok(fr) => {
                     errors.extend(flagged(
                         "free",
-                        &format!("{:?}", fr.status),
+                        &crate::run::json_name(&fr.status),
                         fr.flip_error_rad,
                         fr.tilt_deg,
                         &cfg,
@@ -331,8 +331,8 @@ fn flagged(
     cfg: &Config,
 ) -> Option<String> {
     let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "Solved" | "Converged") {
-        why.push(format!("solver status {}", status.to_lowercase()));
+    if !matches!(status, "solved" | "converged") {
+        why.push(format!("solver status {status}"));
     }
     why.extend(crate::verify::simulate::misses_flip(
         flip_error,

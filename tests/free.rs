@@ -350,6 +350,7 @@ fn an_unmoved_cat_is_half_a_turn_from_the_flip_and_a_hopeless_limit_fails() {
 fn accepted_scp_steps_never_increase_the_penalised_objective() {
     let c = cfg("seed", &[]);
     let mut seen = 0;
+    let mut anchor: Option<f64> = None;
     let r = catflip::design::free::optimize(&c, catflip::design::free::Seed::Analytic, |it| {
         if it.accepted {
             seen += 1;
@@ -360,9 +361,13 @@ fn accepted_scp_steps_never_increase_the_penalised_objective() {
                 it.merit,
                 it.merit_after
             );
+        } else if let Some(a) = anchor {
+            // a step that undoes a tentative one ends where that one began
+            assert_eq!(it.merit_after, a);
         } else {
             assert_eq!(it.merit_after, it.merit);
         }
+        anchor = it.tentative.then_some(it.merit);
     })
     .unwrap();
     assert!(seen > 5);
@@ -409,6 +414,7 @@ fn a_tentative_step_stands_only_if_the_next_lowers_the_merit_below_its_start() {
             );
         } else {
             // undone: the anchor again, with a smaller radius, and disarmed
+            assert_eq!(next.merit_after, t.merit);
             let again = &it[i + 2];
             assert!(close(again.merit, t.merit), "iteration {}", i + 2);
             assert!(again.radius < t.radius);

@@ -692,7 +692,7 @@ fn a_sweep_keeps_every_method_and_flags_an_unconverged_one_per_point() {
     for p in &pts {
         let e = p["error"].as_str().unwrap();
         assert!(
-            e.contains("free FLAGGED") && e.contains("iterationlimit"),
+            e.contains("free FLAGGED") && e.contains("solver status iteration-limit"),
             "{e}"
         );
         assert!(!e.contains("phased"), "the phased design converged: {e}");

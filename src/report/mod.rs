@@ -35,6 +35,9 @@ pub struct MethodTrace {
     /// The dense peak torque (the one the table reports), N m; the curve's
     /// samples may fall just short of it.
     pub peak_nm: f64,
+    /// Whether that peak breaks `limits.max_torque` by the verdicts' rule
+    /// ([`crate::run::limits_broken`]).
+    pub over_limit: bool,
     pub phase_bounds: Vec<f64>,
     /// Attitude about the initial spine from the forward simulation.
     pub flip_t: Vec<f64>,
@@ -498,10 +501,7 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
                         }
                     }
                 }
-                let over = match limit {
-                    Some(l) if m.peak_nm > l * (1.0 + 1e-9) => ", OVER LIMIT",
-                    _ => "",
-                };
+                let over = if m.over_limit { ", OVER LIMIT" } else { "" };
                 keys.push((
                     format!("{} (peak {:.4} N m{over})", m.name, m.peak_nm),
                     Key::Line(st),

@@ -412,15 +412,23 @@ pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule>
     let want = cfg.available_time();
     let tol = 1e-6 * (1.0 + want);
     if start.abs() > tol || (end - want).abs() > tol {
+        // a schedule from 0 fits one height; one that starts later, none
+        let fits = if start.abs() <= tol {
+            format!(
+                "this one fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
+                0.5 * cfg.fall.gravity * (end + cfg.fall.margin).powi(2)
+            )
+        } else {
+            "this one does not start at 0, so no height fits it".into()
+        };
         return Err(Error::Schedule {
             file: origin.into(),
             line: s.rows.len() + 1,
             message: format!(
-                "the schedule runs from t = {start} s to {end} s, but config `{}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then; replay it with the config it was designed for (this one fits `--set fall.height={:.9}` at this fall.gravity and fall.margin), or design one for this fall with `catflip optimize`",
+                "the schedule runs from t = {start} s to {end} s, but config `{}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then; replay it with the config it was designed for ({fits}), or design one for this fall with `catflip optimize`",
                 cfg.name,
                 cfg.fall_time(),
                 cfg.fall.margin,
-                0.5 * cfg.fall.gravity * (end + cfg.fall.margin).powi(2)
             ),
         });
     }
