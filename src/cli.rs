@@ -211,20 +211,14 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
     let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
-    let mut why: Vec<String> = catflip::verify::simulate::misses_flip(
-        a.flip_error_rad,
-        a.tilt_deg,
-        cfg.simulate.flip_tolerance,
-    )
-    .into_iter()
-    .collect();
-    why.extend(catflip::run::limits_broken(
+    let why = catflip::run::schedule_flags(
         &cfg,
+        (a.flip_error_rad, a.tilt_deg),
         a.peak_torque_nm,
         a.closed.bend_deg,
         Some(usage.max_speed_rad_s),
         usage.min_margin,
-    ));
+    );
     let reason = (!why.is_empty()).then(|| why.join("; "));
     let mut v = serde_json::to_value(&a)?;
     v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();

@@ -180,19 +180,51 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
     if !matches!(status, "closed-form" | "solved" | "converged") {
         why.push(format!("solver status {status}"));
     }
-    why.extend(crate::verify::simulate::misses_flip(
-        n.flip_error_rad,
-        n.tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
-    why.extend(limits_broken(
+    why.extend(schedule_flags(
         cfg,
+        (n.flip_error_rad, n.tilt_deg),
         n.peak_torque_nm,
         n.bend_deg,
         Some(n.max_speed_rad_s),
         n.min_envelope_margin,
     ));
     (!why.is_empty()).then(|| why.join("; "))
+}
+
+/// Why a schedule misses its targets whatever made it: the flip and tilt
+/// (`(flip error rad, tilt deg)` from its simulation) beyond
+/// `simulate.flip_tolerance`, then [`limits_broken`].
+pub fn schedule_flags(
+    cfg: &Config,
+    (flip_error_rad, tilt_deg): (f64, f64),
+    peak_torque_nm: f64,
+    bend_deg: f64,
+    max_speed_rad_s: Option<f64>,
+    envelope_margin: Option<f64>,
+) -> Vec<String> {
+    let mut why: Vec<String> =
+        crate::verify::simulate::misses_flip(flip_error_rad, tilt_deg, cfg.simulate.flip_tolerance)
+            .into_iter()
+            .collect();
+    why.extend(limits_broken(
+        cfg,
+        peak_torque_nm,
+        bend_deg,
+        max_speed_rad_s,
+        envelope_margin,
+    ));
+    why
+}
+
+/// Whether a dense peak breaks `limits.max_torque`. Not with a torque-speed
+/// line, where a braking torque may exceed the stall torque: the envelope
+/// margin is the test then.
+pub fn over_torque_limit(cfg: &Config, peak_torque_nm: f64) -> bool {
+    cfg.limits.no_load_speed.is_none()
+        && cfg
+            .limits
+            .max_torque
+            .is_some_and(|lim| peak_torque_nm > lim * (1.0 + 1e-6))
 }
 
 /// Which of the config's limits a schedule breaks: its dense peak torque,
@@ -206,11 +238,8 @@ pub fn limits_broken(
     envelope_margin: Option<f64>,
 ) -> Vec<String> {
     let mut why = Vec::new();
-    // with a torque-speed line a braking torque may exceed the stall torque:
-    // the envelope margin below is the test then
     if let Some(lim) = cfg.limits.max_torque
-        && cfg.limits.no_load_speed.is_none()
-        && peak_torque_nm > lim * (1.0 + 1e-6)
+        && over_torque_limit(cfg, peak_torque_nm)
     {
         why.push(format!(
             "needs {peak_torque_nm:.4} N m, above limits.max_torque = {lim} N m"
@@ -304,19 +333,19 @@ fn summarize(
     }
 }
 
-/// Curves of one method for the figures.
+/// Curves of one method for the figures; `peak` is its dense peak torque,
+/// the table's (the curve's samples may fall just short of it).
 pub fn trace(
     cfg: &Config,
     name: &str,
     plan: &dyn ShapePlan,
+    peak: f64,
     sim: &SimReport,
     per_phase: usize,
 ) -> MethodTrace {
     let cat = cfg.cat();
     let norm = cfg.norm();
     let b = plan.phase_bounds();
-    let (peak, _) =
-        crate::verify::analyze::peak_along(cfg, plan, crate::verify::analyze::dense_samples(cfg));
     let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
     let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
     for i in 0..3 {
@@ -339,9 +368,7 @@ pub fn trace(
         qd,
         tau_xy,
         peak_nm: peak,
-        over_limit: limits_broken(cfg, peak, 0.0, None, None)
-            .iter()
-            .any(|w| w.contains("limits.max_torque")),
+        over_limit: over_torque_limit(cfg, peak),
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),
@@ -408,7 +435,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             ));
             let failed_sim = SimReport::failed();
             let sim = a_sim.as_ref().unwrap_or(&failed_sim);
-            traces.push(trace(cfg, "analytic", &a.plan, sim, 300));
+            traces.push(trace(cfg, "analytic", &a.plan, a.peak_torque_nm, sim, 300));
             tracks.push(track("analytic", sim));
         }
         Err(e) => methods.push(MethodSummary::failed("analytic", e)),
@@ -541,7 +568,14 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 &ph_sched,
                 ph.solve_time_s,
             ));
-            traces.push(trace(cfg, "phased", &ph.plan, ph_sim, 300));
+            traces.push(trace(
+                cfg,
+                "phased",
+                &ph.plan,
+                ph.peak_torque_nm,
+                ph_sim,
+                300,
+            ));
             tracks.push(track("phased", ph_sim));
         }
         Err(e) => methods.push(MethodSummary::failed("phased", e)),
@@ -587,7 +621,14 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
                 &fr_sched,
                 fr.solve_time_s,
             ));
-            traces.push(trace(cfg, "free", &fr.plan, &fr.sim, 300));
+            traces.push(trace(
+                cfg,
+                "free",
+                &fr.plan,
+                fr.peak_torque_nm,
+                &fr.sim,
+                300,
+            ));
             tracks.push(track("free", &fr.sim));
         }
         Err(e) => methods.push(MethodSummary::failed("free", e)),

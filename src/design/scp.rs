@@ -175,9 +175,10 @@ pub struct ScpSettings {
     /// 0.32165 instead of 0.32553 N m, the domestic cat's 1.5345 instead of
     /// 1.5624), 2 equal and the others at most 0.3 % higher (the domestic
     /// cat's per-motor design from the phased seed, 1.5504 against 1.5461).
-    /// Not at a converged point, where rho is noise. Peak costs only: on the time and energy costs of
-    /// `examples/convergence_matrix` it cost iterations (energy 25 to 45,
-    /// the robot's least time 35 to 62). Re-armed only by an accepted step:
+    /// Not at a converged point, where rho is noise. Peak costs only: on the
+    /// time and energy costs of `examples/convergence_matrix` it cost
+    /// iterations (energy 25 to 45, the robot's least time 35 to 62).
+    /// Re-armed only by an accepted step:
     /// armed after every step, the robot's impossible 2 m peak design ran
     /// to the iteration limit instead of failing with its least height.
     pub watchdog: bool,
