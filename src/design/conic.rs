@@ -118,6 +118,140 @@ pub struct ConicSolver {
     /// Slot map of `P`'s entries (diagonal first, then `p_upper`).
     p_slot: Vec<usize>,
     p_nnz: usize,
+    /// The data of the last solve (for [`ConicSolver::sensitivity`]).
+    data: ConicData,
+    kkt: Option<Kkt>,
+}
+
+/// The KKT matrix `[P A'; A -H]` of a solved program (upper triangle), with
+/// its fixed pattern and factorisation reused across solves
+/// ([`ConicSolver::kkt_at_solution`]).
+pub struct Kkt {
+    colptr: Vec<usize>,
+    rowval: Vec<usize>,
+    /// Nonzero slot of each entry of [`kkt_entries`].
+    pos: Vec<usize>,
+    /// The values without the static regularisation.
+    exact: Vec<f64>,
+    /// Diagonal slot of each column.
+    diag: Vec<usize>,
+    n: usize,
+    factor: clarabel::qdldl::QDLDLFactorisation<f64>,
+}
+
+/// Static regularisation of the KKT's diagonal (`+` primal, `-` dual),
+/// removed again by iterative refinement.
+const KKT_REG: f64 = 1e-9;
+
+/// The entries `(row, col, value)` (`row <= col`) of `[P A'; A -H]` at the
+/// last solution, in a fixed order: `P`, the diagonal, `A'`, then `-H`
+/// cone by cone (`H = s / z` for a nonnegative row, zero for an equality,
+/// the Nesterov-Todd `W'W` for a second-order cone).
+fn kkt_entries(d: &ConicData, s: &[f64], z: &[f64]) -> Option<Vec<(usize, usize, f64)>> {
+    let n = d.n;
+    let mut e = Vec::with_capacity(d.p_upper.len() + d.vals.len() + 2 * n + 2 * d.m());
+    if let Some(pd) = &d.p_diag {
+        e.extend(pd.iter().enumerate().map(|(j, &v)| (j, j, v)));
+    }
+    e.extend(d.p_upper.iter().copied());
+    e.extend((0..n).map(|j| (j, j, 0.0)));
+    e.extend((0..d.rows.len()).map(|k| (d.cols[k], n + d.rows[k], d.vals[k])));
+    let mut r0 = 0;
+    for c in &d.cones {
+        match *c {
+            Cone::Zero(k) => e.extend((r0..r0 + k).map(|r| (n + r, n + r, 0.0))),
+            Cone::Nonneg(k) => e.extend((r0..r0 + k).map(|r| (n + r, n + r, -s[r] / z[r]))),
+            Cone::Soc(k) => {
+                let h = soc_scaling(&s[r0..r0 + k], &z[r0..r0 + k])?;
+                for b in 0..k {
+                    for a in 0..=b {
+                        e.push((n + r0 + a, n + r0 + b, -h[a * k + b]));
+                    }
+                }
+            }
+        }
+        r0 += match *c {
+            Cone::Zero(k) | Cone::Nonneg(k) | Cone::Soc(k) => k,
+        };
+    }
+    Some(e)
+}
+
+impl Kkt {
+    fn new(dim: usize, n: usize, entries: &[(usize, usize, f64)]) -> Option<Self> {
+        use clarabel::qdldl::{QDLDLFactorisation, QDLDLSettingsBuilder};
+        let rows: Vec<usize> = entries.iter().map(|e| e.0).collect();
+        let cols: Vec<usize> = entries.iter().map(|e| e.1).collect();
+        let (colptr, rowval, pos) = csc(dim, dim, &rows, &cols);
+        let diag: Vec<usize> = (0..dim)
+            .map(|j| (colptr[j]..colptr[j + 1]).find(|&k| rowval[k] == j))
+            .collect::<Option<_>>()?;
+        let mut values = vec![0.0; rowval.len()];
+        for (&p, e) in pos.iter().zip(entries) {
+            values[p] += e.2;
+        }
+        for (j, &k) in diag.iter().enumerate() {
+            values[k] += if j < n { KKT_REG } else { -KKT_REG };
+        }
+        let a = CscMatrix::new(dim, dim, colptr.clone(), rowval.clone(), values);
+        let signs: Vec<i8> = (0..dim).map(|j| if j < n { 1 } else { -1 }).collect();
+        let opts = QDLDLSettingsBuilder::default().Dsigns(signs).build().ok()?;
+        let factor = QDLDLFactorisation::new(&a, Some(opts)).ok()?;
+        Some(Self {
+            exact: vec![0.0; rowval.len()],
+            colptr,
+            rowval,
+            pos,
+            diag,
+            n,
+            factor,
+        })
+    }
+
+    fn refactor(&mut self, entries: &[(usize, usize, f64)]) -> Option<()> {
+        self.exact.fill(0.0);
+        for (&p, e) in self.pos.iter().zip(entries) {
+            self.exact[p] += e.2;
+        }
+        let mut values = self.exact.clone();
+        for (j, &k) in self.diag.iter().enumerate() {
+            values[k] += if j < self.n { KKT_REG } else { -KKT_REG };
+        }
+        let idx: Vec<usize> = (0..values.len()).collect();
+        self.factor.update_values(&idx, &values);
+        self.factor.refactor().ok()
+    }
+
+    /// The change `dx` of the solution for a change `db` of `b`: `K [dx;
+    /// dy] = [0; db]`.
+    pub fn primal_change(&mut self, db: &[f64]) -> Vec<f64> {
+        let mut rhs = vec![0.0; self.n];
+        rhs.extend_from_slice(db);
+        let mut x = self.solve(&rhs);
+        x.truncate(self.n);
+        x
+    }
+
+    /// `K x = rhs`, refined against the unregularised `K`.
+    fn solve(&mut self, rhs: &[f64]) -> Vec<f64> {
+        let mut x = rhs.to_vec();
+        self.factor.solve(&mut x);
+        for _ in 0..3 {
+            let mut r = rhs.to_vec();
+            for j in 0..rhs.len() {
+                for k in self.colptr[j]..self.colptr[j + 1] {
+                    let (i, v) = (self.rowval[k], self.exact[k]);
+                    r[i] -= v * x[j];
+                    if i != j {
+                        r[j] -= v * x[i];
+                    }
+                }
+            }
+            self.factor.solve(&mut r);
+            x.iter_mut().zip(&r).for_each(|(a, b)| *a += b);
+        }
+        x
+    }
 }
 
 /// How exactly each conic program is solved; settings live apart from the
@@ -288,6 +422,8 @@ impl ConicSolver {
             settings,
             p_slot,
             p_nnz,
+            data: data.clone(),
+            kkt: None,
         })
     }
 
@@ -322,6 +458,7 @@ impl ConicSolver {
                 .update_P(&fill(&self.p_slot, self.p_nnz, &pv))
                 .map_err(err)?;
         }
+        self.data.clone_from(data);
         Ok(())
     }
 
@@ -337,11 +474,66 @@ impl ConicSolver {
         self.solver.solution.iterations
     }
 
+    /// The KKT system of the last solution, `[P A'; A -H]` with the
+    /// interior point's final Nesterov-Todd scaling `H` (`H z = s`, per
+    /// cone), factored: [`Kkt::primal_change`] gives the first-order change
+    /// of the solution when `b` changes, with the solution's own active set
+    /// (a row that binds, `s ~ 0`, is held; one with room, `z ~ 0`, lets its
+    /// slack take the change). `None` if the factorisation fails.
+    pub fn kkt_at_solution(&mut self) -> Option<&mut Kkt> {
+        let sol = &self.solver.solution;
+        let entries = kkt_entries(&self.data, &sol.s, &sol.z)?;
+        if self
+            .kkt
+            .as_ref()
+            .is_none_or(|k| k.pos.len() != entries.len())
+        {
+            self.kkt = Some(Kkt::new(self.n + self.m, self.n, &entries)?);
+        }
+        let kkt = self.kkt.as_mut()?;
+        kkt.refactor(&entries)?;
+        Some(kkt)
+    }
+
     /// The dual solution `z` of the last solve (one per row; the
     /// Lagrangian is `q'x + z'(A x - b)`).
     pub fn duals(&self) -> &[f64] {
         &self.solver.solution.z
     }
+}
+
+/// The Nesterov-Todd scaling `W'W` of a second-order cone at interior
+/// `(s, z)` (dense, row-major): `eta^2 (2 w w' - J)`, `J = diag(1, -I)`,
+/// with `W'W z = s` (Clarabel's own formula).
+fn soc_scaling(s: &[f64], z: &[f64]) -> Option<Vec<f64>> {
+    let k = s.len();
+    let res = |v: &[f64]| {
+        let r = v[0] * v[0] - v[1..].iter().map(|x| x * x).sum::<f64>();
+        (r > 0.0).then(|| r.sqrt())
+    };
+    let (ss, zs) = (res(s)?, res(z)?);
+    let eta2 = ss / zs;
+    let mut w: Vec<f64> = s.iter().map(|v| v / ss).collect();
+    w[0] += z[0] / zs;
+    for i in 1..k {
+        w[i] -= z[i] / zs;
+    }
+    let ws = res(&w)?;
+    w.iter_mut().for_each(|v| *v /= ws);
+    let mut h = vec![0.0; k * k];
+    for a in 0..k {
+        for b in 0..k {
+            let j = if a != b {
+                0.0
+            } else if a == 0 {
+                1.0
+            } else {
+                -1.0
+            };
+            h[a * k + b] = eta2 * (2.0 * w[a] * w[b] - j);
+        }
+    }
+    Some(h)
 }
 
 /// Builds a solver for `data`, or refills `slot`'s solver if the pattern fits.
@@ -398,5 +590,63 @@ mod tests {
         d.cone(Cone::Zero(2));
         let (st, _, _) = ConicSolver::new(&d).unwrap().solve();
         assert_eq!(st, SolveStatus::Infeasible);
+    }
+
+    #[test]
+    fn soc_scaling_maps_z_to_s() {
+        let (s, z) = ([2.0, 0.5, -1.0], [1.5, -0.3, 0.8]);
+        let h = soc_scaling(&s, &z).unwrap();
+        for a in 0..3 {
+            let hz: f64 = (0..3).map(|b| h[a * 3 + b] * z[b]).sum();
+            assert!((hz - s[a]).abs() < 1e-12, "{a}: {hz} vs {}", s[a]);
+        }
+    }
+
+    #[test]
+    fn the_kkt_at_a_solution_gives_the_solutions_change_with_b() {
+        // minimise t s.t. ||(x - 1, y - 2)|| <= t, x + y = c, x <= u: the
+        // point of the line nearest (1, 2) is (3, 4) for c = 7; with u = 2.5
+        // the bound binds and the solution is (u, c - u)
+        let build = |c: f64, u: f64| {
+            let mut d = ConicData::new(3);
+            d.q[2] = 1.0;
+            d.row(&[(0, 1.0), (1, 1.0)], c);
+            d.cone(Cone::Zero(1));
+            d.row(&[(0, 1.0)], u);
+            d.cone(Cone::Nonneg(1));
+            d.row(&[(2, -1.0)], 0.0);
+            d.row(&[(0, -1.0)], -1.0);
+            d.row(&[(1, -1.0)], -2.0);
+            d.cone(Cone::Soc(3));
+            d
+        };
+        let mut solver = ConicSolver::new(&build(7.0, 2.5)).unwrap();
+        let (st, x, _) = solver.solve();
+        assert_eq!(st, SolveStatus::Solved);
+        assert!(
+            (x[0] - 2.5).abs() < 1e-6 && (x[1] - 4.5).abs() < 1e-6,
+            "{x:?}"
+        );
+        let kkt = solver.kkt_at_solution().unwrap();
+        // d/dc: x held by the bound, y = c - u, t = |(x - 1, y - 2)|
+        let dt_dy = 2.5 / (1.5f64.powi(2) + 2.5f64.powi(2)).sqrt();
+        let dx = kkt.primal_change(&[1.0, 0.0, 0.0, 0.0, 0.0]);
+        for (got, want) in dx.iter().zip([0.0, 1.0, dt_dy]) {
+            assert!((got - want).abs() < 1e-4, "d/dc: {dx:?}");
+        }
+        // d/du: x = u, y = c - u
+        let dx = kkt.primal_change(&[0.0, 1.0, 0.0, 0.0, 0.0]);
+        let dt_du = (1.5 - 2.5) / (1.5f64.powi(2) + 2.5f64.powi(2)).sqrt();
+        for (got, want) in dx.iter().zip([1.0, -1.0, dt_du]) {
+            assert!((got - want).abs() < 1e-4, "d/du: {dx:?}");
+        }
+        // a bound with room (u = 5) lets its slack take the change
+        let mut solver = ConicSolver::new(&build(7.0, 5.0)).unwrap();
+        solver.solve();
+        let dx = solver
+            .kkt_at_solution()
+            .unwrap()
+            .primal_change(&[0.0, 1.0, 0.0, 0.0, 0.0]);
+        assert!(dx.iter().all(|v| v.abs() < 1e-4), "{dx:?}");
     }
 }
