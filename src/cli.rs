@@ -666,8 +666,9 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     r.sim_peak_torque_nm,
                 ),
                 format!(
-                    "{:.3} s ({} SCP iterations, {} nodes per phase)",
-                    r.solve_time_s, r.scp_iterations, r.nodes
+                    "{:.3} s ({})",
+                    r.solve_time_s,
+                    catflip::design::free::iterations_text(&r.mesh_levels)
                 ),
                 written,
             );
@@ -781,11 +782,10 @@ fn cmd_run(c: &Common) -> Result<Status> {
     }
     let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     say!(
-        "  free-form / phased peak {}, phased / analytic {}; {} SCP iterations at {} nodes per phase",
+        "  free-form / phased peak {}, phased / analytic {}; {}",
         show(s.free_over_phased),
         show(s.phased_over_analytic),
-        s.scp_iterations,
-        s.nodes
+        catflip::design::free::iterations_text(&s.mesh_levels)
     );
     if let Some(a) = &s.answer {
         say!("  {}", a.sentence());

@@ -215,6 +215,11 @@ pub struct FreeConfig {
     pub tolerance: f64,
     /// Flip tolerance of the converged design, rad (default 1e-6).
     pub attitude_tolerance: f64,
+    /// Mesh continuation of peak-torque designs (default true): from a
+    /// seed, solve at half the nodes first (halving again while that leaves
+    /// at least 20 per phase), loosely, and refine; see
+    /// `design::free::optimize_from`.
+    pub mesh_continuation: bool,
 }
 
 impl Default for FreeConfig {
@@ -224,6 +229,7 @@ impl Default for FreeConfig {
             max_iterations: 150,
             tolerance: 1e-4,
             attitude_tolerance: 1e-6,
+            mesh_continuation: true,
         }
     }
 }

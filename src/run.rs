@@ -125,6 +125,8 @@ pub struct RunSummary {
     pub free_over_phased: Option<f64>,
     pub scp_iterations: usize,
     pub nodes: usize,
+    /// The free-form design's meshes (mesh continuation), coarse to fine.
+    pub mesh_levels: Vec<crate::design::free::MeshLevel>,
     pub analytic: ClosedForms,
     pub figures: Vec<String>,
     /// With motor limits: can the motors flip the cat from `fall.height`, and
@@ -675,6 +677,15 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .as_ref()
         .map(|fr| fr.iterations.clone())
         .unwrap_or_default();
+    let mesh_levels = free.as_ref().map_or_else(
+        |_| {
+            vec![crate::design::free::MeshLevel {
+                nodes: cfg.free.nodes,
+                scp_iterations: 0,
+            }]
+        },
+        |fr| fr.mesh_levels.clone(),
+    );
     let mut figures = vec![
         ("angles.svg", report::angles(&traces)),
         (
@@ -691,7 +702,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     if !iterations.is_empty() {
         figures.push((
             "convergence.svg",
-            report::convergence(&iterations, cfg.design.objective),
+            report::convergence(&iterations, &mesh_levels, cfg.design.objective),
         ));
     }
     let mut notes = notes_early;
@@ -726,6 +737,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         methods,
         scp_iterations,
         nodes,
+        mesh_levels,
         analytic: crate::design::analytic::closed_forms(cfg),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
         answer,
@@ -736,14 +748,13 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     notes.insert(
         0,
         format!(
-            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form: {} SCP iterations, {} nodes per phase.",
+            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form: {}.",
             summary.joint,
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,
             show(summary.free_over_phased),
             show(summary.phased_over_analytic),
-            summary.scp_iterations,
-            summary.nodes
+            crate::design::free::iterations_text(&summary.mesh_levels)
         ),
     );
     notes.insert(

@@ -605,10 +605,32 @@ pub fn shape_path(methods: &[MethodTrace]) -> Result<String> {
     })
 }
 
+/// Where each finer mesh of the continuation starts (a dashed line).
+fn mesh_switches(
+    c: &mut Chart,
+    levels: &[crate::design::free::MeshLevel],
+    y: (f64, f64),
+) -> Result<()> {
+    let mut at = 0;
+    for l in &levels[..levels.len().saturating_sub(1)] {
+        at += l.scp_iterations;
+        c.draw_series(DashedLineSeries::new(
+            vec![(at as f64, y.0), (at as f64, y.1)],
+            2,
+            3,
+            BLACK.stroke_width(1),
+        ))
+        .map_err(perr)?;
+    }
+    Ok(())
+}
+
 /// SCP convergence: peak and infeasibility per iteration.
-/// `objective` names what the SCP minimised (its [`Objective`](crate::design::objective::Objective)).
+/// `objective` names what the SCP minimised (its [`Objective`](crate::design::objective::Objective));
+/// `levels` the meshes the iterations ran on (coarse to fine).
 pub fn convergence(
     iters: &[ScpIteration],
+    levels: &[crate::design::free::MeshLevel],
     objective: crate::design::objective::Objective,
 ) -> Result<String> {
     let title = format!("Free-form SCP: {} per iteration", objective.name());
@@ -619,6 +641,7 @@ pub fn convergence(
         let (plot, side) = with_legend(&panels[0]);
         let y = range(iters.iter().map(|i| i.objective));
         let mut c = chart(&plot, &title, (0.0, n), y, ("iteration", &axis), true)?;
+        mesh_switches(&mut c, levels, y)?;
         let st = style(1);
         let pts: Vec<_> = iters
             .iter()
@@ -639,26 +662,31 @@ pub fn convergence(
             )
             .map_err(perr)?;
         }
-        legend(
-            &side,
-            &[
-                ("peak at the iterate".into(), Key::Line(st)),
-                (
-                    "rejected step".into(),
-                    Key::Mark(Style {
-                        marker: Marker::Cross,
-                        ..rejected
-                    }),
-                ),
-                (
-                    "tentative step (watchdog)".into(),
-                    Key::Mark(Style {
-                        marker: Marker::Circle,
-                        ..tentative
-                    }),
-                ),
-            ],
-        )?;
+        let mut keys = vec![
+            ("peak at the iterate".into(), Key::Line(st)),
+            (
+                "rejected step".into(),
+                Key::Mark(Style {
+                    marker: Marker::Cross,
+                    ..rejected
+                }),
+            ),
+            (
+                "tentative step (watchdog)".into(),
+                Key::Mark(Style {
+                    marker: Marker::Circle,
+                    ..tentative
+                }),
+            ),
+        ];
+        if levels.len() > 1 {
+            let nodes: Vec<String> = levels.iter().map(|l| l.nodes.to_string()).collect();
+            keys.push((
+                format!("finer mesh ({} nodes per phase)", nodes.join(" / ")),
+                Key::Boundary,
+            ));
+        }
+        legend(&side, &keys)?;
         let (plot, side) = with_legend(&panels[1]);
         let lg = |v: f64| v.max(1e-16).log10();
         let y = range(
@@ -675,6 +703,7 @@ pub fn convergence(
             ("iteration", "log10 of max |r| (rad) or of radius"),
             true,
         )?;
+        mesh_switches(&mut c, levels, y)?;
         let mut keys = Vec::new();
         for (k, name) in [
             "max |r|, constraint violation (rad)",
