@@ -6,7 +6,8 @@
 //! `perf stat -e instructions cargo run --release --example bench_scp_suite`.
 //! The SCP's settings and rules (conic accuracy, trust-region cut,
 //! correction weight) were chosen on its totals. Each config's torque-speed
-//! line is left out (issue 11's peak-torque cases: the stall torque alone).
+//! line is left out (issue 11's peak-torque cases: the stall torque alone),
+//! and so is mesh continuation: the suite measures the SCP on one mesh.
 use catflip::Config;
 use catflip::design::free::Seed;
 use std::time::Instant;
@@ -34,7 +35,14 @@ fn main() -> anyhow::Result<()> {
     for (file, norm, nodes, seed) in cases {
         let path = format!("{root}/configs/{file}.toml");
         let text = std::fs::read_to_string(&path)?.replace("no_load_speed", "# no_load_speed");
-        let cfg = Config::from_toml(&text, &path, &[format!("limits.norm={norm}")])?;
+        let cfg = Config::from_toml(
+            &text,
+            &path,
+            &[
+                format!("limits.norm={norm}"),
+                "free.mesh_continuation=false".into(),
+            ],
+        )?;
         let nodes = nodes.unwrap_or(cfg.free.nodes);
         let t = Instant::now();
         let plan = seed.plan(&cfg)?;

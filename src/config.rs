@@ -218,7 +218,7 @@ pub struct FreeConfig {
     /// Mesh continuation of peak-torque designs (default true): from a
     /// seed, solve at half the nodes first (halving again while that leaves
     /// at least 20 per phase), loosely, and refine; see
-    /// `design::free::optimize_from`.
+    /// `design::free::coarse_start`.
     pub mesh_continuation: bool,
 }
 

@@ -682,6 +682,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             vec![crate::design::free::MeshLevel {
                 nodes: cfg.free.nodes,
                 scp_iterations: 0,
+                converged: false,
             }]
         },
         |fr| fr.mesh_levels.clone(),

@@ -118,7 +118,7 @@ pub struct ConicSolver {
     /// Slot map of `P`'s entries (diagonal first, then `p_upper`).
     p_slot: Vec<usize>,
     p_nnz: usize,
-    /// The data of the last solve (for [`ConicSolver::sensitivity`]).
+    /// The data of the last solve (for [`ConicSolver::kkt_at_solution`]).
     data: ConicData,
     kkt: Option<Kkt>,
 }
@@ -479,7 +479,8 @@ impl ConicSolver {
     /// cone), factored: [`Kkt::primal_change`] gives the first-order change
     /// of the solution when `b` changes, with the solution's own active set
     /// (a row that binds, `s ~ 0`, is held; one with room, `z ~ 0`, lets its
-    /// slack take the change). `None` if the factorisation fails.
+    /// slack take the change). `None` if the factorisation fails or a
+    /// second-order cone's `s` or `z` is not strictly inside it.
     pub fn kkt_at_solution(&mut self) -> Option<&mut Kkt> {
         let sol = &self.solver.solution;
         let entries = kkt_entries(&self.data, &sol.s, &sol.z)?;
@@ -600,6 +601,20 @@ mod tests {
             let hz: f64 = (0..3).map(|b| h[a * 3 + b] * z[b]).sum();
             assert!((hz - s[a]).abs() < 1e-12, "{a}: {hz} vs {}", s[a]);
         }
+        // the Nesterov-Todd scaling of the cone: H J H = eta^4 J with
+        // eta^4 = (s'Js) / (z'Jz), and H positive definite
+        let jn = |v: &[f64; 3]| v[0] * v[0] - v[1] * v[1] - v[2] * v[2];
+        let eta4 = jn(&s) / jn(&z);
+        let j = [1.0, -1.0, -1.0];
+        for a in 0..3 {
+            for b in 0..3 {
+                let hjh: f64 = (0..3).map(|k| h[a * 3 + k] * j[k] * h[k * 3 + b]).sum();
+                let want = if a == b { eta4 * j[a] } else { 0.0 };
+                assert!((hjh - want).abs() < 1e-12, "({a}, {b}): {hjh} vs {want}");
+            }
+        }
+        let m = nalgebra::Matrix3::from_row_slice(&h);
+        assert!(m.symmetric_eigenvalues().iter().all(|&e| e > 0.0));
     }
 
     #[test]

@@ -23,6 +23,10 @@
 //! derivative is the exact derivative of that discrete map: a perturbation
 //! `dOmega_j` of step `j` moves the final attitude by `R_{j+1} J_r(Omega_j) dOmega_j`
 //! in the world frame.
+//!
+//! From a seed, a peak-torque design is solved on coarser meshes first (half
+//! the nodes, and so on while 20 or more remain per phase), loosely, and each
+//! starts the next ([`coarse_start`], mesh continuation).
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
@@ -915,7 +919,11 @@ impl Seed {
     }
 }
 
-/// Runs the SCP from a seed plan at `nodes` per phase.
+/// Runs the SCP from a seed plan at `nodes` per phase; a peak-torque design
+/// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`).
+/// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
+/// order (`mesh_levels`), and the observer sees them numbered on. A fine
+/// design the coarse one cannot start is solved from the seed.
 pub fn optimize_from(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
@@ -924,37 +932,50 @@ pub fn optimize_from(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let clock = std::time::Instant::now();
+    // every iteration is shown once, numbered on across meshes and re-solves
     let mut observe = observe;
+    let mut shown = 0;
+    let mut show = |it: &ScpIteration| {
+        observe(&ScpIteration {
+            iteration: shown,
+            ..*it
+        });
+        shown += 1;
+    };
+    let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
     let z0 = if cfg.free.mesh_continuation && cfg.design.objective == Objective::PeakTorque {
-        coarse_start(cfg, seed_plan, nodes, &mut observe, &mut levels)
+        coarse_start(cfg, seed_plan, nodes, &mut show, &mut levels)
     } else {
-        Transcription::new(3, nodes).sample(seed_plan)
+        seed_start()
     };
-    let coarse_s = clock.elapsed().as_secs_f64();
-    let n0: usize = levels.iter().map(|l: &Coarse| l.1.len()).sum();
-    let mut r = optimize_start(cfg, &z0, None, seed, nodes, |it| {
-        observe(&ScpIteration {
-            iteration: it.iteration + n0,
-            ..*it
-        })
-    })?;
+    let mut before = clock.elapsed().as_secs_f64();
+    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, &mut show) {
+        // a fine design the coarse one could not start: from the seed (the
+        // coarse meshes stay on the record)
+        Err(_) if !levels.is_empty() => {
+            before = clock.elapsed().as_secs_f64();
+            optimize_start(cfg, &seed_start(), None, seed, nodes, &mut show)?
+        }
+        r => r?,
+    };
     if !levels.is_empty() {
-        r.solve_time_s += coarse_s;
+        r.solve_time_s += before;
         let mut meshes: Vec<MeshLevel> = levels
             .iter()
-            .map(|(nodes, its)| MeshLevel {
-                nodes: *nodes,
+            .map(|(level, its)| MeshLevel {
+                nodes: level.nodes,
                 scp_iterations: its.len(),
+                converged: level.converged,
             })
             .collect();
         meshes.extend(r.mesh_levels.iter().copied());
         r.mesh_levels = meshes;
         let mut iterations: Vec<ScpIteration> = levels.into_iter().flat_map(|l| l.1).collect();
-        iterations.extend(r.iterations.iter().map(|it| ScpIteration {
-            iteration: it.iteration + n0,
-            ..*it
-        }));
+        iterations.append(&mut r.iterations);
+        for (i, it) in iterations.iter_mut().enumerate() {
+            it.iteration = i;
+        }
         r.iterations = iterations;
         r.scp_iterations = r.iterations.len();
     }
@@ -972,34 +993,45 @@ const COARSEST_NODES: usize = 20;
 /// 3 %, 3e-4 12 % more; 1e-3 gave the lowest peaks.
 const COARSE_TOLERANCE: f64 = 1e-3;
 
-/// One mesh a design was solved on: nodes per phase and SCP iterations.
+/// One mesh a design was solved on: nodes per phase, SCP iterations, and
+/// whether it converged (a coarse mesh that did not leaves the seed as the
+/// next one's start).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct MeshLevel {
     pub nodes: usize,
     pub scp_iterations: usize,
+    pub converged: bool,
 }
 
-/// "17 SCP iterations: 8 at 20 and 9 at 40 nodes per phase" (or "9 SCP
-/// iterations at 40 nodes per phase" on one mesh).
+/// The iteration limit of a coarse mesh: it only starts the finer one
+/// (the coarse meshes of issue 11's cases took 7 to 30).
+const COARSE_MAX_ITERATIONS: usize = 50;
+
+/// "17 SCP iterations (8 at 20 and 9 at 40 nodes per phase)", or "9 SCP
+/// iterations at 40 nodes per phase" on one mesh.
 pub fn iterations_text(levels: &[MeshLevel]) -> String {
     let total: usize = levels.iter().map(|l| l.scp_iterations).sum();
     match levels {
+        [] => "no SCP iterations".into(),
         [one] => format!("{total} SCP iterations at {} nodes per phase", one.nodes),
         _ => {
             let parts: Vec<String> = levels
                 .iter()
-                .map(|l| format!("{} at {}", l.scp_iterations, l.nodes))
+                .map(|l| {
+                    let failed = if l.converged { "" } else { ", not converged" };
+                    format!("{} at {}{failed}", l.scp_iterations, l.nodes)
+                })
                 .collect();
             format!(
-                "{total} SCP iterations: {} nodes per phase",
+                "{total} SCP iterations ({} nodes per phase)",
                 parts.join(" and ")
             )
         }
     }
 }
 
-/// A coarse level's nodes and iterations (numbered on from the coarser).
-type Coarse = (usize, Vec<ScpIteration>);
+/// A coarse mesh's summary and its iterations.
+type Coarse = (MeshLevel, Vec<ScpIteration>);
 
 /// Mesh continuation: the start at `nodes` per phase, the design at half
 /// the nodes (itself started the same way while half leaves at least
@@ -1030,33 +1062,25 @@ fn coarse_start(
     let z0 = coarse_start(cfg, seed_plan, coarse, observe, levels);
     let mut loose = cfg.clone();
     loose.free.tolerance = COARSE_TOLERANCE.max(cfg.free.tolerance);
-    let n0: usize = levels.iter().map(|l| l.1.len()).sum();
+    loose.free.max_iterations = COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations);
+    let mut its = Vec::new();
     let solved = design(&loose, &z0, None, coarse, |it| {
-        observe(&ScpIteration {
-            iteration: it.iteration + n0,
-            ..*it
-        })
+        observe(it);
+        its.push(*it);
     });
+    let converged = matches!(&solved, Ok(s) if s.res.status == ScpStatus::Converged);
+    levels.push((
+        MeshLevel {
+            nodes: coarse,
+            scp_iterations: its.len(),
+            converged,
+        },
+        its,
+    ));
     match solved {
-        Ok(s) if s.res.status == ScpStatus::Converged => {
-            levels.push((
-                coarse,
-                s.res
-                    .iterations
-                    .iter()
-                    .map(|it| ScpIteration {
-                        iteration: it.iteration + n0,
-                        ..*it
-                    })
-                    .collect(),
-            ));
-            tr.sample(&s.plan)
-        }
-        _ => {
-            // the finer levels start from the seed again
-            levels.clear();
-            tr.sample(seed_plan)
-        }
+        Ok(s) if converged => tr.sample(&s.plan),
+        // the finer mesh starts from the seed again
+        _ => tr.sample(seed_plan),
     }
 }
 
@@ -1201,15 +1225,20 @@ fn inside_envelope(
             let f = 1.0 + 1.5 * margin;
             tight.limits.max_torque = tight.limits.max_torque.map(|t| t * f);
             tight.limits.no_load_speed = tight.limits.no_load_speed.map(|w| w * f);
+            let mut iterations = std::mem::take(&mut solved.res.iterations);
+            let n0 = iterations.len();
             let again = design(
                 &tight,
                 &solved.plan.z,
                 Some(&solved.res.warm),
                 nodes,
-                &mut *observe,
+                |it: &ScpIteration| {
+                    observe(&ScpIteration {
+                        iteration: it.iteration + n0,
+                        ..*it
+                    })
+                },
             )?;
-            let mut iterations = std::mem::take(&mut solved.res.iterations);
-            let n0 = iterations.len();
             iterations.extend(again.res.iterations.iter().map(|it| ScpIteration {
                 iteration: it.iteration + n0,
                 ..*it
@@ -1298,6 +1327,7 @@ pub fn optimize_start(
         mesh_levels: vec![MeshLevel {
             nodes,
             scp_iterations: res.iterations.len(),
+            converged: res.status == ScpStatus::Converged,
         }],
         z_scaled,
         warm: res.warm.clone(),
@@ -1446,7 +1476,7 @@ fn dense_objective(cfg: &Config, plan: &dyn ShapePlan) -> (f64, f64) {
 }
 
 /// Mesh-refinement check: the design re-optimised at twice the nodes per
-/// phase, warm-started from the coarse solution.
+/// phase, started from the design itself.
 #[derive(Debug, Clone, Serialize)]
 pub struct MeshCheck {
     pub nodes: usize,

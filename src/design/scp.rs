@@ -21,9 +21,10 @@
 //! rows' linearisation errors (one factorisation, see
 //! [`sensitivity_correction`]), and when that recovers less than half the
 //! predicted decrease, a conic one (one more conic solve, or two when the
-//! bounded one fails, see [`correction`]). The model's Hessian is scaled by
-//! the steps' `rho` ([`Multipliers::adapt_curvature`]). Accepted when `rho > 0.1` (so an accepted
-//! step never increases `phi`); the radius falls to half the model's step
+//! bounded one fails, see [`correction`]); the better of the two is
+//! kept. The model's Hessian is scaled by the steps' `rho`
+//! ([`Multipliers::adapt_curvature`]). Accepted when `rho > 0.1` (so an
+//! accepted step never increases `phi`); the radius falls to half the model's step
 //! when `rho < 0.1` and doubles when `rho > 0.5`, except right after a
 //! rejected step. For a peak cost a step that would be rejected is first
 //! taken tentatively (the watchdog, [`ScpSettings::watchdog`]): the next
@@ -685,9 +686,9 @@ fn correction(
 
 /// The share of the predicted decrease a sensitivity correction must
 /// recover to stand in for the conic correction (over
-/// `examples/bench_scp_suite`: 0.3 and 0.5 gave 207 and 208 SCP iterations,
-/// 0.75 gave 223, 0.1 gave 287; a weak cheap correction keeps the path off
-/// the better conic one).
+/// `examples/bench_scp_suite`, measured when chosen: 0.3 and 0.5 gave 207
+/// and 208 SCP iterations, 0.75 gave 223, 0.1 gave 287; a weak cheap
+/// correction keeps the path off the better conic one).
 const SENSITIVITY_ACCEPT: f64 = 0.5;
 
 /// One subproblem as built: its point, linearisation, data and Hessian.
@@ -702,8 +703,9 @@ struct Model<'a> {
 }
 
 /// Fletcher's second-order correction, to first order: the subproblem
-/// again, with the constant of every nonlinear row (terms, limits,
-/// residuals) shifted by its linearisation error at the trial point
+/// again, with the constant of every nonlinear row (a peak's terms,
+/// limits, residuals; a sum of squares' terms are in the objective, not in
+/// the rows, and stay) shifted by its linearisation error at the trial point
 /// `c(z + d) - c(z) - J d`, solved from the subproblem's solution with the
 /// solution's own active set (one KKT solve with the interior point's final
 /// scaling, [`ConicSolver::kkt_at_solution`]); repeated `rounds` times with
@@ -877,13 +879,15 @@ fn iterate(
             }
             _ => None,
         };
+        // the best point so far; the conic correction starts from the
+        // uncorrected trial point either way
+        let mut best: Option<(Vec<f64>, Merit)> = None;
         let mut done = false;
         if let Some((corrected, at_c)) = cheap
             && at_c.0 < there.0
-            && phi - at_c.0 > SENSITIVITY_ACCEPT * predicted
         {
-            (trial, there) = (corrected, at_c);
-            done = true;
+            done = phi - at_c.0 > SENSITIVITY_ACCEPT * predicted;
+            best = Some((corrected, at_c));
         }
         let tries = [
             (true, &mut solvers.bounded_correction),
@@ -903,11 +907,14 @@ fn iterate(
             {
                 let corrected: Vec<f64> = trial.iter().zip(&dc[..n]).map(|(a, b)| a + b).collect();
                 let at_c = merit(p, &corrected, w);
-                if at_c.0 < there.0 {
-                    (trial, there) = (corrected, at_c);
+                if at_c.0 < best.as_ref().map_or(there.0, |b| b.1.0) {
+                    best = Some((corrected, at_c));
                 }
                 break;
             }
+        }
+        if let Some(b) = best {
+            (trial, there) = b;
         }
     }
     let step = scaled_max(trial.iter().zip(z).map(|(a, b)| a - b), scales);
@@ -958,8 +965,10 @@ struct Anchor {
     /// The radius had its step been rejected.
     cut: f64,
     /// The multipliers of its subproblem (the curvature a rejection there
-    /// would have passed on).
+    /// would have passed on), and whether the trust region bounded its step
+    /// (for the curvature scale's rule on an undo).
     multipliers: Multipliers,
+    bounded: bool,
 }
 
 /// Multipliers of the terms of a peak cost and of the limited terms, and
@@ -996,10 +1005,13 @@ impl Multipliers {
     /// for `rho = 2 - 1/kappa`: steps that fall short, converging linearly).
     /// After an accepted step inside the trust region with `rho > 1` the
     /// scale is multiplied by `2 - rho` (at least a quarter per step); after
-    /// a rejected step inside it, doubled (at most 1). Over
-    /// `examples/bench_scp_suite` 264 SCP iterations instead of 294, every
-    /// peak lower or equal (the robot's per-motor design 0.05303 instead of
-    /// 0.05309 N m).
+    /// a rejected step inside it, doubled (at most 1). `rho` is the
+    /// iteration's, after any second-order correction (as measured: the
+    /// correction removes the constraints' curvature, not the cost's). Over
+    /// `examples/bench_scp_suite` (before the sensitivity correction) 264
+    /// SCP iterations instead of 294, every peak lower or equal (the
+    /// robot's per-motor design 0.05303 instead of 0.05309 N m). A warm
+    /// start begins again at 1.
     fn adapt_curvature(&mut self, rec: &ScpIteration) {
         if rec.bounded() {
             return;
@@ -1007,8 +1019,13 @@ impl Multipliers {
         if rec.accepted && rec.rho > 1.0 {
             self.curvature = (self.curvature * (2.0 - rec.rho).max(0.25)).max(MIN_CURVATURE);
         } else if !rec.accepted {
-            self.curvature = (self.curvature * 2.0).min(1.0);
+            self.reject_curvature();
         }
+    }
+
+    /// A step inside the trust region was rejected: the model was too flat.
+    fn reject_curvature(&mut self) {
+        self.curvature = (self.curvature * 2.0).min(1.0);
     }
 }
 
@@ -1050,7 +1067,11 @@ pub fn solve_warm(
     let mut solvers = Solvers::default();
     let mut iterations = Vec::new();
     let mut status = ScpStatus::IterationLimit;
-    let mut mult = warm.map_or_else(Multipliers::default, |w| w.multipliers.clone());
+    let mut mult = warm.map_or_else(Multipliers::default, |w| Multipliers {
+        // a neighbour's curvature scale belongs to its tail
+        curvature: 1.0,
+        ..w.multipliers.clone()
+    });
     let mut window = Vec::new();
     let mut rule = StopRule::None;
     let mut failures = 0;
@@ -1124,6 +1145,10 @@ pub fn solve_warm(
                 (z, here, radius, mult) = (a.z, a.merit, a.cut, a.multipliers);
                 undone = true;
                 armed = false;
+                if settings.adapt_curvature && !a.bounded {
+                    // the anchor's own step was the rejected one
+                    mult.reject_curvature();
+                }
             }
         } else if settings.watchdog
             && p.cost() == Cost::Peak
@@ -1143,6 +1168,7 @@ pub fn solve_warm(
                 predicted: rec.predicted,
                 cut: cut(&rec),
                 multipliers: mult.clone(),
+                bounded: rec.bounded(),
             });
             continue;
         }
@@ -1152,7 +1178,7 @@ pub fn solve_warm(
             (z, here) = (trial, there);
             armed = true;
         }
-        if settings.adapt_curvature {
+        if settings.adapt_curvature && !undone {
             mult.adapt_curvature(&rec);
         }
         if undone {

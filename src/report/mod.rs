@@ -269,7 +269,8 @@ enum Key {
     Line(Style),
     /// A marker alone (e.g. rejected SCP steps).
     Mark(Style),
-    /// Phase boundaries: thin dotted black, each topped with the method's marker.
+    /// Phase boundaries (thin dotted black, each topped with the method's
+    /// marker), or where a finer mesh starts in the convergence figure.
     Boundary,
     /// A reference level (torque limit, +-180 deg): solid black, thin.
     Level,

@@ -35,7 +35,9 @@ pub fn caption(file: &str) -> Option<&'static str> {
             "Rotation about the initial spine in the forward simulation (motor model applied)."
         }
         "shape_path.svg" => "The shape path in the (q1, q2) plane.",
-        "convergence.svg" => "Free-form SCP convergence.",
+        "convergence.svg" => {
+            "Free-form SCP convergence; a dashed line marks where a finer mesh starts (mesh continuation: the coarse design starts the fine one)."
+        }
         _ => return None,
     })
 }
