@@ -1004,7 +1004,8 @@ pub struct MeshLevel {
 }
 
 /// The iteration limit of a coarse mesh: it only starts the finer one
-/// (the coarse meshes of issue 11's cases took 7 to 30).
+/// (the coarse meshes of issue 11's cases took 7 to 16; the seed's per-motor
+/// design from the analytic seed, on a path since left, crawled past 50).
 const COARSE_MAX_ITERATIONS: usize = 25;
 
 /// "17 SCP iterations (8 at 20 and 9 at 40 nodes per phase)", or "9 SCP
