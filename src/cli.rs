@@ -640,8 +640,11 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
             row(
                 "certificate",
                 format!(
-                    "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {:?})",
-                    cert.step, cert.constraint_violation, cert.criticality, cert.rule
+                    "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {})",
+                    cert.step,
+                    cert.constraint_violation,
+                    cert.criticality,
+                    catflip::run::json_name(&cert.rule)
                 ),
             );
             if let Some(m) = &r.mesh_check {
@@ -782,7 +785,7 @@ fn cmd_run(c: &Common) -> Result<Status> {
     }
     let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     say!(
-        "  free-form / phased peak {}, phased / analytic {}; {}",
+        "  free-form / phased peak {}, phased / analytic {}; free-form design: {}",
         show(s.free_over_phased),
         show(s.phased_over_analytic),
         catflip::design::free::iterations_text(&s.mesh_levels)

@@ -215,7 +215,8 @@ pub struct FreeConfig {
     pub tolerance: f64,
     /// Flip tolerance of the converged design, rad (default 1e-6).
     pub attitude_tolerance: f64,
-    /// Mesh continuation of peak-torque designs (default true): from a
+    /// Mesh continuation of peak-torque designs without a torque-speed
+    /// line or speed limit (default true): from a
     /// seed, solve at half the nodes first (halving again while that leaves
     /// at least 20 per phase), loosely, and refine; see
     /// `design::free::coarse_start`.

@@ -677,16 +677,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         .as_ref()
         .map(|fr| fr.iterations.clone())
         .unwrap_or_default();
-    let mesh_levels = free.as_ref().map_or_else(
-        |_| {
-            vec![crate::design::free::MeshLevel {
-                nodes: cfg.free.nodes,
-                scp_iterations: 0,
-                converged: false,
-            }]
-        },
-        |fr| fr.mesh_levels.clone(),
-    );
+    // none when the free-form design failed
+    let mesh_levels = free
+        .as_ref()
+        .map_or_else(|_| Vec::new(), |fr| fr.mesh_levels.clone());
     let mut figures = vec![
         ("angles.svg", report::angles(&traces)),
         (
@@ -749,7 +743,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     notes.insert(
         0,
         format!(
-            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form: {}.",
+            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form design: {}.",
             summary.joint,
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,

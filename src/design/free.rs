@@ -944,16 +944,19 @@ pub fn optimize_from(
     };
     let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
-    let z0 = if cfg.free.mesh_continuation && cfg.design.objective == Objective::PeakTorque {
+    let z0 = if cfg.free.mesh_continuation && !cfg.uses_envelope() {
         coarse_start(cfg, seed_plan, nodes, &mut show, &mut levels)
     } else {
         seed_start()
     };
     let mut before = clock.elapsed().as_secs_f64();
+    // whether the fine mesh starts from a coarse design (not the seed)
+    let from_coarse = levels.last().is_some_and(|l: &Coarse| l.0.converged);
     let mut r = match optimize_start(cfg, &z0, None, seed, nodes, &mut show) {
         // a fine design the coarse one could not start: from the seed (the
-        // coarse meshes stay on the record)
-        Err(_) if !levels.is_empty() => {
+        // coarse meshes stay on the record); not an impossible flip, which
+        // the seed would only find again
+        Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
             before = clock.elapsed().as_secs_f64();
             optimize_start(cfg, &seed_start(), None, seed, nodes, &mut show)?
         }
@@ -1008,23 +1011,24 @@ pub struct MeshLevel {
 /// design from the analytic seed, on a path since left, crawled past 50).
 const COARSE_MAX_ITERATIONS: usize = 25;
 
-/// "17 SCP iterations (8 at 20 and 9 at 40 nodes per phase)", or "9 SCP
-/// iterations at 40 nodes per phase" on one mesh.
+/// "17 SCP iterations, 8 at 20 and 9 at 40 nodes per phase", or "9 SCP
+/// iterations at 40 nodes per phase" on one mesh; "failed, see its row"
+/// with none (a `run` whose free-form design failed).
 pub fn iterations_text(levels: &[MeshLevel]) -> String {
     let total: usize = levels.iter().map(|l| l.scp_iterations).sum();
     match levels {
-        [] => "no SCP iterations".into(),
+        [] => "failed, see its row".into(),
         [one] => format!("{total} SCP iterations at {} nodes per phase", one.nodes),
         _ => {
             let parts: Vec<String> = levels
                 .iter()
                 .map(|l| {
-                    let failed = if l.converged { "" } else { ", not converged" };
+                    let failed = if l.converged { "" } else { " (not converged)" };
                     format!("{} at {}{failed}", l.scp_iterations, l.nodes)
                 })
                 .collect();
             format!(
-                "{total} SCP iterations ({} nodes per phase)",
+                "{total} SCP iterations, {} nodes per phase",
                 parts.join(" and ")
             )
         }
@@ -1037,11 +1041,14 @@ type Coarse = (MeshLevel, Vec<ScpIteration>);
 /// Mesh continuation: the start at `nodes` per phase, the design at half
 /// the nodes (itself started the same way while half leaves at least
 /// [`COARSEST_NODES`]) solved to [`COARSE_TOLERANCE`] and sampled on the
-/// finer mesh; for the peak-torque objective. On `examples/convergence_matrix`
-/// the time and energy designs took more iterations with it (the robot's
-/// least time from the analytic seed 62 instead of 37) and the robot's
-/// least time rose 0.5 % (0.7540 s against 0.7497 s), so they start on the
-/// finest mesh. A coarse iteration costs about a third of a fine one, and
+/// finer mesh; for the peak-torque objective without a torque-speed line
+/// or speed limit (`Config::uses_envelope`). On
+/// `examples/convergence_matrix` the time and energy designs took more
+/// iterations with it (the robot's least time from the analytic seed 62
+/// instead of 37) and the robot's least time rose 0.5 % (0.7540 s against
+/// 0.7497 s); the robot's envelope peak design from 6 m took 7.7 s instead
+/// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Those
+/// start on the finest mesh. A coarse iteration costs about a third of a fine one, and
 /// from the coarse design the fine one takes 2 to 4 iterations
 /// (`examples/bench_free`: the robot's design from the phased seed 12
 /// iterations and 6.1 G instructions, seeding included, instead of 15 and

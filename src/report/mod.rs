@@ -681,7 +681,13 @@ pub fn convergence(
             ),
         ];
         if levels.len() > 1 {
-            let nodes: Vec<String> = levels.iter().map(|l| l.nodes.to_string()).collect();
+            let nodes: Vec<String> = levels
+                .iter()
+                .map(|l| {
+                    let failed = if l.converged { "" } else { " (not converged)" };
+                    format!("{}{failed}", l.nodes)
+                })
+                .collect();
             keys.push((
                 format!("finer mesh ({} nodes per phase)", nodes.join(" / ")),
                 Key::Boundary,
