@@ -118,8 +118,6 @@ pub struct ConicSolver {
     /// Slot map of `P`'s entries (diagonal first, then `p_upper`).
     p_slot: Vec<usize>,
     p_nnz: usize,
-    /// The data of the last solve (for [`ConicSolver::kkt_at_solution`]).
-    data: ConicData,
     kkt: Option<Kkt>,
 }
 
@@ -135,6 +133,8 @@ pub struct Kkt {
     exact: Vec<f64>,
     /// Diagonal slot of each column.
     diag: Vec<usize>,
+    /// Every slot (QDLDL's value update takes a slot list).
+    slots: Vec<usize>,
     n: usize,
     factor: clarabel::qdldl::QDLDLFactorisation<f64>,
 }
@@ -178,27 +178,28 @@ fn kkt_entries(d: &ConicData, s: &[f64], z: &[f64]) -> Option<Vec<(usize, usize,
 }
 
 impl Kkt {
+    /// The pattern of `entries` and its symbolic factorisation (ordering);
+    /// [`Kkt::refactor`] fills the values.
     fn new(dim: usize, n: usize, entries: &[(usize, usize, f64)]) -> Option<Self> {
         use clarabel::qdldl::{QDLDLFactorisation, QDLDLSettingsBuilder};
         let rows: Vec<usize> = entries.iter().map(|e| e.0).collect();
         let cols: Vec<usize> = entries.iter().map(|e| e.1).collect();
         let (colptr, rowval, pos) = csc(dim, dim, &rows, &cols);
+        let nnz = rowval.len();
         let diag: Vec<usize> = (0..dim)
             .map(|j| (colptr[j]..colptr[j + 1]).find(|&k| rowval[k] == j))
             .collect::<Option<_>>()?;
-        let mut values = vec![0.0; rowval.len()];
-        for (&p, e) in pos.iter().zip(entries) {
-            values[p] += e.2;
-        }
-        for (j, &k) in diag.iter().enumerate() {
-            values[k] += if j < n { KKT_REG } else { -KKT_REG };
-        }
-        let a = CscMatrix::new(dim, dim, colptr.clone(), rowval.clone(), values);
+        let a = CscMatrix::new(dim, dim, colptr.clone(), rowval.clone(), vec![0.0; nnz]);
         let signs: Vec<i8> = (0..dim).map(|j| if j < n { 1 } else { -1 }).collect();
-        let opts = QDLDLSettingsBuilder::default().Dsigns(signs).build().ok()?;
+        let opts = QDLDLSettingsBuilder::default()
+            .Dsigns(signs)
+            .logical(true)
+            .build()
+            .ok()?;
         let factor = QDLDLFactorisation::new(&a, Some(opts)).ok()?;
         Some(Self {
-            exact: vec![0.0; rowval.len()],
+            exact: vec![0.0; nnz],
+            slots: (0..nnz).collect(),
             colptr,
             rowval,
             pos,
@@ -217,8 +218,7 @@ impl Kkt {
         for (j, &k) in self.diag.iter().enumerate() {
             values[k] += if j < self.n { KKT_REG } else { -KKT_REG };
         }
-        let idx: Vec<usize> = (0..values.len()).collect();
-        self.factor.update_values(&idx, &values);
+        self.factor.update_values(&self.slots, &values);
         self.factor.refactor().ok()
     }
 
@@ -422,7 +422,6 @@ impl ConicSolver {
             settings,
             p_slot,
             p_nnz,
-            data: data.clone(),
             kkt: None,
         })
     }
@@ -458,7 +457,6 @@ impl ConicSolver {
                 .update_P(&fill(&self.p_slot, self.p_nnz, &pv))
                 .map_err(err)?;
         }
-        self.data.clone_from(data);
         Ok(())
     }
 
@@ -479,11 +477,13 @@ impl ConicSolver {
     /// cone), factored: [`Kkt::primal_change`] gives the first-order change
     /// of the solution when `b` changes, with the solution's own active set
     /// (a row that binds, `s ~ 0`, is held; one with room, `z ~ 0`, lets its
-    /// slack take the change). `None` if the factorisation fails or a
-    /// second-order cone's `s` or `z` is not strictly inside it.
-    pub fn kkt_at_solution(&mut self) -> Option<&mut Kkt> {
+    /// slack take the change). `data` is the last solve's. `None` if the
+    /// factorisation fails or a second-order cone's `s` or `z` is not
+    /// strictly inside it.
+    pub fn kkt_at_solution(&mut self, data: &ConicData) -> Option<&mut Kkt> {
+        debug_assert!(self.fits(data), "the last solve's data");
         let sol = &self.solver.solution;
-        let entries = kkt_entries(&self.data, &sol.s, &sol.z)?;
+        let entries = kkt_entries(data, &sol.s, &sol.z)?;
         if self
             .kkt
             .as_ref()
@@ -635,14 +635,15 @@ mod tests {
             d.cone(Cone::Soc(3));
             d
         };
-        let mut solver = ConicSolver::new(&build(7.0, 2.5)).unwrap();
+        let data = build(7.0, 2.5);
+        let mut solver = ConicSolver::new(&data).unwrap();
         let (st, x, _) = solver.solve();
         assert_eq!(st, SolveStatus::Solved);
         assert!(
             (x[0] - 2.5).abs() < 1e-6 && (x[1] - 4.5).abs() < 1e-6,
             "{x:?}"
         );
-        let kkt = solver.kkt_at_solution().unwrap();
+        let kkt = solver.kkt_at_solution(&data).unwrap();
         // d/dc: x held by the bound, y = c - u, t = |(x - 1, y - 2)|
         let dt_dy = 2.5 / (1.5f64.powi(2) + 2.5f64.powi(2)).sqrt();
         let dx = kkt.primal_change(&[1.0, 0.0, 0.0, 0.0, 0.0]);
@@ -656,10 +657,11 @@ mod tests {
             assert!((got - want).abs() < 1e-4, "d/du: {dx:?}");
         }
         // a bound with room (u = 5) lets its slack take the change
-        let mut solver = ConicSolver::new(&build(7.0, 5.0)).unwrap();
+        let data = build(7.0, 5.0);
+        let mut solver = ConicSolver::new(&data).unwrap();
         solver.solve();
         let dx = solver
-            .kkt_at_solution()
+            .kkt_at_solution(&data)
             .unwrap()
             .primal_change(&[0.0, 1.0, 0.0, 0.0, 0.0]);
         assert!(dx.iter().all(|v| v.abs() < 1e-4), "{dx:?}");

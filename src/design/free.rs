@@ -24,9 +24,10 @@
 //! `dOmega_j` of step `j` moves the final attitude by `R_{j+1} J_r(Omega_j) dOmega_j`
 //! in the world frame.
 //!
-//! From a seed, a peak-torque design is solved on coarser meshes first (half
-//! the nodes, and so on while 20 or more remain per phase), loosely, and each
-//! starts the next ([`coarse_start`], mesh continuation).
+//! From a seed, a peak-torque design without a torque-speed line or speed
+//! limit is solved on coarser meshes first (half the nodes, and so on while
+//! 20 or more remain per phase), loosely, and each starts the next
+//! ([`coarse_start`], mesh continuation).
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
@@ -964,14 +965,7 @@ pub fn optimize_from(
     };
     if !levels.is_empty() {
         r.solve_time_s += before;
-        let mut meshes: Vec<MeshLevel> = levels
-            .iter()
-            .map(|(level, its)| MeshLevel {
-                nodes: level.nodes,
-                scp_iterations: its.len(),
-                converged: level.converged,
-            })
-            .collect();
+        let mut meshes: Vec<MeshLevel> = levels.iter().map(|l| l.0).collect();
         meshes.extend(r.mesh_levels.iter().copied());
         r.mesh_levels = meshes;
         let mut iterations: Vec<ScpIteration> = levels.into_iter().flat_map(|l| l.1).collect();
@@ -1006,6 +1000,18 @@ pub struct MeshLevel {
     pub converged: bool,
 }
 
+impl MeshLevel {
+    /// "20", or "20 (not converged)".
+    pub fn nodes_label(&self) -> String {
+        let failed = if self.converged {
+            ""
+        } else {
+            " (not converged)"
+        };
+        format!("{}{failed}", self.nodes)
+    }
+}
+
 /// The iteration limit of a coarse mesh: it only starts the finer one
 /// (the coarse meshes of issue 11's cases took 7 to 16; the seed's per-motor
 /// design from the analytic seed, on a path since left, crawled past 50).
@@ -1022,10 +1028,7 @@ pub fn iterations_text(levels: &[MeshLevel]) -> String {
         _ => {
             let parts: Vec<String> = levels
                 .iter()
-                .map(|l| {
-                    let failed = if l.converged { "" } else { " (not converged)" };
-                    format!("{} at {}{failed}", l.scp_iterations, l.nodes)
-                })
+                .map(|l| format!("{} at {}", l.scp_iterations, l.nodes_label()))
                 .collect();
             format!(
                 "{total} SCP iterations, {} nodes per phase",

@@ -21,8 +21,8 @@
 //! rows' linearisation errors (one factorisation, see
 //! [`sensitivity_correction`]), and when that recovers less than half the
 //! predicted decrease, a conic one (one more conic solve, or two when the
-//! bounded one fails, see [`correction`]); the better of the two is
-//! kept. The model's Hessian is scaled by the steps' `rho`
+//! bounded one fails, see [`correction`]); a cheap one that falls short
+//! stands in only when the conic one fails. The model's Hessian is scaled by the steps' `rho`
 //! ([`Multipliers::adapt_curvature`]). Accepted when `rho > 0.1` (so an
 //! accepted step never increases `phi`); the radius falls to half the model's step
 //! when `rho < 0.1` and doubles when `rho > 0.5`, except right after a
@@ -722,7 +722,7 @@ fn sensitivity_correction(
     solver: &mut ConicSolver,
     rounds: usize,
 ) -> Option<(Vec<f64>, Merit)> {
-    let kkt = solver.kkt_at_solution()?;
+    let kkt = solver.kkt_at_solution(model.data)?;
     let lin = model.lin;
     let mut d = step.to_vec();
     let mut at = at.clone();

@@ -369,15 +369,21 @@ fn with_legend<'b>(area: &Area<'b>) -> (Area<'b>, Area<'b>) {
 
 /// Dotted vertical lines at the inner phase boundaries, one style for all
 /// methods, each topped with the method's marker.
+/// A thin dotted black vertical line at `x` (a boundary, [`Key::Boundary`]).
+fn boundary_line(c: &mut Chart, x: f64, y: (f64, f64)) -> Result<()> {
+    c.draw_series(DashedLineSeries::new(
+        vec![(x, y.0), (x, y.1)],
+        2,
+        3,
+        BLACK.stroke_width(1),
+    ))
+    .map_err(perr)?;
+    Ok(())
+}
+
 fn phase_marks(c: &mut Chart, m: &MethodTrace, st: Style, y: (f64, f64)) -> Result<()> {
     for &b in &m.phase_bounds[1..m.phase_bounds.len() - 1] {
-        c.draw_series(DashedLineSeries::new(
-            vec![(b, y.0), (b, y.1)],
-            2,
-            3,
-            BLACK.stroke_width(1),
-        ))
-        .map_err(perr)?;
+        boundary_line(c, b, y)?;
         c.draw_series(std::iter::once(marker((b, y.1), st.marker, st.color)))
             .map_err(perr)?;
     }
@@ -615,13 +621,7 @@ fn mesh_switches(
     let mut at = 0;
     for l in &levels[..levels.len().saturating_sub(1)] {
         at += l.scp_iterations;
-        c.draw_series(DashedLineSeries::new(
-            vec![(at as f64, y.0), (at as f64, y.1)],
-            2,
-            3,
-            BLACK.stroke_width(1),
-        ))
-        .map_err(perr)?;
+        boundary_line(c, at as f64, y)?;
     }
     Ok(())
 }
@@ -681,13 +681,7 @@ pub fn convergence(
             ),
         ];
         if levels.len() > 1 {
-            let nodes: Vec<String> = levels
-                .iter()
-                .map(|l| {
-                    let failed = if l.converged { "" } else { " (not converged)" };
-                    format!("{}{failed}", l.nodes)
-                })
-                .collect();
+            let nodes: Vec<String> = levels.iter().map(|l| l.nodes_label()).collect();
             keys.push((
                 format!("finer mesh ({} nodes per phase)", nodes.join(" / ")),
                 Key::Boundary,
