@@ -84,6 +84,10 @@ pub struct FreeProblem {
     pub max_speed: Option<f64>,
     pub objective: Objective,
     scales: Vec<f64>,
+    /// The check points' shape terms (with second derivatives) of the last
+    /// linearisation, in [`FreeProblem::check_points`] order: the Hessian at
+    /// the same point reads them instead of evaluating them again.
+    second_terms: std::cell::RefCell<Vec<([f64; 2], ShapeTerms)>>,
 }
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
@@ -154,6 +158,16 @@ impl FreeProblem {
             max_speed: cfg.limits.max_speed.map(|w| w * time_unit),
             objective: cfg.design.objective,
             scales,
+            second_terms: Default::default(),
+        }
+    }
+
+    /// [`ShapeTerms::second`] at check point `i` (phases in order) at shape
+    /// `q`: the last linearisation's, if it was at the same shape.
+    fn second_at(&self, i: usize, q: [f64; 2]) -> ShapeTerms {
+        match self.second_terms.borrow().get(i) {
+            Some(&(at, t)) if at == q => t,
+            _ => ShapeTerms::second(&self.cat, q),
         }
     }
 
@@ -232,13 +246,21 @@ impl FreeProblem {
                         (j as f64 + 0.5 + s3 / 6.0) / SUB as f64,
                     ];
                     let pts = cs.map(|c| d.at(c));
-                    let terms = pts.each_ref().map(|it| ShapeTerms::first(&self.cat, it.q));
-                    let w = [0, 1].map(|i| Vector3::from(terms[i].body_rate(pts[i].v)));
+                    // the rate alone needs no derivatives (plain f64, a
+                    // twentieth of the cost)
+                    let terms = want_jac
+                        .then(|| pts.each_ref().map(|it| ShapeTerms::first(&self.cat, it.q)));
+                    let w = [0, 1].map(|i| {
+                        Vector3::from(match &terms {
+                            Some(t) => t[i].body_rate(pts[i].v),
+                            None => self.cat.body_rate(pts[i].q, pts[i].v),
+                        })
+                    });
                     let omega = hs / 2.0 * (w[0] + w[1]) + cm * hs * hs * w[0].cross(&w[1]);
                     r *= exp(&omega);
-                    if !want_jac {
+                    let Some(terms) = &terms else {
                         continue;
-                    }
+                    };
                     let m = r * right_jacobian(&omega);
                     let dpdw = [
                         hs / 2.0 * Matrix3::identity() - cm * hs * hs * hat(&w[1]),
@@ -312,13 +334,19 @@ impl FreeProblem {
         let it = self.cat.i_t();
         let weights = self.quadrature();
         let mut out = Vec::with_capacity(3 * (2 * tr.nodes - 1));
+        let mut seconds = self.second_terms.borrow_mut();
+        if want_grad {
+            seconds.clear();
+        }
         for p in 0..3 {
             let t = z[tr.duration(p)];
             let (s2, s3) = (1.0 / (t * t * it), -2.0 / (t * t * t * it));
             for ((k, q, v, a, coef), &weight) in self.check_points(z, p).into_iter().zip(&weights) {
                 let rows = if want_grad {
                     // normalised-time inverse dynamics; physical torque = tau^ / T^2
-                    let lin = linearize_torque(&ShapeTerms::second(&self.cat, q), v, a);
+                    let terms = ShapeTerms::second(&self.cat, q);
+                    seconds.push((q, terms));
+                    let lin = linearize_torque(&terms, v, a);
                     [0, 1].map(|i| {
                         let mut grad = [0.0; 9];
                         for l in 0..2 {
@@ -489,9 +517,11 @@ fn torque_gradients(cat: &Cat, x: &[f64; 6], terms: Option<&ShapeTerms>) -> [[f6
 /// inverse dynamics `tau_i = M_ij(q) a_j + c_ijk(q) v_j v_k`: the rate block is
 /// the exact `c_ilk + c_ikl`, the acceleration blocks with rate and
 /// acceleration are zero, and the rows in `q` (hence, by symmetry, the
-/// mixed blocks) are central differences of the exact gradients in `q`
-/// alone (the shape terms' third derivatives are not formed). `base` holds
-/// the shape terms at `q`.
+/// mixed blocks) are forward differences of the exact gradients in `q`
+/// alone (the shape terms' third derivatives are not formed; two
+/// evaluations instead of a central difference's four, with a relative
+/// error about 1e-6 in a model that is scaled and clipped anyway). `base`
+/// holds the shape terms at `q`.
 fn weighted_torque_hessian(
     cat: &Cat,
     base: &ShapeTerms,
@@ -499,19 +529,15 @@ fn weighted_torque_hessian(
     y: [f64; 2],
 ) -> [[f64; 6]; 6] {
     let mut g = [[0.0; 6]; 6];
+    let g0 = torque_gradients(cat, &x, Some(base));
     for m in 0..2 {
-        let h = 1e-5 * (1.0 + x[m].abs());
-        let (mut xp, mut xm) = (x, x);
+        let h = 1e-7 * (1.0 + x[m].abs());
+        let mut xp = x;
         xp[m] += h;
-        xm[m] -= h;
-        let (gp, gm) = (
-            torque_gradients(cat, &xp, None),
-            torque_gradients(cat, &xm, None),
-        );
+        let h = xp[m] - x[m];
+        let gp = torque_gradients(cat, &xp, None);
         for c in 0..6 {
-            g[m][c] = (0..2)
-                .map(|i| y[i] * (gp[i][c] - gm[i][c]) / (2.0 * h))
-                .sum();
+            g[m][c] = (0..2).map(|i| y[i] * (gp[i][c] - g0[i][c]) / h).sum();
         }
     }
     // the q rows give the mixed blocks; their own 2x2 block is symmetrised
@@ -557,13 +583,19 @@ impl FreeProblem {
             6.0 / (t.powi(4) * it),
         );
         let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
-        for ((k, q, v, a, coef), w) in self.check_points(z, p).into_iter().zip(y.chunks(2)) {
+        let first = p * (2 * n - 1);
+        for (i, ((k, q, v, a, coef), w)) in self
+            .check_points(z, p)
+            .into_iter()
+            .zip(y.chunks(2))
+            .enumerate()
+        {
             let w = [w[0], w[1]];
             if w[0].abs().max(w[1].abs()) <= cut {
                 continue;
             }
             let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
-            let base = ShapeTerms::second(&self.cat, q);
+            let base = self.second_at(first + i, q);
             let g6 = weighted_torque_hessian(&self.cat, &base, x, w);
             let gr = torque_gradients(&self.cat, &x, Some(&base));
             let tau = torque_from(&base, v, a);
@@ -1579,6 +1611,28 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_hessian_reads_the_linearisations_shape_terms_only_at_the_same_point() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+        let cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
+        let tr = Transcription::new(3, 8);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
+        let fresh = || FreeProblem::new(&cfg, 8, &z0);
+        let p = fresh();
+        let z = p.to_scaled(&z0);
+        let mut moved = z.clone();
+        moved[tr.q(1, 3)] += 0.05;
+        let y: Vec<f64> = (0..p.torques_len()).map(|i| (i % 7) as f64 - 3.0).collect();
+        // without a linearisation (nothing cached) the shape terms are computed
+        let want = fresh().hessian(&z, &y, &[]);
+        let _ = p.linearize(&z);
+        assert_eq!(p.hessian(&z, &y, &[]), want, "cached at the same point");
+        // a linearisation elsewhere must not stand in for this point
+        let _ = p.linearize(&moved);
+        assert_eq!(p.hessian(&z, &y, &[]), want, "cached elsewhere");
+        assert_ne!(p.hessian(&moved, &y, &[]), want);
     }
 
     fn inverse_dynamics_at(cat: &Cat, x: [f64; 6]) -> [f64; 2] {

@@ -27,7 +27,7 @@ pub use body::{Half, InertiaFormula};
 
 use crate::model::small::*;
 use nalgebra::{Const, U1};
-use num_dual::{Derivative, Dual2SVec64, DualSVec64};
+use num_dual::{Derivative, Dual2SVec64, Dual64};
 use serde::{Deserialize, Serialize};
 
 /// How the two halves are joined (docs/model.md section 2).
@@ -314,33 +314,30 @@ pub struct ShapeTerms {
 }
 
 impl ShapeTerms {
-    /// Value and first derivatives (forward dynamics, path timing).
+    /// Value and first derivatives (forward dynamics, path timing): one
+    /// pass of scalar duals per direction, three to five times faster than
+    /// one pass of num-dual's gradient type (`DualSVec64<2>`, whose
+    /// derivative is an optional nalgebra vector) and the same numbers.
     pub fn first(cat: &Cat, q: [f64; 2]) -> Self {
-        let x = [
-            DualSVec64::<2>::from_re(q[0]).derivative(0),
-            DualSVec64::<2>::from_re(q[1]).derivative(1),
-        ];
-        let (m, a) = cat.locked_terms(x);
-        let g = |v: &DualSVec64<2>| -> [f64; 2] {
-            let e = v.eps.unwrap_generic(Const::<2>, U1);
-            [e[0], e[1]]
+        let pass = |k: usize| {
+            let x = [0, 1].map(|i| Dual64::new(q[i], if i == k { 1.0 } else { 0.0 }));
+            cat.locked_terms(x)
         };
+        let passes = [pass(0), pass(1)];
         let mut t = ShapeTerms::default();
         for i in 0..2 {
             for j in 0..2 {
-                t.m[i][j] = m[i][j].re;
-                let gr = g(&m[i][j]);
+                t.m[i][j] = passes[0].0[i][j].re;
                 for k in 0..2 {
-                    t.dm[k][i][j] = gr[k];
+                    t.dm[k][i][j] = passes[k].0[i][j].eps;
                 }
             }
         }
         for j in 0..2 {
             for r in 0..3 {
-                t.a[j][r] = a[j][r].re;
-                let gr = g(&a[j][r]);
+                t.a[j][r] = passes[0].1[j][r].re;
                 for k in 0..2 {
-                    t.da[k][j][r] = gr[k];
+                    t.da[k][j][r] = passes[k].1[j][r].eps;
                 }
             }
         }
