@@ -164,6 +164,12 @@ fn universal_twist_is_found_from_the_integrated_attitude() {
         nt.joint = Joint::NoTwist;
         assert!((twist_for(&nt, bend).unwrap() - tw).abs() > 1e-3);
     }
+    // the free-form design's phased seed root-finds its twist more loosely
+    // (to 1e-8 rad) and still flips, to its 20-interval timing's own error
+    // (2.3e-6 rad with either tolerance)
+    let seed = catflip::design::phased::seed_plan(&c).unwrap();
+    let r = kinematic(&cat, &seed, &Default::default()).unwrap();
+    assert!(r.flip_error_rad.abs() < 1e-5, "{}", r.flip_error_rad);
 }
 
 #[test]

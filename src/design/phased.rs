@@ -78,14 +78,29 @@ impl BendDesign {
 /// the integrated attitude, starting from `pi / C` with the mean half; by F2
 /// the timing is irrelevant and a unit-time cosine plan is used.
 pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
+    twist_to(cat, bend, TWIST_TOL)
+}
+
+/// The flip error (rad) [`twist_for`] root-finds the twist to, and the
+/// relative tolerance of the attitude's integration.
+const TWIST_TOL: f64 = 1e-11;
+
+/// The same for the free-form design's phased seed ([`seed_plan`]): the
+/// free-form design corrects the attitude itself. 1e-8 cut the robot's
+/// seed by a third of its instructions (`universal` joint, whose twist is
+/// root-found at every bend the search tries).
+const SEED_TWIST_TOL: f64 = 1e-8;
+
+/// [`twist_for`] to the flip error `tol` (rad).
+fn twist_to(cat: &Cat, bend: f64, tol: f64) -> Result<f64> {
     let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
     let guess = PI / c;
     if cat.joint == Joint::NoTwist && cat.is_symmetric() {
         return Ok(guess);
     }
     let ode = OdeSettings {
-        rtol: 1e-11,
-        atol: 1e-13,
+        rtol: tol,
+        atol: 1e-2 * tol,
         ..Default::default()
     };
     let flip = |tw: f64| -> Result<f64> {
@@ -98,7 +113,7 @@ pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
     let mut x1 = guess * target / f0;
     for _ in 0..30 {
         let y1 = flip(x1)? - target;
-        if y1.abs() < 1e-11 {
+        if y1.abs() < tol {
             return Ok(x1);
         }
         let x2 = x1 - y1 * (x1 - x0) / (y1 - y0);
@@ -138,7 +153,17 @@ pub struct BendEvaluation {
 /// and the torque is invariant under time reversal, so the unfold reuses the
 /// fold's timing reversed (the discrete SOCP has the same symmetry, tested).
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
-    let twist = twist_for(cat, bend)?;
+    design_to(cat, problem, bend, TWIST_TOL)
+}
+
+/// [`design_at`] with the twist to the flip error `twist_tol` (rad).
+fn design_to(
+    cat: &Cat,
+    problem: &mut TimingProblem,
+    bend: f64,
+    twist_tol: f64,
+) -> Result<BendDesign> {
+    let twist = twist_to(cat, bend, twist_tol)?;
     let paths = Path::phased(bend, twist);
     let solved = match cat.joint {
         Joint::NoTwist => problem.solve_all(cat, &[&paths[0], &paths[1]])?,
@@ -277,17 +302,19 @@ pub fn search_bend(
     observe: impl FnMut(&BendEvaluation),
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
     let tol = cfg.phased.bend_tol_deg.to_radians();
-    let (found, evals) = search_bend_to(cfg, problem, hint, tol, observe)?;
+    let (found, evals) = search_bend_to(cfg, problem, hint, tol, TWIST_TOL, observe)?;
     Ok((certified(&cfg.cat(), problem, found), evals))
 }
 
-/// [`search_bend`] to the bend tolerance `tol` (rad), with the winner at
-/// the search's accuracy (not certified).
+/// [`search_bend`] to the bend tolerance `tol` (rad), with every twist to
+/// the flip error `twist_tol` (rad) and the winner at the search's
+/// accuracy (not certified).
 fn search_bend_to(
     cfg: &Config,
     problem: &TimingProblem,
     hint: Option<BendHint>,
     tol: f64,
+    twist_tol: f64,
     mut observe: impl FnMut(&BendEvaluation),
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
     let cat = cfg.cat();
@@ -296,7 +323,7 @@ fn search_bend_to(
     let mut evals = Vec::new();
     let mut search = problem.for_search();
     let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
-        let d = design_at(&cat, &mut search, b)?;
+        let d = design_to(&cat, &mut search, b, twist_tol)?;
         let e = BendEvaluation {
             bend_deg: b.to_degrees(),
             value: d.unit_peak() / (t * t),
@@ -399,7 +426,7 @@ pub const SEED_BEND_TOL_DEG: f64 = 0.5;
 /// limit still starts a free-form design, which meets the limit or reports
 /// the least height itself. It is a start, not a certificate: at most
 /// [`SEED_NODES`] grid intervals per phase, the bend to
-/// [`SEED_BEND_TOL_DEG`], and the search's accuracy (a config with a motor
+/// [`SEED_BEND_TOL_DEG`], the twist to [`SEED_TWIST_TOL`], and the search's accuracy (a config with a motor
 /// envelope gets the whole envelope design, whose torque-speed line needs
 /// its own iteration).
 pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
@@ -408,7 +435,7 @@ pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
     }
     let problem = TimingProblem::new(cfg.phased.nodes.min(SEED_NODES), cfg.norm());
     let tol = cfg.phased.bend_tol_deg.max(SEED_BEND_TOL_DEG).to_radians();
-    let (design, _) = search_bend_to(cfg, &problem, None, tol, |_| {})?;
+    let (design, _) = search_bend_to(cfg, &problem, None, tol, SEED_TWIST_TOL, |_| {})?;
     Ok(design.plan(design.durations(cfg.available_time())))
 }
 
