@@ -395,3 +395,42 @@ fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
         "{out}"
     );
 }
+
+#[test]
+fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let o = run(
+        &[
+            "optimize",
+            cfg.to_str().unwrap(),
+            "--mode",
+            "free",
+            "--seed",
+            "analytic",
+            "--verbose",
+            "--set",
+            "design.objective=energy",
+            "--set",
+            "free.nodes=10",
+        ],
+        dir.path(),
+    );
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let header = err.lines().find(|l| l.contains("iter")).expect("header");
+    let columns: Vec<&str> = header.split_whitespace().collect();
+    assert_eq!(columns[..3], ["iter", "merit", "energy"], "{header}");
+    // one line per iteration, numbered 0, 1, 2, ... as the summary counts them
+    let numbers: Vec<usize> = err
+        .lines()
+        .filter_map(|l| l.split_whitespace().next()?.parse().ok())
+        .collect();
+    assert!(!numbers.is_empty());
+    assert!(
+        numbers.iter().enumerate().all(|(i, &n)| i == n),
+        "{numbers:?}"
+    );
+    let count = format!("({} SCP iterations", numbers.len());
+    assert!(out.contains(&count), "{count} in\n{out}");
+}

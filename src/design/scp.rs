@@ -245,12 +245,19 @@ pub struct ScpIteration {
     pub solve_ms: f64,
 }
 
+/// How exactly the subproblem's step is known, in scaled units (the
+/// interior point's feasibility tolerance, 1e-8): below it a step cannot be
+/// told from one at the radius (a trust region shrunk to 6e-8 around a kink
+/// the model cannot see gave a step 1 % short of it, read as a model
+/// minimum inside the region, criticality 6e-8: "converged").
+const STEP_ACCURACY: f64 = 1e-8;
+
 impl ScpIteration {
     /// Whether the trust region bounded the subproblem's step (its largest
     /// scaled component at the radius); when not, the model's minimum lies
     /// inside it.
     pub fn bounded(&self) -> bool {
-        self.model_step >= 0.99 * self.radius
+        self.model_step >= 0.99 * self.radius - STEP_ACCURACY
     }
 
     /// First-order criticality: the model decrease at unit trust radius,
@@ -1228,7 +1235,11 @@ pub fn solve_warm(
             && window[window.len() - 1 - settings.window] - phi_now
                 <= settings.tolerance * settings.window as f64 * phi_now.abs();
         let mut raise = stagnates;
-        if critical || slow {
+        // a window that ends in rejections is the trust region still
+        // looking for descent (it stalls if the radius vanishes), not a
+        // settled point: no progress means a step taken that gained nothing
+        let settled = critical || rec.accepted;
+        if (critical || slow) && (settled || inf_now > settings.feasibility) {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
                 rule = if critical {
@@ -1418,6 +1429,30 @@ mod tests {
             with.iterations.len(),
             without.iterations.len()
         );
+    }
+
+    #[test]
+    fn a_run_of_rejected_steps_stalls_instead_of_converging_by_lack_of_progress() {
+        // minimise z0 at a kink the linearisation cannot see: r = 1e3 |z0 - 1|
+        // reported with a zero slope at z0 = 1, so every model step (z0
+        // down) raises the merit; the merit stays put while the radius
+        // shrinks, which is no settled point
+        let kink = Toy {
+            cost: vec![(0, 1.0)],
+            r: |z| {
+                let slope = if z[0] == 1.0 {
+                    0.0
+                } else {
+                    1e3 * (z[0] - 1.0).signum()
+                };
+                (vec![1e3 * (z[0] - 1.0).abs()], vec![(0, 0, slope)])
+            },
+        };
+        let r = solve(&kink, vec![1.0, 0.0], &ScpSettings::default(), |_| {}).unwrap();
+        assert!(r.iterations.iter().all(|it| !it.accepted));
+        assert!(r.iterations.len() > ScpSettings::default().window);
+        assert_eq!(r.status, ScpStatus::Stalled);
+        assert_eq!(r.certificate.rule, StopRule::None);
     }
 
     #[test]
