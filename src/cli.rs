@@ -473,6 +473,41 @@ fn design_flags(cfg: &Config, status: &str, flip_error_rad: f64, tilt_deg: f64) 
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// `--verbose`: one line per SCP iteration, and a line where each mesh
+/// begins (mesh continuation: the trust radius starts again there).
+struct IterationTable {
+    verbose: bool,
+}
+
+impl catflip::design::free::Observer for IterationTable {
+    fn iteration(&mut self, it: &catflip::design::scp::ScpIteration) {
+        if self.verbose {
+            eprintln!(
+                "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
+                it.iteration,
+                it.merit,
+                it.objective,
+                it.infeasibility,
+                it.radius,
+                it.rho,
+                if it.accepted {
+                    "ok"
+                } else if it.tentative {
+                    "try"
+                } else {
+                    "rej"
+                },
+                it.solve_ms
+            );
+        }
+    }
+    fn mesh(&mut self, nodes: usize) {
+        if self.verbose {
+            eprintln!("  -- {nodes} nodes per phase");
+        }
+    }
+}
+
 fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) -> Result<Status> {
     if matches!(mode, Mode::Phased) && seed.is_some() {
         return Err(catflip::Error::Usage(
@@ -574,27 +609,11 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
                 );
             }
-            let r = catflip::design::free::optimize(&cfg, seed, |it| {
-                if verbose {
-                    eprintln!(
-                        "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
-                        it.iteration,
-                        it.merit,
-                        it.objective,
-                        it.infeasibility,
-                        it.radius,
-                        it.rho,
-                        if it.accepted {
-                            "ok"
-                        } else if it.tentative {
-                            "try"
-                        } else {
-                            "rej"
-                        },
-                        it.solve_ms
-                    );
-                }
-            })?;
+            let r = catflip::design::free::optimize_observed(
+                &cfg,
+                seed,
+                &mut IterationTable { verbose },
+            )?;
             let reason = design_flags(
                 &cfg,
                 &catflip::run::json_name(&r.status),

@@ -4,7 +4,7 @@ use catflip::Config;
 use catflip::design::analytic::analytic_plan;
 use catflip::design::collocation::Transcription;
 use catflip::design::free::FreeProblem;
-use catflip::design::scp::{Cost, ScpProblem, ScpStatus, Values};
+use catflip::design::scp::{Cost, ScpIteration, ScpProblem, ScpStatus, Values};
 
 /// A bundled config. The robot's servo also has a torque-speed line, which
 /// only the envelope designs handle (tests/envelope.rs); here the robot is the
@@ -515,6 +515,24 @@ fn per_motor_seed_design_at_120_nodes_is_within_half_a_percent_of_the_ipopt_opti
 /// iterations at 40, with its iterations split between the two meshes.
 #[test]
 fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
+    /// The iterations shown, and each mesh announced with the iterations
+    /// shown until the next.
+    #[derive(Default)]
+    struct Seen {
+        iterations: Vec<(usize, f64)>,
+        meshes: Vec<(usize, usize)>,
+    }
+    impl catflip::design::free::Observer for Seen {
+        fn iteration(&mut self, it: &ScpIteration) {
+            self.iterations.push((it.iteration, it.merit));
+            if let Some(m) = self.meshes.last_mut() {
+                m.1 += 1;
+            }
+        }
+        fn mesh(&mut self, nodes: usize) {
+            self.meshes.push((nodes, 0));
+        }
+    }
     for norm in ["euclidean", "per-motor"] {
         let norm_key = format!("limits.norm={norm}");
         let direct_cfg = cfg("seed", &[&norm_key, "free.mesh_continuation=false"]);
@@ -537,12 +555,24 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
         assert_eq!(levels.len(), 2, "{norm}: {levels:?}");
         assert_eq!((levels[0].0, levels[1].0), (20, 40));
         assert!(continued.mesh_levels.iter().all(|l| l.converged));
-        // what the observer was shown is what the result records
-        let mut shown = Vec::new();
-        let again = catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |it| {
-            shown.push((it.iteration, it.merit))
-        })
+        // what the observer was shown is what the result records, each
+        // mesh announced before its iterations
+        let mut seen = Seen::default();
+        let again = catflip::design::free::optimize_from_observed(
+            &c,
+            &phased.plan,
+            "phased",
+            40,
+            &mut seen,
+        )
         .unwrap();
+        let shown = seen.iterations;
+        let meshes: Vec<(usize, usize)> = again
+            .mesh_levels
+            .iter()
+            .map(|l| (l.nodes, l.scp_iterations))
+            .collect();
+        assert_eq!(seen.meshes, meshes, "{norm}");
         let kept: Vec<(usize, f64)> = again
             .iterations
             .iter()

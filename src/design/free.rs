@@ -952,6 +952,42 @@ impl Seed {
     }
 }
 
+/// What a free-form design reports as it runs (an argmin-style observer):
+/// each SCP iteration and, with mesh continuation, the start of each mesh.
+/// Any `FnMut(&ScpIteration)` is an observer that ignores the meshes.
+pub trait Observer {
+    fn iteration(&mut self, it: &ScpIteration);
+    /// The SCP begins on a mesh of `nodes` per phase (mesh continuation
+    /// only: each coarse mesh, then the finest; again if the finest starts
+    /// over from the seed).
+    fn mesh(&mut self, _nodes: usize) {}
+}
+
+impl<F: FnMut(&ScpIteration)> Observer for F {
+    fn iteration(&mut self, it: &ScpIteration) {
+        self(it)
+    }
+}
+
+/// Numbers the iterations on across meshes and re-solves, each shown once.
+struct Numbered<'a> {
+    inner: &'a mut dyn Observer,
+    shown: usize,
+}
+
+impl Observer for Numbered<'_> {
+    fn iteration(&mut self, it: &ScpIteration) {
+        self.inner.iteration(&ScpIteration {
+            iteration: self.shown,
+            ..*it
+        });
+        self.shown += 1;
+    }
+    fn mesh(&mut self, nodes: usize) {
+        self.inner.mesh(nodes)
+    }
+}
+
 /// Runs the SCP from a seed plan at `nodes` per phase; a peak-torque design
 /// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`).
 /// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
@@ -962,18 +998,24 @@ pub fn optimize_from(
     seed_plan: &dyn crate::design::plan::ShapePlan,
     seed: &str,
     nodes: usize,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    optimize_from_observed(cfg, seed_plan, seed, nodes, &mut observe)
+}
+
+/// [`optimize_from`] with an [`Observer`], which is also told where each
+/// mesh begins.
+pub fn optimize_from_observed(
+    cfg: &Config,
+    seed_plan: &dyn crate::design::plan::ShapePlan,
+    seed: &str,
+    nodes: usize,
+    observe: &mut dyn Observer,
 ) -> Result<FreeResult> {
     let clock = std::time::Instant::now();
-    // every iteration is shown once, numbered on across meshes and re-solves
-    let mut observe = observe;
-    let mut shown = 0;
-    let mut show = |it: &ScpIteration| {
-        observe(&ScpIteration {
-            iteration: shown,
-            ..*it
-        });
-        shown += 1;
+    let mut show = Numbered {
+        inner: observe,
+        shown: 0,
     };
     let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
@@ -982,16 +1024,22 @@ pub fn optimize_from(
     } else {
         seed_start()
     };
+    if !levels.is_empty() {
+        show.mesh(nodes);
+    }
     let mut before = clock.elapsed().as_secs_f64();
     // whether the fine mesh starts from a coarse design (not the seed)
     let from_coarse = levels.last().is_some_and(|l: &Coarse| l.0.converged);
-    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, &mut show) {
+    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, |it| show.iteration(it)) {
         // a fine design the coarse one could not start: from the seed (the
         // coarse meshes stay on the record); not an impossible flip, which
         // the seed would only find again
         Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
             before = clock.elapsed().as_secs_f64();
-            optimize_start(cfg, &seed_start(), None, seed, nodes, &mut show)?
+            show.mesh(nodes);
+            optimize_start(cfg, &seed_start(), None, seed, nodes, |it| {
+                show.iteration(it)
+            })?
         }
         r => r?,
     };
@@ -1094,7 +1142,7 @@ fn coarse_start(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
     nodes: usize,
-    observe: &mut dyn FnMut(&ScpIteration),
+    observe: &mut dyn Observer,
     levels: &mut Vec<Coarse>,
 ) -> Vec<f64> {
     let tr = Transcription::new(3, nodes);
@@ -1107,8 +1155,9 @@ fn coarse_start(
     loose.free.tolerance = COARSE_TOLERANCE.max(cfg.free.tolerance);
     loose.free.max_iterations = COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations);
     let mut its = Vec::new();
+    observe.mesh(coarse);
     let solved = design(&loose, &z0, None, coarse, |it| {
-        observe(it);
+        observe.iteration(it);
         its.push(*it);
     });
     let converged = matches!(&solved, Ok(s) if s.res.status == ScpStatus::Converged);
@@ -1555,7 +1604,17 @@ pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
 pub fn optimize(
     cfg: &Config,
     seed: Seed,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<FreeResult> {
+    optimize_observed(cfg, seed, &mut observe)
+}
+
+/// [`optimize`] with an [`Observer`], which is also told where each mesh
+/// begins.
+pub fn optimize_observed(
+    cfg: &Config,
+    seed: Seed,
+    observe: &mut dyn Observer,
 ) -> Result<FreeResult> {
     check_resolvable(cfg, cfg.free.nodes)?;
     let plan = match seed.plan(cfg) {
@@ -1566,7 +1625,7 @@ pub fn optimize(
         }
         r => r?,
     };
-    let mut r = optimize_from(cfg, plan.as_ref(), seed.name(), cfg.free.nodes, observe)?;
+    let mut r = optimize_from_observed(cfg, plan.as_ref(), seed.name(), cfg.free.nodes, observe)?;
     r.mesh_check = Some(mesh_check(cfg, &r)?);
     Ok(r)
 }
