@@ -959,7 +959,8 @@ pub trait Observer {
     fn iteration(&mut self, it: &ScpIteration);
     /// The SCP begins on a mesh of `nodes` per phase (mesh continuation
     /// only: each coarse mesh, then the finest; again if the finest starts
-    /// over from the seed).
+    /// over from the seed, numbered on from the coarse meshes: the failed
+    /// attempt is not on the record).
     fn mesh(&mut self, _nodes: usize) {}
 }
 
@@ -1036,6 +1037,8 @@ pub fn optimize_from_observed(
         // the seed would only find again
         Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
             before = clock.elapsed().as_secs_f64();
+            // the failed attempt is not on the record: its numbers are reused
+            show.shown = levels.iter().map(|l| l.1.len()).sum();
             show.mesh(nodes);
             optimize_start(cfg, &seed_start(), None, seed, nodes, |it| {
                 show.iteration(it)
@@ -1687,6 +1690,15 @@ mod tests {
         // without a linearisation (nothing cached) the shape terms are computed
         let want = fresh().hessian(&z, &y, &[]);
         let _ = p.linearize(&z);
+        // the linearisation keeps every check point's terms under its shape,
+        // in the order the Hessian indexes them (phase p's point i at
+        // p (2N - 1) + i), so that the Hessian finds them
+        let shapes: Vec<[f64; 2]> = (0..3)
+            .flat_map(|ph| p.check_points(&z, ph).into_iter().map(|c| c.1))
+            .collect();
+        let kept: Vec<[f64; 2]> = p.second_terms.borrow().iter().map(|e| e.0).collect();
+        assert_eq!(kept, shapes);
+        assert_eq!(shapes.len(), 3 * (2 * 8 - 1));
         assert_eq!(p.hessian(&z, &y, &[]), want, "cached at the same point");
         // a linearisation elsewhere must not stand in for this point
         let _ = p.linearize(&moved);

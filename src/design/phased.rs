@@ -87,8 +87,10 @@ const TWIST_TOL: f64 = 1e-11;
 
 /// The same for the free-form design's phased seed ([`seed_plan`]): the
 /// free-form design corrects the attitude itself. 1e-8 cut the robot's
-/// seed by a third of its instructions (`universal` joint, whose twist is
-/// root-found at every bend the search tries).
+/// seed under its stall torque alone (issue 11's bench case) by a third of
+/// its instructions (`universal` joint, whose twist is root-found at every
+/// bend the search tries). A config with a motor envelope is seeded by the
+/// envelope design, which keeps 1e-11.
 const SEED_TWIST_TOL: f64 = 1e-8;
 
 /// [`twist_for`] to the flip error `tol` (rad).

@@ -32,8 +32,9 @@
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
-//! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
-//! names the rule); the penalty grows tenfold when the
+//! over the last `window` iterations, ending on a step taken, with `max |r|
+//! <= feasibility` (converged; the certificate names the rule; a feasible
+//! run whose steps are rejected goes on until the trust region collapses); the penalty grows tenfold when the
 //! model stalls while still infeasible (and, for a linear cost, when the
 //! violation stagnates, see [`ScpSettings::stagnation`]); an iteration limit or a collapsed
 //! trust region (stalled) end the run.
@@ -144,7 +145,8 @@ pub struct ScpSettings {
     /// Initial trust radius in scaled units (default 0.5).
     pub initial_radius: f64,
     /// Iterations over which the merit must fall by `tolerance` (relative)
-    /// per iteration on average to keep going (default 10).
+    /// per iteration on average to keep going (default 10; a feasible run
+    /// stops so only after a step taken).
     pub window: usize,
     /// Penalty weight relative to the initial cost (for a peak cost at least
     /// the limit, which has its unit) (default 2): the exact L1
@@ -245,17 +247,18 @@ pub struct ScpIteration {
     pub solve_ms: f64,
 }
 
-/// How exactly the subproblem's step is known, in scaled units (the
-/// interior point's feasibility tolerance, 1e-8): below it a step cannot be
-/// told from one at the radius (a trust region shrunk to 6e-8 around a kink
-/// the model cannot see gave a step 1 % short of it, read as a model
-/// minimum inside the region, criticality 6e-8: "converged").
+/// An allowance (scaled units) below which a step's shortfall from the
+/// radius is not told apart from the interior point's inexactness (its
+/// solution stops short of an active bound by its gap tolerance): a trust
+/// region shrunk to 6e-8 around a kink the model cannot see gave a step 1 %
+/// (6e-10) short of it, read as a model minimum inside the region,
+/// criticality 6e-8, "converged". It matters only at such radii.
 const STEP_ACCURACY: f64 = 1e-8;
 
 impl ScpIteration {
     /// Whether the trust region bounded the subproblem's step (its largest
-    /// scaled component at the radius); when not, the model's minimum lies
-    /// inside it.
+    /// scaled component at the radius, less [`STEP_ACCURACY`]); when not,
+    /// the model's minimum lies inside it.
     pub fn bounded(&self) -> bool {
         self.model_step >= 0.99 * self.radius - STEP_ACCURACY
     }
@@ -332,8 +335,8 @@ pub enum StopRule {
     /// Criticality below `tolerance`: a first-order point of the model.
     Criticality,
     /// The merit fell by less than `tolerance` (relative) per iteration on
-    /// average over the last `window` iterations: no further progress at
-    /// this tolerance.
+    /// average over the last `window` iterations, the last step taken: no
+    /// further progress at this tolerance.
     Progress,
 }
 
@@ -939,6 +942,9 @@ fn iterate(
     } else {
         0.0
     };
+    // a trial point the model cannot evaluate (a non-finite merit) is a
+    // rejection that cuts the radius, not a NaN that neither cuts nor grows it
+    let rho = if rho.is_nan() { f64::NEG_INFINITY } else { rho };
     let accepted = predicted > 0.0 && rho > 0.1;
     let rec = ScpIteration {
         iteration,
@@ -1453,6 +1459,28 @@ mod tests {
         assert!(r.iterations.len() > ScpSettings::default().window);
         assert_eq!(r.status, ScpStatus::Stalled);
         assert_eq!(r.certificate.rule, StopRule::None);
+    }
+
+    #[test]
+    fn a_trial_point_that_cannot_be_evaluated_cuts_the_radius() {
+        // minimise z0 from 1 where the residual is not a number below 0.9:
+        // every step past it must shrink the trust region (a NaN rho that
+        // neither cut nor grew it repeated the same step to the limit)
+        let cliff = Toy {
+            cost: vec![(0, 1.0)],
+            r: |z| {
+                let r = if z[0] < 0.9 { f64::NAN } else { 0.0 };
+                (vec![r], vec![(0, 0, 0.0)])
+            },
+        };
+        let r = solve(&cliff, vec![1.0, 0.0], &ScpSettings::default(), |_| {}).unwrap();
+        assert!(
+            r.iterations.len() < 100,
+            "{} iterations",
+            r.iterations.len()
+        );
+        assert_ne!(r.status, ScpStatus::IterationLimit);
+        assert!(r.z[0] >= 0.9 && r.z[0] < 0.91, "{:?}", r.z);
     }
 
     #[test]
