@@ -331,21 +331,18 @@ fn impossible_limits_fail_with_a_clear_reason_and_write_nothing() {
     );
 }
 
+/// `optimize CONFIG --mode free --seed analytic`, then `extra`.
+fn free_from_analytic<'a>(cfg: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
+    let mut args = vec!["optimize", cfg, "--mode", "free", "--seed", "analytic"];
+    args.extend_from_slice(extra);
+    args
+}
+
 #[test]
 fn optimize_free_reports_iterations_and_nodes() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = configs().join("seed.toml");
-    let v = run_json(
-        &[
-            "optimize",
-            cfg.to_str().unwrap(),
-            "--mode",
-            "free",
-            "--seed",
-            "analytic",
-        ],
-        dir.path(),
-    );
+    let v = run_json(&free_from_analytic(cfg.to_str().unwrap(), &[]), dir.path());
     assert_keys(&v, &OPTIMIZE_KEYS);
     assert_keys(&v, &["scp_iterations", "nodes"]);
     assert_eq!(v["mode"], "free");
@@ -400,20 +397,15 @@ fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
 fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
     let dir = tempfile::tempdir().unwrap();
     let cfg = configs().join("seed.toml");
+    let args = [
+        "--verbose",
+        "--set",
+        "design.objective=energy",
+        "--set",
+        "free.nodes=10",
+    ];
     let o = run(
-        &[
-            "optimize",
-            cfg.to_str().unwrap(),
-            "--mode",
-            "free",
-            "--seed",
-            "analytic",
-            "--verbose",
-            "--set",
-            "design.objective=energy",
-            "--set",
-            "free.nodes=10",
-        ],
+        &free_from_analytic(cfg.to_str().unwrap(), &args),
         dir.path(),
     );
     let (out, err) = text(&o);
