@@ -32,9 +32,8 @@
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
-//! over the last `window` iterations, ending on a step taken, with `max |r|
-//! <= feasibility` (converged; the certificate names the rule; a feasible
-//! run whose steps are rejected goes on until the trust region collapses); the penalty grows tenfold when the
+//! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
+//! names the rule); the penalty grows tenfold when the
 //! model stalls while still infeasible (and, for a linear cost, when the
 //! violation stagnates, see [`ScpSettings::stagnation`]); an iteration limit or a collapsed
 //! trust region (stalled) end the run.
@@ -145,8 +144,7 @@ pub struct ScpSettings {
     /// Initial trust radius in scaled units (default 0.5).
     pub initial_radius: f64,
     /// Iterations over which the merit must fall by `tolerance` (relative)
-    /// per iteration on average to keep going (default 10; a feasible run
-    /// stops so only after a step taken).
+    /// per iteration on average to keep going (default 10).
     pub window: usize,
     /// Penalty weight relative to the initial cost (for a peak cost at least
     /// the limit, which has its unit) (default 2): the exact L1
@@ -247,20 +245,12 @@ pub struct ScpIteration {
     pub solve_ms: f64,
 }
 
-/// An allowance (scaled units) below which a step's shortfall from the
-/// radius is not told apart from the interior point's inexactness (its
-/// solution stops short of an active bound by its gap tolerance): a trust
-/// region shrunk to 6e-8 around a kink the model cannot see gave a step 1 %
-/// (6e-10) short of it, read as a model minimum inside the region,
-/// criticality 6e-8, "converged". It matters only at such radii.
-const STEP_ACCURACY: f64 = 1e-8;
-
 impl ScpIteration {
     /// Whether the trust region bounded the subproblem's step (its largest
-    /// scaled component at the radius, less [`STEP_ACCURACY`]); when not,
-    /// the model's minimum lies inside it.
+    /// scaled component at the radius); when not, the model's minimum lies
+    /// inside it.
     pub fn bounded(&self) -> bool {
-        self.model_step >= 0.99 * self.radius - STEP_ACCURACY
+        self.model_step >= 0.99 * self.radius
     }
 
     /// First-order criticality: the model decrease at unit trust radius,
@@ -335,8 +325,8 @@ pub enum StopRule {
     /// Criticality below `tolerance`: a first-order point of the model.
     Criticality,
     /// The merit fell by less than `tolerance` (relative) per iteration on
-    /// average over the last `window` iterations, the last step taken: no
-    /// further progress at this tolerance.
+    /// average over the last `window` iterations: no further progress at
+    /// this tolerance.
     Progress,
 }
 
@@ -1241,11 +1231,7 @@ pub fn solve_warm(
             && window[window.len() - 1 - settings.window] - phi_now
                 <= settings.tolerance * settings.window as f64 * phi_now.abs();
         let mut raise = stagnates;
-        // a window that ends in rejections is the trust region still
-        // looking for descent (it stalls if the radius vanishes), not a
-        // settled point: no progress means a step taken that gained nothing
-        let settled = critical || rec.accepted;
-        if (critical || slow) && (settled || inf_now > settings.feasibility) {
+        if critical || slow {
             if inf_now <= settings.feasibility {
                 status = ScpStatus::Converged;
                 rule = if critical {
@@ -1438,34 +1424,10 @@ mod tests {
     }
 
     #[test]
-    fn a_run_of_rejected_steps_stalls_instead_of_converging_by_lack_of_progress() {
-        // minimise z0 at a kink the linearisation cannot see: r = 1e3 |z0 - 1|
-        // reported with a zero slope at z0 = 1, so every model step (z0
-        // down) raises the merit; the merit stays put while the radius
-        // shrinks, which is no settled point
-        let kink = Toy {
-            cost: vec![(0, 1.0)],
-            r: |z| {
-                let slope = if z[0] == 1.0 {
-                    0.0
-                } else {
-                    1e3 * (z[0] - 1.0).signum()
-                };
-                (vec![1e3 * (z[0] - 1.0).abs()], vec![(0, 0, slope)])
-            },
-        };
-        let r = solve(&kink, vec![1.0, 0.0], &ScpSettings::default(), |_| {}).unwrap();
-        assert!(r.iterations.iter().all(|it| !it.accepted));
-        assert!(r.iterations.len() > ScpSettings::default().window);
-        assert_eq!(r.status, ScpStatus::Stalled);
-        assert_eq!(r.certificate.rule, StopRule::None);
-    }
-
-    #[test]
     fn a_trial_point_that_cannot_be_evaluated_cuts_the_radius() {
         // minimise z0 from 1 where the residual is not a number below 0.9:
-        // every step past it must shrink the trust region (a NaN rho that
-        // neither cut nor grew it repeated the same step to the limit)
+        // every step past it must shrink the trust region (a NaN rho
+        // neither cut nor grew it: the same step again)
         let cliff = Toy {
             cost: vec![(0, 1.0)],
             r: |z| {
@@ -1474,13 +1436,18 @@ mod tests {
             },
         };
         let r = solve(&cliff, vec![1.0, 0.0], &ScpSettings::default(), |_| {}).unwrap();
+        let its = &r.iterations;
         assert!(
-            r.iterations.len() < 100,
-            "{} iterations",
-            r.iterations.len()
+            its.iter()
+                .any(|it| !it.merit_after.is_nan() && !it.accepted)
         );
-        assert_ne!(r.status, ScpStatus::IterationLimit);
-        assert!(r.z[0] >= 0.9 && r.z[0] < 0.91, "{:?}", r.z);
+        for pair in its.windows(2) {
+            if !pair[0].accepted {
+                assert!(pair[0].rho < 0.1, "{:?}", pair[0]);
+                assert!(pair[1].radius < pair[0].radius, "{pair:?}");
+            }
+        }
+        assert!(r.z[0] >= 0.9, "{:?}", r.z);
     }
 
     #[test]
