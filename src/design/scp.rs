@@ -30,7 +30,8 @@
 //! taken tentatively (the watchdog, [`ScpSettings::watchdog`]): the next
 //! step must then lower `phi` below the point before it, or both are undone.
 //! Stop: criticality (the predicted decrease at unit radius relative to
-//! `phi`, see [`ScpIteration::criticality`]) below `tolerance`, or a merit
+//! `phi`, without removing a violation already within `feasibility`, see
+//! [`ScpIteration::criticality_within`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
 //! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
 //! names the rule); the penalty grows tenfold when the
@@ -269,6 +270,24 @@ impl ScpIteration {
         self.predicted.max(0.0) / self.merit.abs().max(1e-300) / per_radius
     }
 
+    /// [`ScpIteration::criticality`] at a point whose violations are within
+    /// `feasibility`: without the decrease the model predicts from removing
+    /// them (the merit's penalty, `merit - objective`), which a converged
+    /// point need not earn. At rounding level (the attitude's residual at
+    /// 1e-9 rad) no step can remove it, and with a large penalty weight it
+    /// made the criticality thousands while the merit could not fall.
+    pub fn criticality_within(&self, feasibility: f64) -> f64 {
+        if self.infeasibility > feasibility {
+            return self.criticality();
+        }
+        let penalty = (self.merit - self.objective).max(0.0);
+        ScpIteration {
+            predicted: self.predicted - penalty,
+            ..*self
+        }
+        .criticality()
+    }
+
     /// The record with its cost-valued fields (merit, objective, decreases,
     /// weight) multiplied by `unit`: problems solved in scaled units report
     /// physical ones.
@@ -303,7 +322,8 @@ pub struct Certificate {
     pub step: f64,
     /// Largest equality-constraint violation `max |r(z)|` at the end point.
     pub constraint_violation: f64,
-    /// The method's optimality measure, [`ScpIteration::criticality`] of the
+    /// The method's optimality measure,
+    /// [`ScpIteration::criticality_within`] the feasibility tolerance, of the
     /// last iteration (zero exactly at a KKT point of the penalised problem;
     /// converged below `tolerance`).
     pub criticality: f64,
@@ -1168,7 +1188,8 @@ pub fn solve_warm(
             && rec.rho < 0.1
             && there.0.is_finite()
             // not at a converged point, where rho is noise: the rules below stop there
-            && !(rec.criticality() <= settings.tolerance && here.2 <= settings.feasibility)
+            && !(rec.criticality_within(settings.feasibility) <= settings.tolerance
+                && here.2 <= settings.feasibility)
         {
             rec.tentative = true;
             observe(&rec);
@@ -1223,7 +1244,8 @@ pub fn solve_warm(
                 let (inf_then, cost_then) = stagnant[stagnant.len() - 1 - k];
                 inf_now > 0.8 * inf_then && (here.1 - cost_then).abs() < 1e-2 * here.1.abs()
             };
-        let critical = !stagnates && rec.criticality() <= settings.tolerance;
+        let critical =
+            !stagnates && rec.criticality_within(settings.feasibility) <= settings.tolerance;
         // the merit fell by less than `tolerance` (relative) per iteration,
         // on average over the window
         let slow = !stagnates
@@ -1274,7 +1296,7 @@ pub fn solve_warm(
     let certificate = Certificate {
         step: last.map_or(0.0, |l| l.step),
         constraint_violation: infeasibility,
-        criticality: last.map_or(0.0, |l| l.criticality()),
+        criticality: last.map_or(0.0, |l| l.criticality_within(settings.feasibility)),
         radius,
         weight: w / scale,
         rule,
@@ -1421,6 +1443,36 @@ mod tests {
             with.iterations.len(),
             without.iterations.len()
         );
+    }
+
+    #[test]
+    fn a_feasible_points_criticality_leaves_out_removing_its_tolerated_violation() {
+        // merit 2 = cost 1.5 + penalty 0.5; the model predicts 0.6, of
+        // which up to 0.5 is the penalty's removal
+        let rec = ScpIteration {
+            objective: 1.5,
+            predicted: 0.6,
+            ..record(0.6, 8.0, false)
+        };
+        assert!((rec.criticality() - 0.3).abs() < 1e-15);
+        // within the tolerance: only the rest counts
+        let feasible = ScpIteration {
+            infeasibility: 1e-9,
+            ..rec
+        };
+        assert!((feasible.criticality_within(1e-6) - 0.05).abs() < 1e-15);
+        // a violation above it must still be removed: all of it counts
+        let infeasible = ScpIteration {
+            infeasibility: 1e-3,
+            ..rec
+        };
+        assert_eq!(infeasible.criticality_within(1e-6), rec.criticality());
+        // a prediction that is all penalty: nothing left
+        let all_penalty = ScpIteration {
+            predicted: 0.4,
+            ..feasible
+        };
+        assert_eq!(all_penalty.criticality_within(1e-6), 0.0);
     }
 
     #[test]
