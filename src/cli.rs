@@ -599,12 +599,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                 SeedArg::Analytic => catflip::design::free::Seed::Analytic,
             };
             if verbose {
-                // the objective's column: peak torque (N m), time (s) or energy
-                let objective = match cfg.design.objective {
-                    catflip::design::objective::Objective::PeakTorque => "peak",
-                    catflip::design::objective::Objective::Time => "time",
-                    catflip::design::objective::Objective::Energy => "energy",
-                };
+                let objective = cfg.design.objective.short_name();
                 eprintln!(
                     "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
                 );

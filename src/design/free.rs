@@ -521,15 +521,16 @@ fn torque_gradients(cat: &Cat, x: &[f64; 6], terms: Option<&ShapeTerms>) -> [[f6
 /// alone (the shape terms' third derivatives are not formed; two
 /// evaluations instead of a central difference's four, with a relative
 /// error about 1e-6 in a model that is scaled and clipped anyway). `base`
-/// holds the shape terms at `q`.
+/// holds the shape terms at `q` and `g0` the gradients there
+/// ([`torque_gradients`]).
 fn weighted_torque_hessian(
     cat: &Cat,
     base: &ShapeTerms,
+    g0: &[[f64; 6]; 2],
     x: [f64; 6],
     y: [f64; 2],
 ) -> [[f64; 6]; 6] {
     let mut g = [[0.0; 6]; 6];
-    let g0 = torque_gradients(cat, &x, Some(base));
     for m in 0..2 {
         let h = 1e-7 * (1.0 + x[m].abs());
         let mut xp = x;
@@ -596,8 +597,8 @@ impl FreeProblem {
             }
             let x = [q[0], q[1], v[0], v[1], a[0], a[1]];
             let base = self.second_at(first + i, q);
-            let g6 = weighted_torque_hessian(&self.cat, &base, x, w);
             let gr = torque_gradients(&self.cat, &x, Some(&base));
+            let g6 = weighted_torque_hessian(&self.cat, &base, &gr, x, w);
             let tau = torque_from(&base, v, a);
             // C: local inputs (kind, component) from the interval's 8 values (component, idx)
             let mut c = nalgebra::SMatrix::<f64, 6, 8>::zeros();
@@ -1649,7 +1650,9 @@ mod tests {
             let cat = cfg.cat();
             let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
             let y = [0.8, -1.3];
-            let g = weighted_torque_hessian(&cat, &ShapeTerms::second(&cat, [x[0], x[1]]), x, y);
+            let base = ShapeTerms::second(&cat, [x[0], x[1]]);
+            let g0 = torque_gradients(&cat, &x, Some(&base));
+            let g = weighted_torque_hessian(&cat, &base, &g0, x, y);
             let f = |x: [f64; 6]| {
                 let t = inverse_dynamics_at(&cat, x);
                 y[0] * t[0] + y[1] * t[1]

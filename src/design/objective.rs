@@ -25,6 +25,15 @@ impl Objective {
         }
     }
 
+    /// One word for a column or a legend: `peak`, `time` or `energy`.
+    pub fn short_name(self) -> &'static str {
+        match self {
+            Objective::PeakTorque => "peak",
+            Objective::Time => "time",
+            Objective::Energy => "energy",
+        }
+    }
+
     /// Unit of the objective's value.
     pub fn unit(self) -> &'static str {
         match self {

@@ -664,7 +664,10 @@ pub fn convergence(
             .map_err(perr)?;
         }
         let mut keys = vec![
-            ("peak at the iterate".into(), Key::Line(st)),
+            (
+                format!("{} at the iterate", objective.short_name()),
+                Key::Line(st),
+            ),
             (
                 "rejected step".into(),
                 Key::Mark(Style {
@@ -869,4 +872,51 @@ pub fn index_html(
     }
     h.push_str("</body></html>\n");
     h
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::objective::Objective;
+
+    #[test]
+    fn the_convergence_figure_names_the_objective_it_plots() {
+        let it = |iteration: usize, objective: f64| ScpIteration {
+            iteration,
+            merit: objective,
+            objective,
+            infeasibility: 1e-3,
+            radius: 0.5,
+            weight: 1.0,
+            predicted: 0.1,
+            actual: 0.1,
+            rho: 1.0,
+            accepted: true,
+            tentative: false,
+            merit_after: objective,
+            step: 0.5,
+            model_step: 0.5,
+            solve_ms: 1.0,
+        };
+        let iters = [it(0, 0.9), it(1, 0.8)];
+        let levels = [crate::design::free::MeshLevel {
+            nodes: 40,
+            scp_iterations: 2,
+            converged: true,
+        }];
+        for (objective, word) in [
+            (Objective::Time, "time"),
+            (Objective::Energy, "energy"),
+            (Objective::PeakTorque, "peak"),
+        ] {
+            let svg = convergence(&iters, &levels, objective).unwrap();
+            assert!(svg.contains(&format!("{word} at the iterate")), "{word}");
+            let others = ["time", "energy", "peak"]
+                .into_iter()
+                .filter(|w| *w != word);
+            for other in others {
+                assert!(!svg.contains(&format!("{other} at the iterate")), "{word}");
+            }
+        }
+    }
 }
