@@ -31,7 +31,7 @@
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
-use crate::design::conic::{Cone, ConicData};
+use crate::design::conic::{Cone, ConicData, ConicSettings};
 use crate::design::objective::Objective;
 use crate::design::plan::ShapePlan;
 use crate::design::scp::{
@@ -1074,6 +1074,17 @@ const COARSEST_NODES: usize = 20;
 /// 3 %, 3e-4 12 % more; 1e-3 gave the lowest peaks.
 const COARSE_TOLERANCE: f64 = 1e-3;
 
+/// Which mesh of the continuation a design is solved on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Mesh {
+    /// A coarser mesh, whose design only starts the next one: to
+    /// [`COARSE_TOLERANCE`], at most [`COARSE_MAX_ITERATIONS`], subproblems
+    /// to [`ConicSettings::COARSE`].
+    Coarse,
+    /// The design's own mesh, to the config's `free.tolerance`.
+    Final,
+}
+
 /// One mesh a design was solved on: nodes per phase, SCP iterations, and
 /// whether it converged (a coarse mesh that did not leaves the seed as the
 /// next one's start).
@@ -1155,12 +1166,9 @@ fn coarse_start(
         return tr.sample(seed_plan);
     }
     let z0 = coarse_start(cfg, seed_plan, coarse, observe, levels);
-    let mut loose = cfg.clone();
-    loose.free.tolerance = COARSE_TOLERANCE.max(cfg.free.tolerance);
-    loose.free.max_iterations = COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations);
     let mut its = Vec::new();
     observe.mesh(coarse);
-    let solved = design(&loose, &z0, None, coarse, |it| {
+    let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, |it| {
         observe.iteration(it);
         its.push(*it);
     });
@@ -1219,6 +1227,7 @@ fn design(
     z0: &[f64],
     warm: Option<&WarmStart>,
     nodes: usize,
+    mesh: Mesh,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Solved> {
     check_resolvable(cfg, nodes)?;
@@ -1243,11 +1252,22 @@ fn design(
         }
     }
     let z0 = problem.project(&z0)?;
+    let settings = match mesh {
+        Mesh::Coarse => ScpSettings {
+            max_iterations: COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
+            tolerance: COARSE_TOLERANCE.max(cfg.free.tolerance),
+            conic: ConicSettings::COARSE,
+            ..Default::default()
+        },
+        Mesh::Final => ScpSettings {
+            max_iterations: cfg.free.max_iterations,
+            tolerance: cfg.free.tolerance,
+            ..Default::default()
+        },
+    };
     let settings = ScpSettings {
-        max_iterations: cfg.free.max_iterations,
-        tolerance: cfg.free.tolerance,
         feasibility: cfg.free.attitude_tolerance,
-        ..Default::default()
+        ..settings
     };
     let unit = problem.objective_unit();
     let warm = warm.filter(|w| problem.multipliers_fit(&w.multipliers));
@@ -1328,6 +1348,7 @@ fn inside_envelope(
                 &solved.plan.z,
                 Some(&solved.res.warm),
                 nodes,
+                Mesh::Final,
                 |it: &ScpIteration| {
                     observe(&ScpIteration {
                         iteration: it.iteration + n0,
@@ -1358,7 +1379,7 @@ pub fn optimize_start(
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let start = std::time::Instant::now();
-    let solved = design(cfg, z0, warm, nodes, &mut observe)?;
+    let solved = design(cfg, z0, warm, nodes, Mesh::Final, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(cfg, solved.node_peak));
     }
@@ -1592,7 +1613,7 @@ pub struct MeshCheck {
 pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = Transcription::new(3, nodes).sample(&r.plan);
-    let fine = design(cfg, &z0, None, nodes, |_| {})?;
+    let fine = design(cfg, &z0, None, nodes, Mesh::Final, |_| {})?;
     let (peak, value) = dense_objective(cfg, &fine.plan);
     Ok(MeshCheck {
         nodes,

@@ -195,6 +195,9 @@ pub struct ScpSettings {
     /// Whether the model's curvature is scaled by the steps' `rho` (default
     /// on), see [`Multipliers::adapt_curvature`].
     pub adapt_curvature: bool,
+    /// How exactly the subproblems and corrections are solved (default
+    /// [`ConicSettings::MODEL`]).
+    pub conic: ConicSettings,
 }
 
 impl Default for ScpSettings {
@@ -210,6 +213,7 @@ impl Default for ScpSettings {
             watchdog: true,
             correction_rounds: 3,
             adapt_curvature: true,
+            conic: ConicSettings::MODEL,
         }
     }
 }
@@ -835,7 +839,7 @@ fn iterate(
     let (data, constant, term_rows, limit_rows) =
         subproblem(p, z, &lin, scales, radius, w, &hessian);
     let clock = Instant::now();
-    let (st, x, obj) = solve_reusing_with(&mut solvers.subproblem, &data, ConicSettings::MODEL)?;
+    let (st, x, obj) = solve_reusing_with(&mut solvers.subproblem, &data, settings.conic)?;
     let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
     if !st.ok() {
         return Err(Error::Solver {
@@ -929,7 +933,7 @@ fn iterate(
             }
             let bounds = with_bounds.then_some((&at, x[n], sigma));
             let cd = correction(p, &trial, &lin, &rhs, scales, bounds);
-            if let Ok((cs, dc, _)) = solve_reusing_with(slot, &cd, ConicSettings::MODEL)
+            if let Ok((cs, dc, _)) = solve_reusing_with(slot, &cd, settings.conic)
                 && cs.ok()
             {
                 let corrected: Vec<f64> = trial.iter().zip(&dc[..n]).map(|(a, b)| a + b).collect();
