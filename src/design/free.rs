@@ -1252,22 +1252,24 @@ fn design(
         }
     }
     let z0 = problem.project(&z0)?;
-    let settings = match mesh {
-        Mesh::Coarse => ScpSettings {
-            max_iterations: COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
-            tolerance: COARSE_TOLERANCE.max(cfg.free.tolerance),
-            conic: ConicSettings::COARSE,
-            ..Default::default()
-        },
-        Mesh::Final => ScpSettings {
-            max_iterations: cfg.free.max_iterations,
-            tolerance: cfg.free.tolerance,
-            ..Default::default()
-        },
+    let (max_iterations, tolerance, conic) = match mesh {
+        Mesh::Coarse => (
+            COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
+            COARSE_TOLERANCE.max(cfg.free.tolerance),
+            ConicSettings::COARSE,
+        ),
+        Mesh::Final => (
+            cfg.free.max_iterations,
+            cfg.free.tolerance,
+            ConicSettings::MODEL,
+        ),
     };
     let settings = ScpSettings {
+        max_iterations,
+        tolerance,
         feasibility: cfg.free.attitude_tolerance,
-        ..settings
+        conic,
+        ..Default::default()
     };
     let unit = problem.objective_unit();
     let warm = warm.filter(|w| problem.multipliers_fit(&w.multipliers));
