@@ -227,3 +227,35 @@ fn a_broken_phase_problem_surfaces_as_a_solver_status() {
     let _ = good.timing.t.len();
     let _ = ShapePlan::duration(&cosine_plan(1.0, 1.0, [1.0; 3]));
 }
+
+#[test]
+fn the_fold_solved_alongside_the_twist_root_find_is_the_same_design() {
+    // the robot (universal joint): its fold is solved on its own thread
+    // while the twist is found; the three phases must come back in order and
+    // equal the phases solved together, and a failed root-find must fail
+    // the bend (after the fold's thread is joined)
+    let c = cfg("robot-universal", &[]);
+    let cat = c.cat();
+    let bend = 1.2;
+    let twist = twist_for(&cat, bend).unwrap();
+    let [fold, arc, unfold] = Path::phased(bend, twist);
+    let mut together = TimingProblem::new(20, c.norm());
+    let all = together.solve_all(&cat, &[&fold, &arc, &unfold]).unwrap();
+    let mut apart = TimingProblem::new(20, c.norm());
+    let alongside = apart
+        .solve_alongside(&cat, &fold, || Ok(vec![arc, unfold]))
+        .unwrap();
+    assert_eq!(alongside.len(), 3);
+    for (a, b) in all.iter().zip(&alongside) {
+        assert_eq!(a.unit_peak, b.unit_peak);
+        assert_eq!(a.timing, b.timing);
+    }
+    // the twist phase differs from the fold: the order is checked, not assumed
+    assert_ne!(all[0].unit_peak, all[1].unit_peak);
+    let failed = apart.solve_alongside(&cat, &fold, || {
+        Err(Error::Unreachable {
+            reason: "no twist".into(),
+        })
+    });
+    assert!(matches!(failed, Err(Error::Unreachable { .. })));
+}

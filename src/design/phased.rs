@@ -165,12 +165,18 @@ fn design_to(
     bend: f64,
     twist_tol: f64,
 ) -> Result<BendDesign> {
-    let twist = twist_to(cat, bend, twist_tol)?;
-    let paths = Path::phased(bend, twist);
-    let solved = match cat.joint {
-        Joint::NoTwist => problem.solve_all(cat, &[&paths[0], &paths[1]])?,
-        Joint::Universal => problem.solve_all(cat, &[&paths[0], &paths[1], &paths[2]])?,
-    };
+    // the fold does not depend on the twist: it is solved while the twist
+    // is root-found
+    let [fold_path, ..] = Path::phased(bend, 0.0);
+    let mut twist = 0.0;
+    let solved = problem.solve_alongside(cat, &fold_path, || {
+        twist = twist_to(cat, bend, twist_tol)?;
+        let [_, twist_path, unfold_path] = Path::phased(bend, twist);
+        Ok(match cat.joint {
+            Joint::NoTwist => vec![twist_path],
+            Joint::Universal => vec![twist_path, unfold_path],
+        })
+    })?;
     let mut solved = solved.into_iter();
     let (fold, twist_phase) = (solved.next().unwrap(), solved.next().unwrap());
     let unfold = solved.next().unwrap_or_else(|| PhaseTiming {

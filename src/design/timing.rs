@@ -130,29 +130,69 @@ impl TimingProblem {
     /// the phases of a bend are independent SOCPs (a bend's two or three
     /// SOCPs take the time of the longest on two cores).
     pub fn solve_all(&mut self, cat: &Cat, paths: &[&Path]) -> Result<Vec<PhaseTiming>> {
-        if paths.is_empty() {
-            return Ok(Vec::new());
-        }
         if self.solvers.len() < paths.len() {
             self.solvers.resize_with(paths.len(), || None);
         }
+        solve_paths(self.socp, &mut self.solvers, cat, paths)
+    }
+
+    /// Solves the phase along `first` on its own thread while `rest` finds
+    /// the other phases' paths on this one (the twist root-find, which the
+    /// fold does not wait for), then those as [`Self::solve_all`] does; the
+    /// results in that order.
+    pub fn solve_alongside(
+        &mut self,
+        cat: &Cat,
+        first: &Path,
+        rest: impl FnOnce() -> Result<Vec<Path>>,
+    ) -> Result<Vec<PhaseTiming>> {
         let socp = self.socp;
-        let (first, rest) = self.solvers.split_at_mut(1);
+        if self.solvers.len() < 3 {
+            self.solvers.resize_with(3, || None);
+        }
+        let (head, tail) = self.solvers.split_at_mut(1);
         std::thread::scope(|scope| {
-            let others: Vec<_> = paths[1..]
-                .iter()
-                .zip(rest.iter_mut())
-                .map(|(&path, slot)| scope.spawn(move || socp.solve(slot, cat, path)))
-                .collect();
-            let mut out = vec![socp.solve(&mut first[0], cat, paths[0])];
-            out.extend(
-                others
-                    .into_iter()
-                    .map(|h| h.join().expect("a phase SOCP thread panicked")),
-            );
-            out.into_iter().collect()
+            let fold = scope.spawn(|| socp.solve(&mut head[0], cat, first));
+            let others = rest().and_then(|paths| {
+                let refs: Vec<&Path> = paths.iter().collect();
+                solve_paths(socp, &mut tail[..refs.len()], cat, &refs)
+            });
+            let fold = fold.join().expect("a phase SOCP thread panicked");
+            let mut out = vec![fold?];
+            out.extend(others?);
+            Ok(out)
         })
     }
+}
+
+/// The phases along `paths`, one solver slot each, the first on this
+/// thread and the others on their own.
+fn solve_paths(
+    socp: PhaseSocp,
+    slots: &mut [Option<ConicSolver>],
+    cat: &Cat,
+    paths: &[&Path],
+) -> Result<Vec<PhaseTiming>> {
+    let Some((first, rest)) = slots.split_first_mut() else {
+        return Ok(Vec::new());
+    };
+    if paths.is_empty() {
+        return Ok(Vec::new());
+    }
+    std::thread::scope(|scope| {
+        let others: Vec<_> = paths[1..]
+            .iter()
+            .zip(rest.iter_mut())
+            .map(|(&path, slot)| scope.spawn(move || socp.solve(slot, cat, path)))
+            .collect();
+        let mut out = vec![socp.solve(first, cat, paths[0])];
+        out.extend(
+            others
+                .into_iter()
+                .map(|h| h.join().expect("a phase SOCP thread panicked")),
+        );
+        out.into_iter().collect()
+    })
 }
 
 impl PhaseSocp {
