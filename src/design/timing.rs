@@ -139,7 +139,8 @@ impl TimingProblem {
     /// Solves the phase along `first` on its own thread while `rest` finds
     /// the other phases' paths on this one (the twist root-find, which the
     /// fold does not wait for), then those as [`Self::solve_all`] does; the
-    /// results in that order.
+    /// results in that order. A bend has three phases: `rest` gives at most
+    /// two paths.
     pub fn solve_alongside(
         &mut self,
         cat: &Cat,
@@ -150,12 +151,14 @@ impl TimingProblem {
         if self.solvers.len() < 3 {
             self.solvers.resize_with(3, || None);
         }
+        let most = self.solvers.len() - 1;
         let (head, tail) = self.solvers.split_at_mut(1);
         std::thread::scope(|scope| {
             let fold = scope.spawn(|| socp.solve(&mut head[0], cat, first));
             let others = rest().and_then(|paths| {
+                assert!(paths.len() <= most, "a bend has at most three phases");
                 let refs: Vec<&Path> = paths.iter().collect();
-                solve_paths(socp, &mut tail[..refs.len()], cat, &refs)
+                solve_paths(socp, tail, cat, &refs)
             });
             let fold = fold.join().expect("a phase SOCP thread panicked");
             let mut out = vec![fold?];
@@ -165,27 +168,26 @@ impl TimingProblem {
     }
 }
 
-/// The phases along `paths`, one solver slot each, the first on this
-/// thread and the others on their own.
+/// The phases along `paths`, with the solver slots in that order (at least
+/// one per path), the first on this thread and the others on their own.
 fn solve_paths(
     socp: PhaseSocp,
     slots: &mut [Option<ConicSolver>],
     cat: &Cat,
     paths: &[&Path],
 ) -> Result<Vec<PhaseTiming>> {
-    let Some((first, rest)) = slots.split_first_mut() else {
+    assert!(slots.len() >= paths.len(), "a solver slot per phase");
+    let Some((&first_path, rest_paths)) = paths.split_first() else {
         return Ok(Vec::new());
     };
-    if paths.is_empty() {
-        return Ok(Vec::new());
-    }
+    let (first, rest) = slots.split_first_mut().expect("a solver slot per phase");
     std::thread::scope(|scope| {
-        let others: Vec<_> = paths[1..]
+        let others: Vec<_> = rest_paths
             .iter()
             .zip(rest.iter_mut())
             .map(|(&path, slot)| scope.spawn(move || socp.solve(slot, cat, path)))
             .collect();
-        let mut out = vec![socp.solve(first, cat, paths[0])];
+        let mut out = vec![socp.solve(first, cat, first_path)];
         out.extend(
             others
                 .into_iter()
