@@ -173,7 +173,13 @@ impl FreeProblem {
 
     /// Number of flattened torque rows (two per check point).
     pub fn torques_len(&self) -> usize {
-        3 * 2 * (2 * self.tr.nodes - 1)
+        3 * 2 * self.points_per_phase()
+    }
+
+    /// Torque check points per phase: every node and every interval
+    /// midpoint ([`FreeProblem::check_points`]).
+    fn points_per_phase(&self) -> usize {
+        2 * self.tr.nodes - 1
     }
 
     /// The objective's unit in physical terms: N m (peak), s (time) or
@@ -297,7 +303,7 @@ impl FreeProblem {
     /// `(q_k, q^_k, q^^_k, q^^_{k+1})` of interval `k`.
     fn check_points(&self, z: &[f64], p: usize) -> Vec<CheckPoint> {
         let tr = &self.tr;
-        let mut out = Vec::with_capacity(2 * tr.nodes - 1);
+        let mut out = Vec::with_capacity(self.points_per_phase());
         for k in 0..tr.nodes {
             let kk = k.min(tr.nodes - 2);
             let d = tr.interval(z, p, kk);
@@ -317,7 +323,7 @@ impl FreeProblem {
     /// order) for `integral_0^1 f ds`.
     fn quadrature(&self) -> Vec<f64> {
         let h = self.tr.h();
-        let mut w = Vec::with_capacity(2 * self.tr.nodes - 1);
+        let mut w = Vec::with_capacity(self.points_per_phase());
         for k in 0..self.tr.nodes - 1 {
             w.push(if k == 0 { h / 6.0 } else { h / 3.0 });
             w.push(2.0 * h / 3.0);
@@ -333,7 +339,7 @@ impl FreeProblem {
         let tr = &self.tr;
         let it = self.cat.i_t();
         let weights = self.quadrature();
-        let mut out = Vec::with_capacity(3 * (2 * tr.nodes - 1));
+        let mut out = Vec::with_capacity(3 * self.points_per_phase());
         let mut seconds = self.second_terms.borrow_mut();
         if want_grad {
             seconds.clear();
@@ -584,7 +590,7 @@ impl FreeProblem {
             6.0 / (t.powi(4) * it),
         );
         let mut blocks = vec![nalgebra::SMatrix::<f64, 9, 9>::zeros(); n - 1];
-        let first = p * (2 * n - 1);
+        let first = p * self.points_per_phase();
         for (i, ((k, q, v, a, coef), w)) in self
             .check_points(z, p)
             .into_iter()
