@@ -114,6 +114,13 @@ impl Publisher {
     /// Writes every file into the staging folder, then switches the link to it.
     /// Returns the files' published paths.
     pub fn publish(mut self, out: Output) -> Result<Vec<PathBuf>> {
+        self.switch(&out)?;
+        self.retire();
+        Ok(out.files.iter().map(|(n, _)| self.link().join(n)).collect())
+    }
+
+    /// Writes the files and switches the link to the staging folder.
+    fn switch(&mut self, out: &Output) -> Result<()> {
         let staging = self.staging();
         for (name, bytes) in &out.files {
             let path = staging.join(name);
@@ -134,11 +141,22 @@ impl Publisher {
             werr(e)
         })?;
         self.published = true;
+        Ok(())
+    }
+
+    /// After [`Publisher::switch`]: releases the lock and removes superseded sets,
+    /// this one included if another writer switched the link meanwhile.
+    fn retire(&self) {
         // the link is switched before the lock goes: a set without a lock file
         // is either the link's target or superseded
         let _ = fs::remove_file(self.lock_path(&self.id));
         self.remove_leftovers();
-        Ok(out.files.iter().map(|(n, _)| self.link().join(n)).collect())
+        // A writer that switched the link after ours, while we still held the
+        // lock, skipped our set as live; it is superseded, and only we see it.
+        let own = format!(".{}.{}", self.set, self.id);
+        if fs::read_link(self.link()).ok().as_deref() != Some(Path::new(&own)) {
+            let _ = fs::remove_dir_all(self.staging());
+        }
     }
 
     fn lock_path(&self, id: &str) -> PathBuf {
@@ -292,5 +310,62 @@ fn create_dirs(dir: &Path) -> std::result::Result<Vec<PathBuf>, (PathBuf, std::i
 fn remove_created(created: &[PathBuf]) {
     for d in created.iter().rev() {
         let _ = fs::remove_dir(d);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn hidden_sets(dir: &Path) -> Vec<String> {
+        let mut v: Vec<String> = fs::read_dir(dir)
+            .unwrap()
+            .filter_map(|e| e.ok()?.file_name().into_string().ok())
+            .filter(|n| n.starts_with(".s.") && !n.ends_with(".lock"))
+            .collect();
+        v.sort();
+        v
+    }
+
+    fn one_file(text: &str) -> Output {
+        let mut o = Output::default();
+        o.add("a.txt", text);
+        o
+    }
+
+    /// A switches the link, B switches it after and cleans up while A still
+    /// holds its lock (so B skips A as live): A must then remove its own set.
+    #[test]
+    fn a_writer_superseded_while_it_held_its_lock_removes_its_own_set() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut a = Publisher::begin(dir.path(), "s").unwrap();
+        let b = Publisher::begin(dir.path(), "s").unwrap();
+        a.switch(&one_file("A")).unwrap();
+        b.publish(one_file("B")).unwrap();
+        assert_eq!(hidden_sets(dir.path()).len(), 2, "B skipped A as live");
+        a.retire();
+        let left = hidden_sets(dir.path());
+        assert_eq!(left.len(), 1, "{left:?}");
+        assert_eq!(
+            fs::read_to_string(dir.path().join("s/a.txt")).unwrap(),
+            "B",
+            "the last switch is published"
+        );
+        assert_eq!(
+            Path::new(&left[0]),
+            fs::read_link(dir.path().join("s")).unwrap()
+        );
+    }
+
+    /// In the other order (A's lock gone before B cleans up) B removes A.
+    #[test]
+    fn a_superseded_set_without_a_lock_is_removed_by_the_next_writer() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = Publisher::begin(dir.path(), "s").unwrap();
+        let b = Publisher::begin(dir.path(), "s").unwrap();
+        a.publish(one_file("A")).unwrap();
+        b.publish(one_file("B")).unwrap();
+        assert_eq!(hidden_sets(dir.path()).len(), 1);
+        assert_eq!(fs::read_to_string(dir.path().join("s/a.txt")).unwrap(), "B");
     }
 }
