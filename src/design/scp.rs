@@ -715,15 +715,37 @@ fn correction(
 /// correction keeps the path off the better conic one).
 const SENSITIVITY_ACCEPT: f64 = 0.5;
 
-/// One subproblem as built: its point, linearisation, data and Hessian.
+/// One subproblem as built: its point, linearisation, data, the rows of
+/// its terms and limits ([`subproblem`]'s), and the penalty weight.
 struct Model<'a> {
     z: &'a [f64],
     lin: &'a Linearization,
     data: &'a ConicData,
-    hessian: &'a Triplets,
-    scales: &'a [f64],
-    radius: f64,
+    term_rows: &'a TermRows,
+    limit_rows: &'a TermRows,
     w: f64,
+}
+
+impl Model<'_> {
+    /// The change of the subproblem's `b` when its residuals, terms and
+    /// limited terms change by `d`: [`subproblem`] puts the residuals first
+    /// (`b = -r`), and a term with sign `s` in a row's Lagrangian has `-s`
+    /// times its value in that row's `b` (what rebuilding the subproblem
+    /// would give, without its matrix).
+    fn rhs_change(&self, d: &Values) -> Vec<f64> {
+        let mut db = vec![0.0; self.data.b.len()];
+        for (b, r) in db.iter_mut().zip(&d.residual) {
+            *b = -r;
+        }
+        for (rows, change) in [(self.term_rows, &d.terms), (self.limit_rows, &d.limited)] {
+            for (rows, c) in rows.iter().zip(change) {
+                for &(row, sign) in rows {
+                    db[row] -= sign * c;
+                }
+            }
+        }
+        db
+    }
 }
 
 /// Fletcher's second-order correction, to first order: the subproblem
@@ -752,36 +774,20 @@ fn sensitivity_correction(
     let mut at = at.clone();
     let mut best: Option<(Vec<f64>, Merit)> = None;
     for _ in 0..rounds {
-        // each value where its linearisation at z meets c(z + d)
-        let shifted = |vals: &[f64], jac: &Triplets, actual: &[f64]| -> Vec<f64> {
+        // each value's linearisation error at z + d, c(z + d) - c(z) - J d
+        let error = |vals: &[f64], jac: &Triplets, actual: &[f64]| -> Vec<f64> {
             let mut error: Vec<f64> = actual.iter().zip(vals).map(|(a, v)| a - v).collect();
             for &(r, c, v) in jac {
                 error[r] -= v * d[c];
             }
-            vals.iter().zip(&error).map(|(v, e)| v + e).collect()
+            error
         };
-        let moved = Linearization {
-            terms: shifted(&lin.terms, &lin.terms_jac, &at.terms),
-            limited: shifted(&lin.limited, &lin.limited_jac, &at.limited),
-            residual: shifted(&lin.residual, &lin.residual_jac, &at.residual),
-            ..lin.clone()
+        let shift = Values {
+            terms: error(&lin.terms, &lin.terms_jac, &at.terms),
+            limited: error(&lin.limited, &lin.limited_jac, &at.limited),
+            residual: error(&lin.residual, &lin.residual_jac, &at.residual),
         };
-        let (data, ..) = subproblem(
-            p,
-            model.z,
-            &moved,
-            model.scales,
-            model.radius,
-            model.w,
-            model.hessian,
-        );
-        let db: Vec<f64> = data
-            .b
-            .iter()
-            .zip(&model.data.b)
-            .map(|(a, b)| a - b)
-            .collect();
-        let dx = kkt.primal_change(&db);
+        let dx = kkt.primal_change(&model.rhs_change(&shift));
         if dx.iter().any(|v| !v.is_finite()) {
             break;
         }
@@ -894,9 +900,8 @@ fn iterate(
                     z,
                     lin: &lin,
                     data: &data,
-                    hessian: &hessian,
-                    scales,
-                    radius,
+                    term_rows: &term_rows,
+                    limit_rows: &limit_rows,
                     w,
                 };
                 sensitivity_correction(p, &model, &x[..n], &at, solver, settings.correction_rounds)
@@ -1532,6 +1537,131 @@ mod tests {
         );
     }
 
+    /// Peak-cost terms and limited terms (two of dimension 2 each) and one
+    /// residual, in either norm, the limits on rows of their own or on the
+    /// epigraph: every kind of row whose `b` holds a value.
+    struct Peaked {
+        norm: TorqueNorm,
+        on_epigraph: bool,
+    }
+
+    impl ScpProblem for Peaked {
+        fn dim(&self) -> usize {
+            2
+        }
+        fn term_dim(&self) -> usize {
+            2
+        }
+        fn norm(&self) -> TorqueNorm {
+            self.norm
+        }
+        fn evaluate(&self, z: &[f64]) -> Values {
+            let l = self.linearize(z);
+            Values {
+                terms: l.terms,
+                limited: l.limited,
+                residual: l.residual,
+            }
+        }
+        fn linearize(&self, z: &[f64]) -> Linearization {
+            let (a, b) = (z[0], z[1]);
+            Linearization {
+                terms: vec![a * a, b, a * b, b * b],
+                terms_jac: vec![
+                    (0, 0, 2.0 * a),
+                    (1, 1, 1.0),
+                    (2, 0, b),
+                    (2, 1, a),
+                    (3, 1, 2.0 * b),
+                ],
+                limited: vec![a, b * b, a + b, a * b],
+                limited_jac: vec![
+                    (0, 0, 1.0),
+                    (1, 1, 2.0 * b),
+                    (2, 0, 1.0),
+                    (2, 1, 1.0),
+                    (3, 0, b),
+                    (3, 1, a),
+                ],
+                residual: vec![a + b - 1.0],
+                residual_jac: vec![(0, 0, 1.0), (0, 1, 1.0)],
+            }
+        }
+        fn add_constraints(&self, _: &mut ConicData, _: &[f64], _: &dyn Fn(usize) -> usize) {}
+        fn scales(&self) -> Vec<f64> {
+            vec![1.0, 1.0]
+        }
+        fn limit(&self) -> Option<f64> {
+            Some(2.0)
+        }
+        fn limited_are_terms(&self) -> bool {
+            self.on_epigraph
+        }
+    }
+
+    #[test]
+    fn the_right_hand_side_change_is_what_rebuilding_the_subproblem_gives() {
+        let z = [0.3, 0.9];
+        let shift = Values {
+            terms: vec![0.01, -0.02, 0.03, 0.005],
+            limited: vec![-0.04, 0.015, 0.02, -0.01],
+            residual: vec![0.07],
+        };
+        for norm in [TorqueNorm::Euclidean, TorqueNorm::PerMotor] {
+            for on_epigraph in [false, true] {
+                let p = Peaked { norm, on_epigraph };
+                let lin = p.linearize(&z);
+                let moved = Linearization {
+                    terms: lin
+                        .terms
+                        .iter()
+                        .zip(&shift.terms)
+                        .map(|(a, b)| a + b)
+                        .collect(),
+                    limited: lin
+                        .limited
+                        .iter()
+                        .zip(&shift.limited)
+                        .map(|(a, b)| a + b)
+                        .collect(),
+                    residual: vec![lin.residual[0] + shift.residual[0]],
+                    ..lin.clone()
+                };
+                let build =
+                    |l: &Linearization| subproblem(&p, &z, l, &p.scales(), 0.5, 3.0, &Vec::new());
+                let (data, _, term_rows, limit_rows) = build(&lin);
+                assert_eq!(limit_rows.is_empty(), on_epigraph);
+                let rebuilt: Vec<f64> = build(&moved)
+                    .0
+                    .b
+                    .iter()
+                    .zip(&data.b)
+                    .map(|(a, b)| a - b)
+                    .collect();
+                let model = Model {
+                    z: &z,
+                    lin: &lin,
+                    data: &data,
+                    term_rows: &term_rows,
+                    limit_rows: &limit_rows,
+                    w: 3.0,
+                };
+                let db = model.rhs_change(&shift);
+                assert_eq!(db.len(), rebuilt.len());
+                assert!(
+                    rebuilt.iter().filter(|v| v.abs() > 1e-3).count() >= 5,
+                    "{rebuilt:?}"
+                );
+                for (i, (a, b)) in db.iter().zip(&rebuilt).enumerate() {
+                    assert!(
+                        (a - b).abs() < 1e-15,
+                        "{norm:?} epigraph {on_epigraph}, row {i}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+
     #[test]
     fn the_sensitivity_correction_puts_a_step_along_the_circle_back_on_it() {
         // from (0.6, 0.8) the linearised circle is a tangent line: the step
@@ -1542,7 +1672,8 @@ mod tests {
         let scales = p.scales();
         let (w, radius) = (2.0, 0.3);
         let hessian = Triplets::new();
-        let (data, ..) = subproblem(&p, &z, &lin, &scales, radius, w, &hessian);
+        let (data, _, term_rows, limit_rows) =
+            subproblem(&p, &z, &lin, &scales, radius, w, &hessian);
         let mut solver = ConicSolver::with_settings(&data, ConicSettings::MODEL).unwrap();
         let (st, x, _) = solver.solve();
         assert!(st.ok(), "{st:?}");
@@ -1557,9 +1688,8 @@ mod tests {
             z: &z,
             lin: &lin,
             data: &data,
-            hessian: &hessian,
-            scales: &scales,
-            radius,
+            term_rows: &term_rows,
+            limit_rows: &limit_rows,
             w,
         };
         let (corrected, m) =
