@@ -217,8 +217,8 @@ pub struct FreeConfig {
     pub attitude_tolerance: f64,
     /// Mesh continuation of peak-torque designs without a torque-speed
     /// line or speed limit (default true): from a
-    /// seed, solve at half the nodes first (halving again while that leaves
-    /// at least 20 per phase), loosely, and refine; see
+    /// seed, solve at a third of the nodes first (or half; again while that
+    /// leaves at least 20 per phase), loosely, and refine; see
     /// `design::free::coarse_start`.
     pub mesh_continuation: bool,
 }

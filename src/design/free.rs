@@ -25,9 +25,9 @@
 //! in the world frame.
 //!
 //! From a seed, a peak-torque design without a torque-speed line or speed
-//! limit is solved on coarser meshes first (half the nodes, and so on while
-//! 20 or more remain per phase), loosely, and each starts the next
-//! ([`coarse_start`], mesh continuation).
+//! limit is solved on coarser meshes first (a third of the nodes, or half,
+//! and so on while 20 or more remain per phase), loosely, and each starts
+//! the next ([`coarse_start`], mesh continuation).
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
@@ -1074,6 +1074,26 @@ pub fn optimize_from_observed(
 /// halved twice) took 30 iterations instead of 12.
 const COARSEST_NODES: usize = 20;
 
+/// The mesh below `nodes` in the continuation: a third of the nodes while
+/// that leaves [`COARSEST_NODES`], else half, else none. A coarse iteration
+/// at a third costs about half one at a half, and the finer mesh still
+/// took 3 or 4 iterations from it: with a third, the robot's design (60 to
+/// 20 nodes per phase instead of 30) from the phased seed took 4.0 G
+/// instructions instead of 4.6 G (14 iterations instead of 12), from the
+/// analytic seed 3.8 G instead of 4.0 G (18 instead of 14), both to lower
+/// peaks (0.052961 and 0.052932 N m instead of 0.053005 and 0.052967); the
+/// seed's per-motor design at 120 nodes per phase (40 and 20 before it
+/// instead of 60 and 30) 5.4 G instead of 8.6 G, 0.317362 N m instead of
+/// 0.317229. Straight to 20 took 6.8 G there, and a quarter first 6.0 G;
+/// at 80 nodes per phase a third (26) took 4.5 G, half (40 and 20) 4.8 G,
+/// a quarter (20) 5.0 G.
+fn coarser(nodes: usize) -> Option<usize> {
+    [3, 2]
+        .into_iter()
+        .map(|k| nodes / k)
+        .find(|&c| c >= COARSEST_NODES)
+}
+
 /// The stopping tolerance on the coarser meshes (the finest keeps
 /// `free.tolerance`): a start needs no more. On issue 11's six cases
 /// (`examples/bench_free`) 1e-2, 3e-3 and 1e-3 took the same work within
@@ -1142,10 +1162,9 @@ pub fn iterations_text(levels: &[MeshLevel]) -> String {
 /// A coarse mesh's summary and its iterations.
 type Coarse = (MeshLevel, Vec<ScpIteration>);
 
-/// Mesh continuation: the start at `nodes` per phase, the design at half
-/// the nodes (itself started the same way while half leaves at least
-/// [`COARSEST_NODES`]) solved to [`COARSE_TOLERANCE`] and sampled on the
-/// finer mesh; for the peak-torque objective without a torque-speed line
+/// Mesh continuation: the start at `nodes` per phase, the design on the
+/// mesh below ([`coarser`], itself started the same way) solved to
+/// [`COARSE_TOLERANCE`] and sampled on the finer mesh; for the peak-torque objective without a torque-speed line
 /// or speed limit (`Config::uses_envelope`). On
 /// `examples/convergence_matrix` the time and energy designs took more
 /// iterations with it (the robot's least time from the analytic seed 62
@@ -1167,10 +1186,9 @@ fn coarse_start(
     levels: &mut Vec<Coarse>,
 ) -> Vec<f64> {
     let tr = Transcription::new(3, nodes);
-    let coarse = nodes / 2;
-    if coarse < COARSEST_NODES {
+    let Some(coarse) = coarser(nodes) else {
         return tr.sample(seed_plan);
-    }
+    };
     let z0 = coarse_start(cfg, seed_plan, coarse, observe, levels);
     let mut its = Vec::new();
     observe.mesh(coarse);
@@ -1666,6 +1684,31 @@ pub fn optimize_observed(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_continuation_coarsens_by_a_third_then_a_half_down_to_twenty_nodes() {
+        let chain = |mut n: usize| {
+            let mut meshes = vec![n];
+            while let Some(c) = coarser(n) {
+                meshes.push(c);
+                n = c;
+            }
+            meshes
+        };
+        assert_eq!(chain(40), [40, 20]);
+        assert_eq!(chain(60), [60, 20]);
+        assert_eq!(chain(120), [120, 40, 20]);
+        assert_eq!(chain(80), [80, 26]);
+        assert_eq!(chain(39), [39]);
+        for n in 1..400 {
+            let c = chain(n);
+            assert!(c[1..].iter().all(|&m| m >= COARSEST_NODES), "{c:?}");
+            assert!(
+                c.windows(2).all(|w| w[1] == w[0] / 3 || w[1] == w[0] / 2),
+                "{c:?}"
+            );
+        }
+    }
 
     #[test]
     fn torque_hessian_matches_second_differences_of_the_inverse_dynamics() {
