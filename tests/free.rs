@@ -459,7 +459,7 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
     }
 }
 
-/// The free-form design's phased seed is a coarse search (20 grid intervals per
+/// The free-form design's phased seed is a coarse search (15 grid intervals per
 /// phase, the bend to half a degree, no certified re-solve): it must lead to
 /// the optimum the certified phased design leads to.
 #[test]
