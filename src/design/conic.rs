@@ -332,25 +332,40 @@ fn clarabel_settings(s: ConicSettings) -> DefaultSettings<f64> {
         .expect("valid Clarabel settings")
 }
 
+/// Compressed-column pattern of the triplets `(rows[k], cols[k])`:
+/// `(colptr, rowval, slot)`, rows ascending within each column, duplicates
+/// merged, `slot[k]` the position of triplet `k`. The slots are bucketed by
+/// column (a counting sort) and each column's few entries sorted by row: a
+/// KKT pattern of 40k triplets took 3.3 ms with one comparison sort of all.
 fn csc(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
-    // order slots by (col, row), merging duplicates
-    let mut order: Vec<usize> = (0..rows.len()).collect();
-    order.sort_by_key(|&i| (cols[i], rows[i]));
-    let mut colptr = vec![0usize; n + 1];
-    let mut rowval = Vec::new();
-    let mut slot = vec![0usize; rows.len()];
-    let mut last: Option<(usize, usize)> = None;
-    for &i in &order {
-        let key = (cols[i], rows[i]);
-        if last != Some(key) {
-            rowval.push(rows[i]);
-            colptr[cols[i] + 1] += 1;
-            last = Some(key);
-        }
-        slot[i] = rowval.len() - 1;
+    let mut start = vec![0usize; n + 1];
+    for &c in cols {
+        start[c + 1] += 1;
     }
     for c in 0..n {
-        colptr[c + 1] += colptr[c];
+        start[c + 1] += start[c];
+    }
+    let mut order = vec![0usize; rows.len()];
+    let mut next = start.clone();
+    for (k, &c) in cols.iter().enumerate() {
+        order[next[c]] = k;
+        next[c] += 1;
+    }
+    let mut colptr = vec![0usize; n + 1];
+    let mut rowval = Vec::with_capacity(rows.len());
+    let mut slot = vec![0usize; rows.len()];
+    for c in 0..n {
+        let column = &mut order[start[c]..start[c + 1]];
+        column.sort_unstable_by_key(|&k| rows[k]);
+        let mut last = None;
+        for &k in column.iter() {
+            if last != Some(rows[k]) {
+                rowval.push(rows[k]);
+                last = Some(rows[k]);
+            }
+            slot[k] = rowval.len() - 1;
+        }
+        colptr[c + 1] = rowval.len();
     }
     debug_assert!(rows.iter().all(|&r| r < m));
     (colptr, rowval, slot)
@@ -573,6 +588,44 @@ pub fn solve_reusing_with(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_compressed_pattern_sorts_merges_and_maps_every_triplet() {
+        // a pseudo-random pattern with many duplicates and empty columns
+        let (m, n) = (37, 23);
+        let mut x: u64 = 0x9e37_79b9_7f4a_7c15;
+        let mut draw = |k: usize| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % k as u64) as usize
+        };
+        let (rows, cols): (Vec<usize>, Vec<usize>) =
+            (0..400).map(|_| (draw(m), 2 * draw(n / 2))).unzip();
+        let (colptr, rowval, slot) = csc(m, n, &rows, &cols);
+        assert_eq!(colptr.len(), n + 1);
+        assert_eq!(colptr[n], rowval.len());
+        let mut distinct: Vec<(usize, usize)> =
+            cols.iter().copied().zip(rows.iter().copied()).collect();
+        distinct.sort();
+        distinct.dedup();
+        assert_eq!(rowval.len(), distinct.len());
+        for c in 0..n {
+            let column = &rowval[colptr[c]..colptr[c + 1]];
+            assert!(
+                column.windows(2).all(|w| w[0] < w[1]),
+                "column {c}: {column:?}"
+            );
+            if c % 2 == 1 {
+                assert!(column.is_empty());
+            }
+        }
+        for k in 0..rows.len() {
+            let s = slot[k];
+            assert_eq!(rowval[s], rows[k]);
+            assert!(colptr[cols[k]] <= s && s < colptr[cols[k] + 1]);
+        }
+    }
 
     #[test]
     fn small_socp_and_update_in_place() {
