@@ -88,6 +88,9 @@ pub struct FreeProblem {
     /// linearisation, in [`FreeProblem::check_points`] order: the Hessian at
     /// the same point reads them instead of evaluating them again.
     second_terms: std::cell::RefCell<Vec<([f64; 2], ShapeTerms)>>,
+    /// Whether the torque is checked at the interval midpoints too (true
+    /// but on a coarse mesh of the continuation, [`FreeProblem::at_nodes_only`]).
+    midpoints: bool,
 }
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
@@ -159,7 +162,27 @@ impl FreeProblem {
             objective: cfg.design.objective,
             scales,
             second_terms: Default::default(),
+            midpoints: true,
         }
+    }
+
+    /// The problem with the torque checked at the nodes only: half the
+    /// torque rows, for a coarse mesh of the continuation, whose design only
+    /// starts the finer one (which checks the midpoints again). Over issue
+    /// 11's six `bench_free` cases 16.4 G instructions instead of 19.9 G,
+    /// seeding and verification included (the robot's design from the
+    /// analytic seed 13 SCP iterations instead of 18). The finer meshes end
+    /// in other local optima of the peak, mostly lower: of
+    /// `examples/convergence_matrix`'s eight continued peak designs seven
+    /// (the seed's per-motor design from the analytic seed 0.320877 instead
+    /// of 0.324756 N m, the domestic cat's from the phased seed 1.5101
+    /// instead of 1.5346) and the seed's per-motor design at 120 nodes per
+    /// phase (0.317146 instead of 0.317362); higher the seed's Euclidean
+    /// design from the analytic seed (+0.17 %) and the robot's two (+0.07 %
+    /// and +0.17 %, 0.052989 and 0.053020 N m).
+    pub fn at_nodes_only(mut self) -> Self {
+        self.midpoints = false;
+        self
     }
 
     /// [`ShapeTerms::second`] at check point `i` (phases in order) at shape
@@ -177,9 +200,13 @@ impl FreeProblem {
     }
 
     /// Torque check points per phase: every node and every interval
-    /// midpoint ([`FreeProblem::check_points`]).
+    /// midpoint, or every node ([`FreeProblem::check_points`]).
     fn points_per_phase(&self) -> usize {
-        2 * self.tr.nodes - 1
+        if self.midpoints {
+            2 * self.tr.nodes - 1
+        } else {
+            self.tr.nodes
+        }
     }
 
     /// The objective's unit in physical terms: N m (peak), s (time) or
@@ -299,7 +326,7 @@ impl FreeProblem {
 
     /// Normalised-time state at the torque check points of phase `p`: every
     /// node and every interval midpoint (the midpoints bound the torque between
-    /// nodes to second order), with the interpolation coefficients on
+    /// nodes to second order; none [`FreeProblem::at_nodes_only`]), with the interpolation coefficients on
     /// `(q_k, q^_k, q^^_k, q^^_{k+1})` of interval `k`.
     fn check_points(&self, z: &[f64], p: usize) -> Vec<CheckPoint> {
         let tr = &self.tr;
@@ -308,7 +335,11 @@ impl FreeProblem {
             let kk = k.min(tr.nodes - 2);
             let d = tr.interval(z, p, kk);
             for c in if k < tr.nodes - 1 {
-                vec![0.0, 0.5]
+                if self.midpoints {
+                    vec![0.0, 0.5]
+                } else {
+                    vec![0.0]
+                }
             } else {
                 vec![1.0]
             } {
@@ -320,10 +351,15 @@ impl FreeProblem {
     }
 
     /// Simpson weights of one phase's check points (in [`Self::check_points`]
-    /// order) for `integral_0^1 f ds`.
+    /// order) for `integral_0^1 f ds`; trapezoid weights at the nodes only.
     fn quadrature(&self) -> Vec<f64> {
         let h = self.tr.h();
         let mut w = Vec::with_capacity(self.points_per_phase());
+        if !self.midpoints {
+            let last = self.tr.nodes - 1;
+            w.extend((0..=last).map(|k| if k == 0 || k == last { h / 2.0 } else { h }));
+            return w;
+        }
         for k in 0..self.tr.nodes - 1 {
             w.push(if k == 0 { h / 6.0 } else { h / 3.0 });
             w.push(2.0 * h / 3.0);
@@ -1105,7 +1141,8 @@ const COARSE_TOLERANCE: f64 = 1e-3;
 enum Mesh {
     /// A coarser mesh, whose design only starts the next one: to
     /// [`COARSE_TOLERANCE`], at most [`COARSE_MAX_ITERATIONS`], subproblems
-    /// to [`ConicSettings::COARSE`].
+    /// to [`ConicSettings::COARSE`], the torque checked at the nodes only
+    /// ([`FreeProblem::at_nodes_only`]).
     Coarse,
     /// The design's own mesh, to the config's `free.tolerance`.
     Final,
@@ -1256,7 +1293,10 @@ fn design(
 ) -> Result<Solved> {
     check_resolvable(cfg, nodes)?;
     let tr = Transcription::new(3, nodes);
-    let problem = FreeProblem::new(cfg, nodes, z0);
+    let problem = match mesh {
+        Mesh::Coarse => FreeProblem::new(cfg, nodes, z0).at_nodes_only(),
+        Mesh::Final => FreeProblem::new(cfg, nodes, z0),
+    };
     if problem.objective == Objective::Time
         && problem.max_torque.is_none()
         && problem.max_speed.is_none()
