@@ -144,8 +144,11 @@ impl Publisher {
         Ok(())
     }
 
-    /// After [`Publisher::switch`]: releases the lock and removes superseded sets,
-    /// this one included if another writer switched the link meanwhile.
+    /// After [`Publisher::switch`]: removes the lock file and the superseded
+    /// sets, this one included if another writer switched the link
+    /// meanwhile. The lock itself stays held until the publisher drops, after
+    /// this: a writer that finds our lock file still locked skips our set,
+    /// and then this check, which comes after its switch, removes it.
     fn retire(&self) {
         // the link is switched before the lock goes: a set without a lock file
         // is either the link's target or superseded

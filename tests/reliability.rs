@@ -54,17 +54,18 @@ fn csv_peak(text: &str) -> (f64, usize) {
     (peak, n)
 }
 
-/// Reads an `analyze` set through its link once resolved; `None` when it is
-/// not there (or was superseded and removed while reading). Panics when the
-/// folder is there but incomplete, or its files come from different runs.
-/// Returns the set's `theta_deg`.
+/// Reads an `analyze` set through its link's target; `None` when there is
+/// no link yet, or the set was superseded (the link moved on) and removed
+/// while reading. Panics when a file of the set the link still points at is
+/// missing (the live set incomplete, or deleted), or the files come from
+/// different runs. Returns the set's `theta_deg`.
 fn read_analyze_set(link: &Path) -> Option<f64> {
-    let dir = std::fs::canonicalize(link).ok()?;
+    let target = std::fs::read_link(link).ok()?;
+    let dir = link.parent().unwrap().join(&target);
     let read = |name: &str| match std::fs::read_to_string(dir.join(name)) {
         Ok(t) => Some(t),
-        // superseded while reading (the link moved on, the set is being removed): allowed
-        Err(_) if std::fs::canonicalize(link).ok().as_deref() != Some(dir.as_path()) => None,
-        Err(e) => panic!("{} is incomplete: {name}: {e}", dir.display()),
+        Err(_) if std::fs::read_link(link).ok().as_ref() != Some(&target) => None,
+        Err(e) => panic!("{} (the link's target) lost {name}: {e}", dir.display()),
     };
     let json = read("analyze.json")?;
     let csv = read("analytic.csv")?;
@@ -166,12 +167,12 @@ fn row11_concurrent_writers_publish_whole_sets_while_a_reader_watches() {
     let base = dir.path().join("output/seed");
     let link = base.join("analyze");
     let thetas = [40.0, 50.0, 60.0];
+    let mut seen = 0;
     for _round in 0..4 {
         let mut children: Vec<_> = thetas
             .iter()
             .map(|&t| analyze_cmd(dir.path(), t).spawn().unwrap())
             .collect();
-        let mut seen = 0;
         loop {
             if let Some(t) = read_analyze_set(&link) {
                 assert!(thetas.contains(&t));
@@ -186,8 +187,9 @@ fn row11_concurrent_writers_publish_whole_sets_while_a_reader_watches() {
         }
         let t = read_analyze_set(&link).expect("a set is published");
         assert!(thetas.contains(&t));
-        let _ = seen;
     }
+    // after the first round a set is always published: the reader read some
+    assert!(seen > 0, "the reader never saw a whole set");
     // superseded sets are removed by the writers: one hidden folder per link
     let hidden: Vec<String> = std::fs::read_dir(&base)
         .unwrap()

@@ -172,14 +172,15 @@ impl FreeProblem {
     /// 11's six `bench_free` cases 16.4 G instructions instead of 19.9 G,
     /// seeding and verification included (the robot's design from the
     /// analytic seed 13 SCP iterations instead of 18). The finer meshes end
-    /// in other local optima of the peak, mostly lower: of
-    /// `examples/convergence_matrix`'s eight continued peak designs seven
-    /// (the seed's per-motor design from the analytic seed 0.320877 instead
-    /// of 0.324756 N m, the domestic cat's from the phased seed 1.5101
-    /// instead of 1.5346) and the seed's per-motor design at 120 nodes per
-    /// phase (0.317146 instead of 0.317362); higher the seed's Euclidean
-    /// design from the analytic seed (+0.17 %) and the robot's two (+0.07 %
-    /// and +0.17 %, 0.052989 and 0.053020 N m).
+    /// in other local optima of the peak, mostly lower. Of
+    /// `examples/convergence_matrix`'s eight continued peak designs, seven
+    /// lower (the seed's per-motor design from the analytic seed 0.320877
+    /// instead of 0.324756 N m, the domestic cat's from the phased seed
+    /// 1.5101 instead of 1.5346), one higher (the seed's Euclidean design
+    /// from the analytic seed, +0.17 %). Of `bench_free`'s, also the robot's
+    /// two higher (+0.07 % and +0.17 %, 0.052989 and 0.053020 N m); the
+    /// seed's per-motor design at 120 nodes per phase lower (0.317146
+    /// instead of 0.317362).
     pub fn at_nodes_only(mut self) -> Self {
         self.midpoints = false;
         self
@@ -351,7 +352,8 @@ impl FreeProblem {
     }
 
     /// Simpson weights of one phase's check points (in [`Self::check_points`]
-    /// order) for `integral_0^1 f ds`; trapezoid weights at the nodes only.
+    /// order) for `integral_0^1 f ds`; trapezoid weights at the nodes only
+    /// (only the energy objective reads them, which has no coarse meshes).
     fn quadrature(&self) -> Vec<f64> {
         let h = self.tr.h();
         let mut w = Vec::with_capacity(self.points_per_phase());
@@ -449,7 +451,7 @@ impl FreeProblem {
 
     /// The cost's terms and the limited terms from the torque points, with
     /// gradients (in the points' nine columns) when the points carry them.
-    /// Peak: the torque. Energy: `sqrt(w T_p) tau` (Simpson weight `w`), so
+    /// Peak: the torque. Energy: `sqrt(w T_p) tau` (quadrature weight `w`), so
     /// that the sum of squares is `integral |tau|^2 dt`. Time: none. Limited:
     /// `tau + slope q^ / T_p` (the torque-speed line), when there is a limit.
     fn terms_of(&self, pts: &[TorquePoint]) -> (Vec<TorqueRow>, Vec<TorqueRow>) {
@@ -526,7 +528,7 @@ struct TorquePoint {
     /// `q^` at the point and its coefficients on the interval's values.
     rate: [f64; 2],
     rate_coef: [f64; 4],
-    /// Simpson weight in normalised time.
+    /// Quadrature weight in normalised time ([`FreeProblem::quadrature`]).
     weight: f64,
     rows: [TorqueRow; 2],
 }
@@ -1208,13 +1210,16 @@ type Coarse = (MeshLevel, Vec<ScpIteration>);
 /// instead of 37) and the robot's least time rose 0.5 % (0.7540 s against
 /// 0.7497 s); the robot's envelope peak design from 6 m took 7.7 s instead
 /// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Those
-/// start on the finest mesh. A coarse iteration costs about a third of a fine one, and
-/// from the coarse design the fine one takes 2 to 4 iterations
-/// (`examples/bench_free`: the robot's design from the phased seed 12
-/// iterations and 6.1 G instructions, seeding included, instead of 15 and
-/// 10.9 G; the seed's per-motor design at 120 nodes per phase 13.1 G
-/// instead of 54.5 G, 0.317201 N m instead of 0.317395). A coarse design
-/// that fails or does not converge leaves the seed itself as the start.
+/// start on the finest mesh. From the coarse design the fine one takes 2
+/// to 4 iterations. When the continuation was introduced (half the nodes,
+/// midpoints checked; since then [`coarser`] and
+/// [`FreeProblem::at_nodes_only`] made the coarse meshes cheaper), a
+/// coarse iteration cost about a third of a fine one (`examples/bench_free`:
+/// the robot's design from the phased seed 12 iterations and 6.1 G
+/// instructions, seeding included, instead of 15 and 10.9 G on one mesh;
+/// the seed's per-motor design at 120 nodes per phase 13.1 G instead of
+/// 54.5 G, 0.317201 N m instead of 0.317395). A coarse design that fails
+/// or does not converge leaves the seed itself as the start.
 fn coarse_start(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
@@ -1788,6 +1793,89 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The nodes-only problem is the full one without its midpoints: the
+    /// same torques and torque gradients at the nodes, the same Hessian
+    /// when the midpoints' multipliers are zero, and a quadrature that
+    /// integrates a linear function exactly.
+    #[test]
+    fn checking_at_the_nodes_only_drops_the_midpoints_and_nothing_else() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+        let cfg = Config::load(
+            std::path::Path::new(path),
+            &["limits.norm=per-motor".into()],
+        )
+        .unwrap();
+        let n = 8;
+        let tr = Transcription::new(3, n);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
+        let full = FreeProblem::new(&cfg, n, &z0);
+        let nodes = FreeProblem::new(&cfg, n, &z0).at_nodes_only();
+        let z = full.to_scaled(&z0);
+        assert_eq!(nodes.torques_len(), 3 * 2 * n);
+        assert_eq!(full.torques_len(), 3 * 2 * (2 * n - 1));
+        // full point 2k of each phase is node k
+        let node_of = |r: usize| {
+            let (ph, rest) = (r / (2 * n), r % (2 * n));
+            ph * 2 * (2 * n - 1) + 2 * 2 * (rest / 2) + rest % 2
+        };
+        let (lf, ln) = (full.linearize(&z), nodes.linearize(&z));
+        assert_eq!(ln.terms.len(), nodes.torques_len());
+        for (r, v) in ln.terms.iter().enumerate() {
+            assert_eq!(*v, lf.terms[node_of(r)], "row {r}");
+        }
+        let grads = |jac: &Triplets, row: usize| {
+            let mut g: Vec<(usize, f64)> = jac
+                .iter()
+                .filter(|e| e.0 == row)
+                .map(|e| (e.1, e.2))
+                .collect();
+            g.sort_by_key(|e| e.0);
+            g
+        };
+        for r in [0, 5, 2 * n + 3, 6 * n - 1] {
+            assert_eq!(
+                grads(&ln.terms_jac, r),
+                grads(&lf.terms_jac, node_of(r)),
+                "row {r}"
+            );
+        }
+        // multipliers on the nodes only: the same curvature
+        let y_nodes: Vec<f64> = (0..nodes.torques_len())
+            .map(|i| (i % 5) as f64 - 2.0)
+            .collect();
+        let mut y_full = vec![0.0; full.torques_len()];
+        for (r, y) in y_nodes.iter().enumerate() {
+            y_full[node_of(r)] = *y;
+        }
+        let dense = |t: Triplets| {
+            let mut m = std::collections::BTreeMap::new();
+            for (i, j, v) in t {
+                *m.entry((i, j)).or_insert(0.0) += v;
+            }
+            m.retain(|_, v: &mut f64| *v != 0.0);
+            m
+        };
+        let (hf, hn) = (
+            dense(full.hessian(&z, &y_full, &[])),
+            dense(nodes.hessian(&z, &y_nodes, &[])),
+        );
+        assert!(!hn.is_empty());
+        assert_eq!(hf.len(), hn.len());
+        for (k, v) in &hn {
+            assert!(
+                (v - hf[k]).abs() <= 1e-12 * v.abs().max(1.0),
+                "{k:?}: {v} vs {}",
+                hf[k]
+            );
+        }
+        // trapezoid weights: 1 and s integrate to 1 and 1/2
+        let w = nodes.quadrature();
+        assert_eq!(w.len(), n);
+        let s_at = |k: usize| k as f64 / (n - 1) as f64;
+        assert!((w.iter().sum::<f64>() - 1.0).abs() < 1e-14);
+        assert!((w.iter().enumerate().map(|(k, w)| w * s_at(k)).sum::<f64>() - 0.5).abs() < 1e-14);
     }
 
     #[test]
