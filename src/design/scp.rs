@@ -1611,20 +1611,11 @@ mod tests {
             for on_epigraph in [false, true] {
                 let p = Peaked { norm, on_epigraph };
                 let lin = p.linearize(&z);
+                let plus = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a + b).collect();
                 let moved = Linearization {
-                    terms: lin
-                        .terms
-                        .iter()
-                        .zip(&shift.terms)
-                        .map(|(a, b)| a + b)
-                        .collect(),
-                    limited: lin
-                        .limited
-                        .iter()
-                        .zip(&shift.limited)
-                        .map(|(a, b)| a + b)
-                        .collect(),
-                    residual: vec![lin.residual[0] + shift.residual[0]],
+                    terms: plus(&lin.terms, &shift.terms),
+                    limited: plus(&lin.limited, &shift.limited),
+                    residual: plus(&lin.residual, &shift.residual),
                     ..lin.clone()
                 };
                 let build =
