@@ -108,7 +108,13 @@ impl Publisher {
     }
 
     fn staging(&self) -> PathBuf {
-        self.dir.join(format!(".{}.{}", self.set, self.id))
+        self.dir.join(self.folder_name(&self.id))
+    }
+
+    /// The hidden folder of the set staged by `id`: `.<set>.<id>` (the
+    /// link's target, relative to `dir`).
+    fn folder_name(&self, id: &str) -> String {
+        format!(".{}.{id}", self.set)
     }
 
     /// Writes every file into the staging folder, then switches the link to it.
@@ -129,13 +135,14 @@ impl Publisher {
                 message: e.to_string(),
             })?;
         }
-        let tmp_link = self.dir.join(format!(".{}.{}.link", self.set, self.id));
+        let own = self.folder_name(&self.id);
+        let tmp_link = self.dir.join(format!("{own}.link"));
         let _ = fs::remove_file(&tmp_link);
         let werr = |e: std::io::Error| Error::Write {
             path: self.link(),
             message: e.to_string(),
         };
-        symlink(Path::new(&format!(".{}.{}", self.set, self.id)), &tmp_link).map_err(werr)?;
+        symlink(Path::new(&own), &tmp_link).map_err(werr)?;
         fs::rename(&tmp_link, self.link()).map_err(|e| {
             let _ = fs::remove_file(&tmp_link);
             werr(e)
@@ -156,14 +163,14 @@ impl Publisher {
         self.remove_leftovers();
         // A writer that switched the link after ours, while we still held the
         // lock, skipped our set as live; it is superseded, and only we see it.
-        let own = format!(".{}.{}", self.set, self.id);
+        let own = self.folder_name(&self.id);
         if fs::read_link(self.link()).ok().as_deref() != Some(Path::new(&own)) {
             let _ = fs::remove_dir_all(self.staging());
         }
     }
 
     fn lock_path(&self, id: &str) -> PathBuf {
-        self.dir.join(format!(".{}.{id}.lock", self.set))
+        self.dir.join(format!("{}.lock", self.folder_name(id)))
     }
 
     /// Removes staging folders of dead processes and superseded sets.
@@ -198,7 +205,7 @@ impl Publisher {
                 }
                 _held = f;
             }
-            let name = format!(".{}.{id}", self.set);
+            let name = self.folder_name(&id);
             let _ = fs::remove_file(self.dir.join(format!("{name}.link")));
             let target = fs::read_link(self.link()).ok();
             if target.as_deref() != Some(Path::new(&name)) {

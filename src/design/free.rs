@@ -1298,9 +1298,21 @@ fn design(
 ) -> Result<Solved> {
     check_resolvable(cfg, nodes)?;
     let tr = Transcription::new(3, nodes);
-    let problem = match mesh {
-        Mesh::Coarse => FreeProblem::new(cfg, nodes, z0).at_nodes_only(),
-        Mesh::Final => FreeProblem::new(cfg, nodes, z0),
+    let problem = FreeProblem::new(cfg, nodes, z0);
+    // what a mesh of the continuation means: its problem and SCP settings
+    let (problem, max_iterations, tolerance, conic) = match mesh {
+        Mesh::Coarse => (
+            problem.at_nodes_only(),
+            COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
+            COARSE_TOLERANCE.max(cfg.free.tolerance),
+            ConicSettings::COARSE,
+        ),
+        Mesh::Final => (
+            problem,
+            cfg.free.max_iterations,
+            cfg.free.tolerance,
+            ConicSettings::MODEL,
+        ),
     };
     if problem.objective == Objective::Time
         && problem.max_torque.is_none()
@@ -1321,18 +1333,6 @@ fn design(
         }
     }
     let z0 = problem.project(&z0)?;
-    let (max_iterations, tolerance, conic) = match mesh {
-        Mesh::Coarse => (
-            COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
-            COARSE_TOLERANCE.max(cfg.free.tolerance),
-            ConicSettings::COARSE,
-        ),
-        Mesh::Final => (
-            cfg.free.max_iterations,
-            cfg.free.tolerance,
-            ConicSettings::MODEL,
-        ),
-    };
     let settings = ScpSettings {
         max_iterations,
         tolerance,
