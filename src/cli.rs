@@ -49,10 +49,12 @@ struct Common {
     /// Override a config key, e.g. `--set cat.joint=universal` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
-    /// Print one JSON object instead of a table.
+    /// Print JSON instead of the table: one object (`sweep`: an array of
+    /// its points; `export` has no table and lists the files it wrote
+    /// either way).
     #[arg(long)]
     json: bool,
-    /// Folder that receives `<name>/` (default `output`).
+    /// Folder that receives `<name>/`.
     #[arg(long, default_value = "output")]
     out: PathBuf,
 }
@@ -947,35 +949,46 @@ fn cmd_sweep(
         say!("{}", serde_json::to_string_pretty(&points)?);
         return Ok(status_of(partial));
     }
+    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
     say!(
-        "catflip sweep: {} over {} ({} points, {threads} at a time)",
+        "catflip sweep: {} over {} ({}, {} at a time)",
         cfg.name,
         spec.key,
-        points.len()
+        plural(points.len(), "point"),
+        threads
     );
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
-    say!(
-        "  {:>12} {:>12} {:>12} {:>12} {:>12}",
-        spec.key,
-        "analytic N m",
-        "phased N m",
-        "free N m",
-        "least h (m)"
+    // the least drop heights, when a torque limit gives them
+    let heights = points
+        .iter()
+        .any(|p| p.least_height_phased_m.is_some() || p.least_height_free_m.is_some());
+    let mut head = format!(
+        "  {:>12} {:>12} {:>12} {:>12}",
+        spec.key, "analytic N m", "phased N m", "free N m"
     );
+    if heights {
+        head += &format!(" {:>14} {:>14}", "phased h_min m", "free h_min m");
+    }
+    say!("{head}");
     for p in &points {
-        let h = p.least_height_free_m.or(p.least_height_phased_m);
-        say!(
-            "  {:>12.5} {:>12} {:>12} {:>12} {:>12}{}",
+        let mut line = format!(
+            "  {:>12.5} {:>12} {:>12} {:>12}",
             p.value,
             show(p.analytic_peak_nm),
             show(p.phased_peak_nm),
             show(p.free_peak_nm),
-            show(h),
-            p.error
-                .as_ref()
-                .map(|e| format!("  error: {e}"))
-                .unwrap_or_default()
         );
+        if heights {
+            line += &format!(
+                " {:>14} {:>14}",
+                show(p.least_height_phased_m),
+                show(p.least_height_free_m)
+            );
+        }
+        if let Some(e) = &p.error {
+            line += &format!("  error: {e}");
+        }
+        say!("{line}");
     }
     for w in written {
         row("wrote", w.display().to_string());

@@ -117,7 +117,9 @@ pub struct RunSummary {
     pub joint: &'static str,
     pub peak_norm: crate::model::TorqueNorm,
     pub max_torque_nm: Option<f64>,
-    /// `ok` when every method is ok, `partial` when some are flagged or failed.
+    /// `ok` when every method is ok, `partial` when some are flagged or
+    /// failed, `impossible` when the motors cannot flip the cat from
+    /// `fall.height` (exit 4; `answer` says from what height they can).
     pub outcome: &'static str,
     pub methods: Vec<MethodSummary>,
     /// Peak ratios between methods (absent when either failed).
@@ -152,27 +154,6 @@ impl RunResult {
     pub fn is_impossible(&self) -> bool {
         self.summary.answer.as_ref().is_some_and(|a| !a.possible)
     }
-}
-
-/// Whether a free-form design can answer the robot question: its
-/// constraints met (the SCP's violation within `free.attitude_tolerance`),
-/// inside the motor envelope at every written row, and flipping under the
-/// motor model within `simulate.flip_tolerance`. Optimality is not needed:
-/// any schedule that does this shows the flip possible from its height (the
-/// least height found is an upper bound either way), so a design that ran
-/// out of iterations still counts, and says so in its status.
-fn verified(cfg: &Config, fr: &crate::design::free::FreeResult) -> bool {
-    let margin = crate::design::envelope::usage_of(cfg, &fr.plan)
-        .min_margin
-        .unwrap_or(1.0);
-    fr.certificate.constraint_violation <= cfg.free.attitude_tolerance
-        && margin >= -1e-6
-        && crate::verify::simulate::misses_flip(
-            fr.flip_error_rad,
-            fr.tilt_deg,
-            cfg.simulate.flip_tolerance,
-        )
-        .is_none()
 }
 
 /// Why a verified design misses its targets, if it does: solver status,
@@ -457,56 +438,15 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             name: "least drop height (shortest manoeuvre inside the motor envelope)",
         });
         let clock = Instant::now();
-        let a = crate::design::least_height::answer(cfg);
-        let a = match a {
-            // the free-form time design from the phased schedule and from
-            // the analytic one (a local method: each seed can end in another
-            // optimum; on the robot 0.776 s and 0.750 s), the shortest that
-            // verifies (see `verified`), when shorter than the phased one;
-            // the two run at once (the robot's run: 12.4-13.7 s -> 8.5-9.5 s)
-            Ok(Some(mut a)) => {
-                phased_short = (!a.possible).then_some(a.least_height_m);
-                let mut timed = cfg.clone();
-                timed.design.objective = crate::design::objective::Objective::Time;
-                let analytic_plan = crate::design::analytic::analytic_plan(cfg);
-                let (from_phased, from_analytic) = std::thread::scope(|s| {
-                    let analytic = s.spawn(|| {
-                        crate::design::free::optimize_from(
-                            &timed,
-                            &analytic_plan,
-                            "analytic",
-                            cfg.free.nodes,
-                            |_| {},
-                        )
-                    });
-                    let phased = crate::design::free::optimize_from(
-                        &timed,
-                        &a.schedule,
-                        "phased",
-                        cfg.free.nodes,
-                        |it| progress(Progress::Scp(it)),
-                    );
-                    let analytic = analytic
-                        .join()
-                        .unwrap_or_else(|e| std::panic::resume_unwind(e));
-                    (phased, analytic)
-                });
-                for fr in [from_phased, from_analytic].into_iter().flatten() {
-                    if verified(cfg, &fr)
-                        && fastest_free
-                            .as_ref()
-                            .is_none_or(|f| fr.manoeuvre_time_s < f.manoeuvre_time_s)
-                    {
-                        fastest_free = Some(fr);
-                    }
-                }
-                if let Some(fr) = &fastest_free {
-                    a.improve_with(cfg, fr);
-                }
-                Ok(Some(a))
-            }
-            other => other,
-        };
+        let a =
+            crate::design::least_height::heights(cfg, |it| progress(Progress::Scp(it))).map(|h| {
+                h.map(|h| {
+                    phased_short =
+                        (h.phased_m > cfg.fall.height * (1.0 + 1e-9)).then_some(h.phased_m);
+                    fastest_free = h.free;
+                    h.answer
+                })
+            });
         stage_end(&mut progress, clock, a.as_ref().err());
         match a {
             Ok(Some(a)) => {
@@ -722,7 +662,9 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         joint: cfg.cat.joint.name(),
         peak_norm: cfg.norm(),
         max_torque_nm: cfg.limits.max_torque,
-        outcome: if methods.iter().all(|m| m.verdict == Verdict::Ok) {
+        outcome: if answer.as_ref().is_some_and(|a| !a.possible) {
+            "impossible"
+        } else if methods.iter().all(|m| m.verdict == Verdict::Ok) {
             "ok"
         } else {
             "partial"
@@ -766,7 +708,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     if let Some(a) = &summary.answer {
         notes.insert(0, a.sentence());
     }
-    if summary.outcome != "ok" {
+    if summary.outcome == "partial" {
         notes.insert(
             0,
             "PARTIAL RESULT: some methods are flagged or failed; the verdict column says why. Their schedules, if any, are written but miss a target.".into(),

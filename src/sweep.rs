@@ -198,6 +198,12 @@ fn point(
     };
     let mut kept = None;
     let limit = cfg.limits.max_torque;
+    // F7 (the least height from the peak by time scaling) holds for a
+    // torque limit alone: a torque-speed line or a speed limit does not
+    // scale with the fall, so there each least height is its family's
+    // `time` design inside the envelope, as `run` finds it
+    let envelope = limit.is_some() && (cfg.motor().slope() > 0.0 || cfg.limits.max_speed.is_some());
+    let limited_cfg = cfg;
     let mut cfg = cfg.clone();
     cfg.limits.max_torque = None;
     let t2 = cfg.available_time().powi(2);
@@ -270,8 +276,9 @@ fn point(
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
-                p.least_height_phased_m =
-                    limit.map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
+                p.least_height_phased_m = limit
+                    .filter(|_| !envelope)
+                    .map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
             }
             Err(e) if methods.phased => errors.push(format!("phased: {e}")),
             _ => {}
@@ -306,13 +313,33 @@ fn point(
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
-                    p.least_height_free_m =
-                        limit.map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+                    p.least_height_free_m = limit
+                        .filter(|_| !envelope)
+                        .map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
                     p.free_status = Some(crate::run::json_name(&fr.status));
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
             }
+        }
+    }
+    if envelope && (methods.phased || methods.free) {
+        match crate::design::least_height::heights(limited_cfg, |_| {}) {
+            Ok(Some(h)) => {
+                if methods.phased {
+                    p.least_height_phased_m = Some(h.phased_m);
+                }
+                if methods.free {
+                    p.least_height_free_m = h.free.as_ref().map(|f| {
+                        crate::design::envelope::height_for(limited_cfg, f.manoeuvre_time_s)
+                    });
+                    if h.free.is_none() {
+                        errors.push("free least height: no free-form time design verified".into());
+                    }
+                }
+            }
+            Ok(None) => {}
+            Err(e) => errors.push(format!("least height: {e}")),
         }
     }
     if !errors.is_empty() {

@@ -194,3 +194,37 @@ fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_opt
     let bends: Vec<f64> = points.iter().map(|p| p.2).collect();
     assert!(bends.windows(2).all(|w| w[1] > w[0] + 1.0), "{bends:?}");
 }
+
+/// A torque-speed line does not scale with the fall (F7 holds for a torque
+/// limit alone): a sweep of the robot must give, at each point, the least
+/// heights `run` answers with there, from the time designs inside the
+/// envelope (the F7 scaling of the peak said 0.2 m where `run` says 3.5).
+#[test]
+fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
+    let path = configs().join("robot-universal.toml");
+    let spec: catflip::sweep::SweepSpec = "cat.mass=0.45:0.45:1".parse().unwrap();
+    let methods = catflip::sweep::Methods {
+        analytic: false,
+        phased: true,
+        free: true,
+    };
+    let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
+    for p in &points {
+        let cfg = catflip::Config::load(&path, &[format!("cat.mass={}", p.value)]).unwrap();
+        let summary = catflip::run::run(&cfg, |_| {}).unwrap().summary;
+        // not possible from 2 m: the summary says so as its outcome (exit 4)
+        assert_eq!(summary.outcome, "impossible");
+        let answer = summary.answer.unwrap();
+        let (phased, free) = (
+            p.least_height_phased_m.unwrap(),
+            p.least_height_free_m.unwrap(),
+        );
+        assert!(
+            (phased.min(free) - answer.least_height_m).abs() < 1e-9 * answer.least_height_m,
+            "mass {}: sweep {phased} / {free} m, run {} m",
+            p.value,
+            answer.least_height_m
+        );
+        assert!(!answer.possible && answer.least_height_m > cfg.fall.height);
+    }
+}
