@@ -85,13 +85,13 @@ fn main() -> anyhow::Result<()> {
                                 .min_margin
                                 .map_or("-".to_string(), |m| format!("{m:.1e}"));
                             println!(
-                                "{:<30} {:<10} {:<12} {:<9} {:>15} {:>12.6} {:>5} {:>9.1e} {:>9.1e} {:>9} {:>7.2}",
+                                "{:<30} {:<10} {:<12} {:<9} {:>15} {:>12} {:>5} {:>9.1e} {:>9.1e} {:>9} {:>7.2}",
                                 name,
                                 norm,
                                 objective,
                                 seed.name(),
                                 catflip::run::json_name(&r.status),
-                                r.objective_value,
+                                significant(r.objective_value, 6),
                                 r.scp_iterations,
                                 r.certificate.criticality,
                                 r.certificate.constraint_violation,
@@ -110,4 +110,11 @@ fn main() -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// `v` to `digits` significant digits (the energies are 4e-4 N^2 m^2 s,
+/// the times near 1 s).
+fn significant(v: f64, digits: i32) -> String {
+    let decimals = (digits - 1 - v.abs().log10().floor() as i32).max(0);
+    format!("{v:.*}", decimals as usize)
 }

@@ -247,6 +247,24 @@ fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
     }
 }
 
+/// The parser's messages name Rust's types ("expected f64"); the user
+/// wrote TOML.
+fn plain_types(message: &str) -> String {
+    [
+        ("expected f64", "expected a number"),
+        ("expected usize", "expected a whole number (0 or more)"),
+        ("expected u64", "expected a whole number (0 or more)"),
+        ("expected u32", "expected a whole number (0 or more)"),
+        ("expected i64", "expected a whole number"),
+        (
+            "unit variant, expected string only",
+            "a number, expected a name",
+        ),
+    ]
+    .iter()
+    .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
+}
+
 impl Config {
     /// Reads, overrides and validates a config file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config> {
@@ -263,7 +281,7 @@ impl Config {
     pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
         let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
-            message: e.to_string(),
+            message: plain_types(&e.to_string()),
         };
         let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
         // the file alone, parsed from its own text: unknown keys and wrong
@@ -281,7 +299,7 @@ impl Config {
             if let Err(e) = t.try_into::<Config>() {
                 return Err(Error::Override {
                     arg: arg.clone(),
-                    message: e.message().trim().to_string(),
+                    message: plain_types(e.message().trim()),
                 });
             }
             apply_override(&mut table, arg)?;
@@ -291,7 +309,7 @@ impl Config {
             .try_into()
             .map_err(|e: toml::de::Error| Error::ConfigParse {
                 origin: format!("{origin} (with --set overrides)"),
-                message: e.message().trim().to_string(),
+                message: plain_types(e.message().trim()),
             })?;
         cfg.validate()?;
         Ok(cfg)
@@ -723,6 +741,27 @@ gravity = 9.8
             "limits.max_torque, limits.no_load_speed"
         );
         assert_eq!(with(&["limits.max_speed=3"]), "limits.max_speed");
+    }
+
+    #[test]
+    fn wrong_types_are_named_in_toml_words_not_rusts() {
+        for (set, plain) in [
+            ("cat.mass=abc", "expected a number"),
+            ("phased.nodes=10.5", "expected a whole number"),
+            ("cat.joint=1", "expected a name"),
+        ] {
+            let e = Config::from_toml(SEED, "t", &[set.into()])
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(plain), "{set}: {e}");
+            for rust in ["f64", "usize", "variant"] {
+                assert!(!e.contains(rust), "{set}: {e}");
+            }
+        }
+        let e = Config::from_toml(&SEED.replace("mass = 1.0", "mass = \"heavy\""), "t", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("expected a number") && !e.contains("f64"), "{e}");
     }
 
     #[test]

@@ -175,6 +175,12 @@ impl Schedule {
         let (_, header) = lines
             .next()
             .ok_or_else(|| bad(1, "empty file; expected a header line".into()))?;
+        if header.trim_start().starts_with(['{', '[']) {
+            return Err(bad(
+                1,
+                "this is JSON; a schedule is the CSV catflip writes beside it (e.g. `free.csv` for `free.schedule.json`)".into(),
+            ));
+        }
         let cols: Vec<&str> = header.split(',').map(str::trim).collect();
         let want = [
             "t_s",
@@ -200,7 +206,9 @@ impl Schedule {
             cols.iter().position(|c| *c == "qdd2_rad_s2"),
         ];
         let mut rows = Vec::new();
+        let mut last_line = 1;
         for (n, line) in lines {
+            last_line = n + 1;
             let f: Vec<&str> = line.split(',').map(str::trim).collect();
             let num = |i: usize| -> Result<f64> {
                 let v = f
@@ -259,10 +267,15 @@ impl Schedule {
         }
         let sched = Schedule { rows };
         for p in Phase::ALL {
-            if sched.phase_range(p).len() < 2 {
+            let n = sched.phase_range(p).len();
+            if n < 2 {
                 return Err(bad(
-                    1,
-                    format!("phase {} needs at least two rows", p.name()),
+                    last_line,
+                    format!(
+                        "phase {} has {n} row{} where each phase needs at least two (its start and its end): is the file cut short?",
+                        p.name(),
+                        if n == 1 { "" } else { "s" }
+                    ),
                 ));
             }
         }
@@ -345,5 +358,54 @@ impl ShapePlan for Schedule {
             a.tau[0] + x * (b.tau[0] - a.tau[0]),
             a.tau[1] + x * (b.tau[1] - a.tau[1]),
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+
+    /// The seed's analytic schedule as catflip writes it.
+    fn written() -> String {
+        let cfg = crate::config::Config::from_toml(
+            &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml"))
+                .unwrap(),
+            "seed.toml",
+            &[],
+        )
+        .unwrap();
+        let plan = crate::design::analytic::analytic_plan(&cfg);
+        Schedule::sample(&cfg.cat(), &plan, 20).to_csv()
+    }
+
+    fn message(text: &str) -> (usize, String) {
+        match Schedule::from_csv(text, "s.csv") {
+            Err(Error::Schedule { line, message, .. }) => (line, message),
+            other => panic!("expected a schedule error, got {other:?}"),
+        }
+    }
+
+    #[test]
+    fn a_schedule_cut_short_is_named_at_its_last_line() {
+        let full = written();
+        assert!(Schedule::from_csv(&full, "s.csv").is_ok());
+        // cut inside the twist: unfold has no rows
+        let lines: Vec<&str> = full.lines().collect();
+        let twist = lines.iter().position(|l| l.contains(",twist,")).unwrap();
+        let cut = lines[..twist + 3].join("\n");
+        let (line, msg) = message(&cut);
+        assert_eq!(line, twist + 3, "{msg}");
+        assert!(
+            msg.contains("phase unfold has 0 rows") && msg.contains("cut short"),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn a_json_schedule_is_pointed_at_its_csv() {
+        let (line, msg) = message("{\"rows\": []}\n");
+        assert_eq!(line, 1);
+        assert!(msg.contains("JSON") && msg.contains("free.csv"), "{msg}");
     }
 }
