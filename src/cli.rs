@@ -673,12 +673,12 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                 row(
                     "mesh check (N vs 2N)",
                     format!(
-                        "{:.5} {} at {} nodes per phase ({:+.2} %), {:?}",
+                        "{:.5} {} at {} nodes per phase ({:+.2} %), {}",
                         m.objective_value,
                         r.objective.unit(),
                         m.nodes,
                         100.0 * m.relative_change,
-                        m.status
+                        catflip::run::json_name(&m.status)
                     ),
                 );
             }

@@ -336,7 +336,7 @@ impl Config {
             return Err(Error::Invalid {
                 key: "name".into(),
                 value: format!("{:?}", self.name),
-                expected: "a non-empty folder name of letters, digits, '-', '_' or '.'".into(),
+                expected: "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (hidden folders hold catflip's unpublished sets)".into(),
             });
         }
         let c = &self.cat;

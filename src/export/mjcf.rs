@@ -41,7 +41,12 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push('.');
     }
     if let Some(w) = super::speed_limit(cfg) {
-        s.push_str(&format!("\n     Joint speed limit {w} rad/s."));
+        let why = if cfg.limits.max_speed.is_some() {
+            "limits.max_speed"
+        } else {
+            "the no-load speed: the motor cannot drive faster"
+        };
+        s.push_str(&format!("\n     Joint speed limit {w} rad/s ({why})."));
     }
     s
 }

@@ -136,7 +136,8 @@ pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<Strin
     }
     if beyond(tilt_deg.to_radians()) {
         why.push(format!(
-            "tilts the spine by {tilt_deg:.3} deg (simulate.flip_tolerance = {tol:e} rad)"
+            "tilts the spine by {tilt_deg:.3} deg = {:.3e} rad (simulate.flip_tolerance = {tol:e} rad)",
+            tilt_deg.to_radians()
         ));
     }
     (!why.is_empty()).then(|| why.join("; "))
