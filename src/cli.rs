@@ -731,6 +731,12 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
                 }
                 let _ = writeln!(e, " FAILED after {seconds:.2} s: {reason}");
             }
+            Progress::StageSkipped { reason } => {
+                if live {
+                    let _ = write!(e, "\r\x1b[2K");
+                }
+                let _ = writeln!(e, " not attempted: {reason}");
+            }
             Progress::Bend {
                 evaluations,
                 bend_deg,

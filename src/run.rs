@@ -30,6 +30,11 @@ pub enum Progress<'a> {
         seconds: f64,
         reason: &'a str,
     },
+    /// The stage's method was not attempted: the motors cannot flip the
+    /// cat from this height (the least-height stage found it).
+    StageSkipped {
+        reason: &'a str,
+    },
     Bend {
         evaluations: usize,
         bend_deg: f64,
@@ -522,7 +527,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         }
         Err(e) => methods.push(MethodSummary::failed("phased", e)),
     }
-    stage_end(&mut progress, clock, phased.as_ref().err());
+    match &impossible {
+        Some(reason) => progress(Progress::StageSkipped { reason }),
+        None => stage_end(&mut progress, clock, phased.as_ref().err()),
+    }
 
     progress(Progress::Stage {
         index: stage(3),
@@ -575,7 +583,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         }
         Err(e) => methods.push(MethodSummary::failed("free", e)),
     }
-    stage_end(&mut progress, clock, free.as_ref().err());
+    match &free_impossible {
+        Some(reason) => progress(Progress::StageSkipped { reason }),
+        None => stage_end(&mut progress, clock, free.as_ref().err()),
+    }
 
     if let Some(a) = answer.as_mut().filter(|a| !a.possible)
         && let Some(m) = methods

@@ -211,9 +211,19 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
     let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
     for p in &points {
         let cfg = catflip::Config::load(&path, &[format!("cat.mass={}", p.value)]).unwrap();
-        let summary = catflip::run::run(&cfg, |_| {}).unwrap().summary;
-        // not possible from 2 m: the summary says so as its outcome (exit 4)
+        let mut skipped = 0;
+        let summary = catflip::run::run(&cfg, |p| {
+            if let catflip::run::Progress::StageSkipped { reason } = p {
+                assert!(reason.contains("fall.height"), "{reason}");
+                skipped += 1;
+            }
+        })
+        .unwrap()
+        .summary;
+        // not possible from 2 m: the summary says so as its outcome (exit 4),
+        // and the phased and free-form stages say they were not attempted
         assert_eq!(summary.outcome, "impossible");
+        assert_eq!(skipped, 2);
         let answer = summary.answer.unwrap();
         let (phased, free) = (
             p.least_height_phased_m.unwrap(),
