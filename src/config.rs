@@ -257,8 +257,8 @@ fn plain_types(message: &str) -> String {
         ("expected u32", "expected a whole number (0 or more)"),
         ("expected i64", "expected a whole number"),
         (
-            "unit variant, expected string only",
-            "a number, expected a name",
+            "invalid type: unit variant, expected string only",
+            "expected a name (a word such as `universal`), not a number, true/false or a list",
         ),
     ]
     .iter()
@@ -336,7 +336,7 @@ impl Config {
             return Err(Error::Invalid {
                 key: "name".into(),
                 value: format!("{:?}", self.name),
-                expected: "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (hidden folders hold catflip's unpublished sets)".into(),
+                expected: "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (catflip keeps its sets in hidden folders)".into(),
             });
         }
         let c = &self.cat;
@@ -749,6 +749,7 @@ gravity = 9.8
             ("cat.mass=abc", "expected a number"),
             ("phased.nodes=10.5", "expected a whole number"),
             ("cat.joint=1", "expected a name"),
+            ("cat.joint=true", "expected a name"),
         ] {
             let e = Config::from_toml(SEED, "t", &[set.into()])
                 .unwrap_err()

@@ -150,7 +150,8 @@ pub struct RunResult {
 }
 
 impl RunResult {
-    /// True when some method is flagged or failed.
+    /// True when some method is flagged or failed (always so when the flip
+    /// is impossible: [`RunResult::is_impossible`] comes first).
     pub fn is_partial(&self) -> bool {
         self.summary.outcome != "ok"
     }
@@ -443,8 +444,8 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             name: "least drop height (shortest manoeuvre inside the motor envelope)",
         });
         let clock = Instant::now();
-        let a =
-            crate::design::least_height::heights(cfg, |it| progress(Progress::Scp(it))).map(|h| {
+        let a = crate::design::least_height::heights(cfg, true, |it| progress(Progress::Scp(it)))
+            .map(|h| {
                 h.map(|h| {
                     phased_short =
                         (h.phased_m > cfg.fall.height * (1.0 + 1e-9)).then_some(h.phased_m);

@@ -324,7 +324,7 @@ fn point(
         }
     }
     if envelope && (methods.phased || methods.free) {
-        match crate::design::least_height::heights(limited_cfg, |_| {}) {
+        match crate::design::least_height::heights(limited_cfg, methods.free, |_| {}) {
             Ok(Some(h)) => {
                 if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);
@@ -613,7 +613,9 @@ pub fn figures(
         figs.push((
             format!("sweep-{file_key}-least-height.svg"),
             crate::report::lines(
-                &format!("Least drop height for {l} N m against {key}"),
+                &format!(
+                    "Least drop height within the motor limits (stall torque {l} N m) against {key}"
+                ),
                 &xdesc,
                 "least drop height (m)",
                 &x,

@@ -893,7 +893,7 @@ fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
     Error::Unreachable {
         reason: match least {
             Some(h) => format!(
-                "no phased {} schedule fits the motor envelope ({}) in the {:.4} s the fall from {} m leaves for the manoeuvre; the phased design needs a drop of at least {h:.3} m (fall.height) or stronger or faster motors (the free-form design may need less: `catflip run` finds the least height)",
+                "no phased {} schedule fits the motor envelope ({}) in the {:.4} s the fall from {} m leaves for the manoeuvre; the phased design needs a drop of at least {h:.3} m (fall.height) or stronger or faster motors; `catflip run` also tries the free-form design, which may need less",
                 cfg.design.objective.name(),
                 cfg.envelope_keys(),
                 cfg.available_time(),

@@ -77,12 +77,24 @@ pub struct Heights {
 /// schedule and from the analytic plan (a local method: each seed can end
 /// in another optimum; on the robot 0.776 s and 0.750 s), run at once (the
 /// robot's run: 12.4-13.7 s -> 8.5-9.5 s); `observe` sees the iterations of
-/// the one from the phased schedule.
-pub fn heights(cfg: &Config, observe: impl FnMut(&ScpIteration)) -> Result<Option<Heights>> {
+/// the one from the phased schedule. Without `with_free`, the phased answer
+/// alone.
+pub fn heights(
+    cfg: &Config,
+    with_free: bool,
+    observe: impl FnMut(&ScpIteration),
+) -> Result<Option<Heights>> {
     let Some(mut answer) = self::answer(cfg)? else {
         return Ok(None);
     };
     let phased_m = answer.least_height_m;
+    if !with_free {
+        return Ok(Some(Heights {
+            answer,
+            phased_m,
+            free: None,
+        }));
+    }
     let mut timed = cfg.clone();
     timed.design.objective = Objective::Time;
     // the analytic plan and the problem's scaling are the configured fall's,

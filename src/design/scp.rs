@@ -1112,8 +1112,14 @@ pub fn solve_warm(
     // instead of 47, 47, 49 and 50; sweeps are unchanged)
     let mut w = (settings.weight * scale).max(
         warm.map_or(0.0, |ws| ws.weight)
-            .min(1e4 * settings.weight * scale),
+            .min(1e3 * settings.weight * scale),
     );
+    // the stagnation rule's two raises count from where the weight started;
+    // the infeasibility bound (1e6 times the default) does not move: from a
+    // weight carried 1e3 times up three raises are left, and the robot's
+    // impossible 2 m designs, whose re-solves inside the envelope start
+    // there, ended in a failed subproblem at 1e6 times the carried weight
+    let w_start = w;
     let mut radius = warm.map_or(settings.initial_radius, |w| {
         w.radius.clamp(1e-3, settings.initial_radius)
     });
@@ -1261,7 +1267,7 @@ pub fn solve_warm(
             && linear_cost
             && stagnant.len() > k
             && inf_now > 100.0 * settings.feasibility
-            && w < 50.0 * settings.weight * scale
+            && w < 50.0 * w_start
             && {
                 let (inf_then, cost_then) = stagnant[stagnant.len() - 1 - k];
                 inf_now > 0.8 * inf_then && (here.1 - cost_then).abs() < 1e-2 * here.1.abs()
