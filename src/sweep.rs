@@ -84,7 +84,17 @@ impl SweepSpec {
             return vec![self.from];
         }
         (0..self.count)
-            .map(|i| self.from + (self.to - self.from) * (i as f64 / (self.count - 1) as f64))
+            // by a step: exact for whole ends and steps (`i / (count - 1)`
+            // first made 0:22:23's 16th point 14.999999999999998); the last
+            // point is TO itself
+            .map(|i| {
+                let step = (self.to - self.from) / (self.count - 1) as f64;
+                if i == self.count - 1 {
+                    self.to
+                } else {
+                    self.from + step * i as f64
+                }
+            })
             .collect()
     }
 }
@@ -407,6 +417,19 @@ pub fn sweep_shard(
         ov.push(format!("{}={}", spec.key, v));
         Config::load(path, &ov)
     };
+    // a key that takes whole numbers fails as a whole on a grid with
+    // fractions (checked over the whole grid, so that every shard agrees)
+    if let Some(v) = all.iter().find(|v| v.fract() != 0.0)
+        && load(*v).is_err_and(|e| e.to_string().contains("expected a whole number"))
+    {
+        return Err(Error::Range {
+            arg: spec.arg(),
+            message: format!(
+                "{} takes whole numbers, and this grid has {v}: choose whole FROM and TO and a COUNT for which (TO - FROM) / (COUNT - 1) is whole",
+                spec.key
+            ),
+        });
+    }
     // a point whose config is invalid is that point's failure; when every
     // point is invalid (e.g. an unknown key) the sweep fails before any work
     let configs: Vec<Result<Config>> = values

@@ -238,3 +238,52 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
         assert!(!answer.possible && answer.least_height_m > cfg.fall.height);
     }
 }
+
+/// A grid with whole ends and a whole step is whole at every point (the
+/// step was once formed before multiplying: 0:22:23 gave 14.999999999999998).
+#[test]
+fn whole_ends_and_steps_give_whole_grid_values() {
+    for (from, to) in [(0, 22), (0, 29), (3, 30), (-20, 40)] {
+        for count in 2..=(to - from + 1) as usize {
+            if !((to - from) as usize).is_multiple_of(count - 1) {
+                continue;
+            }
+            let spec: catflip::sweep::SweepSpec =
+                format!("phased.nodes={from}:{to}:{count}").parse().unwrap();
+            let values = spec.values();
+            assert!(values.iter().all(|v| v.fract() == 0.0), "{values:?}");
+            assert_eq!((values[0], values[count - 1]), (from as f64, to as f64));
+        }
+    }
+}
+
+/// A key that takes whole numbers on a grid with fractions fails as bad
+/// input before any work, naming the key and the value; a whole grid runs.
+#[test]
+fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
+    let dir = tempfile::tempdir().unwrap();
+    let cfg = configs().join("seed.toml");
+    let sweep = |range: &str| {
+        Command::new(env!("CARGO_BIN_EXE_catflip"))
+            .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
+            .args(["--methods", "phased", "--out", "out"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = sweep("phased.nodes=10.5:20:2");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("phased.nodes takes whole numbers") && err.contains("10.5"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
+    let o = sweep("phased.nodes=10:20:3");
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
