@@ -448,7 +448,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             .map(|h| {
                 h.map(|h| {
                     phased_short =
-                        (h.phased_m > cfg.fall.height * (1.0 + 1e-9)).then_some(h.phased_m);
+                        (!crate::design::least_height::fits(cfg, h.phased_m)).then_some(h.phased_m);
                     fastest_free = h.free;
                     h.answer
                 })

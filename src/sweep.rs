@@ -83,12 +83,12 @@ impl SweepSpec {
         if self.count == 1 {
             return vec![self.from];
         }
+        // by a step: exact for whole ends and steps (`i / (count - 1)`
+        // first made 0:22:23's 16th point 14.999999999999998); the last
+        // point is TO itself
+        let step = (self.to - self.from) / (self.count - 1) as f64;
         (0..self.count)
-            // by a step: exact for whole ends and steps (`i / (count - 1)`
-            // first made 0:22:23's 16th point 14.999999999999998); the last
-            // point is TO itself
             .map(|i| {
-                let step = (self.to - self.from) / (self.count - 1) as f64;
                 if i == self.count - 1 {
                     self.to
                 } else {

@@ -49,9 +49,9 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
     let mut timed = cfg.clone();
     timed.design.objective = Objective::Time;
     let r = crate::design::phased::optimize(&timed, |_| {})?;
-    let least = 0.5 * cfg.fall.gravity * (r.manoeuvre_time_s + cfg.fall.margin).powi(2);
+    let least = crate::design::envelope::height_for(cfg, r.manoeuvre_time_s);
     Ok(Some(HeightAnswer {
-        possible: least <= cfg.fall.height * (1.0 + 1e-9),
+        possible: fits(cfg, least),
         height_m: cfg.fall.height,
         least_height_m: least,
         least_time_s: r.manoeuvre_time_s,
@@ -60,6 +60,11 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
         flip_error_rad: r.flip_error_rad,
         schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     }))
+}
+
+/// Whether a drop from `height` is within the configured one (to rounding).
+pub fn fits(cfg: &Config, height: f64) -> bool {
+    height <= cfg.fall.height * (1.0 + 1e-9)
 }
 
 /// The least drop heights of both design families, each from its `time`
@@ -166,7 +171,7 @@ impl HeightAnswer {
         }
         self.least_time_s = fr.manoeuvre_time_s;
         self.least_height_m = crate::design::envelope::height_for(cfg, fr.manoeuvre_time_s);
-        self.possible = self.least_height_m <= cfg.fall.height * (1.0 + 1e-9);
+        self.possible = fits(cfg, self.least_height_m);
         self.method = "free";
         self.status = crate::run::json_name(&fr.status);
         self.flip_error_rad = fr.flip_error_rad;
