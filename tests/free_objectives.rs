@@ -3,7 +3,7 @@
 
 use catflip::Config;
 use catflip::design::envelope::{height_for, usage_of};
-use catflip::design::free::{FreeResult, optimize_from};
+use catflip::design::free::{FreeDesign, FreeResult};
 
 fn seed(overrides: &[&str]) -> Config {
     let text =
@@ -16,7 +16,10 @@ fn seed(overrides: &[&str]) -> Config {
 /// (the mesh check left out).
 fn free(cfg: &Config) -> FreeResult {
     let phased = catflip::design::phased::optimize(cfg, |_| {}).unwrap();
-    let r = optimize_from(cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+    let r = FreeDesign::new(cfg)
+        .from_plan(&phased.plan, "phased")
+        .solve()
+        .unwrap();
     assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
     r
 }
@@ -86,7 +89,10 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
             "limits.no_load_speed=8",
         ]);
         let phased = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let r = optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+        let r = FreeDesign::new(&cfg)
+            .from_plan(&phased.plan, "phased")
+            .solve()
+            .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
         let margin = usage_of(&cfg, &r.plan).min_margin.unwrap();
         assert!(margin >= -1e-6, "{objective}: margin {margin}");
