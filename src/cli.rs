@@ -2,8 +2,8 @@
 
 use anyhow::Result;
 use catflip::Config;
-use catflip::design::plan::Schedule;
 use catflip::output::{Output, Publisher};
+use catflip::pipeline::{Design, Method};
 use catflip::verdict::{self, Simulated};
 use catflip::verify::analyze::{analytic_schedule, analyze, verify};
 use catflip::verify::simulate::SimReport;
@@ -218,12 +218,11 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let reason = catflip::run::judge(
+    let reason = catflip::pipeline::judge(
         &cfg,
         verdict::Status::ClosedForm,
-        a.peak_torque_nm,
-        a.closed.bend_deg,
-        &sched,
+        (a.peak_torque_nm, a.closed.bend_deg),
+        Some(&sched),
         &Simulated::Flip {
             flip_error_rad: a.flip_error_rad,
             tilt_deg: a.tilt_deg,
@@ -421,32 +420,6 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     Ok(status_of(partial))
 }
 
-/// Writes `<stem>.csv` and `<stem>.json`; prints the JSON and returns `None` with `--json`.
-fn write_design(
-    c: &Common,
-    publisher: Publisher,
-    stem: &str,
-    sched: &Schedule,
-    json: serde_json::Value,
-    reason: Option<String>,
-) -> Result<Option<Vec<PathBuf>>> {
-    let mut json = json;
-    json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
-    if let Some(r) = reason {
-        json["reason"] = r.into();
-    }
-    let json = serde_json::to_string_pretty(&json)?;
-    let mut out = Output::default();
-    sched.add_to(&mut out, stem);
-    out.add(format!("{stem}.json"), json.clone());
-    let written = publisher.publish(out)?;
-    if c.json {
-        say!("{json}");
-        return Ok(None);
-    }
-    Ok(Some(written))
-}
-
 /// The rows both optimisers print: timing, verification, solve time, files.
 fn design_rows(
     durations: [f64; 3],
@@ -469,28 +442,6 @@ fn design_rows(
     for w in written {
         row("wrote", w.display().to_string());
     }
-}
-
-/// The verdict on an optimiser's design, as `run` gives it ([`catflip::run::judge`]).
-fn design_flags(
-    cfg: &Config,
-    status: verdict::Status,
-    (peak, bend): (f64, f64),
-    sched: &Schedule,
-    (flip_error_rad, tilt_deg): (f64, f64),
-) -> Option<String> {
-    catflip::run::judge(
-        cfg,
-        status,
-        peak,
-        bend,
-        sched,
-        &Simulated::Flip {
-            flip_error_rad,
-            tilt_deg,
-        },
-    )
-    .reason()
 }
 
 /// The name serde gives a unit enum value (`criticality`), for display only.
@@ -550,81 +501,17 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
         Mode::Free => "optimize-free",
     };
     let publisher = publisher(c, &cfg, set)?;
-    let partial;
-    match mode {
-        Mode::Phased => {
-            let r = catflip::design::phased::optimize(&cfg, |e| {
-                if verbose {
-                    eprintln!(
-                        "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
-                        e.bend_deg,
-                        maybe(e.unit_peak, 5),
-                        maybe(e.peak_nm, 5)
-                    );
-                }
-            })?;
-            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
-            let reason = design_flags(
-                &cfg,
-                r.status.into(),
-                (r.peak_torque_nm, r.bend_deg),
-                &sched,
-                (r.flip_error_rad, r.tilt_deg),
-            );
-            partial = flag("the phased design", reason.clone());
-            let Some(written) = write_design(
-                c,
-                publisher,
-                "phased",
-                &sched,
-                serde_json::to_value(&r)?,
-                reason,
-            )?
-            else {
-                return Ok(status_of(partial));
-            };
-            say!(
-                "catflip optimize --mode phased: {} ({} joint), status {}",
-                cfg.name,
-                cfg.cat.joint.name(),
-                verdict::Status::from(r.status)
-            );
-            row(
-                "peak torque",
-                format!(
-                    "{:.5} N m (SOCP bound {})",
-                    r.peak_torque_nm,
-                    maybe(r.socp_peak_torque_nm, 5)
-                ),
-            );
-            row(
-                "bend / theta",
-                format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
-            );
-            row("twist", format!("{:.6} rad", r.twist_rad));
-            row(
-                "seed cosine schedule, same bend",
-                format!(
-                    "{:.5} N m ({:.2}x the optimum)",
-                    r.analytic_peak_same_bend_nm, r.improvement_factor
-                ),
-            );
-            design_rows(
-                r.phase_durations_s,
-                (
-                    r.flip_deg,
-                    r.flip_error_rad,
-                    r.tilt_deg,
-                    r.sim_peak_torque_nm,
-                ),
-                format!(
-                    "{:.3} s ({} bend evaluations)",
-                    r.solve_time_s,
-                    r.evaluations.len()
-                ),
-                written,
-            );
-        }
+    let design = match mode {
+        Mode::Phased => Design::Phased(catflip::design::phased::optimize(&cfg, |e| {
+            if verbose {
+                eprintln!(
+                    "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
+                    e.bend_deg,
+                    maybe(e.unit_peak, 5),
+                    maybe(e.peak_nm, 5)
+                );
+            }
+        })?),
         Mode::Free => {
             let seed = match seed {
                 SeedArg::Phased => catflip::design::free::Seed::Phased,
@@ -636,101 +523,164 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
                 );
             }
-            let r = catflip::design::free::FreeDesign::new(&cfg)
-                .seed(seed)
-                .check_mesh()
-                .observe(&mut IterationTable { verbose })
-                .solve()?;
-            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
-            let reason = design_flags(
-                &cfg,
-                r.status.into(),
-                (r.peak_torque_nm, r.bend_deg),
-                &sched,
-                (r.flip_error_rad, r.tilt_deg),
-            );
-            partial = flag("the free-form design", reason.clone());
-            let Some(written) = write_design(
-                c,
-                publisher,
-                "free",
-                &sched,
-                serde_json::to_value(&r)?,
-                reason,
-            )?
-            else {
-                return Ok(status_of(partial));
-            };
-            say!(
-                "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
-                cfg.name,
-                cfg.cat.joint.name(),
-                verdict::Status::from(r.status),
-                r.seed
-            );
-            row(
-                &format!("objective ({})", r.objective.name()),
-                format!(
-                    "{:.6} {} (manoeuvre {:.4} s)",
-                    r.objective_value,
-                    r.objective.unit(),
-                    r.manoeuvre_time_s
-                ),
-            );
-            row(
-                "peak torque",
-                format!(
-                    "{:.5} N m (at check points {:.5})",
-                    r.peak_torque_nm, r.node_peak_torque_nm
-                ),
-            );
-            row(
-                "largest bend / theta",
-                format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
-            );
-            row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
-            let cert = &r.certificate;
-            row(
-                "certificate",
-                format!(
-                    "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {})",
-                    cert.step,
-                    cert.constraint_violation,
-                    cert.criticality,
-                    shown(&cert.rule)
-                ),
-            );
-            if let Some(m) = &r.mesh_check {
-                row(
-                    "mesh check (N vs 2N)",
-                    format!(
-                        "{:.5} {} at {} nodes per phase ({:+.2} %), {}",
-                        m.objective_value,
-                        r.objective.unit(),
-                        m.nodes,
-                        100.0 * m.relative_change,
-                        verdict::Status::from(m.status)
-                    ),
-                );
-            }
-            design_rows(
-                r.phase_durations_s,
-                (
-                    r.flip_deg,
-                    r.flip_error_rad,
-                    r.tilt_deg,
-                    r.sim_peak_torque_nm,
-                ),
-                format!(
-                    "{:.3} s ({})",
-                    r.solve_time_s,
-                    catflip::design::free::iterations_text(&r.mesh_levels)
-                ),
-                written,
-            );
+            Design::Free(
+                catflip::design::free::FreeDesign::new(&cfg)
+                    .seed(seed)
+                    .check_mesh()
+                    .observe(&mut IterationTable { verbose })
+                    .solve()?,
+            )
         }
+    };
+    // the same stage as `run`: schedule, verdict, files
+    let judged = catflip::pipeline::stage(&cfg, design, 0.0);
+    let method = judged.design.method();
+    let reason = judged.verdict.reason();
+    let what = match method {
+        Method::Free => "the free-form design",
+        _ => "the phased design",
+    };
+    let partial = flag(what, reason.clone());
+    let mut json = match &judged.design {
+        Design::Phased(r) => serde_json::to_value(r)?,
+        Design::Free(r) => serde_json::to_value(r)?,
+        Design::Analytic(a) => serde_json::to_value(a)?,
+    };
+    json["verdict"] = serde_json::to_value(judged.verdict.grade())?;
+    if let Some(r) = reason {
+        json["reason"] = r.into();
+    }
+    let json = serde_json::to_string_pretty(&json)?;
+    let mut out = Output::default();
+    judged.add_files(&mut out);
+    out.add(format!("{}.json", method.name()), json.clone());
+    let written = publisher.publish(out)?;
+    if c.json {
+        say!("{json}");
+        return Ok(status_of(partial));
+    }
+    match &judged.design {
+        Design::Phased(r) => print_phased(&cfg, r, written),
+        Design::Free(r) => print_free(&cfg, r, written),
+        Design::Analytic(_) => {}
     }
     Ok(status_of(partial))
+}
+
+/// `optimize --mode phased`'s table.
+fn print_phased(cfg: &Config, r: &catflip::design::phased::PhasedResult, written: Vec<PathBuf>) {
+    say!(
+        "catflip optimize --mode phased: {} ({} joint), status {}",
+        cfg.name,
+        cfg.cat.joint.name(),
+        verdict::Status::from(r.status)
+    );
+    row(
+        "peak torque",
+        format!(
+            "{:.5} N m (SOCP bound {})",
+            r.peak_torque_nm,
+            maybe(r.socp_peak_torque_nm, 5)
+        ),
+    );
+    row(
+        "bend / theta",
+        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+    );
+    row("twist", format!("{:.6} rad", r.twist_rad));
+    row(
+        "seed cosine schedule, same bend",
+        format!(
+            "{:.5} N m ({:.2}x the optimum)",
+            r.analytic_peak_same_bend_nm, r.improvement_factor
+        ),
+    );
+    design_rows(
+        r.phase_durations_s,
+        (
+            r.flip_deg,
+            r.flip_error_rad,
+            r.tilt_deg,
+            r.sim_peak_torque_nm,
+        ),
+        format!(
+            "{:.3} s ({} bend evaluations)",
+            r.solve_time_s,
+            r.evaluations.len()
+        ),
+        written,
+    );
+}
+
+/// `optimize --mode free`'s table.
+fn print_free(cfg: &Config, r: &catflip::design::free::FreeResult, written: Vec<PathBuf>) {
+    say!(
+        "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
+        cfg.name,
+        cfg.cat.joint.name(),
+        verdict::Status::from(r.status),
+        r.seed
+    );
+    row(
+        &format!("objective ({})", r.objective.name()),
+        format!(
+            "{:.6} {} (manoeuvre {:.4} s)",
+            r.objective_value,
+            r.objective.unit(),
+            r.manoeuvre_time_s
+        ),
+    );
+    row(
+        "peak torque",
+        format!(
+            "{:.5} N m (at check points {:.5})",
+            r.peak_torque_nm, r.node_peak_torque_nm
+        ),
+    );
+    row(
+        "largest bend / theta",
+        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+    );
+    row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+    let cert = &r.certificate;
+    row(
+        "certificate",
+        format!(
+            "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {})",
+            cert.step,
+            cert.constraint_violation,
+            cert.criticality,
+            shown(&cert.rule)
+        ),
+    );
+    if let Some(m) = &r.mesh_check {
+        row(
+            "mesh check (N vs 2N)",
+            format!(
+                "{:.5} {} at {} nodes per phase ({:+.2} %), {}",
+                m.objective_value,
+                r.objective.unit(),
+                m.nodes,
+                100.0 * m.relative_change,
+                verdict::Status::from(m.status)
+            ),
+        );
+    }
+    design_rows(
+        r.phase_durations_s,
+        (
+            r.flip_deg,
+            r.flip_error_rad,
+            r.tilt_deg,
+            r.sim_peak_torque_nm,
+        ),
+        format!(
+            "{:.3} s ({})",
+            r.solve_time_s,
+            catflip::design::free::iterations_text(&r.mesh_levels)
+        ),
+        written,
+    );
 }
 
 /// Stage lines on stderr; live iteration counters when stderr is a terminal.

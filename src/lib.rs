@@ -14,6 +14,7 @@ pub mod error;
 pub mod export;
 pub mod model;
 pub mod output;
+pub mod pipeline;
 pub mod report;
 pub mod run;
 pub mod sweep;

@@ -15,7 +15,7 @@ use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
-use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
+use crate::verdict::{Simulated, Status};
 use crate::verify::analyze::peak_along;
 use serde::Serialize;
 use std::path::Path;
@@ -188,6 +188,59 @@ impl std::str::FromStr for Shard {
 /// the design: the phased peak design is the same path at every value.
 const FALL_ONLY: [&str; 3] = ["fall.height", "fall.gravity", "fall.margin"];
 
+/// What one chunk carries from point to point (continuation): the last
+/// two free-form designs when they are consecutive points (the start and
+/// the secant predictor), the chunk's first phased design in a sweep of the
+/// fall alone (F3 time scaling) and the chunk's solved phased bends, in
+/// order (the bend search's hint).
+#[derive(Default)]
+struct Continuation {
+    warm: Option<FreeResult>,
+    before: Option<FreeResult>,
+    /// Whether the point before produced a free-form design (`warm`).
+    last_ok: bool,
+    /// `Some` in a sweep of the fall alone: the chunk's first phased design
+    /// and its manoeuvre time, once computed.
+    phased: Option<Option<(f64, crate::design::phased::PhasedResult)>>,
+    bends: Vec<f64>,
+}
+
+impl Continuation {
+    fn new(fall_only: bool) -> Self {
+        Continuation {
+            phased: fall_only.then_some(None),
+            ..Default::default()
+        }
+    }
+
+    /// The point at `value`, continued from the chunk's points before it.
+    fn point(&mut self, cfg: &Config, value: f64, methods: Methods) -> SweepPoint {
+        let (p, fr) = point(
+            cfg,
+            value,
+            methods,
+            self.warm.as_ref(),
+            self.before.as_ref(),
+            self.phased.as_mut(),
+            &mut self.bends,
+        );
+        // a failed point leaves the last good design as the start, and no
+        // secant until two consecutive points have designs again
+        let produced = fr.is_some();
+        let last = fr.and_then(|fr| self.warm.replace(fr));
+        self.before = last.filter(|_| self.last_ok);
+        self.last_ok = produced;
+        p
+    }
+
+    /// A point whose config is invalid: the next scans its bend afresh.
+    fn skip(&mut self) {
+        self.bends.clear();
+        self.before = None;
+        self.last_ok = false;
+    }
+}
+
 /// One sweep point; `warm` is the last free-form design in the same chunk
 /// (continuation) and `before` the one at the point before it, when both
 /// points are consecutive (the secant predictor); `bends` the chunk's
@@ -357,7 +410,7 @@ fn point(
 
 /// A kept design that misses a target (unconverged, flip missed, bend
 /// limit broken) is named in the point's `error` column beside its numbers
-/// ([`verdict`]; a sweep's peaks are computed without the torque limit and
+/// ([`crate::pipeline::judge`]; a sweep's peaks are computed without the torque limit and
 /// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
@@ -367,15 +420,11 @@ fn flagged(
     bend_deg: f64,
     (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
-    let v = verdict(
-        &Targets::of(cfg),
-        &DesignNumbers {
-            status,
-            peak_torque_nm,
-            bend_deg,
-            max_speed_rad_s: None,
-            envelope_margin: None,
-        },
+    let v = crate::pipeline::judge(
+        cfg,
+        status,
+        (peak_torque_nm, bend_deg),
+        None,
         &Simulated::Flip {
             flip_error_rad,
             tilt_deg,
@@ -478,48 +527,19 @@ pub fn sweep_shard(
                     if c >= chunks.len() {
                         break;
                     }
-                    // the chunk's last two free-form designs, when they are
-                    // consecutive points (the secant predictor)
-                    let mut warm: Option<FreeResult> = None;
-                    let mut before: Option<FreeResult> = None;
-                    // a sweep of the fall alone reuses the chunk's first
-                    // phased design (F3 time scaling)
-                    let mut phased_warm = None;
-                    let mut bends = Vec::new();
-                    let mut last_ok = false;
+                    let mut chain = Continuation::new(FALL_ONLY.contains(&spec.key.as_str()));
                     for i in chunks[c].clone() {
-                        let slot = FALL_ONLY
-                            .contains(&spec.key.as_str())
-                            .then_some(&mut phased_warm);
-                        let (p, fr) = match &configs[i] {
-                            Ok(cfg) => point(
-                                cfg,
-                                values[i],
-                                methods,
-                                warm.as_ref(),
-                                before.as_ref(),
-                                slot,
-                                &mut bends,
-                            ),
+                        let p = match &configs[i] {
+                            Ok(cfg) => chain.point(cfg, values[i], methods),
                             Err(e) => {
-                                bends.clear();
-                                (
-                                    SweepPoint {
-                                        value: values[i],
-                                        error: Some(e.to_string()),
-                                        ..Default::default()
-                                    },
-                                    None,
-                                )
+                                chain.skip();
+                                SweepPoint {
+                                    value: values[i],
+                                    error: Some(e.to_string()),
+                                    ..Default::default()
+                                }
                             }
                         };
-                        // a failed point leaves the last good design as the
-                        // start, and no secant until two consecutive points
-                        // have designs again
-                        let produced = fr.is_some();
-                        let last = fr.and_then(|fr| warm.replace(fr));
-                        before = last.filter(|_| last_ok);
-                        last_ok = produced;
                         results.lock().unwrap()[i] = Some(p);
                         progress(done.fetch_add(1, Ordering::SeqCst) + 1, values.len());
                     }

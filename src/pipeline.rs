@@ -1,0 +1,400 @@
+//! The per-method stage every command shares: a method's design is sampled
+//! as the schedule that is written, simulated (unless the design brought
+//! its verifying simulation), judged by [`crate::verdict`], and turned into
+//! its summary line, its files, its figure curves and its animation track.
+//! `run` passes each method through [`stage`]; `optimize` passes its one
+//! design; `sweep` judges its points with [`judge`] (peaks only, no files).
+
+use crate::config::Config;
+use crate::design::free::FreeResult;
+use crate::design::phased::PhasedResult;
+use crate::design::plan::{Schedule, ShapePlan};
+use crate::error::{Error, Result};
+use crate::output::Output;
+use crate::report::MethodTrace;
+use crate::report::animation::Track;
+use crate::verdict::{DesignNumbers, Grade, Simulated, Status, Targets, Verdict, verdict};
+use crate::verify::analyze::Analysis;
+use crate::verify::simulate::{SimReport, dynamic_cfg};
+use serde::Serialize;
+
+/// The design methods, in the order every table lists them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Method {
+    /// The seed's closed-form cosine schedule.
+    Analytic,
+    /// The certified fold / twist / unfold optimum.
+    Phased,
+    /// Collocation and successive convexification.
+    Free,
+}
+
+impl Method {
+    pub const ALL: [Method; 3] = [Method::Analytic, Method::Phased, Method::Free];
+
+    /// The name of its files (`phased.csv`) and table rows.
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Analytic => "analytic",
+            Method::Phased => "phased",
+            Method::Free => "free",
+        }
+    }
+}
+
+/// A method's design, whatever made it (one per method and run: the
+/// variants' sizes do not matter, so they are not boxed).
+#[allow(clippy::large_enum_variant)]
+pub enum Design {
+    Analytic(Analysis),
+    Phased(PhasedResult),
+    Free(FreeResult),
+}
+
+impl Design {
+    pub fn method(&self) -> Method {
+        match self {
+            Design::Analytic(_) => Method::Analytic,
+            Design::Phased(_) => Method::Phased,
+            Design::Free(_) => Method::Free,
+        }
+    }
+
+    pub fn plan(&self) -> &dyn ShapePlan {
+        match self {
+            Design::Analytic(a) => &a.plan,
+            Design::Phased(p) => &p.plan,
+            Design::Free(f) => &f.plan,
+        }
+    }
+
+    pub fn status(&self) -> Status {
+        match self {
+            Design::Analytic(_) => Status::ClosedForm,
+            Design::Phased(p) => p.status.into(),
+            Design::Free(f) => f.status.into(),
+        }
+    }
+
+    /// Dense peak joint torque of the schedule, N m.
+    pub fn peak_torque_nm(&self) -> f64 {
+        match self {
+            Design::Analytic(a) => a.peak_torque_nm,
+            Design::Phased(p) => p.peak_torque_nm,
+            Design::Free(f) => f.peak_torque_nm,
+        }
+    }
+
+    /// Largest bend (deg), twist of the bend direction (rad), phase durations (s).
+    pub fn path_numbers(&self) -> (f64, f64, [f64; 3]) {
+        match self {
+            Design::Analytic(a) => (
+                a.closed.bend_deg,
+                a.closed.twist_rad,
+                a.closed.phase_durations_s,
+            ),
+            Design::Phased(p) => (p.bend_deg, p.twist_rad, p.phase_durations_s),
+            Design::Free(f) => (f.bend_deg, f.twist_rad, f.phase_durations_s),
+        }
+    }
+
+    /// The dynamic simulation the design was verified with, if it brought one.
+    fn simulation(&self) -> Option<&SimReport> {
+        match self {
+            Design::Analytic(_) => None,
+            Design::Phased(p) => p.sim.as_ref(),
+            Design::Free(f) => Some(&f.sim),
+        }
+    }
+}
+
+/// The verdict on a design with this status, dense peak and largest bend
+/// (deg), written as `schedule` (the motor usage of its rows; `None`: not
+/// judged on speed and envelope) and simulated as `simulated`.
+pub fn judge(
+    cfg: &Config,
+    status: Status,
+    (peak_torque_nm, bend_deg): (f64, f64),
+    schedule: Option<&Schedule>,
+    simulated: &Simulated,
+) -> Verdict {
+    let motor = schedule.map(|s| usage(cfg, s));
+    verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status,
+            peak_torque_nm,
+            bend_deg,
+            max_speed_rad_s: motor.map(|m| m.max_speed_rad_s),
+            envelope_margin: motor.and_then(|m| m.min_margin),
+        },
+        simulated,
+    )
+}
+
+/// How the motors are used by a written schedule's rows.
+fn usage(cfg: &Config, schedule: &Schedule) -> crate::model::motor::MotorUse {
+    cfg.motor()
+        .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)))
+}
+
+/// A design through the stage: its schedule, simulation, verdict and line.
+pub struct Judged {
+    pub design: Design,
+    pub schedule: Schedule,
+    /// The dynamic simulation, or why it failed (the design is then kept,
+    /// flagged, with NaN simulation numbers).
+    pub sim: Result<SimReport>,
+    pub verdict: Verdict,
+    pub summary: MethodSummary,
+}
+
+/// The stage: sample, simulate, judge, summarise. `solve_time_s` is the
+/// method's time (the analytic design's includes its simulation).
+pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
+    let schedule = Schedule::sample(&cfg.cat(), design.plan(), cfg.simulate.samples_per_phase);
+    let sim = match design.simulation() {
+        Some(s) => Ok(s.clone()),
+        None => dynamic_cfg(cfg, design.plan()),
+    };
+    let method = design.method();
+    let (bend, twist, durations) = design.path_numbers();
+    let peak = design.peak_torque_nm();
+    let failed_sim = SimReport::failed();
+    let s = sim.as_ref().unwrap_or(&failed_sim);
+    let motor = usage(cfg, &schedule);
+    let n = MethodNumbers {
+        peak_torque_nm: peak,
+        bend_deg: bend,
+        theta_deg: 180.0 - bend,
+        twist_rad: twist,
+        phase_durations_s: durations,
+        flip_deg: s.flip_deg,
+        flip_error_rad: s.flip_error_rad,
+        tilt_deg: s.tilt_deg,
+        sim_peak_torque_nm: s.peak_torque_nm,
+        momentum_drift_nms: s.momentum_drift_nms,
+        final_shape_error_rad: s.final_shape_error_rad,
+        max_speed_rad_s: motor.max_speed_rad_s,
+        min_envelope_margin: motor.min_margin,
+        energy_n2m2s: schedule.torque_squared_integral(),
+        solve_time_s,
+        schedule_csv: format!("{}.csv", method.name()),
+        schedule_json: format!("{}.schedule.json", method.name()),
+    };
+    let verdict = judge(
+        cfg,
+        design.status(),
+        (peak, bend),
+        Some(&schedule),
+        &Simulated::of(sim.as_ref()),
+    );
+    let summary = MethodSummary {
+        method: method.name(),
+        status: design.status(),
+        verdict: verdict.grade(),
+        reason: verdict.reason(),
+        result: Some(n),
+    };
+    Judged {
+        design,
+        schedule,
+        sim,
+        verdict,
+        summary,
+    }
+}
+
+impl Judged {
+    /// The simulation, or the NaN report of a failed one.
+    fn sim_or_failed(&self) -> std::borrow::Cow<'_, SimReport> {
+        match &self.sim {
+            Ok(s) => std::borrow::Cow::Borrowed(s),
+            Err(_) => std::borrow::Cow::Owned(SimReport::failed()),
+        }
+    }
+
+    /// `<method>.csv` and `<method>.schedule.json`.
+    pub fn add_files(&self, out: &mut Output) {
+        self.schedule.add_to(out, self.design.method().name());
+    }
+
+    /// Curves for the figures, `per_phase` samples a phase.
+    pub fn trace(&self, cfg: &Config, per_phase: usize) -> MethodTrace {
+        trace(
+            cfg,
+            self.design.method().name(),
+            self.design.plan(),
+            self.design.peak_torque_nm(),
+            &self.sim_or_failed(),
+            per_phase,
+        )
+    }
+
+    /// The animation's track.
+    pub fn track(&self, cfg: &Config) -> Track {
+        crate::report::animation::track(
+            &cfg.cat(),
+            cfg.norm(),
+            self.design.method().name(),
+            &self.sim_or_failed(),
+            crate::report::animation::FRAMES,
+        )
+    }
+}
+
+/// Curves of one method for the figures; `peak` is its dense peak torque,
+/// the table's (the curve's samples may fall just short of it).
+pub fn trace(
+    cfg: &Config,
+    name: &str,
+    plan: &dyn ShapePlan,
+    peak: f64,
+    sim: &SimReport,
+    per_phase: usize,
+) -> MethodTrace {
+    let cat = cfg.cat();
+    let norm = cfg.norm();
+    let b = plan.phase_bounds();
+    let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
+    for i in 0..3 {
+        for k in 0..=per_phase {
+            let tt = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+            t.push(tt);
+            let s = plan.state_in(i, tt);
+            q.push(s.q);
+            qd.push(s.qd);
+            let v = plan.torque_in(&cat, i, tt);
+            tau.push(norm.of(v));
+            tau_xy.push(v);
+        }
+    }
+    MethodTrace {
+        name: name.into(),
+        t,
+        q,
+        tau,
+        qd,
+        tau_xy,
+        peak_nm: peak,
+        over_limit: Targets::of(cfg).over_torque(peak),
+        phase_bounds: b,
+        flip_t: sim.trace.iter().map(|p| p.t).collect(),
+        flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),
+    }
+}
+
+/// One method's line of the summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodSummary {
+    pub method: &'static str,
+    /// Solver status (`closed-form`, `solved`, `converged`, ...), or `failed`.
+    pub status: Status,
+    pub verdict: Grade,
+    /// Why the method is flagged or failed (absent when ok).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// The numbers, absent when the method failed.
+    #[serde(flatten)]
+    pub result: Option<MethodNumbers>,
+}
+
+/// The numbers of a method that produced a schedule.
+#[derive(Debug, Clone, Serialize)]
+pub struct MethodNumbers {
+    /// Peak joint torque of the schedule (inverse dynamics, dense), N m.
+    pub peak_torque_nm: f64,
+    pub bend_deg: f64,
+    pub theta_deg: f64,
+    pub twist_rad: f64,
+    pub phase_durations_s: [f64; 3],
+    /// Dynamic simulation (feed-forward + PD, torque limit if any).
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    pub sim_peak_torque_nm: f64,
+    pub momentum_drift_nms: f64,
+    pub final_shape_error_rad: f64,
+    /// Largest joint speed of the written schedule, rad/s (motor norm).
+    pub max_speed_rad_s: f64,
+    /// Smallest motor-envelope margin over the written rows (1 unused, 0 on
+    /// the envelope, negative violated; absent without limits).
+    pub min_envelope_margin: Option<f64>,
+    /// `integral |tau|^2 dt` over the written rows, N^2 m^2 s (the energy
+    /// objective; the peak and the durations give the other two).
+    pub energy_n2m2s: f64,
+    pub solve_time_s: f64,
+    pub schedule_csv: String,
+    pub schedule_json: String,
+}
+
+impl MethodSummary {
+    /// The line of a method that produced no design.
+    pub fn failed(method: Method, e: &Error) -> MethodSummary {
+        MethodSummary {
+            method: method.name(),
+            status: Status::Failed,
+            verdict: Grade::Failed,
+            reason: Some(e.to_string()),
+            result: None,
+        }
+    }
+
+    pub fn peak(&self) -> Option<f64> {
+        self.result.as_ref().map(|r| r.peak_torque_nm)
+    }
+}
+
+/// Columns of the comparison table (terminal and index.html).
+pub const TABLE_HEADER: [&str; 11] = [
+    "method",
+    "status",
+    "peak N m",
+    "energy N2m2s",
+    "bend deg",
+    "durations s",
+    "flip error rad",
+    "tilt deg",
+    "sim peak N m",
+    "solve s",
+    "verdict",
+];
+
+/// A small number in the table: `0` for exact zero, else 3 significant digits.
+fn small(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// One line of the comparison table; a failed method shows `-` for its numbers.
+pub fn table_row(m: &MethodSummary) -> Vec<String> {
+    let verdict = match (m.verdict, &m.reason) {
+        (Grade::Ok, _) => "ok".to_string(),
+        (Grade::Flagged, r) => format!("FLAGGED: {}", r.as_deref().unwrap_or("")),
+        (Grade::Failed, r) => format!("FAILED: {}", r.as_deref().unwrap_or("")),
+    };
+    let mut row = vec![m.method.to_string(), m.status.to_string()];
+    match &m.result {
+        Some(n) => {
+            let d = n.phase_durations_s;
+            row.extend([
+                format!("{:.5}", n.peak_torque_nm),
+                format!("{:.4e}", n.energy_n2m2s),
+                format!("{:.2}", n.bend_deg),
+                format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
+                small(n.flip_error_rad),
+                small(n.tilt_deg),
+                format!("{:.5}", n.sim_peak_torque_nm),
+                format!("{:.3}", n.solve_time_s),
+            ]);
+        }
+        None => row.extend(std::iter::repeat_n("-".to_string(), 8)),
+    }
+    row.push(verdict);
+    row
+}
