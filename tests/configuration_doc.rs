@@ -2,6 +2,8 @@
 //! a row, every row names a key the config accepts, and every documented
 //! default is the code's default. Either side changing alone fails here.
 
+mod util;
+
 use catflip::Config;
 use std::collections::BTreeMap;
 
@@ -17,8 +19,8 @@ struct Row {
 
 /// The rows of the document's key tables: `| `key` | default | unit | allowed | ... |`.
 fn documented() -> BTreeMap<String, Row> {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/configuration.md");
-    let text = std::fs::read_to_string(path).expect("docs/configuration.md exists");
+    let text = std::fs::read_to_string(util::repo().join("docs/configuration.md"))
+        .expect("docs/configuration.md exists");
     let mut rows = BTreeMap::new();
     for line in text.lines() {
         let cells = cells(line);
