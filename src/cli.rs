@@ -139,8 +139,13 @@ enum SeedArg {
     Analytic,
 }
 
+/// Loads and checks the config; likely unit slips are warned about on stderr.
 fn load(c: &Common) -> Result<Config> {
-    Ok(Config::load(&c.config, &c.set)?)
+    let cfg = Config::load(&c.config, &c.set)?;
+    for s in cfg.slips() {
+        eprintln!("warning: {s}");
+    }
+    Ok(cfg)
 }
 
 fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
@@ -230,6 +235,7 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     )
     .reason();
     let mut v = serde_json::to_value(&a)?;
+    catflip::output::ensure_finite(&v, &[])?;
     v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
     if let Some(r) = &reason {
         v["reason"] = r.clone().into();
@@ -388,6 +394,7 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     .map(ToString::to_string)
     .collect();
     let reason = (!why.is_empty()).then(|| why.join("; "));
+    catflip::output::ensure_finite(&serde_json::to_value(&report)?, &[])?;
     let mut out = Output::default();
     out.add("simulation.csv", trace);
     let written = publisher.publish(out)?;
@@ -546,6 +553,18 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
         Design::Free(r) => serde_json::to_value(r)?,
         Design::Analytic(a) => serde_json::to_value(a)?,
     };
+    // a number that is not finite is refused, not written as null
+    catflip::output::ensure_finite(
+        &json,
+        &[
+            "peak_torque_nm",
+            "bend_deg",
+            "flip_deg",
+            "tilt_deg",
+            "sim_peak_torque_nm",
+            "phase_durations_s",
+        ],
+    )?;
     json["verdict"] = serde_json::to_value(judged.verdict.grade())?;
     if let Some(r) = reason {
         json["reason"] = r.into();

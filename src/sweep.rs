@@ -485,17 +485,41 @@ pub fn sweep_shard(
             ),
         });
     }
+    sweep_values(
+        &spec.key,
+        &spec.arg(),
+        values,
+        load,
+        methods,
+        threads,
+        progress,
+    )
+}
+
+/// The points of a sweep of `key` over `values` (any values, in order; the
+/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
+/// value and `arg` naming the sweep in messages: what [`sweep_shard`] runs,
+/// and what a caller with its own values (the Python package) calls.
+pub fn sweep_values(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
     // a point whose config is invalid is that point's failure; when every
     // point is invalid (e.g. an unknown key) the sweep fails before any work
     let configs: Vec<Result<Config>> = values
         .iter()
         .map(|&v| {
             load(v).map_err(|e| Error::Range {
-                arg: spec.arg(),
+                arg: arg.into(),
                 message: match e {
                     // the override is internal: name the point, not a `--set`
-                    Error::Override { message, .. } => format!("at {} = {v}: {message}", spec.key),
-                    e => format!("at {} = {v}: {e}", spec.key),
+                    Error::Override { message, .. } => format!("at {key} = {v}: {message}"),
+                    e => format!("at {key} = {v}: {e}"),
                 },
             })
         })
@@ -504,7 +528,7 @@ pub fn sweep_shard(
         && configs.iter().all(|c| c.is_err())
     {
         return Err(Error::Range {
-            arg: spec.arg(),
+            arg: arg.into(),
             message: match first {
                 Error::Range { message, .. } => format!("every point is invalid; {message}"),
                 e => e.to_string(),
@@ -527,7 +551,7 @@ pub fn sweep_shard(
                     if c >= chunks.len() {
                         break;
                     }
-                    let mut chain = Continuation::new(FALL_ONLY.contains(&spec.key.as_str()));
+                    let mut chain = Continuation::new(FALL_ONLY.contains(&key));
                     for i in chunks[c].clone() {
                         let p = match &configs[i] {
                             Ok(cfg) => chain.point(cfg, values[i], methods),
