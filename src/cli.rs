@@ -4,8 +4,9 @@ use anyhow::Result;
 use catflip::Config;
 use catflip::output::{Output, Publisher};
 use catflip::pipeline::{Design, Method};
-use catflip::verdict::{self, Simulated};
-use catflip::verify::analyze::{analytic_schedule, analyze, verify};
+use catflip::sweep::Methods;
+use catflip::verdict;
+use catflip::verify::analyze::{analyze, verify};
 use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
 use std::path::{Path, PathBuf};
@@ -79,19 +80,24 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// KEY=FROM:TO:COUNT, e.g. fall.height=0.5:10:40.
-        #[arg(long = "set-range", value_name = "KEY=FROM:TO:COUNT")]
-        range: String,
+        #[arg(long = "set-range", value_name = "KEY=FROM:TO:COUNT", value_parser = parsed::<catflip::sweep::SweepSpec>)]
+        range: catflip::sweep::SweepSpec,
         /// Methods to compute, comma separated (default all three).
-        #[arg(long, value_delimiter = ',', default_value = "analytic,phased,free")]
-        methods: Vec<String>,
-        /// Points computed at once (default: the machine's cores).
-        #[arg(long)]
-        threads: Option<usize>,
+        #[arg(
+            long,
+            value_enum,
+            value_delimiter = ',',
+            default_value = "analytic,phased,free"
+        )]
+        methods: Vec<MethodArg>,
+        /// Points computed at once, at least 1 (default: the machine's cores).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        threads: Option<u32>,
         /// K/N: compute only the K-th of N disjoint slices of the grid (for a
         /// batch scheduler's job array); the shards' CSVs concatenate into the
         /// whole sweep's.
-        #[arg(long, value_name = "K/N")]
-        shard: Option<String>,
+        #[arg(long, value_name = "K/N", value_parser = parsed::<catflip::sweep::Shard>)]
+        shard: Option<catflip::sweep::Shard>,
     },
     /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
@@ -137,6 +143,49 @@ enum Mode {
 enum SeedArg {
     Phased,
     Analytic,
+}
+
+impl From<SeedArg> for catflip::design::free::Seed {
+    fn from(s: SeedArg) -> Self {
+        match s {
+            SeedArg::Phased => catflip::design::free::Seed::Phased,
+            SeedArg::Analytic => catflip::design::free::Seed::Analytic,
+        }
+    }
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, PartialEq, Eq)]
+enum MethodArg {
+    Analytic,
+    Phased,
+    Free,
+}
+
+/// A value parser from the library's own `FromStr` (its message names the
+/// argument and the remedy; clap adds the flag and exits with status 2).
+fn parsed<T: std::str::FromStr<Err = catflip::Error>>(s: &str) -> Result<T, String> {
+    s.parse().map_err(|e: catflip::Error| e.to_string())
+}
+
+/// What `optimize` designs: the phased design, or the free-form one from a seed.
+#[derive(Clone, Copy)]
+enum Optimizer {
+    Phased,
+    Free(catflip::design::free::Seed),
+}
+
+impl Optimizer {
+    /// `--mode` and `--seed`, checked: a seed belongs to the free-form design.
+    fn of(mode: Mode, seed: Option<SeedArg>) -> Result<Optimizer> {
+        match (mode, seed) {
+            (Mode::Phased, Some(_)) => Err(catflip::Error::Usage(
+                "--seed applies to --mode free (the phased design has no seed); add --mode free or leave --seed out".into(),
+            )
+            .into()),
+            (Mode::Phased, None) => Ok(Optimizer::Phased),
+            (Mode::Free, seed) => Ok(Optimizer::Free(seed.unwrap_or(SeedArg::Phased).into())),
+        }
+    }
 }
 
 /// Loads and checks the config; likely unit slips are warned about on stderr.
@@ -192,7 +241,17 @@ pub fn run() -> Result<Status> {
             methods,
             threads,
             shard,
-        } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref()),
+        } => cmd_sweep(
+            &common,
+            &range,
+            Methods {
+                analytic: methods.contains(&MethodArg::Analytic),
+                phased: methods.contains(&MethodArg::Phased),
+                free: methods.contains(&MethodArg::Free),
+            },
+            threads.map(|t| t as usize),
+            shard.unwrap_or(catflip::sweep::Shard::ALL),
+        ),
         Command::Export {
             format,
             common,
@@ -205,7 +264,7 @@ pub fn run() -> Result<Status> {
             mode,
             seed,
             verbose,
-        } => cmd_optimize(&common, mode, seed, verbose),
+        } => cmd_optimize(&common, Optimizer::of(mode, seed)?, verbose),
     }
 }
 
@@ -222,21 +281,11 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
-    let sched = analytic_schedule(&cfg, &a.plan);
-    let reason = catflip::pipeline::judge(
-        &cfg,
-        verdict::Status::ClosedForm,
-        (a.peak_torque_nm, a.closed.bend_deg),
-        Some(&sched),
-        &Simulated::Flip {
-            flip_error_rad: a.flip_error_rad,
-            tilt_deg: a.tilt_deg,
-        },
-    )
-    .reason();
+    let (sched, verdict) = catflip::pipeline::judge_analysis(&cfg, &a);
+    let reason = verdict.reason();
     let mut v = serde_json::to_value(&a)?;
     catflip::output::ensure_finite(&v, &[])?;
-    v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    v["verdict"] = serde_json::to_value(verdict.grade())?;
     if let Some(r) = &reason {
         v["reason"] = r.clone().into();
     }
@@ -385,15 +434,11 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
             p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
         ));
     }
-    let why: Vec<String> = verdict::flip_misses(
+    let reason = verdict::flip_reason(
         report.flip_error_rad,
         report.tilt_deg,
         cfg.simulate.flip_tolerance,
-    )
-    .iter()
-    .map(ToString::to_string)
-    .collect();
-    let reason = (!why.is_empty()).then(|| why.join("; "));
+    );
     catflip::output::ensure_finite(&serde_json::to_value(&report)?, &[])?;
     let mut out = Output::default();
     out.add("simulation.csv", trace);
@@ -494,22 +539,15 @@ impl catflip::design::free::Observer for IterationTable {
     }
 }
 
-fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) -> Result<Status> {
-    if matches!(mode, Mode::Phased) && seed.is_some() {
-        return Err(catflip::Error::Usage(
-            "--seed applies to --mode free (the phased design has no seed); add --mode free or leave --seed out".into(),
-        )
-        .into());
-    }
-    let seed = seed.unwrap_or(SeedArg::Phased);
+fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
-    let set = match mode {
-        Mode::Phased => "optimize-phased",
-        Mode::Free => "optimize-free",
+    let set = match optimizer {
+        Optimizer::Phased => "optimize-phased",
+        Optimizer::Free(_) => "optimize-free",
     };
     let publisher = publisher(c, &cfg, set)?;
-    let design = match mode {
-        Mode::Phased => Design::Phased(catflip::design::phased::optimize(&cfg, |e| {
+    let design = match optimizer {
+        Optimizer::Phased => Design::Phased(catflip::design::phased::optimize(&cfg, |e| {
             if verbose {
                 eprintln!(
                     "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
@@ -519,11 +557,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                 );
             }
         })?),
-        Mode::Free => {
-            let seed = match seed {
-                SeedArg::Phased => catflip::design::free::Seed::Phased,
-                SeedArg::Analytic => catflip::design::free::Seed::Analytic,
-            };
+        Optimizer::Free(seed) => {
             if verbose {
                 let objective = cfg.design.objective.short_name();
                 eprintln!(
@@ -839,41 +873,12 @@ fn cmd_run(c: &Common) -> Result<Status> {
 
 fn cmd_sweep(
     c: &Common,
-    range: &str,
-    methods: &[String],
+    spec: &catflip::sweep::SweepSpec,
+    m: Methods,
     threads: Option<usize>,
-    shard: Option<&str>,
+    shard: catflip::sweep::Shard,
 ) -> Result<Status> {
     let cfg = load(c)?;
-    let spec: catflip::sweep::SweepSpec = range.parse()?;
-    if threads == Some(0) {
-        return Err(catflip::Error::Usage(
-            "--threads 0: at least one point must be computed at a time; give --threads 1 or more, or leave it out for one per core".into(),
-        )
-        .into());
-    }
-    let shard = match shard {
-        Some(s) => s.parse()?,
-        None => catflip::sweep::Shard::ALL,
-    };
-    let mut m = catflip::sweep::Methods {
-        analytic: false,
-        phased: false,
-        free: false,
-    };
-    for name in methods {
-        match name.trim() {
-            "analytic" => m.analytic = true,
-            "phased" => m.phased = true,
-            "free" => m.free = true,
-            other => {
-                return Err(catflip::Error::Usage(format!(
-                    "unknown method `{other}` in --methods; use analytic, phased and/or free"
-                ))
-                .into());
-            }
-        }
-    }
     let threads = threads.unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -908,14 +913,8 @@ fn cmd_sweep(
     // a live bar on a terminal, plain lines otherwise
     let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let clock = std::time::Instant::now();
-    let points = catflip::sweep::sweep_shard(
-        &c.config,
-        &c.set,
-        &spec,
-        m,
-        threads,
-        shard,
-        |done, total| {
+    let points =
+        catflip::sweep::sweep_shard(&c.config, &c.set, spec, m, threads, shard, |done, total| {
             if quiet {
                 return;
             }
@@ -930,8 +929,7 @@ fn cmd_sweep(
             } else {
                 eprintln!("  {line}");
             }
-        },
-    )?;
+        })?;
     if !quiet && live {
         eprintln!();
     }

@@ -133,6 +133,23 @@ pub fn judge(
     )
 }
 
+/// The seed's analytic schedule as written, and its verdict (closed form;
+/// the flip from the analysis's kinematic simulation).
+pub fn judge_analysis(cfg: &Config, a: &Analysis) -> (Schedule, Verdict) {
+    let schedule = crate::verify::analyze::analytic_schedule(cfg, &a.plan);
+    let v = judge(
+        cfg,
+        Status::ClosedForm,
+        (a.peak_torque_nm, a.closed.bend_deg),
+        Some(&schedule),
+        &Simulated::Flip {
+            flip_error_rad: a.flip_error_rad,
+            tilt_deg: a.tilt_deg,
+        },
+    );
+    (schedule, v)
+}
+
 /// How the motors are used by a written schedule's rows.
 fn usage(cfg: &Config, schedule: &Schedule) -> crate::model::motor::MotorUse {
     cfg.motor()

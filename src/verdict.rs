@@ -394,6 +394,16 @@ pub fn flip_misses(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Vec<Miss> {
     why
 }
 
+/// [`flip_misses`] in one line (`None` when the flip lands): the verdict
+/// on a replayed schedule, which has no solver and no limits of its own.
+pub fn flip_reason(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
+    let why: Vec<String> = flip_misses(flip_error_rad, tilt_deg, tol)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
 /// Which limits a design breaks.
 pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
     let mut why = Vec::new();

@@ -278,19 +278,10 @@ impl Config {
 
 // --- Design -----------------------------------------------------------------
 
-/// Why a design misses its targets: its solver status and the flip
-/// (mirrors the CLI's `design_flags`).
-fn design_flags(cfg: &Cfg, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(catflip::verify::simulate::misses_flip(
-        flip_error_rad,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
-    (!why.is_empty()).then(|| why.join("; "))
+/// A design through the library's per-method stage (the same schedule,
+/// simulation and verdict as `catflip run` and `catflip optimize`).
+fn staged(cfg: &Cfg, design: catflip::pipeline::Design) -> catflip::pipeline::Judged {
+    catflip::pipeline::stage(cfg, design, 0.0)
 }
 
 fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_json::Value {
@@ -350,12 +341,20 @@ fn run_design(
                     )));
                 }
             };
-            let r = catflip::design::free::optimize(cfg, seed, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
+            let r = catflip::design::free::FreeDesign::new(cfg)
+                .seed(seed)
+                .check_mesh()
+                .solve()
+                .map_err(err)?;
+            let j = staged(cfg, catflip::pipeline::Design::Free(r));
+            let catflip::pipeline::Design::Free(r) = &j.design else {
+                unreachable!("the stage keeps the design")
+            };
+            let status = catflip::verdict::Status::from(r.status).to_string();
+            let reason = j.verdict.reason();
+            let json = with_verdict(serde_json::to_value(r).expect("serialises"), &reason);
             Ok((
-                Box::new(r.plan),
+                Box::new(r.plan.clone()),
                 json,
                 status,
                 reason,
@@ -368,11 +367,15 @@ fn run_design(
                 return Err(no_seed("the phased design"));
             }
             let r = catflip::design::phased::optimize(cfg, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
+            let j = staged(cfg, catflip::pipeline::Design::Phased(r));
+            let catflip::pipeline::Design::Phased(r) = &j.design else {
+                unreachable!("the stage keeps the design")
+            };
+            let status = catflip::verdict::Status::from(r.status).to_string();
+            let reason = j.verdict.reason();
+            let json = with_verdict(serde_json::to_value(r).expect("serialises"), &reason);
             Ok((
-                Box::new(r.plan),
+                Box::new(r.plan.clone()),
                 json,
                 status,
                 reason,
@@ -386,17 +389,8 @@ fn run_design(
             }
             // mirrors the CLI's `analyze`: a miss is flagged in the analysis
             let a = catflip::verify::analyze::analyze(cfg).map_err(err)?;
-            let sched = catflip::verify::analyze::analytic_schedule(cfg, &a.plan);
-            let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
-            let why = catflip::run::schedule_flags(
-                cfg,
-                (a.flip_error_rad, a.tilt_deg),
-                a.peak_torque_nm,
-                a.closed.bend_deg,
-                Some(usage.max_speed_rad_s),
-                usage.min_margin,
-            );
-            let reason = (!why.is_empty()).then(|| why.join("; "));
+            let (_, verdict) = catflip::pipeline::judge_analysis(cfg, &a);
+            let reason = verdict.reason();
             let json = with_verdict(serde_json::to_value(&a).expect("serialises"), &reason);
             Ok((
                 Box::new(a.plan),
@@ -685,7 +679,7 @@ fn simulate(
             }
         };
         let report = report.map_err(err)?;
-        let reason = catflip::verify::simulate::misses_flip(
+        let reason = catflip::verdict::flip_reason(
             report.flip_error_rad,
             report.tilt_deg,
             cfg.simulate.flip_tolerance,
@@ -860,7 +854,7 @@ impl LeastHeight {
     /// That design's solver status.
     #[getter]
     fn status(&self) -> String {
-        self.answer.status.clone()
+        self.answer.status.to_string()
     }
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -1011,7 +1005,7 @@ fn sweep_columns<'py>(
         "free_status",
         points
             .iter()
-            .map(|p| p.free_status.clone())
+            .map(|p| p.free_status.map(|s| s.to_string()))
             .collect::<Vec<_>>(),
     )?;
     d.set_item(
@@ -1193,7 +1187,7 @@ impl Controls {
     /// Peak norm: `euclidean` or `per-motor`.
     #[getter]
     fn norm(&self) -> String {
-        catflip::run::json_name(&self.cfg.norm())
+        self.cfg.norm().name().to_string()
     }
     /// Step start times, s: float64, shape (n + 1,).
     #[getter]

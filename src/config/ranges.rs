@@ -317,15 +317,21 @@ pub fn impossible(cfg: &Config) -> Result<()> {
             ));
         }
     }
-    let cf = crate::design::analytic::closed_forms(cfg);
-    let turns = cf.twist_rad / (2.0 * PI);
-    if !(cf.c > 0.0 && turns.is_finite() && turns <= MAX_ANALYTIC_TURNS) {
+    // the closed forms' twist (F1), without the design layer
+    let cat = cfg.cat();
+    let (_, c) = crate::model::twist::yy_inertia_and_c(
+        cat.i_t(),
+        cat.i_a(),
+        cfg.analytic.theta_deg.to_radians(),
+    );
+    let turns = PI / c / (2.0 * PI);
+    if !(c > 0.0 && turns.is_finite() && turns <= MAX_ANALYTIC_TURNS) {
         return Err(invalid(
             "analytic.theta_deg",
             cfg.analytic.theta_deg,
             format!(
                 "needs {turns:.3e} turns of the bend direction (C = {:.3e}), more than {MAX_ANALYTIC_TURNS}: so nearly straight a cat barely turns by twisting; choose a smaller angle between the halves",
-                cf.c
+                c
             ),
         ));
     }

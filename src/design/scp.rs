@@ -1579,6 +1579,9 @@ impl<'a> Scp<'a> {
     /// little. A cheap correction that falls short is kept only when the
     /// conic one fails: it took the path to worse points. Returns the point
     /// kept and its merit.
+    // the trial's three parts (point, values, merit) travel together; the
+    // SCP's own layout (issue 25 item 2) owns this signature
+    #[allow(clippy::too_many_arguments)]
     fn correct(
         &self,
         state: &mut State,

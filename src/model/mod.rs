@@ -22,6 +22,7 @@ pub mod dynamics;
 pub mod motor;
 pub mod small;
 pub mod so3;
+pub mod twist;
 
 pub use body::{Half, InertiaFormula};
 
