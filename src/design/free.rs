@@ -997,23 +997,9 @@ impl Seed {
     }
 }
 
-/// What a free-form design reports as it runs (an argmin-style observer):
-/// each SCP iteration and, with mesh continuation, the start of each mesh.
-/// Any `FnMut(&ScpIteration)` is an observer that ignores the meshes.
-pub trait Observer {
-    fn iteration(&mut self, it: &ScpIteration);
-    /// The SCP begins on a mesh of `nodes` per phase (mesh continuation
-    /// only: each coarse mesh, then the finest; again if the finest starts
-    /// over from the seed, numbered on from the coarse meshes: the failed
-    /// attempt is not on the record).
-    fn mesh(&mut self, _nodes: usize) {}
-}
-
-impl<F: FnMut(&ScpIteration)> Observer for F {
-    fn iteration(&mut self, it: &ScpIteration) {
-        self(it)
-    }
-}
+/// What a free-form design reports as it runs: the SCP's observer (each
+/// iteration and, with mesh continuation, the start of each mesh).
+pub use crate::design::scp::Observer;
 
 /// Numbers the iterations on across meshes and re-solves, each shown once.
 struct Numbered<'a> {
