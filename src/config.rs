@@ -10,6 +10,9 @@ use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+mod start;
+pub use start::{LandConfig, MAX_START_RATE, StartConfig};
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
@@ -29,6 +32,10 @@ pub struct Config {
     pub phased: PhasedConfig,
     #[serde(default)]
     pub free: FreeConfig,
+    #[serde(default)]
+    pub start: StartConfig,
+    #[serde(default)]
+    pub land: LandConfig,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -540,6 +547,8 @@ impl Config {
             fr.attitude_tolerance > 0.0,
             "must be > 0 rad",
         )?;
+        self.start.validate()?;
+        self.land.validate()?;
         Ok(())
     }
 
@@ -660,7 +669,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 29] = [
+pub const UNITS: [(&str, &str); 30] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -690,6 +699,7 @@ pub const UNITS: [(&str, &str); 29] = [
     ("free.max_iterations", "count"),
     ("free.tolerance", "relative"),
     ("free.attitude_tolerance", "rad"),
+    ("land.max_tilt_deg", "deg"),
 ];
 
 /// A config key with its unit, e.g. `fall.height (m)`.
@@ -798,6 +808,7 @@ gravity = 9.8
             "cat.front.mass=2",
             "cat.front.length=1",
             "cat.front.radius=0.1",
+            "land.max_tilt_deg=5",
         ];
         let c = Config::from_toml(SEED, "t", &optional.map(String::from)).unwrap();
         fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {

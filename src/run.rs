@@ -84,6 +84,8 @@ pub struct MethodNumbers {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
+    pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
@@ -177,6 +179,10 @@ fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
         Some(n.max_speed_rad_s),
         n.min_envelope_margin,
     ));
+    why.extend(crate::verify::simulate::misses_landing(
+        cfg,
+        n.landing_error_deg,
+    ));
     (!why.is_empty()).then(|| why.join("; "))
 }
 
@@ -191,10 +197,14 @@ pub fn schedule_flags(
     max_speed_rad_s: Option<f64>,
     envelope_margin: Option<f64>,
 ) -> Vec<String> {
-    let mut why: Vec<String> =
+    // from another start the flip about the reference spine means nothing: the landing decides
+    let mut why: Vec<String> = if cfg.start.is_default() {
         crate::verify::simulate::misses_flip(flip_error_rad, tilt_deg, cfg.simulate.flip_tolerance)
             .into_iter()
-            .collect();
+            .collect()
+    } else {
+        Vec::new()
+    };
     why.extend(limits_broken(
         cfg,
         peak_torque_nm,
@@ -295,6 +305,7 @@ fn summarize(
         flip_deg: sim.flip_deg,
         flip_error_rad: sim.flip_error_rad,
         tilt_deg: sim.tilt_deg,
+        landing_error_deg: sim.landing_error_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,

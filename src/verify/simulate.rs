@@ -10,9 +10,13 @@
 use crate::config::Config;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::error::{Error, Result};
-use crate::model::dynamics::{angular_momentum, bias, solve2};
+use crate::model::dynamics::angular_momentum;
+use crate::model::momentum::{
+    Start, body_rate, body_rate_from, forward_dynamics_from, landing_error, rigid_turn,
+};
 use crate::model::motor::Motor;
-use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate};
+use crate::model::small::cross;
+use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate, to_na};
 use crate::model::{Cat, ShapeTerms};
 use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
@@ -46,8 +50,18 @@ pub struct SimReport {
     pub final_rate_error_rad_s: f64,
     /// Largest `|q - q_plan|` along the way, rad (zero for kinematic runs).
     pub max_tracking_error_rad: f64,
-    /// Largest `|L|` recomputed from the bodies' velocities, N m s.
+    /// Largest `|L - L(0)|`, `L` recomputed from the bodies' velocities, N m s
+    /// (at zero momentum: the largest `|L|`).
     pub momentum_drift_nms: f64,
+    /// The belly's angle from straight down at touchdown, the straight cat
+    /// turning rigidly during `fall.margin` (MODEL.md section 6), degrees.
+    pub landing_error_deg: f64,
+    /// Body A's attitude `[w, x, y, z]` and body-frame momentum `R_A' L` (N m s)
+    /// at the end of the manoeuvre.
+    #[serde(skip)]
+    pub final_attitude: [f64; 4],
+    #[serde(skip)]
+    pub final_body_momentum: [f64; 3],
     /// Largest joint torque applied, N m (in the config's norm).
     pub peak_torque_nm: f64,
     pub steps: usize,
@@ -56,6 +70,18 @@ pub struct SimReport {
 }
 
 impl SimReport {
+    /// Sets the landing error for a landing `margin` seconds after the
+    /// manoeuvre, the straight cat turning rigidly meanwhile (F8).
+    pub fn land(&mut self, cat: &Cat, margin: f64) {
+        let r = to_na(&from_na(
+            quat_from(&self.final_attitude)
+                .to_rotation_matrix()
+                .matrix(),
+        ));
+        let r = rigid_turn(cat, &r, self.final_body_momentum, margin);
+        self.landing_error_deg = landing_error(&r).to_degrees();
+    }
+
     /// The report of a simulation that failed: every number NaN (null in JSON).
     pub fn failed() -> SimReport {
         SimReport {
@@ -66,6 +92,9 @@ impl SimReport {
             final_rate_error_rad_s: f64::NAN,
             max_tracking_error_rad: f64::NAN,
             momentum_drift_nms: f64::NAN,
+            landing_error_deg: f64::NAN,
+            final_attitude: [f64::NAN; 4],
+            final_body_momentum: [f64::NAN; 3],
             peak_torque_nm: f64::NAN,
             steps: 0,
             trace: Vec::new(),
@@ -143,6 +172,26 @@ pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<Strin
     (!why.is_empty()).then(|| why.join("; "))
 }
 
+/// Why a simulated landing misses belly-down, if it does: with
+/// `land.max_tilt_deg` set or a start other than today's, the landing error
+/// beyond `land.max_tilt_deg` (default: `simulate.flip_tolerance`). Today's
+/// problem keeps today's check alone ([`misses_flip`]).
+pub fn misses_landing(cfg: &Config, landing_error_deg: f64) -> Option<String> {
+    if cfg.land.max_tilt_deg.is_none() && cfg.start.is_default() {
+        return None;
+    }
+    let (tol, key) = match cfg.land.max_tilt_deg {
+        Some(t) => (t, "land.max_tilt_deg"),
+        None => (
+            cfg.simulate.flip_tolerance.to_degrees(),
+            "land.max_tilt_deg, by default simulate.flip_tolerance",
+        ),
+    };
+    // NaN compares false: a failed number is a miss
+    (landing_error_deg.is_nan() || landing_error_deg > tol)
+        .then(|| format!("lands {landing_error_deg:.3} deg from belly-down ({key} = {tol:.4} deg)"))
+}
+
 fn finish(
     flip: f64,
     tilt: f64,
@@ -163,6 +212,9 @@ fn finish(
         final_rate_error_rad_s: 0.0,
         max_tracking_error_rad: 0.0,
         momentum_drift_nms: 0.0,
+        landing_error_deg: f64::NAN,
+        final_attitude: [f64::NAN; 4],
+        final_body_momentum: [f64::NAN; 3],
         peak_torque_nm: 0.0,
         steps,
         trace,
@@ -172,6 +224,8 @@ fn finish(
 /// Records attitude, momentum and torque at every accepted step.
 struct Recorder<'a> {
     cat: &'a Cat,
+    /// The world momentum at release, N m s.
+    l0: [f64; 3],
     trace: Vec<TracePoint>,
     flip: FlipTracker,
     steps: usize,
@@ -179,9 +233,10 @@ struct Recorder<'a> {
 }
 
 impl<'a> Recorder<'a> {
-    fn new(cat: &'a Cat) -> Self {
+    fn new(cat: &'a Cat, start: &Start) -> Self {
         Self {
             cat,
+            l0: start.momentum(cat),
             trace: Vec::new(),
             flip: FlipTracker::default(),
             steps: 0,
@@ -189,17 +244,29 @@ impl<'a> Recorder<'a> {
         }
     }
 
-    /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from `q`, `qd`.
+    /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from
+    /// `q`, `qd` and the body-frame momentum `lam`.
     /// False when the state is no longer finite (the motion diverged).
-    fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) -> bool {
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &mut self,
+        t: f64,
+        quat: &[f64],
+        q: [f64; 2],
+        qd: [f64; 2],
+        tau: [f64; 2],
+        lam: [f64; 3],
+        w: [f64; 3],
+    ) -> bool {
         self.steps += 1;
         let qa = quat_from(quat);
         let (flip, tilt) = self.flip.push(&qa);
         let ra = from_na(qa.to_rotation_matrix().matrix());
-        let l = angular_momentum(self.cat, &ra, self.cat.body_rate(q, qd), q, qd);
+        let l = angular_momentum(self.cat, &ra, w, q, qd);
+        let e = [0, 1, 2].map(|i| l[i] - self.l0[i]);
         self.drift = self
             .drift
-            .max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
+            .max((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt());
         self.trace.push(TracePoint {
             t,
             flip,
@@ -212,19 +279,26 @@ impl<'a> Recorder<'a> {
             .chain(&q)
             .chain(&qd)
             .chain(&tau)
+            .chain(&lam)
             .all(|x| x.is_finite())
     }
 
+    /// `y` is the final state: attitude quaternion first, body-frame momentum last.
     fn finish(
         mut self,
-        quat: &[f64],
+        y: &[f64],
         status: OdeStatus,
         ode: &OdeSettings,
         limit: Option<f64>,
     ) -> Result<SimReport> {
-        let (flip, tilt) = self.flip.push(&quat_from(quat));
+        let (flip, tilt) = self.flip.push(&quat_from(y));
+        let cat = self.cat;
         let mut r = finish(flip, tilt, self.trace, self.steps, status, ode, limit)?;
         r.momentum_drift_nms = self.drift;
+        r.final_attitude = [y[0], y[1], y[2], y[3]];
+        let n = y.len();
+        r.final_body_momentum = [y[n - 3], y[n - 2], y[n - 1]];
+        r.land(cat, 0.0);
         Ok(r)
     }
 }
@@ -261,20 +335,49 @@ fn over_phases<const N: usize>(
     (y, OdeStatus::Done)
 }
 
-/// Attitude along a prescribed shape trajectory.
+/// Attitude along a prescribed shape trajectory, from rest upside down.
 pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<SimReport> {
-    let mut rec = Recorder::new(cat);
+    kinematic_from(cat, plan, &Start::default(), ode)
+}
+
+/// The state `[quaternion, lambda]` of an attitude-only run at release.
+fn attitude_state(cat: &Cat, start: &Start) -> [f64; 7] {
+    let (a, l) = (start.attitude, start.body_momentum(cat));
+    [a[0], a[1], a[2], a[3], l[0], l[1], l[2]]
+}
+
+/// Rate of the attitude and of the body-frame momentum (`lambda x w`).
+fn attitude_rate(y: &[f64], w: [f64; 3], lam: [f64; 3]) -> ([f64; 4], [f64; 3]) {
+    (quat_rate(y, w), cross(lam, w))
+}
+
+/// Attitude along a prescribed shape trajectory from `start`: the body
+/// rate `J^-1 lambda - A q_dot`, the body-frame momentum `lambda` turning as
+/// `lambda x w` (its world value `R_A lambda` is the conserved `L`).
+pub fn kinematic_from(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    start: &Start,
+    ode: &OdeSettings,
+) -> Result<SimReport> {
+    let mut rec = Recorder::new(cat, start);
+    let rate = |i: usize, t: f64, y: &[f64; 7]| {
+        let s = plan.state_in(i, t);
+        let lam = [y[4], y[5], y[6]];
+        (s, lam, body_rate(cat, s.q, s.qd, lam))
+    };
     let (y, status) = over_phases(
         plan,
-        [1.0, 0.0, 0.0, 0.0],
+        attitude_state(cat, start),
         ode,
         |i, t, y| {
-            let s = plan.state_in(i, t);
-            quat_rate(y, cat.body_rate(s.q, s.qd))
+            let (_, lam, w) = rate(i, t, y);
+            let (dq, dl) = attitude_rate(y, w, lam);
+            [dq[0], dq[1], dq[2], dq[3], dl[0], dl[1], dl[2]]
         },
         |i, t, y| {
-            let s = plan.state_in(i, t);
-            rec.record(t, y, s.q, s.qd, [0.0; 2])
+            let (s, lam, w) = rate(i, t, y);
+            rec.record(t, y, s.q, s.qd, [0.0; 2], lam, w)
         },
     );
     let mut r = rec.finish(&y, status, ode, None)?;
@@ -326,42 +429,60 @@ impl Controller {
     }
 }
 
-/// Full forward dynamics under feed-forward torque plus PD tracking of the plan.
+/// Full forward dynamics under feed-forward torque plus PD tracking of the
+/// plan, from rest upside down.
 pub fn dynamic(
     cat: &Cat,
     plan: &dyn ShapePlan,
     ctrl: &Controller,
     ode: &OdeSettings,
 ) -> Result<SimReport> {
+    dynamic_from(cat, plan, ctrl, ode, &Start::default())
+}
+
+/// Full forward dynamics from `start`: state `[quaternion, q, q_dot, lambda]`.
+pub fn dynamic_from(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    ctrl: &Controller,
+    ode: &OdeSettings,
+    start: &Start,
+) -> Result<SimReport> {
     let s0 = plan.state(plan.phase_bounds()[0]);
-    let applied = |i: usize, t: f64, y: &[f64; 8]| {
+    let a0 = attitude_state(cat, start);
+    let applied = |i: usize, t: f64, y: &[f64; 11]| {
         let s = plan.state_in(i, t);
         let ff = plan.torque_in(cat, i, t);
         (ctrl.apply(ff, [y[4], y[5]], [y[6], y[7]], s.q, s.qd), s.q)
     };
-    let mut rec = Recorder::new(cat);
+    let mut rec = Recorder::new(cat, start);
     let (mut peak, mut track) = (0.0f64, 0.0f64);
     let (y, status) = over_phases(
         plan,
-        [1.0, 0.0, 0.0, 0.0, s0.q[0], s0.q[1], s0.qd[0], s0.qd[1]],
+        [
+            a0[0], a0[1], a0[2], a0[3], s0.q[0], s0.q[1], s0.qd[0], s0.qd[1], a0[4], a0[5], a0[6],
+        ],
         ode,
         |i, t, y| {
             let (tau, _) = applied(i, t, y);
-            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            let (q, qd, lam) = ([y[4], y[5]], [y[6], y[7]], [y[8], y[9], y[10]]);
             let terms = ShapeTerms::first(cat, q);
-            let h = bias(&terms, qd);
-            let qdd = solve2(&terms.m, [tau[0] - h[0], tau[1] - h[1]]);
-            let dq = quat_rate(y, terms.body_rate(qd));
-            [dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1]]
+            let qdd = forward_dynamics_from(cat, &terms, q, qd, tau, lam);
+            let w = body_rate_from(cat, &terms, q, qd, lam);
+            let (dq, dl) = attitude_rate(y, w, lam);
+            [
+                dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1], dl[0], dl[1], dl[2],
+            ]
         },
         |i, t, y| {
             let (tau, qref) = applied(i, t, y);
-            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            let (q, qd, lam) = ([y[4], y[5]], [y[6], y[7]], [y[8], y[9], y[10]]);
             peak = peak.max(ctrl.motor.norm.of(tau));
             let off = (q[0] - qref[0]).hypot(q[1] - qref[1]);
             track = track.max(off);
+            let w = body_rate_from(cat, &ShapeTerms::first(cat, q), q, qd, lam);
             // a shape a full turn away from the plan has left the schedule
-            rec.record(t, y, q, qd, tau) && off <= MAX_TRACKING_ERROR
+            rec.record(t, y, q, qd, tau, lam, w) && off <= MAX_TRACKING_ERROR
         },
     );
     let mut r = rec.finish(&y, status, ode, ctrl.motor.max_torque)?;
@@ -372,19 +493,28 @@ pub fn dynamic(
     Ok(r)
 }
 
-/// Kinematic run with the config's tolerances.
+/// Kinematic run from the config's start with its tolerances; the landing
+/// error after its `fall.margin`.
 pub fn kinematic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    kinematic(&cfg.cat(), plan, &settings(cfg))
+    let cat = cfg.cat();
+    let mut r = kinematic_from(&cat, plan, &cfg.start.start(), &settings(cfg))?;
+    r.land(&cat, cfg.fall.margin);
+    Ok(r)
 }
 
-/// Dynamic run with the config's tolerances, gains and limits.
+/// Dynamic run from the config's start with its tolerances, gains and
+/// limits; the landing error after its `fall.margin`.
 pub fn dynamic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    dynamic(
-        &cfg.cat(),
+    let cat = cfg.cat();
+    let mut r = dynamic_from(
+        &cat,
         plan,
         &Controller::from_config(cfg),
         &settings(cfg),
-    )
+        &cfg.start.start(),
+    )?;
+    r.land(&cat, cfg.fall.margin);
+    Ok(r)
 }
 
 /// Most rows a schedule file may have. Every row is a kink of the
