@@ -506,7 +506,7 @@ pub fn verdict(targets: &Targets, design: &DesignNumbers, simulation: &Simulated
         }
         // NaN compares false: a failed number is a miss
         if let Some((tol, key)) = targets.landing_tolerance
-            && !(*landing_error_deg <= tol)
+            && (landing_error_deg.is_nan() || *landing_error_deg > tol)
         {
             misses.push(Miss::Landing {
                 error_deg: *landing_error_deg,
