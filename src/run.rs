@@ -39,7 +39,8 @@ pub enum Progress<'a> {
     Bend {
         evaluations: usize,
         bend_deg: f64,
-        peak_nm: f64,
+        /// Absent for an objective other than the peak.
+        peak_nm: Option<f64>,
     },
     Scp(&'a ScpIteration),
 }
@@ -473,11 +474,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     };
     let free = match &free_impossible {
         Some(r) => Err(skipped(r)),
-        None => {
-            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-                progress(Progress::Scp(it))
-            })
-        }
+        None => crate::design::free::FreeDesign::new(cfg)
+            .from_plan(seed_plan, seed_name)
+            .on_iteration(&mut |it| progress(Progress::Scp(it)))
+            .solve(),
     };
     match &free {
         Ok(fr) => {

@@ -53,7 +53,7 @@ impl Simulator {
         }
     }
 
-    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::mjcf::dc_motor`]).
+    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::common::dc_motor`]).
     pub fn columns(self, joint: Joint, dc: bool) -> &'static str {
         match (self, joint) {
             (Simulator::Mujoco, Joint::NoTwist) => {
@@ -215,7 +215,7 @@ impl Controls {
         let b = plan.phase_bounds();
         let (dt, n) = time_step(b[3] - b[0], sim.target_step());
         // MuJoCo's DC-motor actuators take the command tau + k qd
-        let slope = match (sim, super::mjcf::dc_motor(cfg)) {
+        let slope = match (sim, super::common::dc_motor(cfg)) {
             (Simulator::Mujoco, Some(_)) => cfg.motor().slope(),
             _ => 0.0,
         };
