@@ -73,6 +73,8 @@ pub struct MethodNumbers {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
+    pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
@@ -213,6 +215,7 @@ fn summarize(
         flip_deg: sim.flip_deg,
         flip_error_rad: sim.flip_error_rad,
         tilt_deg: sim.tilt_deg,
+        landing_error_deg: sim.landing_error_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
@@ -225,9 +228,10 @@ fn summarize(
     };
     let simulated = match sim_error {
         Some(e) => Simulated::Failed(e),
-        None => Simulated::Flip {
+        None => Simulated::Landing {
             flip_error_rad: n.flip_error_rad,
             tilt_deg: n.tilt_deg,
+            landing_error_deg: n.landing_error_deg,
         },
     };
     let v = judge(cfg, status, peak, bend, schedule, &simulated);
