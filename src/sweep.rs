@@ -16,8 +16,10 @@ use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
 use crate::verify::analyze::peak_along;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+pub mod resume;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -109,7 +111,7 @@ pub struct Methods {
 
 /// One point of a sweep. Peaks are computed without the torque limit; with a
 /// limit, the least drop height at which each design meets it (F7) is given.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SweepPoint {
     pub value: f64,
     pub analytic_peak_nm: Option<f64>,
@@ -409,6 +411,34 @@ pub fn sweep_shard(
     shard: Shard,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<Vec<SweepPoint>> {
+    let store = Mutex::new(Vec::new());
+    sweep_shard_into(
+        path, overrides, spec, methods, threads, shard, &store, progress,
+    )?;
+    Ok(store
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .map(|p| p.expect("every point ran"))
+        .collect())
+}
+
+/// [`sweep_shard`] into `store`, one slot a point of the shard, which the
+/// caller may read while it runs (an interrupted sweep publishes the points
+/// finished so far, [`crate::interrupt`]). Slots already filled (a resumed
+/// sweep, [`resume`]) are kept: a chunk whose every point is filled is
+/// skipped, a chunk filled in part is computed again from its start, so
+/// that each point has the same continuation as in an uninterrupted sweep.
+pub fn sweep_shard_into(
+    path: &Path,
+    overrides: &[String],
+    spec: &SweepSpec,
+    methods: Methods,
+    threads: usize,
+    shard: Shard,
+    store: &Mutex<Vec<Option<SweepPoint>>>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<()> {
     let all = spec.values();
     let range = shard.points(all.len());
     let values = &all[range];
@@ -457,13 +487,18 @@ pub fn sweep_shard(
         });
     }
     // shards start on chunk boundaries, so local chunks are global chunks
-    let chunks: Vec<std::ops::Range<usize>> = (0..values.len())
-        .step_by(CHUNK)
-        .map(|a| a..(a + CHUNK).min(values.len()))
-        .collect();
+    let results = store;
+    let chunks: Vec<std::ops::Range<usize>> = {
+        let mut kept = results.lock().unwrap();
+        kept.resize(values.len(), None);
+        (0..values.len())
+            .step_by(CHUNK)
+            .map(|a| a..(a + CHUNK).min(values.len()))
+            .filter(|c| kept[c.clone()].iter().any(|p| p.is_none()))
+            .collect()
+    };
     let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<SweepPoint>>> = Mutex::new(vec![None; values.len()]);
+    let done = AtomicUsize::new(values.len() - chunks.iter().map(|c| c.len()).sum::<usize>());
     std::thread::scope(|s| {
         for _ in 0..threads.max(1).min(chunks.len()) {
             s.spawn(|| {
@@ -521,12 +556,7 @@ pub fn sweep_shard(
             });
         }
     });
-    Ok(results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|p| p.expect("every point ran"))
-        .collect())
+    Ok(())
 }
 
 /// A progress line for `done` of `total` points after `elapsed` seconds:

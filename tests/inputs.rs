@@ -227,3 +227,182 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The sweep of the interrupt tests: 20 points, two continuation chunks,
+/// one thread, so that the chunks run in order (about 0.2 s a point).
+fn sweep_args(out: &str) -> Vec<String> {
+    [
+        "sweep",
+        &config("seed.toml"),
+        "--set-range",
+        "cat.mass=0.5:2.4:20",
+        "--methods",
+        "analytic,phased",
+        "--threads",
+        "1",
+        "--set",
+        "phased.nodes=10",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// Starts the sweep, waits for the progress line that shows `points` done,
+/// sends `signal`; returns the exit status, the time from the signal to the
+/// exit, and stderr.
+fn interrupt_after(
+    dir: &Path,
+    args: &[String],
+    points: usize,
+    signal: &str,
+) -> (Option<i32>, std::time::Duration, String) {
+    use std::io::BufRead;
+    let mut child = bin()
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut text = String::new();
+    let needle = format!(" {points}/");
+    loop {
+        let mut line = String::new();
+        assert!(err.read_line(&mut line).unwrap() > 0, "ended early: {text}");
+        text.push_str(&line);
+        if line.contains(&needle) {
+            break;
+        }
+    }
+    let sent = std::time::Instant::now();
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args([signal, &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    (status.code(), took, text + &rest)
+}
+
+fn read(p: PathBuf) -> String {
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = |out: &str| dir.path().join(out).join("seed/sweep-cat_mass");
+    let o = run(
+        &sweep_args("whole")
+            .iter()
+            .map(|s| s.as_str())
+            .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = read(set("whole").join("sweep-cat_mass.csv"));
+    // SIGINT after the first chunk (10 points) and one more point
+    let args = sweep_args("part");
+    let (code, took, err) = interrupt_after(dir.path(), &args, 11, "-INT");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < std::time::Duration::from_secs(1),
+        "stopped after {took:?}"
+    );
+    assert!(
+        err.contains("interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    let csv = read(set("part").join("sweep-cat_mass.csv"));
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("sweep-cat_mass.state.json"))).unwrap();
+    assert_eq!(state["status"], "partial");
+    let done = state["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| !p.is_null())
+        .count();
+    assert!((11..20).contains(&done), "{done}");
+    assert_eq!(csv.lines().count(), done + 1);
+    // the finished points are the uninterrupted sweep's, row for row
+    for row in csv.lines() {
+        assert!(whole.lines().any(|w| w == row), "{row}");
+    }
+    // no staging folder or lock left behind
+    let leftovers: Vec<PathBuf> = tree(&dir.path().join("part"))
+        .into_iter()
+        .filter(|p| {
+            p.to_string_lossy().ends_with(".lock") || p.to_string_lossy().ends_with(".link")
+        })
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // a resume with another grid is refused, and leaves the partial set
+    let mut other = args.clone();
+    other[3] = "cat.mass=0.5:2.4:21".into();
+    other.push("--resume".into());
+    let o = run(
+        &other.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("other settings") && stderr(&o).contains("the range"),
+        "{}",
+        stderr(&o)
+    );
+    let mut same = args.clone();
+    same.extend(["--set".into(), "cat.radius=0.11".into(), "--resume".into()]);
+    let o = run(
+        &same.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the config"), "{}", stderr(&o));
+    // --resume computes the rest only, and the result is the whole sweep's
+    let mut resume = args.clone();
+    resume.push("--resume".into());
+    let o = run(
+        &resume.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("resuming: {done} of 20 points kept")),
+        "{err}"
+    );
+    assert!(
+        !err.contains(" 1/20 points"),
+        "recomputed the kept chunk: {err}"
+    );
+    assert_eq!(read(set("part").join("sweep-cat_mass.csv")), whole);
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("sweep-cat_mass.state.json"))).unwrap();
+    assert_eq!(state["status"], "complete");
+}
+
+#[test]
+fn sigterm_stops_a_sweep_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < std::time::Duration::from_secs(1),
+        "stopped after {took:?}"
+    );
+    let state = read(
+        dir.path()
+            .join("t/seed/sweep-cat_mass/sweep-cat_mass.state.json"),
+    );
+    assert!(state.contains("\"partial\""), "{state}");
+}
