@@ -69,7 +69,8 @@ enum Command {
     Simulate {
         #[command(flatten)]
         common: Common,
-        /// Schedule CSV to apply (as written by catflip); its torque is the feed-forward.
+        /// Schedule to apply, as catflip writes it: `<method>.csv` or the same
+        /// rows as `<method>.schedule.json`; its torque is the feed-forward.
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
@@ -156,9 +157,13 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
 }
 
 /// Starts the command's output set `<out>/<name>/<set>` before any work, so
-/// that an unwritable `--out` fails at once.
+/// that an unwritable `--out` fails at once. With `--set` overrides the set
+/// is named after them too ([`catflip::output::set_name`]).
 fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
-    Ok(Publisher::begin(&out_dir(c, cfg), set)?)
+    Ok(Publisher::begin(
+        &out_dir(c, cfg),
+        &catflip::output::set_name(set, &c.set),
+    )?)
 }
 
 /// How a command that finished ended: the exit status tells them apart.

@@ -57,6 +57,11 @@ impl std::str::FromStr for SweepSpec {
         if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
         }
+        if count == 1 && from != to {
+            return Err(bad(&format!(
+                "COUNT 1 computes FROM alone, not the range to {to}: give {from}:{from}:1 for one point, or a COUNT of 2 or more"
+            )));
+        }
         if count > MAX_POINTS {
             return Err(bad(&format!(
                 "COUNT {count} is more than the {MAX_POINTS} points a sweep may have; split the range into several sweeps"
@@ -441,7 +446,7 @@ pub fn sweep_shard_into(
 ) -> Result<()> {
     let all = spec.values();
     let range = shard.points(all.len());
-    let values = &all[range];
+    let values = &all[range.clone()];
     let load = |v: f64| {
         let mut ov = overrides.to_vec();
         ov.push(format!("{}={}", spec.key, v));
@@ -460,9 +465,9 @@ pub fn sweep_shard_into(
             ),
         });
     }
-    // a point whose config is invalid is that point's failure; when every
-    // point is invalid (e.g. an unknown key) the sweep fails before any work
-    let configs: Vec<Result<Config>> = values
+    // a point whose config is invalid (outside the key's range) fails the
+    // sweep before any work, over the whole grid so that every shard agrees
+    let configs: Vec<Result<Config>> = all
         .iter()
         .map(|&v| {
             load(v).map_err(|e| Error::Range {
@@ -475,17 +480,25 @@ pub fn sweep_shard_into(
             })
         })
         .collect();
-    if let Some(Err(first)) = configs.first()
-        && configs.iter().all(|c| c.is_err())
-    {
+    let bad = configs.iter().filter(|c| c.is_err()).count();
+    if let Some(Err(first)) = configs.iter().find(|c| c.is_err()) {
+        let message = match first {
+            Error::Range { message, .. } => message.clone(),
+            e => e.to_string(),
+        };
         return Err(Error::Range {
             arg: spec.arg(),
-            message: match first {
-                Error::Range { message, .. } => format!("every point is invalid; {message}"),
-                e => e.to_string(),
+            message: if bad == configs.len() {
+                format!("every point is invalid; {message}")
+            } else {
+                format!(
+                    "{bad} of {} points are invalid, the first {message}; choose FROM and TO inside the key's range",
+                    configs.len()
+                )
             },
         });
     }
+    let configs = &configs[range.clone()];
     // shards start on chunk boundaries, so local chunks are global chunks
     let results = store;
     let chunks: Vec<std::ops::Range<usize>> = {

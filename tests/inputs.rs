@@ -300,7 +300,11 @@ fn read(p: PathBuf) -> String {
 #[test]
 fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_results() {
     let dir = tempfile::tempdir().unwrap();
-    let set = |out: &str| dir.path().join(out).join("seed/sweep-cat_mass");
+    let set = |out: &str| {
+        dir.path()
+            .join(out)
+            .join("seed/sweep-cat_mass@phased.nodes=10")
+    };
     let o = run(
         &sweep_args("whole")
             .iter()
@@ -360,10 +364,24 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
         "{}",
         stderr(&o)
     );
+    // another --set is another sweep (its own set): nothing to resume there
     let mut same = args.clone();
     same.extend(["--set".into(), "cat.radius=0.11".into(), "--resume".into()]);
     let o = run(
         &same.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no sweep to resume"), "{}", stderr(&o));
+    // an edited config file is refused by the state's record of the config
+    let edited = dir.path().join("seed.toml");
+    let text = read(PathBuf::from(config("seed.toml")));
+    std::fs::write(&edited, text.replace("radius = 0.1 ", "radius = 0.11 ")).unwrap();
+    let mut changed = args.clone();
+    changed[1] = edited.display().to_string();
+    changed.push("--resume".into());
+    let o = run(
+        &changed.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
         dir.path(),
     );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
@@ -402,7 +420,237 @@ fn sigterm_stops_a_sweep_too() {
     );
     let state = read(
         dir.path()
-            .join("t/seed/sweep-cat_mass/sweep-cat_mass.state.json"),
+            .join("t/seed/sweep-cat_mass@phased.nodes=10/sweep-cat_mass.state.json"),
     );
     assert!(state.contains("\"partial\""), "{state}");
+}
+
+/// Files under `dir` (relative, sorted) with their contents.
+fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut v: Vec<(PathBuf, Vec<u8>)> = tree(dir)
+        .into_iter()
+        .filter(|p| p.is_file())
+        .map(|p| {
+            (
+                p.strip_prefix(dir).unwrap().to_path_buf(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_report_is_an_ordinary_folder_that_copies_and_runs_keep_their_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = config("seed.toml");
+    let plain = ["run", &seed, "--set", "free.nodes=12"];
+    let o = run(&plain, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = dir.path().join("output/seed/run@free.nodes=12");
+    assert_eq!(
+        report,
+        dir.path()
+            .join("output/seed")
+            .join(catflip::output::set_name("run", &["free.nodes=12".into()]))
+    );
+    let meta = std::fs::symlink_metadata(&report).unwrap();
+    assert!(meta.is_dir() && !meta.file_type().is_symlink(), "{meta:?}");
+    // no hidden staging folder or lock left beside it
+    let hidden: Vec<PathBuf> = tree(&dir.path().join("output/seed"))
+        .into_iter()
+        .filter(|p| p.parent() == Some(&dir.path().join("output/seed")))
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+    let original = contents(&report);
+    assert!(original.iter().any(|(p, _)| p == Path::new("index.html")));
+    // cp -r and tar give working copies: the same files, and every file the
+    // page refers to is there
+    let copy = dir.path().join("copy");
+    assert!(
+        Command::new("cp")
+            .arg("-r")
+            .arg(&report)
+            .arg(&copy)
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert_eq!(contents(&copy), original);
+    let html = read(copy.join("index.html"));
+    for part in html.split("src=\"").skip(1) {
+        let target = part.split('"').next().unwrap();
+        if !target.starts_with("data:") && !target.contains("://") && !target.starts_with('#') {
+            assert!(
+                copy.join(target).is_file(),
+                "index.html refers to missing {target}"
+            );
+        }
+    }
+    let tgz = dir.path().join("r.tgz");
+    let ok = Command::new("tar")
+        .arg("czf")
+        .arg(&tgz)
+        .arg("-C")
+        .arg(dir.path().join("output/seed"))
+        .arg("run@free.nodes=12")
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let x = dir.path().join("x");
+    std::fs::create_dir(&x).unwrap();
+    assert!(
+        Command::new("tar")
+            .arg("xzf")
+            .arg(&tgz)
+            .arg("-C")
+            .arg(&x)
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert_eq!(contents(&x.join("run@free.nodes=12")), original);
+    // the issue's item 5: a run with another override keeps its own report,
+    // and the plain run's is untouched
+    let twist = [
+        "run",
+        &seed,
+        "--set",
+        "free.nodes=12",
+        "--set",
+        "cat.joint=no-twist",
+    ];
+    let o = run(&twist, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let other = dir
+        .path()
+        .join("output/seed/run@free.nodes=12,cat.joint=no-twist");
+    assert!(other.join("summary.json").is_file());
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .contains("run@free.nodes=12,cat.joint=no-twist/index.html")
+    );
+    assert_eq!(
+        contents(&report),
+        original,
+        "the first run's report changed"
+    );
+    // running the same again replaces its own report whole (by exchange)
+    let o = run(&plain, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::symlink_metadata(&report).unwrap().is_dir());
+    let names = |d: &Path| contents(d).into_iter().map(|(p, _)| p).collect::<Vec<_>>();
+    assert_eq!(names(&report), names(&copy));
+    // a folder catflip did not write is never replaced
+    let mine = dir.path().join("output/seed/analyze");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    let o = run(&["analyze", &seed], dir.path());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not a set published by catflip"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(read(mine.join("notes.txt")), "mine");
+}
+
+#[test]
+fn the_small_inconsistencies_are_fixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = config("seed.toml");
+    // a JSON schedule replays as its CSV does
+    let o = run(&["analyze", &seed], dir.path());
+    assert!(o.status.success());
+    let base = dir.path().join("output/seed/analyze");
+    let replay = |file: &str| {
+        let path = base.join(file).display().to_string();
+        let o = run(
+            &[
+                "simulate",
+                &seed,
+                "--schedule",
+                &path,
+                "--json",
+                "--out",
+                "sim",
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{file}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["flip_error_rad"].as_f64().unwrap()
+    };
+    let (from_csv, from_json) = (replay("analytic.csv"), replay("analytic.schedule.json"));
+    assert!(from_json.abs() < 1e-6, "{from_json}");
+    // the CSV rounds to 12 digits, the JSON keeps every bit: the same flip to 1e-9
+    assert!(
+        (from_csv - from_json).abs() < 1e-9,
+        "{from_csv} vs {from_json}"
+    );
+    // a broken JSON schedule names the row and points at the CSV
+    let bad = dir.path().join("bad.schedule.json");
+    let text = read(base.join("analytic.schedule.json")).replacen("\"fold\"", "\"folding\"", 1);
+    std::fs::write(&bad, text).unwrap();
+    let o = run(
+        &[
+            "simulate",
+            &seed,
+            "--schedule",
+            bad.to_str().unwrap(),
+            "--out",
+            "bad",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("row 0") && stderr(&o).contains("folding"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("bad").exists());
+    // one point of a range is refused, one point given as FROM:FROM:1 runs
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=1:10:1"],
+        &["--set-range", "COUNT 1", "1:1:1"],
+    );
+    let o = run(
+        &[
+            "sweep",
+            &seed,
+            "--set-range",
+            "fall.height=1:1:1",
+            "--methods",
+            "analytic",
+            "--out",
+            "one",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    // values outside the key's range are refused up front, like free.nodes=40:50:4
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=-1:10:4"],
+        &[
+            "--set-range",
+            "fall.height=-1:10:4",
+            "1 of 4 points",
+            "fall.height = -1",
+        ],
+    );
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=1:1e4:3"],
+        &["2 of 3 points", "fall.height", "30 s"],
+    );
+    // venv/ is ignored
+    let ignore = read(Path::new(env!("CARGO_MANIFEST_DIR")).join(".gitignore"));
+    assert!(
+        ignore
+            .lines()
+            .any(|l| l.trim() == "/venv/" || l.trim() == "venv/"),
+        "{ignore}"
+    );
 }
