@@ -151,7 +151,17 @@ fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
     }
     if v.is_instance_of::<PyString>() {
         let s: String = v.extract()?;
-        return Ok(serde_json::to_string(&s).expect("a string serialises"));
+        // as the user would type it after `--set KEY=` when the CLI reads it as
+        // that string (so the messages are the CLI's), else quoted
+        let plain = toml::from_str::<toml::Table>(&format!("v = {s}")).is_err()
+            && s.trim() == s
+            && !s.is_empty()
+            && !s.contains(['\n', '\r']);
+        return Ok(if plain {
+            s
+        } else {
+            serde_json::to_string(&s).expect("a string serialises")
+        });
     }
     if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
         let items: PyResult<Vec<String>> = v.try_iter()?.map(|x| toml_text(&x?)).collect();
@@ -165,9 +175,11 @@ fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
 
 #[pymethods]
 impl Config {
-    /// Reads and checks a TOML config file (as `catflip CMD FILE`); raises ConfigError.
+    /// Reads and checks a TOML config file with the CLI's `--set KEY=VALUE` `overrides`
+    /// (as `catflip CMD FILE --set ...`); raises ConfigError.
     #[staticmethod]
-    fn from_toml(path: PathBuf) -> PyResult<Config> {
+    #[pyo3(signature = (path, overrides = None))]
+    fn from_toml(path: PathBuf, overrides: Option<Vec<String>>) -> PyResult<Config> {
         let text = std::fs::read_to_string(&path).map_err(|e| {
             err(catflip::Error::ConfigRead {
                 path: path.clone(),
@@ -177,11 +189,10 @@ impl Config {
         Config::from_source(Source {
             text,
             origin: path.display().to_string(),
-            overrides: Vec::new(),
+            overrides: overrides.unwrap_or_default(),
         })
     }
 
-    /// Checks a config given as TOML text; `origin` names it in messages.
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
     fn from_text(text: String, origin: &str) -> PyResult<Config> {
@@ -249,7 +260,7 @@ impl Config {
         self.snapshot().1.name
     }
 
-    /// The `KEY=VALUE` overrides applied so far by `set`, in order.
+    /// The `KEY=VALUE` overrides applied so far (`from_toml`'s, then each `set`), in order.
     #[getter]
     fn overrides(&self) -> Vec<String> {
         self.snapshot().0.overrides
@@ -322,18 +333,17 @@ struct Design {
     durations: [f64; 3],
 }
 
-fn run_design(
-    cfg: &Cfg,
-    method: &str,
-    seed: Option<&str>,
-) -> PyResult<(
-    Plan,
-    serde_json::Value,
-    String,
-    Option<String>,
-    f64,
-    [f64; 3],
-)> {
+/// What a design method made, before it is sampled.
+struct Made {
+    plan: Plan,
+    json: serde_json::Value,
+    status: String,
+    reason: Option<String>,
+    peak: f64,
+    durations: [f64; 3],
+}
+
+fn run_design(cfg: &Cfg, method: &str, seed: Option<&str>) -> PyResult<Made> {
     let no_seed = |what: &str| {
         ConfigError::new_err(format!(
             "seed applies to method=\"free\" ({what} has no seed); leave seed out or use method=\"free\""
@@ -354,14 +364,14 @@ fn run_design(
             let status = catflip::run::json_name(&r.status);
             let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
             let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok((
-                Box::new(r.plan),
+            Ok(Made {
+                plan: Box::new(r.plan),
                 json,
                 status,
                 reason,
-                r.peak_torque_nm,
-                r.phase_durations_s,
-            ))
+                peak: r.peak_torque_nm,
+                durations: r.phase_durations_s,
+            })
         }
         "phased" => {
             if seed.is_some() {
@@ -371,14 +381,14 @@ fn run_design(
             let status = catflip::run::json_name(&r.status);
             let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
             let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok((
-                Box::new(r.plan),
+            Ok(Made {
+                plan: Box::new(r.plan),
                 json,
                 status,
                 reason,
-                r.peak_torque_nm,
-                r.phase_durations_s,
-            ))
+                peak: r.peak_torque_nm,
+                durations: r.phase_durations_s,
+            })
         }
         "analytic" => {
             if seed.is_some() {
@@ -398,14 +408,14 @@ fn run_design(
             );
             let reason = (!why.is_empty()).then(|| why.join("; "));
             let json = with_verdict(serde_json::to_value(&a).expect("serialises"), &reason);
-            Ok((
-                Box::new(a.plan),
+            Ok(Made {
+                plan: Box::new(a.plan),
                 json,
-                "closed-form".into(),
+                status: "closed-form".into(),
                 reason,
-                a.peak_torque_nm,
-                a.closed.phase_durations_s,
-            ))
+                peak: a.peak_torque_nm,
+                durations: a.closed.phase_durations_s,
+            })
         }
         other => Err(ConfigError::new_err(format!(
             "unknown method `{other}`; use \"free\", \"phased\" or \"analytic\""
@@ -450,8 +460,14 @@ fn design(
     };
     let seed = seed.map(String::from);
     py.detach(move || {
-        let (plan, json, status, reason, peak, durations) =
-            run_design(&cfg, method, seed.as_deref())?;
+        let Made {
+            plan,
+            json,
+            status,
+            reason,
+            peak,
+            durations,
+        } = run_design(&cfg, method, seed.as_deref())?;
         let schedule = Schedule::sample(&cfg.cat(), plan.as_ref(), cfg.simulate.samples_per_phase);
         Ok(Design {
             method,
