@@ -15,6 +15,7 @@ use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
+use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use crate::verify::analyze::peak_along;
 use serde::Serialize;
 use std::path::Path;
@@ -120,7 +121,7 @@ pub struct SweepPoint {
     pub least_height_phased_m: Option<f64>,
     pub least_height_free_m: Option<f64>,
     /// The free-form optimiser's end status (converged, iteration limit, ...).
-    pub free_status: Option<String>,
+    pub free_status: Option<Status>,
     pub error: Option<String>,
 }
 
@@ -279,10 +280,11 @@ fn point(
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
                     "phased",
-                    &crate::run::json_name(&ph.status),
-                    ph.flip_error_rad,
-                    ph.tilt_deg,
                     &cfg,
+                    ph.status.into(),
+                    ph.peak_torque_nm,
+                    ph.bend_deg,
+                    (ph.flip_error_rad, ph.tilt_deg),
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
@@ -316,17 +318,18 @@ fn point(
                 Ok(fr) => {
                     errors.extend(flagged(
                         "free",
-                        &crate::run::json_name(&fr.status),
-                        fr.flip_error_rad,
-                        fr.tilt_deg,
                         &cfg,
+                        fr.status.into(),
+                        fr.peak_torque_nm,
+                        fr.bend_deg,
+                        (fr.flip_error_rad, fr.tilt_deg),
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m = limit
                         .filter(|_| !envelope)
                         .map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
-                    p.free_status = Some(crate::run::json_name(&fr.status));
+                    p.free_status = Some(fr.status.into());
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
@@ -358,24 +361,33 @@ fn point(
     (p, kept)
 }
 
-/// A kept design that misses a target (unconverged, flip missed) is named in
-/// the point's `error` column beside its numbers.
+/// A kept design that misses a target (unconverged, flip missed, bend
+/// limit broken) is named in the point's `error` column beside its numbers
+/// ([`verdict`]; a sweep's peaks are computed without the torque limit and
+/// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
-    status: &str,
-    flip_error: f64,
-    tilt_deg: f64,
     cfg: &Config,
+    status: Status,
+    peak_torque_nm: f64,
+    bend_deg: f64,
+    (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(crate::verify::simulate::misses_flip(
-        flip_error,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
+    let v = verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status,
+            peak_torque_nm,
+            bend_deg,
+            max_speed_rad_s: None,
+            envelope_margin: None,
+        },
+        &Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    );
+    let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
@@ -593,7 +605,7 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
             cell(p.free_bend_deg),
             cell(p.least_height_phased_m),
             cell(p.least_height_free_m),
-            p.free_status.as_deref().unwrap_or(""),
+            p.free_status.map_or("", Status::name),
             p.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
         ));
     }

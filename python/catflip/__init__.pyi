@@ -33,6 +33,10 @@ class ImpossibleError(DesignError):
     """The motors cannot flip the cat from ``fall.height``; the message gives the least drop
     height (``catflip optimize`` stops with it, exit 1; ``catflip run`` reports it, exit 4)."""
 
+class UnitSlipWarning(UserWarning):
+    """A config value that is valid but likely a unit slip (the CLI's ``warning:`` lines),
+    warned when a config is read or set."""
+
 class Config:
     """A checked catflip configuration: the CLI's TOML keys, defaults and checks.
 
@@ -62,6 +66,9 @@ class Config:
     @property
     def name(self) -> str:
         """The config's ``name`` (the CLI's output folder ``output/<name>/``)."""
+    @property
+    def slips(self) -> List[str]:
+        """The config's likely unit slips (the CLI's warnings), in words."""
     @property
     def overrides(self) -> List[str]:
         """The ``KEY=VALUE`` overrides applied so far (``from_toml``'s, then each ``set``), in order."""

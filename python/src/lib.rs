@@ -38,6 +38,12 @@ create_exception!(
 );
 create_exception!(
     catflip,
+    UnitSlipWarning,
+    pyo3::exceptions::PyUserWarning,
+    "A config value that is valid but likely a unit slip (the CLI's `warning:` lines)."
+);
+create_exception!(
+    catflip,
     ImpossibleError,
     DesignError,
     "The motors cannot flip the cat from this height; the message gives the least height."
@@ -111,9 +117,19 @@ struct Config {
     inner: Mutex<Snapshot>,
 }
 
+/// The config's likely unit slips, as Python warnings (the CLI's `warning: ...` lines).
+fn warn_slips(py: Python<'_>, cfg: &Cfg) -> PyResult<()> {
+    for slip in cfg.slips() {
+        let text = std::ffi::CString::new(slip.to_string()).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<UnitSlipWarning>(), &text, 1)?;
+    }
+    Ok(())
+}
+
 impl Config {
-    fn from_source(source: Source) -> PyResult<Config> {
+    fn from_source(py: Python<'_>, source: Source) -> PyResult<Config> {
         let cfg = source.load(None).map_err(err)?;
+        warn_slips(py, &cfg)?;
         Ok(Config {
             inner: Mutex::new(Snapshot { source, cfg }),
         })
@@ -179,28 +195,38 @@ impl Config {
     /// (as `catflip CMD FILE --set ...`); raises ConfigError.
     #[staticmethod]
     #[pyo3(signature = (path, overrides = None))]
-    fn from_toml(path: PathBuf, overrides: Option<Vec<String>>) -> PyResult<Config> {
+    fn from_toml(
+        py: Python<'_>,
+        path: PathBuf,
+        overrides: Option<Vec<String>>,
+    ) -> PyResult<Config> {
         let text = std::fs::read_to_string(&path).map_err(|e| {
             err(catflip::Error::ConfigRead {
                 path: path.clone(),
                 message: e.to_string(),
             })
         })?;
-        Config::from_source(Source {
-            text,
-            origin: path.display().to_string(),
-            overrides: overrides.unwrap_or_default(),
-        })
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: path.display().to_string(),
+                overrides: overrides.unwrap_or_default(),
+            },
+        )
     }
 
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
-    fn from_text(text: String, origin: &str) -> PyResult<Config> {
-        Config::from_source(Source {
-            text,
-            origin: origin.into(),
-            overrides: Vec::new(),
-        })
+    fn from_text(py: Python<'_>, text: String, origin: &str) -> PyResult<Config> {
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: origin.into(),
+                overrides: Vec::new(),
+            },
+        )
     }
 
     /// Checks a config given as a dict of the TOML's tables (`{"name": ..., "cat": {...}, "fall": {...}}`).
@@ -215,22 +241,40 @@ impl Config {
             ))
         })?;
         let text = toml::to_string(&table).map_err(|e| ConfigError::new_err(e.to_string()))?;
-        Config::from_source(Source {
-            text,
-            origin: "dict".into(),
-            overrides: Vec::new(),
-        })
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: "dict".into(),
+                overrides: Vec::new(),
+            },
+        )
     }
 
     /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;
     /// on a ConfigError the config is left as it was.
-    fn set(&self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set(&self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let arg = format!("{key}={}", toml_text(value)?);
-        let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        let cfg = s.source.load(Some(&arg)).map_err(err)?;
-        s.source.overrides.push(arg);
-        s.cfg = cfg;
-        Ok(())
+        let cfg = {
+            let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+            let cfg = s.source.load(Some(&arg)).map_err(err)?;
+            s.source.overrides.push(arg);
+            s.cfg = cfg.clone();
+            cfg
+        };
+        // outside the lock: a warnings filter may run Python code
+        warn_slips(py, &cfg)
+    }
+
+    /// The config's likely unit slips (the CLI's warnings), in words.
+    #[getter]
+    fn slips(&self) -> Vec<String> {
+        self.snapshot()
+            .1
+            .slips()
+            .iter()
+            .map(ToString::to_string)
+            .collect()
     }
 
     /// An independent copy (later `set`s on either leave the other alone).
@@ -289,19 +333,27 @@ impl Config {
 
 // --- Design -----------------------------------------------------------------
 
-/// Why a design misses its targets: its solver status and the flip
-/// (mirrors the CLI's `design_flags`).
-fn design_flags(cfg: &Cfg, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(catflip::verify::simulate::misses_flip(
-        flip_error_rad,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
-    (!why.is_empty()).then(|| why.join("; "))
+/// The verdict on a design, as the CLI's `optimize` and `analyze` give it
+/// (`catflip::run::judge`): solver status, the flip, the limits.
+fn judged(
+    cfg: &Cfg,
+    status: catflip::verdict::Status,
+    (peak, bend): (f64, f64),
+    schedule: &Schedule,
+    (flip_error_rad, tilt_deg): (f64, f64),
+) -> Option<String> {
+    catflip::run::judge(
+        cfg,
+        status,
+        peak,
+        bend,
+        schedule,
+        &catflip::verdict::Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    )
+    .reason()
 }
 
 fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_json::Value {
@@ -312,13 +364,23 @@ fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_j
     json
 }
 
+/// The fields an optimiser's JSON must have finite, as the CLI's `write_design`.
+const FINITE: [&str; 6] = [
+    "peak_torque_nm",
+    "bend_deg",
+    "flip_deg",
+    "tilt_deg",
+    "sim_peak_torque_nm",
+    "phase_durations_s",
+];
+
 type Plan = Box<dyn ShapePlan + Send + Sync>;
 
+#[pyclass(frozen, module = "catflip")]
 /// A designed schedule: what `catflip optimize --mode free|phased` (or `analyze`) writes.
 ///
 /// Immutable; the arrays are fresh copies on each access. N rows: 3 phases
 /// of `simulate.samples_per_phase + 1` samples (a phase junction appears twice).
-#[pyclass(frozen, module = "catflip")]
 struct Design {
     method: &'static str,
     source: Source,
@@ -333,94 +395,121 @@ struct Design {
     durations: [f64; 3],
 }
 
-/// What a design method made, before it is sampled.
-struct Made {
-    plan: Plan,
-    json: serde_json::Value,
-    status: String,
-    reason: Option<String>,
-    peak: f64,
-    durations: [f64; 3],
-}
-
-fn run_design(cfg: &Cfg, method: &str, seed: Option<&str>) -> PyResult<Made> {
+/// The library's design for `method`, judged and sampled as the CLI does.
+fn run_design(
+    cfg: Cfg,
+    source: Source,
+    method: &'static str,
+    seed: Option<&str>,
+) -> PyResult<Design> {
+    use catflip::verdict::Status;
     let no_seed = |what: &str| {
         ConfigError::new_err(format!(
             "seed applies to method=\"free\" ({what} has no seed); leave seed out or use method=\"free\""
         ))
     };
-    match method {
-        "free" => {
-            let seed = match seed.unwrap_or("phased") {
-                "phased" => catflip::design::free::Seed::Phased,
-                "analytic" => catflip::design::free::Seed::Analytic,
-                other => {
-                    return Err(ConfigError::new_err(format!(
-                        "unknown seed `{other}`; use \"phased\" or \"analytic\""
-                    )));
+    let sample =
+        |plan: &dyn ShapePlan| Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+    let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
+        match method {
+            "free" => {
+                let seed = match seed.unwrap_or("phased") {
+                    "phased" => catflip::design::free::Seed::Phased,
+                    "analytic" => catflip::design::free::Seed::Analytic,
+                    other => {
+                        return Err(ConfigError::new_err(format!(
+                            "unknown seed `{other}`; use \"phased\" or \"analytic\""
+                        )));
+                    }
+                };
+                let r = catflip::design::free::optimize(&cfg, seed, |_| {}).map_err(err)?;
+                let sched = sample(&r.plan);
+                let status = Status::from(r.status);
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (r.peak_torque_nm, r.bend_deg),
+                    &sched,
+                    (r.flip_error_rad, r.tilt_deg),
+                );
+                let json = serde_json::to_value(&r).expect("serialises");
+                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
+                (
+                    Box::new(r.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    r.peak_torque_nm,
+                    r.phase_durations_s,
+                )
+            }
+            "phased" => {
+                if seed.is_some() {
+                    return Err(no_seed("the phased design"));
                 }
-            };
-            let r = catflip::design::free::optimize(cfg, seed, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok(Made {
-                plan: Box::new(r.plan),
-                json,
-                status,
-                reason,
-                peak: r.peak_torque_nm,
-                durations: r.phase_durations_s,
-            })
-        }
-        "phased" => {
-            if seed.is_some() {
-                return Err(no_seed("the phased design"));
+                let r = catflip::design::phased::optimize(&cfg, |_| {}).map_err(err)?;
+                let sched = sample(&r.plan);
+                let status = Status::from(r.status);
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (r.peak_torque_nm, r.bend_deg),
+                    &sched,
+                    (r.flip_error_rad, r.tilt_deg),
+                );
+                let json = serde_json::to_value(&r).expect("serialises");
+                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
+                (
+                    Box::new(r.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    r.peak_torque_nm,
+                    r.phase_durations_s,
+                )
             }
-            let r = catflip::design::phased::optimize(cfg, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok(Made {
-                plan: Box::new(r.plan),
-                json,
-                status,
-                reason,
-                peak: r.peak_torque_nm,
-                durations: r.phase_durations_s,
-            })
-        }
-        "analytic" => {
-            if seed.is_some() {
-                return Err(no_seed("the analytic schedule"));
+            _ => {
+                if seed.is_some() {
+                    return Err(no_seed("the analytic schedule"));
+                }
+                // the CLI's `analyze`: a miss is flagged in the analysis
+                let a = catflip::verify::analyze::analyze(&cfg).map_err(err)?;
+                let sched = catflip::verify::analyze::analytic_schedule(&cfg, &a.plan);
+                let status = Status::ClosedForm;
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (a.peak_torque_nm, a.closed.bend_deg),
+                    &sched,
+                    (a.flip_error_rad, a.tilt_deg),
+                );
+                let json = serde_json::to_value(&a).expect("serialises");
+                catflip::output::ensure_finite(&json, &[]).map_err(err)?;
+                (
+                    Box::new(a.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    a.peak_torque_nm,
+                    a.closed.phase_durations_s,
+                )
             }
-            // mirrors the CLI's `analyze`: a miss is flagged in the analysis
-            let a = catflip::verify::analyze::analyze(cfg).map_err(err)?;
-            let sched = catflip::verify::analyze::analytic_schedule(cfg, &a.plan);
-            let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
-            let why = catflip::run::schedule_flags(
-                cfg,
-                (a.flip_error_rad, a.tilt_deg),
-                a.peak_torque_nm,
-                a.closed.bend_deg,
-                Some(usage.max_speed_rad_s),
-                usage.min_margin,
-            );
-            let reason = (!why.is_empty()).then(|| why.join("; "));
-            let json = with_verdict(serde_json::to_value(&a).expect("serialises"), &reason);
-            Ok(Made {
-                plan: Box::new(a.plan),
-                json,
-                status: "closed-form".into(),
-                reason,
-                peak: a.peak_torque_nm,
-                durations: a.closed.phase_durations_s,
-            })
-        }
-        other => Err(ConfigError::new_err(format!(
-            "unknown method `{other}`; use \"free\", \"phased\" or \"analytic\""
-        ))),
-    }
+        };
+    Ok(Design {
+        method,
+        source,
+        cfg,
+        plan,
+        schedule,
+        json: with_verdict(json, &reason),
+        status: status.name().into(),
+        reason,
+        peak,
+        durations,
+    })
 }
 
 /// Designs a torque schedule, as the CLI's `optimize --mode METHOD [--seed SEED]`
@@ -459,29 +548,7 @@ fn design(
         }
     };
     let seed = seed.map(String::from);
-    py.detach(move || {
-        let Made {
-            plan,
-            json,
-            status,
-            reason,
-            peak,
-            durations,
-        } = run_design(&cfg, method, seed.as_deref())?;
-        let schedule = Schedule::sample(&cfg.cat(), plan.as_ref(), cfg.simulate.samples_per_phase);
-        Ok(Design {
-            method,
-            source,
-            cfg,
-            plan,
-            schedule,
-            json,
-            status,
-            reason,
-            peak,
-            durations,
-        })
-    })
+    py.detach(move || run_design(cfg, source, method, seed.as_deref()))
 }
 
 #[pymethods]
@@ -701,11 +768,18 @@ fn simulate(
             }
         };
         let report = report.map_err(err)?;
-        let reason = catflip::verify::simulate::misses_flip(
+        // as the CLI's `simulate`
+        catflip::output::ensure_finite(&serde_json::to_value(&report).expect("serialises"), &[])
+            .map_err(err)?;
+        let why: Vec<String> = catflip::verdict::flip_misses(
             report.flip_error_rad,
             report.tilt_deg,
             cfg.simulate.flip_tolerance,
-        );
+        )
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+        let reason = (!why.is_empty()).then(|| why.join("; "));
         Ok(Simulation {
             report,
             source,
@@ -876,7 +950,7 @@ impl LeastHeight {
     /// That design's solver status.
     #[getter]
     fn status(&self) -> String {
-        self.answer.status.clone()
+        self.answer.status.name().into()
     }
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
@@ -1027,7 +1101,7 @@ fn sweep_columns<'py>(
         "free_status",
         points
             .iter()
-            .map(|p| p.free_status.clone())
+            .map(|p| p.free_status.map(|s| s.name()))
             .collect::<Vec<_>>(),
     )?;
     d.set_item(
@@ -1209,7 +1283,11 @@ impl Controls {
     /// Peak norm: `euclidean` or `per-motor`.
     #[getter]
     fn norm(&self) -> String {
-        catflip::run::json_name(&self.cfg.norm())
+        match self.cfg.norm() {
+            catflip::model::TorqueNorm::Euclidean => "euclidean",
+            catflip::model::TorqueNorm::PerMotor => "per-motor",
+        }
+        .into()
     }
     /// Step start times, s: float64, shape (n + 1,).
     #[getter]
@@ -1278,6 +1356,7 @@ fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("DesignError", py.get_type::<DesignError>())?;
     m.add("ImpossibleError", py.get_type::<ImpossibleError>())?;
+    m.add("UnitSlipWarning", py.get_type::<UnitSlipWarning>())?;
     m.add_class::<Config>()?;
     m.add_class::<Design>()?;
     m.add_class::<Simulation>()?;
