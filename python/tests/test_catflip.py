@@ -336,3 +336,15 @@ def test_the_quickstart_runs(tmp_path):
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "quickstart.png").stat().st_size > 10_000
     assert "MuJoCo flip" in p.stdout
+
+
+def test_unit_slips_warn_as_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, _, stderr = cli("analyze", seed, "--set", "cat.mass=500", out=tmp_path)
+    assert status == 0
+    cli_warnings = [l[len("warning: "):] for l in stderr.splitlines() if "typed as" in l]
+    assert cli_warnings
+    cfg = catflip.Config.from_toml(seed)
+    with pytest.warns(catflip.UnitSlipWarning) as caught:
+        cfg.set("cat.mass", 500)
+    assert [str(w.message) for w in caught] == cli_warnings == cfg.slips
