@@ -216,6 +216,7 @@ impl Config {
         )
     }
 
+    /// Checks a config given as TOML text; `origin` names it in messages.
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
     fn from_text(py: Python<'_>, text: String, origin: &str) -> PyResult<Config> {
@@ -563,6 +564,7 @@ impl Design {
     fn status(&self) -> &str {
         &self.status
     }
+    /// `flagged` when the design misses a target (solver status, flip or tilt, a limit), else `ok`.
     #[getter]
     fn verdict(&self) -> &'static str {
         if self.reason.is_some() {
@@ -571,6 +573,7 @@ impl Design {
             "ok"
         }
     }
+    /// Why it is flagged, in the CLI's words; None when ok.
     #[getter]
     fn reason(&self) -> Option<String> {
         self.reason.clone()
@@ -820,6 +823,7 @@ impl Simulation {
     fn peak_torque_nm(&self) -> f64 {
         self.report.peak_torque_nm
     }
+    /// `flagged` when the flip or tilt misses `simulate.flip_tolerance`, else `ok`.
     #[getter]
     fn verdict(&self) -> &'static str {
         if self.reason.is_some() {
@@ -828,10 +832,12 @@ impl Simulation {
             "ok"
         }
     }
+    /// Why it is flagged; None when ok.
     #[getter]
     fn reason(&self) -> Option<String> {
         self.reason.clone()
     }
+    /// Step times, s: float64, shape (M,).
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.report.trace.iter().map(|p| p.t).collect())
@@ -846,6 +852,7 @@ impl Simulation {
     fn tilt<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.report.trace.iter().map(|p| p.tilt).collect())
     }
+    /// Joint angles, rad: float64, shape (M, 2).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -853,6 +860,7 @@ impl Simulation {
             &self.report.trace.iter().map(|p| p.q).collect::<Vec<_>>(),
         )
     }
+    /// Applied joint torques, N m: float64, shape (M, 2).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -952,10 +960,12 @@ impl LeastHeight {
     fn status(&self) -> String {
         self.answer.status.name().into()
     }
+    /// Times of the least-height schedule, s: float64, shape (N,).
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.answer.schedule.rows.iter().map(|r| r.t).collect())
     }
+    /// Its joint angles, rad: float64, shape (N, 2).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -969,6 +979,7 @@ impl LeastHeight {
                 .collect::<Vec<_>>(),
         )
     }
+    /// Its joint torques, N m: float64, shape (N, 2).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(

@@ -348,3 +348,21 @@ def test_unit_slips_warn_as_the_cli(tmp_path):
     with pytest.warns(catflip.UnitSlipWarning) as caught:
         cfg.set("cat.mass", 500)
     assert [str(w.message) for w in caught] == cli_warnings == cfg.slips
+
+
+def test_everything_public_has_a_docstring_and_a_stub():
+    import ast
+
+    stub = ast.parse((pathlib.Path(catflip.__file__).parent / "__init__.pyi").read_text())
+    stubbed = {n.name: n for n in stub.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    for name in catflip.__all__:
+        obj = getattr(catflip, name)
+        assert (obj.__doc__ or "").strip(), name
+        assert name in stubbed, f"{name} has no stub"
+        if isinstance(obj, type) and not issubclass(obj, BaseException):
+            members = {n.name for n in stubbed[name].body if isinstance(n, ast.FunctionDef)}
+            for attr in dir(obj):
+                if attr.startswith("_"):
+                    continue
+                assert (getattr(obj, attr).__doc__ or "").strip(), f"{name}.{attr} has no docstring"
+                assert attr in members, f"{name}.{attr} has no stub"
