@@ -190,6 +190,7 @@ pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
         flip_deg: s.flip_deg,
         flip_error_rad: s.flip_error_rad,
         tilt_deg: s.tilt_deg,
+        landing_error_deg: s.landing_error_deg,
         sim_peak_torque_nm: s.peak_torque_nm,
         momentum_drift_nms: s.momentum_drift_nms,
         final_shape_error_rad: s.final_shape_error_rad,
@@ -205,7 +206,14 @@ pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
         design.status(),
         (peak, bend),
         Some(&schedule),
-        &Simulated::of(sim.as_ref()),
+        &match &sim {
+            Ok(s) => Simulated::Landing {
+                flip_error_rad: s.flip_error_rad,
+                tilt_deg: s.tilt_deg,
+                landing_error_deg: s.landing_error_deg,
+            },
+            Err(e) => Simulated::Failed(e.to_string()),
+        },
     );
     let summary = MethodSummary {
         method: method.name(),
@@ -331,6 +339,8 @@ pub struct MethodNumbers {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
+    pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,

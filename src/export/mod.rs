@@ -13,6 +13,7 @@
 mod common;
 pub mod controls;
 pub mod mjcf;
+pub mod start;
 pub mod urdf;
 
 pub use common::halves;
