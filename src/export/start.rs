@@ -49,9 +49,17 @@ pub fn base_start(cfg: &Config) -> BaseStart {
     }
 }
 
+/// How a simulator states its base's start: MuJoCo's `wxyz` quaternion with
+/// the rate in the rear frame, or pyBullet's `xyzw` with the rate in the world.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BaseConvention {
+    RearFrameWxyz,
+    WorldXyzw,
+}
+
 /// `# key = a b c` header lines of the controls: the start in catflip's world and
 /// in the simulator's, and the landing margin (the replays continue for it).
-pub fn header_lines(cfg: &Config, sim: super::controls::Simulator) -> String {
+pub fn header_lines(cfg: &Config, convention: BaseConvention) -> String {
     let s = cfg.start.start();
     let b = base_start(cfg);
     let j = |v: &[f64]| {
@@ -60,11 +68,9 @@ pub fn header_lines(cfg: &Config, sim: super::controls::Simulator) -> String {
             .collect::<Vec<_>>()
             .join(" ")
     };
-    let (quat, ang, frame) = match sim {
-        super::controls::Simulator::Mujoco => {
-            (b.quat.to_vec(), b.angular_velocity_body, "rear frame")
-        }
-        super::controls::Simulator::Pybullet => (
+    let (quat, ang, frame) = match convention {
+        BaseConvention::RearFrameWxyz => (b.quat.to_vec(), b.angular_velocity_body, "rear frame"),
+        BaseConvention::WorldXyzw => (
             vec![b.quat[1], b.quat[2], b.quat[3], b.quat[0]],
             b.angular_velocity_world,
             "world",
