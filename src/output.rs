@@ -120,6 +120,12 @@ impl Output {
         self.files.iter().map(|f| f.0.as_str())
     }
 
+    /// The files added so far, name and contents (for a caller that keeps
+    /// them in memory, such as the Python package's `run`).
+    pub fn files(&self) -> impl Iterator<Item = (&str, &[u8])> {
+        self.files.iter().map(|f| (f.0.as_str(), f.1.as_slice()))
+    }
+
     /// Stages and publishes in one go as the set `set_path` (`<dir>/<set>`).
     /// Commands that compute for long should call [`Publisher::begin`] first,
     /// so that an unwritable folder is reported before the work.

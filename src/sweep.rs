@@ -15,6 +15,7 @@ use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
+use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use crate::verify::analyze::peak_along;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -127,7 +128,7 @@ pub struct SweepPoint {
     pub least_height_phased_m: Option<f64>,
     pub least_height_free_m: Option<f64>,
     /// The free-form optimiser's end status (converged, iteration limit, ...).
-    pub free_status: Option<String>,
+    pub free_status: Option<Status>,
     pub error: Option<String>,
 }
 
@@ -286,10 +287,11 @@ fn point(
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
                     "phased",
-                    &crate::run::json_name(&ph.status),
-                    ph.flip_error_rad,
-                    ph.tilt_deg,
                     &cfg,
+                    ph.status.into(),
+                    ph.peak_torque_nm,
+                    ph.bend_deg,
+                    (ph.flip_error_rad, ph.tilt_deg),
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
@@ -323,17 +325,18 @@ fn point(
                 Ok(fr) => {
                     errors.extend(flagged(
                         "free",
-                        &crate::run::json_name(&fr.status),
-                        fr.flip_error_rad,
-                        fr.tilt_deg,
                         &cfg,
+                        fr.status.into(),
+                        fr.peak_torque_nm,
+                        fr.bend_deg,
+                        (fr.flip_error_rad, fr.tilt_deg),
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m = limit
                         .filter(|_| !envelope)
                         .map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
-                    p.free_status = Some(crate::run::json_name(&fr.status));
+                    p.free_status = Some(fr.status.into());
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
@@ -365,24 +368,33 @@ fn point(
     (p, kept)
 }
 
-/// A kept design that misses a target (unconverged, flip missed) is named in
-/// the point's `error` column beside its numbers.
+/// A kept design that misses a target (unconverged, flip missed, bend
+/// limit broken) is named in the point's `error` column beside its numbers
+/// ([`verdict`]; a sweep's peaks are computed without the torque limit and
+/// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
-    status: &str,
-    flip_error: f64,
-    tilt_deg: f64,
     cfg: &Config,
+    status: Status,
+    peak_torque_nm: f64,
+    bend_deg: f64,
+    (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(crate::verify::simulate::misses_flip(
-        flip_error,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
+    let v = verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status,
+            peak_torque_nm,
+            bend_deg,
+            max_speed_rad_s: None,
+            envelope_margin: None,
+        },
+        &Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    );
+    let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
@@ -420,20 +432,24 @@ pub fn sweep_shard(
     sweep_shard_into(
         path, overrides, spec, methods, threads, shard, &store, progress,
     )?;
-    Ok(store
+    Ok(finished(store))
+}
+
+/// Every point of a filled store.
+fn finished(store: Mutex<Vec<Option<SweepPoint>>>) -> Vec<SweepPoint> {
+    store
         .into_inner()
         .unwrap()
         .into_iter()
         .map(|p| p.expect("every point ran"))
-        .collect())
+        .collect()
 }
 
 /// [`sweep_shard`] into `store`, one slot a point of the shard, which the
 /// caller may read while it runs (an interrupted sweep publishes the points
-/// finished so far, [`crate::interrupt`]). Slots already filled (a resumed
-/// sweep, [`resume`]) are kept: a chunk whose every point is filled is
-/// skipped, a chunk filled in part is computed again from its start, so
-/// that each point has the same continuation as in an uninterrupted sweep.
+/// finished so far, [`crate::interrupt`]); slots already filled (a resumed
+/// sweep, [`resume`]) are kept ([`sweep_values_into`]). A grid with a point
+/// outside the key's range is refused before any work.
 pub fn sweep_shard_into(
     path: &Path,
     overrides: &[String],
@@ -446,7 +462,7 @@ pub fn sweep_shard_into(
 ) -> Result<()> {
     let all = spec.values();
     let range = shard.points(all.len());
-    let values = &all[range.clone()];
+    let values = &all[range];
     let load = |v: f64| {
         let mut ov = overrides.to_vec();
         ov.push(format!("{}={}", spec.key, v));
@@ -465,40 +481,100 @@ pub fn sweep_shard_into(
             ),
         });
     }
-    // a point whose config is invalid (outside the key's range) fails the
-    // sweep before any work, over the whole grid so that every shard agrees
-    let configs: Vec<Result<Config>> = all
+    // a point outside the key's range fails the sweep before any work,
+    // over the whole grid so that every shard agrees
+    let invalid: Vec<(f64, Error)> = all
         .iter()
-        .map(|&v| {
-            load(v).map_err(|e| Error::Range {
-                arg: spec.arg(),
-                message: match e {
-                    // the override is internal: name the point, not a `--set`
-                    Error::Override { message, .. } => format!("at {} = {v}: {message}", spec.key),
-                    e => format!("at {} = {v}: {e}", spec.key),
-                },
-            })
-        })
+        .filter_map(|&v| load(v).err().map(|e| (v, e)))
         .collect();
-    let bad = configs.iter().filter(|c| c.is_err()).count();
-    if let Some(Err(first)) = configs.iter().find(|c| c.is_err()) {
-        let message = match first {
-            Error::Range { message, .. } => message.clone(),
+    if let Some((v, e)) = invalid.first()
+        && invalid.len() < all.len()
+    {
+        let message = match e {
+            Error::Override { message, .. } => message.clone(),
             e => e.to_string(),
         };
         return Err(Error::Range {
             arg: spec.arg(),
-            message: if bad == configs.len() {
-                format!("every point is invalid; {message}")
-            } else {
-                format!(
-                    "{bad} of {} points are invalid, the first {message}; choose FROM and TO inside the key's range",
-                    configs.len()
-                )
+            message: format!(
+                "{} of {} points are invalid, the first at {} = {v}: {message}; choose FROM and TO inside the key's range",
+                invalid.len(),
+                all.len(),
+                spec.key
+            ),
+        });
+    }
+    sweep_values_into(
+        &spec.key,
+        &spec.arg(),
+        values,
+        load,
+        methods,
+        threads,
+        store,
+        progress,
+    )
+}
+
+/// The points of a sweep of `key` over `values` (any values, in order; the
+/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
+/// value and `arg` naming the sweep in messages: what [`sweep_shard`] runs,
+/// and what a caller with its own values (the Python package) calls.
+pub fn sweep_values(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
+    let store = Mutex::new(Vec::new());
+    sweep_values_into(key, arg, values, load, methods, threads, &store, progress)?;
+    Ok(finished(store))
+}
+
+/// [`sweep_values`] into `store` (one slot a value, filled as points
+/// finish). Slots already filled are kept: a chunk whose every point is
+/// filled is skipped, a chunk filled in part is computed again from its
+/// start, so that each point has the same continuation as in an
+/// uninterrupted sweep.
+pub fn sweep_values_into(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    store: &Mutex<Vec<Option<SweepPoint>>>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<()> {
+    // a point whose config is invalid is that point's failure; when every
+    // point is invalid (e.g. an unknown key) the sweep fails before any work
+    let configs: Vec<Result<Config>> = values
+        .iter()
+        .map(|&v| {
+            load(v).map_err(|e| Error::Range {
+                arg: arg.into(),
+                message: match e {
+                    // the override is internal: name the point, not a `--set`
+                    Error::Override { message, .. } => format!("at {key} = {v}: {message}"),
+                    e => format!("at {key} = {v}: {e}"),
+                },
+            })
+        })
+        .collect();
+    if let Some(Err(first)) = configs.first()
+        && configs.iter().all(|c| c.is_err())
+    {
+        return Err(Error::Range {
+            arg: arg.into(),
+            message: match first {
+                Error::Range { message, .. } => format!("every point is invalid; {message}"),
+                e => e.to_string(),
             },
         });
     }
-    let configs = &configs[range.clone()];
     // shards start on chunk boundaries, so local chunks are global chunks
     let results = store;
     let chunks: Vec<std::ops::Range<usize>> = {
@@ -530,9 +606,7 @@ pub fn sweep_shard_into(
                     let mut bends = Vec::new();
                     let mut last_ok = false;
                     for i in chunks[c].clone() {
-                        let slot = FALL_ONLY
-                            .contains(&spec.key.as_str())
-                            .then_some(&mut phased_warm);
+                        let slot = FALL_ONLY.contains(&key).then_some(&mut phased_warm);
                         let (p, fr) = match &configs[i] {
                             Ok(cfg) => point(
                                 cfg,
@@ -614,7 +688,7 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
             cell(p.free_bend_deg),
             cell(p.least_height_phased_m),
             cell(p.least_height_free_m),
-            p.free_status.as_deref().unwrap_or(""),
+            p.free_status.map_or("", Status::name),
             p.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
         ));
     }

@@ -1,16 +1,12 @@
 //! Free-form designs for every objective inside the motor envelope, against
 //! F7, time scaling, the motor model and the phased designs.
 
+mod util;
+
 use catflip::Config;
 use catflip::design::envelope::{height_for, usage_of};
 use catflip::design::free::{FreeResult, optimize_from};
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
-}
+use util::seed;
 
 /// The free-form design seeded by the phased design of the same objective
 /// (the mesh check left out).
