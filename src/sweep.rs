@@ -252,7 +252,7 @@ fn point(
             let mut r = prev.clone();
             let k = (t_prev / cfg.available_time()).powi(2);
             r.peak_torque_nm *= k;
-            r.socp_peak_torque_nm *= k;
+            r.socp_peak_torque_nm = r.socp_peak_torque_nm.map(|p| p * k);
             r.objective_value *= k;
             Ok(r)
         } else if methods.phased || warm.is_none() {
@@ -305,21 +305,15 @@ fn point(
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, before, |_| {}),
-                (Ok(ph), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &ph.plan,
-                    "phased",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
-                (Err(_), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &analytic_plan(&cfg),
-                    "analytic",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
+                (_, Some(w)) => crate::design::free::FreeDesign::new(&cfg)
+                    .warm(w, before)
+                    .solve(),
+                (Ok(ph), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&ph.plan, "phased")
+                    .solve(),
+                (Err(_), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&analytic_plan(&cfg), "analytic")
+                    .solve(),
             };
             match fr {
                 Ok(fr) => {
@@ -432,24 +426,20 @@ pub fn sweep_shard(
     sweep_shard_into(
         path, overrides, spec, methods, threads, shard, &store, progress,
     )?;
-    Ok(finished(store))
-}
-
-/// Every point of a filled store.
-fn finished(store: Mutex<Vec<Option<SweepPoint>>>) -> Vec<SweepPoint> {
-    store
+    Ok(store
         .into_inner()
         .unwrap()
         .into_iter()
         .map(|p| p.expect("every point ran"))
-        .collect()
+        .collect())
 }
 
 /// [`sweep_shard`] into `store`, one slot a point of the shard, which the
 /// caller may read while it runs (an interrupted sweep publishes the points
-/// finished so far, [`crate::interrupt`]); slots already filled (a resumed
-/// sweep, [`resume`]) are kept ([`sweep_values_into`]). A grid with a point
-/// outside the key's range is refused before any work.
+/// finished so far, [`crate::interrupt`]). Slots already filled (a resumed
+/// sweep, [`resume`]) are kept: a chunk whose every point is filled is
+/// skipped, a chunk filled in part is computed again from its start, so
+/// that each point has the same continuation as in an uninterrupted sweep.
 pub fn sweep_shard_into(
     path: &Path,
     overrides: &[String],
@@ -462,7 +452,7 @@ pub fn sweep_shard_into(
 ) -> Result<()> {
     let all = spec.values();
     let range = shard.points(all.len());
-    let values = &all[range];
+    let values = &all[range.clone()];
     let load = |v: f64| {
         let mut ov = overrides.to_vec();
         ov.push(format!("{}={}", spec.key, v));
@@ -481,34 +471,11 @@ pub fn sweep_shard_into(
             ),
         });
     }
-    // a point outside the key's range fails the sweep before any work,
-    // over the whole grid so that every shard agrees
-    let invalid: Vec<(f64, Error)> = all
-        .iter()
-        .filter_map(|&v| load(v).err().map(|e| (v, e)))
-        .collect();
-    if let Some((v, e)) = invalid.first()
-        && invalid.len() < all.len()
-    {
-        let message = match e {
-            Error::Override { message, .. } => message.clone(),
-            e => e.to_string(),
-        };
-        return Err(Error::Range {
-            arg: spec.arg(),
-            message: format!(
-                "{} of {} points are invalid, the first at {} = {v}: {message}; choose FROM and TO inside the key's range",
-                invalid.len(),
-                all.len(),
-                spec.key
-            ),
-        });
-    }
-    sweep_values_into(
+    let configs = checked_configs(&spec.key, &spec.arg(), &all, &load)?;
+    compute_into(
         &spec.key,
-        &spec.arg(),
         values,
-        load,
+        &configs[range],
         methods,
         threads,
         store,
@@ -516,41 +483,15 @@ pub fn sweep_shard_into(
     )
 }
 
-/// The points of a sweep of `key` over `values` (any values, in order; the
-/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
-/// value and `arg` naming the sweep in messages: what [`sweep_shard`] runs,
-/// and what a caller with its own values (the Python package) calls.
-pub fn sweep_values(
+/// The configs at `values`, or the sweep's error before any work: a point
+/// whose config is invalid (outside the key's range) fails the whole sweep,
+/// over the whole grid so that every shard agrees.
+fn checked_configs(
     key: &str,
     arg: &str,
     values: &[f64],
     load: impl Fn(f64) -> Result<Config>,
-    methods: Methods,
-    threads: usize,
-    progress: impl Fn(usize, usize) + Sync,
-) -> Result<Vec<SweepPoint>> {
-    let store = Mutex::new(Vec::new());
-    sweep_values_into(key, arg, values, load, methods, threads, &store, progress)?;
-    Ok(finished(store))
-}
-
-/// [`sweep_values`] into `store` (one slot a value, filled as points
-/// finish). Slots already filled are kept: a chunk whose every point is
-/// filled is skipped, a chunk filled in part is computed again from its
-/// start, so that each point has the same continuation as in an
-/// uninterrupted sweep.
-pub fn sweep_values_into(
-    key: &str,
-    arg: &str,
-    values: &[f64],
-    load: impl Fn(f64) -> Result<Config>,
-    methods: Methods,
-    threads: usize,
-    store: &Mutex<Vec<Option<SweepPoint>>>,
-    progress: impl Fn(usize, usize) + Sync,
-) -> Result<()> {
-    // a point whose config is invalid is that point's failure; when every
-    // point is invalid (e.g. an unknown key) the sweep fails before any work
+) -> Result<Vec<Result<Config>>> {
     let configs: Vec<Result<Config>> = values
         .iter()
         .map(|&v| {
@@ -564,17 +505,57 @@ pub fn sweep_values_into(
             })
         })
         .collect();
-    if let Some(Err(first)) = configs.first()
-        && configs.iter().all(|c| c.is_err())
-    {
+    let bad = configs.iter().filter(|c| c.is_err()).count();
+    if let Some(Err(first)) = configs.iter().find(|c| c.is_err()) {
+        let message = match first {
+            Error::Range { message, .. } => message.clone(),
+            e => e.to_string(),
+        };
         return Err(Error::Range {
             arg: arg.into(),
-            message: match first {
-                Error::Range { message, .. } => format!("every point is invalid; {message}"),
-                e => e.to_string(),
+            message: if bad == configs.len() {
+                format!("every point is invalid; {message}")
+            } else {
+                format!(
+                    "{bad} of {} points are invalid, the first {message}; choose FROM and TO inside the key's range",
+                    configs.len()
+                )
             },
         });
     }
+    Ok(configs)
+}
+
+/// The points of a sweep of `key` over `values` (any values, in order; the
+/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
+/// value and `arg` naming the sweep in messages: what a caller with its own
+/// values (the Python package) calls.
+pub fn sweep_values(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
+    let configs = checked_configs(key, arg, values, load)?;
+    let store = Mutex::new(Vec::new());
+    compute_into(key, values, &configs, methods, threads, &store, progress)?;
+    Ok(store.into_inner().unwrap().into_iter().flatten().collect())
+}
+
+/// Computes the points at `values` (with their `configs`) into `store`,
+/// chunk by chunk; chunks whose every slot is filled are skipped.
+fn compute_into(
+    key: &str,
+    values: &[f64],
+    configs: &[Result<Config>],
+    methods: Methods,
+    threads: usize,
+    store: &Mutex<Vec<Option<SweepPoint>>>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<()> {
     // shards start on chunk boundaries, so local chunks are global chunks
     let results = store;
     let chunks: Vec<std::ops::Range<usize>> = {

@@ -645,8 +645,8 @@ fn sweeps_bound_the_count_keep_good_points_and_check_threads() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--threads"), "{err}");
     assert!(!dir.path().join("output").exists());
-    // row 15 (issue 31): points outside the key's range are refused up
-    // front, naming the first, before any work; a range inside is computed
+    // points outside the key's range are refused up front, naming the
+    // first, before any work; a range inside is computed
     let (code, out, err) = run(
         &[
             "sweep",
