@@ -209,6 +209,11 @@ pub fn run() -> Result<Status> {
     }
 }
 
+/// A number that may be absent, to `digits` decimals, else `-`.
+fn maybe(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
+}
+
 fn row(label: &str, value: String) {
     say!("  {label:<34} {value}");
 }
@@ -569,8 +574,10 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
             let r = catflip::design::phased::optimize(&cfg, |e| {
                 if verbose {
                     eprintln!(
-                        "  bend {:8.3} deg   unit peak {:10.5} N m s^2   peak {:9.5} N m",
-                        e.bend_deg, e.unit_peak, e.peak_nm
+                        "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
+                        e.bend_deg,
+                        maybe(e.unit_peak, 5),
+                        maybe(e.peak_nm, 5)
                     );
                 }
             })?;
@@ -603,8 +610,9 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
             row(
                 "peak torque",
                 format!(
-                    "{:.5} N m (SOCP bound {:.5})",
-                    r.peak_torque_nm, r.socp_peak_torque_nm
+                    "{:.5} N m (SOCP bound {})",
+                    r.peak_torque_nm,
+                    maybe(r.socp_peak_torque_nm, 5)
                 ),
             );
             row(
@@ -646,11 +654,11 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
                 );
             }
-            let r = catflip::design::free::optimize_observed(
-                &cfg,
-                seed,
-                &mut IterationTable { verbose },
-            )?;
+            let r = catflip::design::free::FreeDesign::new(&cfg)
+                .seed(seed)
+                .check_mesh()
+                .observe(&mut IterationTable { verbose })
+                .solve()?;
             let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
             let reason = design_flags(
                 &cfg,
@@ -785,7 +793,8 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
             } if live => {
                 let _ = write!(
                     e,
-                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {peak_nm:.5} N m"
+                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {} N m",
+                    maybe(peak_nm, 5)
                 );
             }
             Progress::Scp(it) if live => {

@@ -245,7 +245,7 @@ fn point(
             let mut r = prev.clone();
             let k = (t_prev / cfg.available_time()).powi(2);
             r.peak_torque_nm *= k;
-            r.socp_peak_torque_nm *= k;
+            r.socp_peak_torque_nm = r.socp_peak_torque_nm.map(|p| p * k);
             r.objective_value *= k;
             Ok(r)
         } else if methods.phased || warm.is_none() {
@@ -298,21 +298,15 @@ fn point(
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, before, |_| {}),
-                (Ok(ph), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &ph.plan,
-                    "phased",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
-                (Err(_), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &analytic_plan(&cfg),
-                    "analytic",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
+                (_, Some(w)) => crate::design::free::FreeDesign::new(&cfg)
+                    .warm(w, before)
+                    .solve(),
+                (Ok(ph), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&ph.plan, "phased")
+                    .solve(),
+                (Err(_), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&analytic_plan(&cfg), "analytic")
+                    .solve(),
             };
             match fr {
                 Ok(fr) => {

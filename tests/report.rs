@@ -148,9 +148,10 @@ fn sweep_agrees_with_single_runs() {
             catflip::verify::analyze::dense_samples(&cfg),
         );
         let ph = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let fr =
-            catflip::design::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
-                .unwrap();
+        let fr = catflip::design::free::FreeDesign::new(&cfg)
+            .from_plan(&ph.plan, "phased")
+            .solve()
+            .unwrap();
         assert!((p.analytic_peak_nm.unwrap() - a).abs() <= 1e-12 * a);
         assert!((p.phased_peak_nm.unwrap() - ph.peak_torque_nm).abs() <= 1e-12 * a);
         // a sweep continues from its neighbour's free-form design, a single
