@@ -119,7 +119,7 @@ pub fn lopsided(joint: Joint) -> Cat {
     h.rear.inertia = [
         [0.09, 0.004, -0.003],
         [0.004, 0.08, 0.006],
-        [-0.003, 0.006, 0.012],
+        [-0.003, 0.006, 0.03],
     ];
     h.rear.joint = [0.01, 0.02, 0.5];
     h.front.mass = 0.7;
@@ -127,11 +127,12 @@ pub fn lopsided(joint: Joint) -> Cat {
     h.front.inertia = [
         [0.05, -0.002, 0.0],
         [-0.002, 0.06, 0.001],
-        [0.0, 0.001, 0.004],
+        [0.0, 0.001, 0.02],
     ];
     let s = 0.5f64.sqrt();
     h.rear.axis = [s, s, 0.0];
     h.front.axis = [-s, s, 0.0];
+    assert!(h.rear.problem().is_none() && h.front.problem().is_none());
     Cat::rigid(h, joint)
 }
 

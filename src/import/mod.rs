@@ -92,9 +92,12 @@ pub struct Imported {
 /// Reads a robot description by its extension's kind.
 pub fn read_file(path: &Path, kind: FileKind) -> Result<Imported> {
     let name = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|e| Error::ConfigRead {
-        path: path.to_path_buf(),
-        message: format!("{e} (body.{} is relative to the config file)", kind.key()),
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        invalid(
+            &format!("body.{}", kind.key()),
+            &name,
+            format!("cannot read it ({e}); the path is relative to the config file"),
+        )
     })?;
     match kind {
         FileKind::Urdf => urdf::read(&text, &name),
