@@ -105,7 +105,7 @@ fn main() -> anyhow::Result<()> {
                             f.manoeuvre_time_s,
                             f.peak_torque_nm,
                             f.scp_iterations,
-                            catflip::run::json_name(&f.status),
+                            catflip::verdict::Status::from(f.status),
                             f.objective_value / r.objective_value
                         ),
                         Err(e) => println!("{:<33} {s:>9.3}  free-form: {e}", ""),

@@ -90,7 +90,7 @@ fn main() -> anyhow::Result<()> {
                                 norm,
                                 objective,
                                 seed.name(),
-                                catflip::run::json_name(&r.status),
+                                catflip::verdict::Status::from(r.status).to_string(),
                                 significant(r.objective_value, 6),
                                 r.scp_iterations,
                                 r.certificate.criticality,

@@ -10,6 +10,8 @@ use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+pub mod ranges;
+
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Config {
@@ -245,7 +247,7 @@ fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
     } else {
         Err(Error::Invalid {
             key: key.into(),
-            value: format!("{value}"),
+            value: ranges::show(value),
             expected: expected.into(),
         })
     }
@@ -409,6 +411,7 @@ impl Config {
             f.gravity > 0.0,
             "must be > 0 m/s^2",
         )?;
+        ranges::check_fall_time(self)?;
         check("fall.margin", f.margin, f.margin >= 0.0, "must be >= 0 s")?;
         let ft = self.fall_time();
         check(
@@ -562,7 +565,14 @@ impl Config {
             fr.attitude_tolerance > 0.0,
             "must be > 0 rad",
         )?;
-        Ok(())
+        ranges::check_ranges(self)?;
+        ranges::impossible(self)
+    }
+
+    /// Plausibility warnings (likely unit slips) for a valid config; see
+    /// [`ranges::slips`].
+    pub fn slips(&self) -> Vec<ranges::Slip> {
+        ranges::slips(self)
     }
 
     /// The cat with the inertia formula the config asks for.
@@ -593,9 +603,10 @@ impl Config {
         }
     }
 
-    /// `sqrt(2 h / g)`, s.
+    /// `sqrt(2 h / g)`, s, formed as `sqrt(h / g) sqrt(2)` so that no
+    /// finite height overflows on the way.
     pub fn fall_time(&self) -> f64 {
-        (2.0 * self.fall.height / self.fall.gravity).sqrt()
+        (self.fall.height / self.fall.gravity).sqrt() * std::f64::consts::SQRT_2
     }
 
     /// Time for the manoeuvre: fall time minus margin, s.

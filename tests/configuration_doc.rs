@@ -11,10 +11,11 @@ use std::collections::BTreeMap;
 const MINIMAL: &str =
     "name = \"doc\"\n[cat]\nmass = 1.0\nlength = 1.0\nradius = 0.1\n[fall]\nheight = 10.0\n";
 
-/// A documented key's row: its default and its unit cells.
+/// A documented key's row: its default, unit and allowed cells.
 struct Row {
     default: String,
     unit: String,
+    allowed: String,
 }
 
 /// The rows of the document's key tables: `| `key` | default | unit | allowed | ... |`.
@@ -34,6 +35,7 @@ fn documented() -> BTreeMap<String, Row> {
         let row = Row {
             default: cells[1].clone(),
             unit: cells[2].clone(),
+            allowed: cells[3].clone(),
         };
         assert!(
             rows.insert(key.to_string(), row).is_none(),
@@ -220,4 +222,93 @@ fn documented_units_are_the_units_sweeps_label_axes_with() {
             assert_eq!(row.unit, *unit, "{key}: unit in docs/configuration.md");
         }
     }
+}
+
+/// One end of a documented range: the bound and whether it is allowed.
+type End = Option<(f64, bool)>;
+
+/// The simple forms of an allowed cell: `> a`, `>= a`, `(a, b)` with `[`/`]`
+/// for included ends, `a to b` (whole numbers, both ends included); `None`
+/// for the others (they involve other keys and are checked elsewhere).
+fn range(cell: &str) -> Option<(End, End)> {
+    let num = |s: &str| match s.trim() {
+        "pi" => Some(std::f64::consts::PI),
+        s => s.parse::<f64>().ok(),
+    };
+    if let Some(a) = cell.strip_prefix(">= ") {
+        return Some((Some((num(a)?, true)), None));
+    }
+    if let Some(a) = cell.strip_prefix("> ") {
+        return Some((Some((num(a)?, false)), None));
+    }
+    if let Some((a, b)) = cell.split_once(" to ") {
+        return Some((Some((num(a)?, true)), Some((num(b)?, true))));
+    }
+    let open = cell.chars().next()?;
+    let close = cell.chars().last()?;
+    if "([".contains(open) && ")]".contains(close) {
+        let (a, b) = cell[1..cell.len() - 1].split_once(", ")?;
+        return Some((Some((num(a)?, open == '[')), Some((num(b)?, close == ']'))));
+    }
+    None
+}
+
+/// The words of an allowed cell that lists names: `` `a`, `b` ``.
+fn words(cell: &str) -> Option<Vec<&str>> {
+    cell.split(", ").map(backticked).collect()
+}
+
+/// Each documented range holds at its ends: an included end is accepted,
+/// an excluded one (or one step past an included one) is refused, naming
+/// the key; each listed word is accepted and another refused.
+#[test]
+fn documented_ranges_and_words_are_the_ones_the_code_checks() {
+    let refused = |key: &str, value: &str| match parse(&[format!("{key}={value}")]) {
+        Ok(_) => {
+            panic!("docs/configuration.md: {key}={value} should be refused, the code accepts it")
+        }
+        Err(e) => assert!(
+            e.to_string().contains(key),
+            "{key}={value} is refused without naming the key: {e}"
+        ),
+    };
+    let accepted = |key: &str, value: &str| {
+        if let Err(e) = parse(&[format!("{key}={value}")]) {
+            panic!("docs/configuration.md allows {key}={value}, the code refuses it: {e}")
+        }
+    };
+    let mut checked = 0;
+    for (key, row) in documented() {
+        if let Some((lo, hi)) = range(&row.allowed) {
+            // whole numbers as TOML integers, which every numeric key takes
+            let show = |x: f64| {
+                if x.fract() == 0.0 {
+                    format!("{}", x as i64)
+                } else {
+                    format!("{x:?}")
+                }
+            };
+            for (end, step) in [(lo, -1.0), (hi, 1.0)] {
+                match end {
+                    Some((x, true)) => {
+                        accepted(&key, &show(x));
+                        refused(&key, &show(x + step));
+                    }
+                    Some((x, false)) => refused(&key, &show(x)),
+                    None => {}
+                }
+            }
+            checked += 1;
+        } else if let Some(words) = words(&row.allowed) {
+            for w in &words {
+                accepted(&key, w);
+            }
+            refused(&key, "not-a-listed-word");
+            checked += 1;
+        }
+    }
+    assert!(
+        checked >= 20,
+        "only {checked} allowed cells were in a form this test reads"
+    );
 }

@@ -381,7 +381,7 @@ pub fn least_height(cfg: &Config, unit_peak: f64, tau_max: f64) -> f64 {
 /// Checks a design's peak against `limits.max_torque`.
 pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Result<()> {
     if let Some(lim) = cfg.limits.max_torque
-        && peak > lim * (1.0 + 1e-9)
+        && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
         return Err(Error::Unreachable {
             reason: format!(

@@ -54,7 +54,7 @@ impl Simulator {
     }
 
     /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::mjcf::dc_motor`]).
-    fn columns(self, joint: Joint, dc: bool) -> &'static str {
+    pub fn columns(self, joint: Joint, dc: bool) -> &'static str {
         match (self, joint) {
             (Simulator::Mujoco, Joint::NoTwist) => {
                 "t_s,qpos_w,qpos_x,qpos_y,qpos_z,qvel_x,qvel_y,qvel_z,ctrl_tau_x,ctrl_tau_y,ctrl_tau_z"

@@ -123,26 +123,6 @@ fn failure(
 /// schedule for good: more than a full turn (a saturated motor lags by less).
 const MAX_TRACKING_ERROR: f64 = 2.0 * std::f64::consts::PI;
 
-/// Why a simulated flip misses its target (flip error or spine tilt beyond
-/// `tol`, rad), if it does; NaN counts as a miss.
-pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
-    let mut why = Vec::new();
-    // NaN compares false: a failed number is a miss
-    let beyond = |x: f64| x.is_nan() || x.abs() > tol;
-    if beyond(flip_error_rad) {
-        why.push(format!(
-            "misses the flip by {flip_error_rad:.3e} rad (simulate.flip_tolerance = {tol:e} rad)"
-        ));
-    }
-    if beyond(tilt_deg.to_radians()) {
-        why.push(format!(
-            "tilts the spine by {tilt_deg:.3} deg = {:.3e} rad (simulate.flip_tolerance = {tol:e} rad)",
-            tilt_deg.to_radians()
-        ));
-    }
-    (!why.is_empty()).then(|| why.join("; "))
-}
-
 fn finish(
     flip: f64,
     tilt: f64,
