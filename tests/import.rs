@@ -291,3 +291,44 @@ fn mjcf_files_catflip_cannot_model_are_refused() {
         assert!(e.contains(why) && e.contains("line "), "{what}: {e}");
     }
 }
+
+#[test]
+fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
+    let cfg = config("box-robot", &[]);
+    let cat = cfg.cat();
+    let h = cat.halves();
+    assert_eq!(cat.joint, catflip::model::Joint::Universal);
+    // every part of each half, fixed to it in the URDF, is in its rigid body
+    assert!((h.rear.mass - (0.22 + 0.11 + 0.057 + 2.0 * 0.018)).abs() < 1e-12);
+    assert!((h.front.mass - (0.18 + 0.057 + 0.03 + 2.0 * 0.018)).abs() < 1e-12);
+    // the battery puts the rear's centre of mass off the axis, and products of inertia in
+    assert!(
+        h.rear.com[0].hypot(h.rear.com[1]) > 4e-3,
+        "{:?}",
+        h.rear.com
+    );
+    assert!(h.rear.inertia[0][1].abs() > 1e-7 && h.front.inertia[0][2].abs() > 1e-7);
+    assert!(!cat.is_axisymmetric());
+    // the servos' limits from the file, the torque-speed line from the config
+    assert_eq!(cfg.limits.max_torque, Some(1.4));
+    assert_eq!(cfg.limits.max_speed, Some(5.969));
+    assert_eq!(cfg.limits.no_load_speed, Some(5.969));
+    // the robot question: from its 2 m it cannot; the least height says from where
+    let a = catflip::design::least_height::answer(&cfg)
+        .unwrap()
+        .unwrap();
+    assert!(
+        !a.possible && a.least_height_m > cfg.fall.height,
+        "{}",
+        a.least_height_m
+    );
+    assert!(a.least_height_m.is_finite() && a.flip_error_rad.abs() < 1e-6);
+    let again = config(
+        "box-robot",
+        &[&format!("fall.height={}", 1.01 * a.least_height_m)],
+    );
+    let b = catflip::design::least_height::answer(&again)
+        .unwrap()
+        .unwrap();
+    assert!(b.possible, "from 1.01 x its least height it can");
+}

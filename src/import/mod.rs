@@ -155,6 +155,30 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
         (None, Some(m)) => Some(read_file(&base.join(m), FileKind::Mjcf)?),
         (None, None) => None,
     };
+    for (key, c) in [("body.rear", &body.rear), ("body.front", &body.front)] {
+        if let Some(m) = c.as_ref().and_then(|c| c.mass)
+            && !(m > 0.0 && m.is_finite())
+        {
+            return Err(invalid(
+                &format!("{key}.mass"),
+                m,
+                "must be > 0 kg (a massless half has no dynamics)",
+            ));
+        }
+    }
+    let from_file = file.as_ref().map(|f| f.halves);
+    let rear = half(
+        "body.rear",
+        body.rear.as_ref(),
+        from_file.map(|h| h.rear),
+        [1.0, 0.0, 0.0],
+    )?;
+    let front = half(
+        "body.front",
+        body.front.as_ref(),
+        from_file.map(|h| h.front),
+        [0.0, 1.0, 0.0],
+    )?;
     let cat = table
         .entry("cat")
         .or_insert_with(|| toml::Value::Table(toml::Table::new()))
@@ -192,19 +216,6 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
         (Some(f), _) => f.joint,
         (None, j) => j.unwrap_or(Joint::NoTwist),
     };
-    let from_file = file.as_ref().map(|f| f.halves);
-    let rear = half(
-        "body.rear",
-        body.rear.as_ref(),
-        from_file.map(|h| h.rear),
-        [1.0, 0.0, 0.0],
-    )?;
-    let front = half(
-        "body.front",
-        body.front.as_ref(),
-        from_file.map(|h| h.front),
-        [0.0, 1.0, 0.0],
-    )?;
     let halves = Halves { rear, front };
     if joint == Joint::Universal
         && let Some(p) = halves.axes_problem()
