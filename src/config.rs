@@ -603,10 +603,11 @@ impl Config {
         }
     }
 
-    /// `sqrt(2 h / g)`, s, formed as `sqrt(h / g) sqrt(2)` so that no
-    /// finite height overflows on the way.
+    /// `sqrt(2 h / g)`, s. A height near `f64::MAX` makes it infinite, which
+    /// the fall-time range check refuses (kept in this form: the designs of
+    /// the bundled configs depend on its last bit).
     pub fn fall_time(&self) -> f64 {
-        (self.fall.height / self.fall.gravity).sqrt() * std::f64::consts::SQRT_2
+        (2.0 * self.fall.height / self.fall.gravity).sqrt()
     }
 
     /// Time for the manoeuvre: fall time minus margin, s.
