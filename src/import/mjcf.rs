@@ -139,11 +139,11 @@ fn group<'a>(
     })
 }
 
+/// A body's joint: its type, position, axis and element.
+type BodyJoint<'a> = (String, Vector3<f64>, Vector3<f64>, Node<'a, 'a>);
+
 /// `(type, pos, axis, node)` of a body's joints.
-fn hinge_or_ball<'a>(
-    body: &Node<'a, 'a>,
-    file: &str,
-) -> Result<Vec<(String, Vector3<f64>, Vector3<f64>, Node<'a, 'a>)>> {
+fn hinge_or_ball<'a>(body: &Node<'a, 'a>, file: &str) -> Result<Vec<BodyJoint<'a>>> {
     let mut out = vec![];
     for j in joints(body) {
         let kind = if j.has_tag_name("freejoint") {

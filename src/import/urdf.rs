@@ -152,16 +152,28 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
         }
         joints.push(j);
     }
+    for (k, j) in joints.iter().enumerate() {
+        if let Some(o) = joints[..k].iter().find(|o| o.child == j.child) {
+            return Err(site(&j.node).error(
+                file,
+                format!(
+                    "the link `{}` is already the child of `{}`: a link has one parent",
+                    j.child,
+                    o.node.attribute("name").unwrap_or("?")
+                ),
+            ));
+        }
+        if j.child == j.parent {
+            return Err(site(&j.node).error(file, "joins a link to itself"));
+        }
+    }
     // fold every fixed child into its parent, deepest first, carrying its joints along
-    loop {
-        let Some(k) = joints.iter().position(|j| {
-            j.kind == "fixed"
-                && !joints
-                    .iter()
-                    .any(|o| o.kind == "fixed" && o.parent == j.child)
-        }) else {
-            break;
-        };
+    while let Some(k) = joints.iter().position(|j| {
+        j.kind == "fixed"
+            && !joints
+                .iter()
+                .any(|o| o.kind == "fixed" && o.parent == j.child)
+    }) {
         let j = joints.remove(k);
         let child = links.remove(&j.child).expect("checked above");
         let parent = links.get_mut(&j.parent).ok_or_else(|| {
@@ -172,6 +184,9 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
             o.parent = j.parent.clone();
             o.origin = j.origin.then(&o.origin);
         }
+    }
+    if let Some(j) = joints.iter().find(|j| j.kind == "fixed") {
+        return Err(site(&j.node).error(file, "the fixed joints form a loop"));
     }
     let moving: Vec<&String> = order.iter().filter(|n| links.contains_key(*n)).collect();
     let roots: Vec<&&String> = moving
