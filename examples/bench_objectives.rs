@@ -83,13 +83,9 @@ fn main() -> anyhow::Result<()> {
                     // the free-form design seeded by it, once (its own time,
                     // the seed's not counted): never worse than the phased one
                     let t = Instant::now();
-                    let fr = catflip::design::free::optimize_from(
-                        &cfg,
-                        &r.plan,
-                        "phased",
-                        cfg.free.nodes,
-                        |_| {},
-                    );
+                    let fr = catflip::design::free::FreeDesign::new(&cfg)
+                        .from_plan(&r.plan, "phased")
+                        .solve();
                     let s = t.elapsed().as_secs_f64();
                     match fr {
                         Ok(f) => println!(

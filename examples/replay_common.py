@@ -1,12 +1,17 @@
 """Shared parts of replay_mujoco.py and replay_pybullet.py: reading catflip's
-exported controls and summary, rotation helpers, the flip convention, and the
-comparison table. Needs numpy only."""
+exported controls and summary (from a `catflip run` folder, or made in-process
+by the catflip Python package from a config), rotation helpers, the flip
+convention, and the comparison table. Needs numpy only (and the catflip
+package for a config)."""
 
 import argparse
+import atexit
 import json
 import math
 import pathlib
+import shutil
 import sys
+import tempfile
 
 import numpy as np
 
@@ -25,12 +30,35 @@ def read_controls(path):
         elif line.strip():
             rows.append([float(x) for x in line.split(",")])
     data = np.array(rows)
+    vec = lambda key, default: np.array([float(x) for x in meta[key].split()]) if key in meta \
+        else np.array(default, float)
+    dt = float(meta["dt_s"])
+    # the landing margin: the replay goes on with the shape held straight (last row, at rest,
+    # no feed-forward) until touchdown
+    margin = float(meta.get("margin_s", "0"))
+    # (steps of margin / extra each: the margin exactly, a spinning cat turns on during it)
+    extra = int(math.ceil(margin / dt - 1e-9)) if margin > 0 else 0
+    if extra > 0:
+        last = data[-1].copy()
+        for i, c in enumerate(cols):
+            if c.startswith(("qvel", "vel", "ctrl", "force")):
+                last[i] = 0.0
+        tail = np.tile(last, (extra, 1))
+        tail[:, 0] = data[-1, 0] + dt * np.arange(1, extra + 1)
+        data = np.vstack([data, tail])
     pick = lambda prefix: data[:, [i for i, c in enumerate(cols) if c.startswith(prefix)]]
     limit = None if meta["max_torque_nm"] == "none" else float(meta["max_torque_nm"])
     return {
+        "start_attitude": vec("start_attitude_wxyz", [1, 0, 0, 0]),
+        "start_body_rate": vec("start_body_rate_rad_s", [0, 0, 0]),
+        "start_base_quat": vec("start_base_quat", []),
+        "start_base_linear_velocity": vec("start_base_linear_velocity", [0, 0, 0]),
+        "start_base_angular_velocity": vec("start_base_angular_velocity", [0, 0, 0]),
+        "margin_steps": extra,
+        "margin_dt": margin / extra if extra else dt,
         "slope": float(meta.get("motor_slope_nm_s", "0")),
-        "dt": float(meta["dt_s"]),
-        "steps": int(meta["steps"]),
+        "dt": dt,
+        "steps": int(meta["steps"]) + extra,
         "kp": float(meta["pd_kp"]),
         "kd": float(meta["pd_kd"]),
         "limit": limit,
@@ -90,20 +118,36 @@ def wrap(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def landing_of(r):
+    """The belly's (rear x) angle from straight down (catflip's -x), deg, of the
+    rear half's attitude `r` (w, x, y, z) in catflip's world."""
+    w, x, y, z = r
+    belly = (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
+    return math.degrees(math.atan2(math.hypot(belly[1], belly[2]), -belly[0]))
+
+
 class FlipTracker:
     """catflip's one flip convention (src/model/so3.rs FlipTracker): rotation
-    about the rear half's initial z axis (the spine), right-handed, from the
-    swing-twist split of the attitude relative to the start, unwrapped along
-    the run. Tilt: angle between the final and the initial spine."""
+    about the reference spine (catflip's world z), right-handed, from the
+    swing-twist split of the rear half's attitude in catflip's world, unwrapped
+    along the run. Tilt: angle between the spine and the reference spine.
+    `q0` is the simulator's attitude at release and `start` the release attitude
+    in catflip's world (R0), so that the attitude in catflip's world is
+    `R0 q0^-1 q`. Landing error: the belly's (rear x) angle from straight down
+    (catflip's -x), docs/model.md section 8."""
 
-    def __init__(self, q0):
-        self.q0 = np.asarray(q0, float)
+    def __init__(self, q0, start=(1.0, 0.0, 0.0, 0.0)):
+        self.q0 = quat_mul(np.asarray(q0, float), quat_conj(np.asarray(start, float)))
         self.last = 0.0
         self.acc = 0.0
         self.tilt = 0.0
+        self.landing = float("nan")
+        self.push(q0)
 
     def push(self, q):
         r = quat_mul(quat_conj(self.q0), np.asarray(q, float))
+        self.r = r
+        self.landing = landing_of(r)
         f = 2.0 * math.atan2(r[3], r[0])
         self.acc += wrap(f - self.last)
         self.last = f
@@ -154,7 +198,11 @@ def parse_args(engine, default_tol):
         description=f"Replay catflip's exported schedules in {engine}, feed-forward only and "
         "feed-forward + PD, and compare with catflip's summary.json."
     )
-    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run")
+    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run; or, "
+                   "with the catflip Python package installed (pip install ./python), a config such "
+                   "as configs/seed.toml, run in-process (the same files, not written)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="with a config: override a key, as catflip's --set (repeatable)")
     p.add_argument("--methods", default=None,
                    help="comma-separated methods (default: all in summary.json)")
     p.add_argument("--tol-deg", type=float, default=default_tol,
@@ -163,6 +211,32 @@ def parse_args(engine, default_tol):
                    help="largest |flip - catflip's flip| of the feed-forward-only replay of an "
                    "optimised, unsaturated schedule, deg (default 0.05)")
     return p.parse_args()
+
+
+def run_folder(arg, overrides):
+    """The folder of `catflip run`'s files: `arg` itself (the CSV route), or for a
+    `.toml` config the files of `catflip.run(config)`, made in-process by the Python
+    package and put in a temporary folder, so that both routes read the same files."""
+    path = pathlib.Path(arg)
+    if path.suffix != ".toml":
+        if overrides:
+            raise SystemExit("--set applies to a config; a run folder is replayed as it was written")
+        return path
+    try:
+        import catflip
+    except ImportError:
+        raise SystemExit(f"{arg} is a config: replaying it needs the catflip Python package "
+                         "(pip install ./python, docs/python.md); or give the folder `catflip run` wrote")
+    try:
+        run = catflip.run(catflip.Config.from_toml(path, overrides))
+    except catflip.CatflipError as e:
+        raise SystemExit(f"error: {e}")
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="catflip-run-"))
+    atexit.register(shutil.rmtree, folder, True)
+    for name in run.names:
+        (folder / name).write_text(run.file(name))
+    print(f"{arg}: designed in-process by the catflip package (catflip.run, {run.outcome})", file=sys.stderr)
+    return folder
 
 
 def load_summary(out):
@@ -176,13 +250,19 @@ def report(engine, summary, results, flip_tol, ff_tol):
     feed-forward-only flip of optimised, unsaturated schedules."""
     print(f"{engine} replay of {summary['name']} ({summary['joint']} joint); flip in catflip's convention")
     print(f"  {'method':<9} {'mode':<5} {'flip deg':>16} {'catflip deg':>16} {'diff deg':>10} {'tilt deg':>10} "
+          f"{'landing deg':>12} {'catflip deg':>12} {'diff deg':>10} "
           f"{'shape err rad':>13} {'peak N m':>10} {'catflip N m':>11}")
     fails = []
     for name, mode, r in results:
         m = next(x for x in summary["methods"] if x["method"] == name)
         diff = r["flip_deg"] - m["flip_deg"]
+        land = m.get("landing_error_deg", float("nan"))
+        ldiff = r["landing_deg"] - land
         print(f"  {name:<9} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
-              f"{r['tilt_deg']:10.2e} {r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+              f"{r['tilt_deg']:10.2e} {r['landing_deg']:12.6f} {land:12.6f} {ldiff:10.2e} "
+              f"{r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+        if mode in flip_tol and not abs(ldiff) <= flip_tol[mode]:
+            fails.append(f"{name}: {mode} replay lands {ldiff:.3e} deg from catflip's landing (> {flip_tol[mode]:g})")
         # a schedule that asks more than the motors give (a peak over the stall torque, or
         # outside the torque-speed envelope) runs saturated: open loop it drifts
         saturating = (summary.get("max_torque_nm") is not None
@@ -198,8 +278,10 @@ def report(engine, summary, results, flip_tol, ff_tol):
             if not saturating and r["shape_error_rad"] > 1e-3:
                 fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight")
         elif mode == "ff" and ff_tol is not None and name != "analytic" and not saturating \
-                and abs(diff) > ff_tol:
+                and not r.get("spinning") and abs(diff) > ff_tol:
             fails.append(f"{name}: feed-forward replay flip differs by {diff:.3e} deg (> {ff_tol:g})")
+    print("  landing = the belly's angle from straight down at touchdown (after fall.margin); a spinning\n"
+          "  start's feed-forward-only replay is not checked (a zero-momentum schedule drifts open loop).")
     print("  modes: ff = feed-forward only, pd = feed-forward + catflip's PD. catflip = summary.json: its own\n"
           "  simulation (feed-forward + PD, the config's torque limit); a saturating schedule is compared\n"
           "  with that saturated simulation.")

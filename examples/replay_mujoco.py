@@ -4,6 +4,11 @@
     catflip run configs/seed.toml
     python examples/replay_mujoco.py output/seed/run
 
+or, with the catflip Python package installed (pip install ./python), from the
+config, designed in-process (the same files, so the same output):
+
+    python examples/replay_mujoco.py configs/seed.toml [--set KEY=VALUE]
+
 Loads output/<name>/run/<name>.mjcf.xml and each output/<name>/run/<method>.mujoco.csv
 as catflip wrote them, steps MuJoCo at the model's time step (the CSV's), and
 holds each row's torque over its step: once feed-forward only, once
@@ -25,7 +30,8 @@ import mujoco
 import numpy as np
 
 from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
-                           peak_of, quat_log, read_controls, reference, report, right_jacobian)
+                           peak_of, quat_log, read_controls, reference, report, right_jacobian,
+                           run_folder)
 
 
 def is_dc_motor(model):
@@ -36,6 +42,15 @@ def is_dc_motor(model):
 def replay(model, c, pd):
     """One replay; returns flip, tilt, final shape error and peak catflip-coordinate torque."""
     data = mujoco.MjData(model)
+    # the start: the MJCF's keyframe "start" (attitude and release velocities)
+    if model.nkey > 0:
+        mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+        check_start(model, data, c)
+    elif model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE and c["start_base_quat"].size:
+        # the URDF freed in memory has no keyframe: the controls' header gives the start
+        data.qpos[3:7] = c["start_base_quat"]
+        data.qvel[0:3] = c["start_base_linear_velocity"]
+        data.qvel[3:6] = c["start_base_angular_velocity"]
     mujoco.mj_forward(model, data)
     ball = model.jnt_type[1] == mujoco.mjtJoint.mjJNT_BALL
     dc = is_dc_motor(model)
@@ -44,7 +59,7 @@ def replay(model, c, pd):
                          "(ctrl_cmd = DC-motor command, ctrl_tau = torque)")
     qa, va = model.jnt_qposadr[1], model.jnt_dofadr[1]
     rear = model.body("rear").id
-    tracker = FlipTracker(data.xquat[rear].copy())
+    tracker = FlipTracker(data.xquat[rear].copy(), c["start_attitude"])
     pos, vel, ff = c["pick"]("qpos"), c["pick"]("qvel"), c["pick"]("ctrl")
     peak = 0.0
     # step index, its start time and feed-forward torque, for the control callback
@@ -63,6 +78,7 @@ def replay(model, c, pd):
         return run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff)
     finally:
         mujoco.set_mjcb_control(None)
+        model.opt.timestep = c["dt"]
 
 
 def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff):
@@ -103,18 +119,36 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
             tau_v = limit_catflip_torque(tau_v, qd, c)
             data.ctrl[:] = tau_v
         peak = max(peak, peak_of(tau_v, c["norm"]))
+        if k == c["steps"] - c["margin_steps"]:
+            model.opt.timestep = c["margin_dt"]
         mujoco.mj_step(model, data)
         tracker.push(data.xquat[rear])
+        if k == c["steps"] - c["margin_steps"] - 1:
+            # the flip and tilt at the end of the manoeuvre (catflip's); the landing at touchdown
+            flip, tilt = tracker.acc, tracker.tilt
     if ball:
         shape = np.linalg.norm(quat_log(data.qpos[qa:qa + 4]))
     else:
         shape = np.linalg.norm(data.qpos[qa:qa + 2])
     return {
-        "flip_deg": math.degrees(tracker.acc),
-        "tilt_deg": math.degrees(tracker.tilt),
+        "flip_deg": math.degrees(flip),
+        "tilt_deg": math.degrees(tilt),
+        "landing_deg": tracker.landing,
         "shape_error_rad": float(shape),
         "peak_nm": peak,
+        "spinning": bool(np.any(c["start_body_rate"] != 0)),
     }
+
+
+def check_start(model, data, c):
+    """The keyframe is the start the controls' header states."""
+    want = c["start_base_quat"]
+    got = data.qpos[3:7]
+    if want.size and min(np.abs(got - want).max(), np.abs(got + want).max()) > 1e-12:
+        raise SystemExit(f"the MJCF's start attitude {got} is not the controls' {want}")
+    w = c["start_base_angular_velocity"]
+    if np.abs(data.qvel[3:6] - w).max() > 1e-12:
+        raise SystemExit(f"the MJCF's start rate {data.qvel[3:6]} is not the controls' {w}")
 
 
 def check_urdf(out, name, model, controls, mjcf_flips):
@@ -161,7 +195,7 @@ def check_urdf(out, name, model, controls, mjcf_flips):
 
 def main():
     args = parse_args("MuJoCo", 1e-3)
-    out = pathlib.Path(args.output)
+    out = run_folder(args.output, args.overrides)
     summary = load_summary(out)
     name = summary["name"]
     model = mujoco.MjModel.from_xml_path(str(out / f"{name}.mjcf.xml"))

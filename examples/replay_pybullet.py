@@ -4,6 +4,11 @@
     catflip run configs/seed.toml
     python examples/replay_pybullet.py output/seed/run
 
+or, with the catflip Python package installed (pip install ./python), from the
+config, designed in-process (the same files, so the same output):
+
+    python examples/replay_pybullet.py configs/seed.toml [--set KEY=VALUE]
+
 Loads output/<name>/run/<name>.urdf with URDF_USE_INERTIA_FROM_FILE (without it
 pyBullet recomputes the inertias from the collision cylinders) and each
 output/<name>/run/<method>.pybullet.csv as catflip wrote them; sets the links'
@@ -26,8 +31,10 @@ import sys
 import numpy as np
 import pybullet as p
 
-from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
-                           peak_of, quat_log, read_controls, reference, report, right_jacobian)
+from replay_common import (FlipTracker, finish, landing_of, limit_catflip_torque, load_summary, parse_args,
+                           quat_conj, quat_mul,
+                           peak_of, quat_log, read_controls, reference, report, right_jacobian,
+                           run_folder)
 
 # pyBullet integrates with semi-implicit Euler: its flip error is first order in
 # the step (1 to 3 deg at catflip's 0.25 ms step on the seed and robot configs,
@@ -66,8 +73,14 @@ def replay(urdf, c, pd, substeps=1):
                                         physicsClientId=cid)
         # a universal joint with a torque-speed line: the clip depends on the speed
         dc = not ball and c["slope"] > 0
+        # the start from the controls' header: attitude and release velocities (world)
+        if c["start_base_quat"].size:
+            p.resetBasePositionAndOrientation(body, [0, 0, 10], list(c["start_base_quat"]),
+                                              physicsClientId=cid)
+            p.resetBaseVelocity(body, list(c["start_base_linear_velocity"]),
+                                list(c["start_base_angular_velocity"]), physicsClientId=cid)
         _, q0 = p.getBasePositionAndOrientation(body, physicsClientId=cid)
-        tracker = FlipTracker(xyzw_to_wxyz(q0))
+        tracker = FlipTracker(xyzw_to_wxyz(q0), c["start_attitude"])
         pos, vel, ff = c["pick"]("pos"), c["pick"]("vel"), c["pick"]("force")
         peak = 0.0
         for k in range(c["steps"]):
@@ -93,6 +106,9 @@ def replay(urdf, c, pd, substeps=1):
                 tau_v = limit_catflip_torque(tau_v, qd, c)
                 u = tau_v
             peak = max(peak, peak_of(tau_v, c["norm"]))
+            if k == c["steps"] - c["margin_steps"]:
+                p.setPhysicsEngineParameter(fixedTimeStep=c["margin_dt"] / substeps, numSubSteps=0,
+                                            physicsClientId=cid)
             for sub in range(substeps):
                 if dc and sub > 0:
                     # torque-speed line: catflip's controller at every pyBullet step, PD on the
@@ -115,16 +131,22 @@ def replay(urdf, c, pd, substeps=1):
                 p.stepSimulation(physicsClientId=cid)
                 _, qb = p.getBasePositionAndOrientation(body, physicsClientId=cid)
                 tracker.push(xyzw_to_wxyz(qb))
+            if k == c["steps"] - c["margin_steps"] - 1:
+                # the flip and tilt at the end of the manoeuvre (catflip's); the landing at touchdown
+                flip, tilt = tracker.acc, tracker.tilt
         if ball:
             st = p.getJointStateMultiDof(body, joints[0], physicsClientId=cid)
             shape = np.linalg.norm(quat_log(xyzw_to_wxyz(st[0])))
         else:
             shape = np.linalg.norm([s[0] for s in p.getJointStates(body, joints, physicsClientId=cid)])
         return {
-            "flip_deg": math.degrees(tracker.acc),
-            "tilt_deg": math.degrees(tracker.tilt),
+            "flip_deg": math.degrees(flip),
+            "tilt_deg": math.degrees(tilt),
+            "landing_deg": tracker.landing,
+            "attitude": tracker.r,
             "shape_error_rad": float(shape),
             "peak_nm": peak,
+            "spinning": bool(np.any(c["start_body_rate"] != 0)),
         }
     finally:
         p.disconnect(cid)
@@ -132,7 +154,7 @@ def replay(urdf, c, pd, substeps=1):
 
 def main():
     args = parse_args("pyBullet", PYBULLET_TOL_DEG)
-    out = pathlib.Path(args.output)
+    out = run_folder(args.output, args.overrides)
     summary = load_summary(out)
     urdf = out / f"{summary['name']}.urdf"
     # every method that produced a schedule (a failed one has none)
@@ -147,6 +169,9 @@ def main():
         # first-order integrator: error(dt) ~ 2 (flip(dt) - flip(dt/2)); remove it (Richardson)
         # (the peak torque too: 0.027 N m designs are off by 2.7 % at dt, 0.07 % extrapolated)
         extrapolated = dict(pd, flip_deg=2.0 * half["flip_deg"] - pd["flip_deg"],
+                            # the attitude extrapolated (the landing is not linear in its error)
+                            landing_deg=landing_of(quat_mul(half["attitude"], quat_mul(
+                                quat_conj(pd["attitude"]), half["attitude"]))),
                             peak_nm=2.0 * half["peak_nm"] - pd["peak_nm"])
         results += [(method, "pd", pd), (method, "pd/2", half), (method, "pd-x", extrapolated)]
     fails = report("pyBullet", summary, results, {"pd-x": args.tol_deg}, None)

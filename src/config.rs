@@ -11,6 +11,8 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 pub mod ranges;
+mod start;
+pub use start::{LandConfig, MAX_START_RATE, StartConfig};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -35,6 +37,10 @@ pub struct Config {
     /// (default: none, the cylinders of `[cat]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub body: Option<crate::import::BodyConfig>,
+    #[serde(default)]
+    pub start: StartConfig,
+    #[serde(default)]
+    pub land: LandConfig,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -565,6 +571,8 @@ impl Config {
             fr.attitude_tolerance > 0.0,
             "must be > 0 rad",
         )?;
+        self.start.validate()?;
+        self.land.validate()?;
         ranges::check_ranges(self)?;
         ranges::impossible(self)
     }
@@ -695,7 +703,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 29] = [
+pub const UNITS: [(&str, &str); 30] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -725,6 +733,7 @@ pub const UNITS: [(&str, &str); 29] = [
     ("free.max_iterations", "count"),
     ("free.tolerance", "relative"),
     ("free.attitude_tolerance", "rad"),
+    ("land.max_tilt_deg", "deg"),
 ];
 
 /// A config key with its unit, e.g. `fall.height (m)`.
@@ -833,6 +842,7 @@ gravity = 9.8
             "cat.front.mass=2",
             "cat.front.length=1",
             "cat.front.radius=0.1",
+            "land.max_tilt_deg=5",
         ];
         let c = Config::from_toml(SEED, "t", &optional.map(String::from)).unwrap();
         fn walk(prefix: &str, t: &toml::Table, out: &mut Vec<String>) {

@@ -13,6 +13,7 @@ pub mod design;
 pub mod error;
 pub mod export;
 pub mod import;
+pub mod interrupt;
 pub mod model;
 pub mod output;
 pub mod report;

@@ -39,7 +39,8 @@ pub enum Progress<'a> {
     Bend {
         evaluations: usize,
         bend_deg: f64,
-        peak_nm: f64,
+        /// Absent for an objective other than the peak.
+        peak_nm: Option<f64>,
     },
     Scp(&'a ScpIteration),
 }
@@ -72,6 +73,8 @@ pub struct MethodNumbers {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
+    pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     pub final_shape_error_rad: f64,
@@ -212,6 +215,7 @@ fn summarize(
         flip_deg: sim.flip_deg,
         flip_error_rad: sim.flip_error_rad,
         tilt_deg: sim.tilt_deg,
+        landing_error_deg: sim.landing_error_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         final_shape_error_rad: sim.final_shape_error_rad,
@@ -224,9 +228,10 @@ fn summarize(
     };
     let simulated = match sim_error {
         Some(e) => Simulated::Failed(e),
-        None => Simulated::Flip {
+        None => Simulated::Landing {
             flip_error_rad: n.flip_error_rad,
             tilt_deg: n.tilt_deg,
+            landing_error_deg: n.landing_error_deg,
         },
     };
     let v = judge(cfg, status, peak, bend, schedule, &simulated);
@@ -469,11 +474,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     };
     let free = match &free_impossible {
         Some(r) => Err(skipped(r)),
-        None => {
-            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-                progress(Progress::Scp(it))
-            })
-        }
+        None => crate::design::free::FreeDesign::new(cfg)
+            .from_plan(seed_plan, seed_name)
+            .on_iteration(&mut |it| progress(Progress::Scp(it)))
+            .solve(),
     };
     match &free {
         Ok(fr) => {

@@ -6,7 +6,7 @@
 use crate::config::Config;
 use crate::design::conic::SolveStatus;
 use crate::design::scp::ScpStatus;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// The tolerances of every judgement, in one place.
@@ -28,7 +28,7 @@ pub mod tolerance {
 }
 
 /// How a design's solver ended, for every method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Status {
     /// The analytic schedule: closed forms, nothing to converge.
@@ -124,6 +124,12 @@ pub struct Targets {
     pub max_bend_deg: Option<f64>,
     /// Largest flip error and spine tilt, rad.
     pub flip_tolerance: f64,
+    /// Largest landing error, deg, when the landing is judged (`land.max_tilt_deg`,
+    /// or any start other than today's: docs/model.md section 8), and the key that sets it.
+    pub landing_tolerance: Option<(f64, &'static str)>,
+    /// Whether the flip and tilt about the reference spine are judged: only
+    /// from today's start (from another the landing decides).
+    pub judge_flip: bool,
     /// The limit keys the config sets, for messages.
     pub envelope_keys: String,
 }
@@ -136,6 +142,15 @@ impl Targets {
             max_speed: cfg.limits.max_speed,
             max_bend_deg: cfg.limits.max_bend_deg,
             flip_tolerance: cfg.simulate.flip_tolerance,
+            landing_tolerance: match cfg.land.max_tilt_deg {
+                Some(t) => Some((t, "land.max_tilt_deg")),
+                None if !cfg.start.is_default() => Some((
+                    cfg.simulate.flip_tolerance.to_degrees(),
+                    "land.max_tilt_deg, by default simulate.flip_tolerance",
+                )),
+                None => None,
+            },
+            judge_flip: cfg.start.is_default(),
             envelope_keys: cfg.envelope_keys(),
         }
     }
@@ -169,6 +184,13 @@ pub struct DesignNumbers {
 pub enum Simulated {
     /// Flip error and spine tilt of the run.
     Flip { flip_error_rad: f64, tilt_deg: f64 },
+    /// Flip error, spine tilt and landing error (deg) of a run from the
+    /// configured start: the landing judged as [`Targets`] says.
+    Landing {
+        flip_error_rad: f64,
+        tilt_deg: f64,
+        landing_error_deg: f64,
+    },
     /// The simulation itself failed, for this reason.
     Failed(String),
 }
@@ -221,6 +243,13 @@ pub enum Miss {
         bend_deg: f64,
         limit: f64,
     },
+    /// The belly's angle from straight down at touchdown beyond the tolerance
+    /// (or NaN), deg, and the key that sets the tolerance.
+    Landing {
+        error_deg: f64,
+        tolerance_deg: f64,
+        key: &'static str,
+    },
 }
 
 impl Miss {
@@ -228,7 +257,7 @@ impl Miss {
     pub fn is_flip(&self) -> bool {
         matches!(
             self,
-            Miss::Simulation(_) | Miss::Flip { .. } | Miss::Tilt { .. }
+            Miss::Simulation(_) | Miss::Flip { .. } | Miss::Tilt { .. } | Miss::Landing { .. }
         )
     }
 
@@ -276,6 +305,14 @@ impl fmt::Display for Miss {
             Miss::Bend { bend_deg, limit } => write!(
                 f,
                 "bends {bend_deg:.2} deg, above limits.max_bend_deg = {limit} deg"
+            ),
+            Miss::Landing {
+                error_deg,
+                tolerance_deg,
+                key,
+            } => write!(
+                f,
+                "lands {error_deg:.3} deg from belly-down ({key} = {tolerance_deg:.4} deg)"
             ),
         }
     }
@@ -454,6 +491,30 @@ pub fn verdict(targets: &Targets, design: &DesignNumbers, simulation: &Simulated
             targets.flip_tolerance,
         ));
     }
+    if let Simulated::Landing {
+        flip_error_rad,
+        tilt_deg,
+        landing_error_deg,
+    } = simulation
+    {
+        if targets.judge_flip {
+            misses.extend(flip_misses(
+                *flip_error_rad,
+                *tilt_deg,
+                targets.flip_tolerance,
+            ));
+        }
+        // NaN compares false: a failed number is a miss
+        if let Some((tol, key)) = targets.landing_tolerance
+            && (landing_error_deg.is_nan() || *landing_error_deg > tol)
+        {
+            misses.push(Miss::Landing {
+                error_deg: *landing_error_deg,
+                tolerance_deg: tol,
+                key,
+            });
+        }
+    }
     misses.extend(limit_misses(targets, design));
     Verdict {
         status: design.status,
@@ -486,6 +547,8 @@ mod tests {
             max_speed: Some(10.0),
             max_bend_deg: Some(90.0),
             flip_tolerance: 0.01,
+            landing_tolerance: None,
+            judge_flip: true,
             envelope_keys: "limits.max_torque, limits.max_speed".into(),
         }
     }
@@ -660,5 +723,37 @@ mod tests {
         assert_eq!(v.reasons().len(), 1, "{:?}", v.reasons());
         assert!(v.reasons()[0].contains("above limits.max_torque"));
         assert!(!v.within_envelope());
+    }
+
+    /// From another start the landing is judged at its tolerance and the flip is not.
+    #[test]
+    fn the_landing_is_judged_from_another_start() {
+        let t = Targets {
+            landing_tolerance: Some((0.5, "land.max_tilt_deg")),
+            judge_flip: false,
+            ..targets()
+        };
+        let land = |e: f64| Simulated::Landing {
+            flip_error_rad: 1.0,
+            tilt_deg: 30.0,
+            landing_error_deg: e,
+        };
+        assert!(verdict(&t, &design(Status::Converged), &land(0.4999)).is_ok());
+        for e in [0.5001, f64::NAN] {
+            let v = verdict(&t, &design(Status::Converged), &land(e));
+            assert!(!v.flips(), "{e}");
+            assert!(
+                v.reason().unwrap().contains("land.max_tilt_deg"),
+                "{:?}",
+                v.reason()
+            );
+        }
+        // today's start: the flip decides, the landing only when a tolerance is set
+        let today = Targets {
+            judge_flip: true,
+            landing_tolerance: None,
+            ..targets()
+        };
+        assert!(!verdict(&today, &design(Status::Converged), &land(0.1)).flips());
     }
 }

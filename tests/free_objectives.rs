@@ -5,14 +5,17 @@ mod util;
 
 use catflip::Config;
 use catflip::design::envelope::{height_for, usage_of};
-use catflip::design::free::{FreeResult, optimize_from};
+use catflip::design::free::{FreeDesign, FreeResult};
 use util::seed;
 
 /// The free-form design seeded by the phased design of the same objective
 /// (the mesh check left out).
 fn free(cfg: &Config) -> FreeResult {
     let phased = catflip::design::phased::optimize(cfg, |_| {}).unwrap();
-    let r = optimize_from(cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+    let r = FreeDesign::new(cfg)
+        .from_plan(&phased.plan, "phased")
+        .solve()
+        .unwrap();
     assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
     r
 }
@@ -82,7 +85,10 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
             "limits.no_load_speed=8",
         ]);
         let phased = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let r = optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+        let r = FreeDesign::new(&cfg)
+            .from_plan(&phased.plan, "phased")
+            .solve()
+            .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
         let margin = usage_of(&cfg, &r.plan).min_margin.unwrap();
         assert!(margin >= -1e-6, "{objective}: margin {margin}");

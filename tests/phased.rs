@@ -119,7 +119,7 @@ fn optimum_never_exceeds_the_cosine_schedule_at_the_same_bend_and_split() {
             "{name}: {}",
             r.improvement_factor
         );
-        assert!(r.optimum_same_split_nm <= r.analytic_peak_same_bend_nm);
+        assert!(r.optimum_same_split_nm.unwrap() <= r.analytic_peak_same_bend_nm);
         assert!(
             r.flip_error_rad.abs() < 1e-5,
             "{name}: flip error {}",

@@ -6,7 +6,7 @@
 mod util;
 
 use catflip::Config;
-use catflip::design::free::{Seed, optimize as free_optimize};
+use catflip::design::free::{FreeDesign, Seed};
 use catflip::design::least_height;
 use catflip::design::phased::optimize;
 use catflip::model::dynamics::kinetic_energy;
@@ -102,8 +102,11 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
     // the free-form design of the seed
     let cfg = seed(&["free.nodes=24"]);
     let (fa, fb) = (
-        free_optimize(&cfg, Seed::Phased, |_| {}).unwrap(),
-        free_optimize(&as_tensors(&cfg), Seed::Phased, |_| {}).unwrap(),
+        FreeDesign::new(&cfg).seed(Seed::Phased).solve().unwrap(),
+        FreeDesign::new(&as_tensors(&cfg))
+            .seed(Seed::Phased)
+            .solve()
+            .unwrap(),
     );
     close(fa.peak_torque_nm, fb.peak_torque_nm, "free");
     close(fa.flip_deg, fb.flip_deg, "free");

@@ -88,7 +88,7 @@ pub struct Heights {
 pub fn heights(
     cfg: &Config,
     with_free: bool,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Option<Heights>> {
     let Some(mut answer) = self::answer(cfg)? else {
         return Ok(None);
@@ -112,10 +112,14 @@ pub fn heights(
     let analytic_plan = crate::design::analytic::analytic_plan(cfg);
     let (from_phased, from_analytic) = std::thread::scope(|s| {
         let analytic = s.spawn(|| {
-            free::optimize_from(&timed, &analytic_plan, "analytic", cfg.free.nodes, |_| {})
+            free::FreeDesign::new(&timed)
+                .from_plan(&analytic_plan, "analytic")
+                .solve()
         });
-        let phased =
-            free::optimize_from(&timed, &answer.schedule, "phased", cfg.free.nodes, observe);
+        let phased = free::FreeDesign::new(&timed)
+            .from_plan(&answer.schedule, "phased")
+            .on_iteration(&mut observe)
+            .solve();
         let analytic = analytic
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));

@@ -53,7 +53,7 @@ impl Simulator {
         }
     }
 
-    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::mjcf::dc_motor`]).
+    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::common::dc_motor`]).
     pub fn columns(self, joint: Joint, dc: bool) -> &'static str {
         match (self, joint) {
             (Simulator::Mujoco, Joint::NoTwist) => {
@@ -215,7 +215,7 @@ impl Controls {
         let b = plan.phase_bounds();
         let (dt, n) = time_step(b[3] - b[0], sim.target_step());
         // MuJoCo's DC-motor actuators take the command tau + k qd
-        let slope = match (sim, super::mjcf::dc_motor(cfg)) {
+        let slope = match (sim, super::common::dc_motor(cfg)) {
             (Simulator::Mujoco, Some(_)) => cfg.motor().slope(),
             _ => 0.0,
         };
@@ -283,7 +283,8 @@ impl Controls {
              # to be held for the step (zero-order hold, exact impulse). The last row is the final\n\
              # planned state (torque 0). Units: s, rad, rad/s, N m.\n{joint_note}\
              # dt_s = {dt:.15e}\n# steps = {n}\n# pd_kp = {kp:.15e}\n# pd_kd = {kd:.15e}\n\
-             # max_torque_nm = {lim}\n# motor_slope_nm_s = {slope:.15e}\n# peak_norm = {norm}\n{cols}\n",
+             # max_torque_nm = {lim}\n# motor_slope_nm_s = {slope:.15e}\n# peak_norm = {norm}\n{start}{cols}\n",
+            start = super::start::header_lines(cfg, self.simulator),
             sim = self.simulator.name(),
             name = cfg.name,
             joint = self.joint.name(),

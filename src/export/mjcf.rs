@@ -1,7 +1,7 @@
 //! The cat as an MJCF model for MuJoCo.
 
+use super::common::{Shape, dc_motor, f, shapes, torque_limit, v3};
 use super::controls::{Simulator, time_step};
-use super::{Shape, f, shapes, torque_limit, v3};
 use crate::config::Config;
 use crate::model::Joint;
 
@@ -81,7 +81,7 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         }
         s.push('.');
     }
-    if let Some(w) = super::speed_limit(cfg) {
+    if let Some(w) = super::common::speed_limit(cfg) {
         let why = if cfg.limits.max_speed.is_some() {
             "limits.max_speed"
         } else {
@@ -90,26 +90,6 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push_str(&format!("\n     Joint speed limit {w} rad/s ({why})."));
     }
     s
-}
-
-/// Attributes of a hinge's `<general>` actuator that is the linear DC motor
-/// `|tau + k qd| <= T` (universal joint with a torque-speed line): gain 1,
-/// affine bias `-k qd`, `ctrl` (the voltage in N m, `tau + k qd`) limited to
-/// `[-T, T]`. MuJoCo recomputes the bias at each RK4 stage, so a saturated
-/// motor follows `T - k qd` continuously as catflip's simulation does.
-/// `None` without a torque-speed line (a plain `<motor>` then says it all).
-pub(crate) fn dc_motor(cfg: &Config) -> Option<String> {
-    let m = cfg.motor();
-    let t = m.max_torque?;
-    if m.slope() == 0.0 || cfg.cat.joint != Joint::Universal {
-        return None;
-    }
-    Some(format!(
-        " gaintype=\"fixed\" gainprm=\"1\" biastype=\"affine\" biasprm=\"0 0 {nk}\" ctrllimited=\"true\" ctrlrange=\"{a} {b}\"",
-        nk = f(-m.slope()),
-        a = f(-t),
-        b = f(t)
-    ))
 }
 
 /// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.
@@ -153,6 +133,24 @@ pub fn mjcf(cfg: &Config) -> String {
             ),
         ),
     };
+    let start = super::start::base_start(cfg);
+    let (shape_pos, shape_vel) = match cfg.cat.joint {
+        Joint::Universal => ("0 0", "0 0"),
+        Joint::NoTwist => ("1 0 0 0", "0 0 0"),
+    };
+    let mut qpos: Vec<String> = [0.0, 0.0, cfg.fall.height]
+        .iter()
+        .chain(&start.quat)
+        .map(|x| f(*x))
+        .collect();
+    qpos.push(shape_pos.into());
+    let mut qvel: Vec<String> = start
+        .linear_velocity
+        .iter()
+        .chain(&start.angular_velocity_body)
+        .map(|x| f(*x))
+        .collect();
+    qvel.push(shape_vel.into());
     format!(
         r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in catflip's docs/model.md;
      SI units, angles in rad. Time step {dt:.9e} s = the manoeuvre time / an integer, the
@@ -160,8 +158,9 @@ pub fn mjcf(cfg: &Config) -> String {
 <mujoco model="{name}">
   <option gravity="0 0 -{g}" timestep="{dt:.15e}" integrator="RK4"/>
   <worldbody>
-    <!-- spine (the rear half's z axis) horizontal along world x; rotate about it to set the initial roll -->
-    <body name="rear" pos="0 0 {height}" euler="0 90 0">
+    <!-- the start (catflip's [start]): the rear half at W R0, spine along world x in the reference
+         pose, belly (its x) up; the keyframe "start" adds the release velocities -->
+    <body name="rear" pos="0 0 {height}" quat="{quat}">
       <freejoint name="fall"/>
 {rear_parts}      <body name="front" pos="{joint_at}">
 {joints}{front_parts}      </body>
@@ -169,8 +168,15 @@ pub fn mjcf(cfg: &Config) -> String {
   </worldbody>
   <actuator>
 {actuators}  </actuator>
+  <keyframe>
+    <!-- release: free joint at W R0 with A's velocity (world) and rate (A's frame), shape straight -->
+    <key name="start" qpos="{qpos}" qvel="{qvel}"/>
+  </keyframe>
 </mujoco>
 "#,
+        quat = start.quat.map(f).join(" "),
+        qpos = qpos.join(" "),
+        qvel = qvel.join(" "),
         name = cfg.name,
         joint = cfg.cat.joint.name(),
         g = f(cfg.fall.gravity),

@@ -1,7 +1,7 @@
 //! The cat as a URDF for pyBullet (the seed's simulator); the universal one
 //! also loads in MuJoCo.
 
-use super::{Shape, f, shapes, speed_limit, torque_limit, v3};
+use super::common::{Shape, f, shapes, speed_limit, torque_limit, v3};
 use crate::config::Config;
 use crate::model::Joint;
 

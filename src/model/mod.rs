@@ -19,6 +19,7 @@
 
 pub mod body;
 pub mod dynamics;
+pub mod momentum;
 pub mod motor;
 pub mod rigid;
 pub mod small;
@@ -253,12 +254,16 @@ impl Cat {
         self.locked_terms_of(&exp_so3(v), left_jacobian_columns(v))
     }
 
-    /// Locked terms for any joint with relative rotation `rel` and rate columns `sj`.
-    fn locked_terms_of<T: Real, const N: usize>(
-        &self,
-        rel: &M3<T>,
-        sj: [V3<T>; N],
-    ) -> ([[T; N]; N], [V3<T>; N]) {
+    /// Locked inertia `J(q)` and the columns of `K(q)` (A frame): the body-frame
+    /// angular momentum about the common centre of mass is `J w_A + K q_dot`.
+    pub fn locked_inertia<T: Real>(&self, q: [T; 2]) -> (M3<T>, [V3<T>; 2]) {
+        let (j, kt, _) = self.locked_parts_of(&self.rel_rotation(q));
+        let sj = self.rel_rate_jacobian(q);
+        (j, std::array::from_fn(|i| mat_vec(&kt, sj[i])))
+    }
+
+    /// `J`, `Kt` and `Nt` of the module doc for a relative rotation `rel`.
+    fn locked_parts_of<T: Real>(&self, rel: &M3<T>) -> (M3<T>, M3<T>, M3<T>) {
         let (s, d) = self.offsets(rel);
         let mu = c::<T>(self.reduced_mass());
         let h = self.halves();
@@ -281,6 +286,16 @@ impl Cat {
         let j = mat_add(&mat_add(&ic, &ib), &mat_scale(mu, &gram(d, d)));
         let kt = mat_add(&ib, &mat_scale(mu, &gram(d, s)));
         let nt = mat_add(&ib, &mat_scale(mu, &gram(s, s)));
+        (j, kt, nt)
+    }
+
+    /// Locked terms for any joint with relative rotation `rel` and rate columns `sj`.
+    fn locked_terms_of<T: Real, const N: usize>(
+        &self,
+        rel: &M3<T>,
+        sj: [V3<T>; N],
+    ) -> ([[T; N]; N], [V3<T>; N]) {
+        let (j, kt, nt) = self.locked_parts_of(rel);
         let k: [V3<T>; N] = std::array::from_fn(|i| mat_vec(&kt, sj[i]));
         let a: [V3<T>; N] = std::array::from_fn(|i| solve3(&j, k[i]));
         let mut m = [[T::zero(); N]; N];

@@ -10,9 +10,13 @@
 use crate::config::Config;
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::error::{Error, Result};
-use crate::model::dynamics::{angular_momentum, bias, solve2};
+use crate::model::dynamics::angular_momentum;
+use crate::model::momentum::{
+    Start, body_rate, body_rate_from, forward_dynamics_from, landing_error, rigid_turn,
+};
 use crate::model::motor::Motor;
-use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate};
+use crate::model::small::cross;
+use crate::model::so3::{FlipTracker, from_na, normalize_quat, quat_from, quat_rate, to_na};
 use crate::model::{Cat, ShapeTerms};
 use crate::verify::ode::{OdeSettings, OdeStatus, integrate};
 use serde::Serialize;
@@ -46,8 +50,18 @@ pub struct SimReport {
     pub final_rate_error_rad_s: f64,
     /// Largest `|q - q_plan|` along the way, rad (zero for kinematic runs).
     pub max_tracking_error_rad: f64,
-    /// Largest `|L|` recomputed from the bodies' velocities, N m s.
+    /// Largest `|L - L(0)|`, `L` recomputed from the bodies' velocities, N m s
+    /// (at zero momentum: the largest `|L|`).
     pub momentum_drift_nms: f64,
+    /// The belly's angle from straight down at touchdown, the straight cat
+    /// turning rigidly during `fall.margin` (MODEL.md section 6), degrees.
+    pub landing_error_deg: f64,
+    /// Body A's attitude `[w, x, y, z]` and body-frame momentum `R_A' L` (N m s)
+    /// at the end of the manoeuvre.
+    #[serde(skip)]
+    pub final_attitude: [f64; 4],
+    #[serde(skip)]
+    pub final_body_momentum: [f64; 3],
     /// Largest joint torque applied, N m (in the config's norm).
     pub peak_torque_nm: f64,
     pub steps: usize,
@@ -56,6 +70,18 @@ pub struct SimReport {
 }
 
 impl SimReport {
+    /// Sets the landing error for a landing `margin` seconds after the
+    /// manoeuvre, the straight cat turning rigidly meanwhile (F8).
+    pub fn land(&mut self, cat: &Cat, margin: f64) {
+        let r = to_na(&from_na(
+            quat_from(&self.final_attitude)
+                .to_rotation_matrix()
+                .matrix(),
+        ));
+        let r = rigid_turn(cat, &r, self.final_body_momentum, margin);
+        self.landing_error_deg = landing_error(&r).to_degrees();
+    }
+
     /// The report of a simulation that failed: every number NaN (null in JSON).
     pub fn failed() -> SimReport {
         SimReport {
@@ -66,6 +92,9 @@ impl SimReport {
             final_rate_error_rad_s: f64::NAN,
             max_tracking_error_rad: f64::NAN,
             momentum_drift_nms: f64::NAN,
+            landing_error_deg: f64::NAN,
+            final_attitude: [f64::NAN; 4],
+            final_body_momentum: [f64::NAN; 3],
             peak_torque_nm: f64::NAN,
             steps: 0,
             trace: Vec::new(),
@@ -143,6 +172,9 @@ fn finish(
         final_rate_error_rad_s: 0.0,
         max_tracking_error_rad: 0.0,
         momentum_drift_nms: 0.0,
+        landing_error_deg: f64::NAN,
+        final_attitude: [f64::NAN; 4],
+        final_body_momentum: [f64::NAN; 3],
         peak_torque_nm: 0.0,
         steps,
         trace,
@@ -152,6 +184,8 @@ fn finish(
 /// Records attitude, momentum and torque at every accepted step.
 struct Recorder<'a> {
     cat: &'a Cat,
+    /// The world momentum at release, N m s.
+    l0: [f64; 3],
     trace: Vec<TracePoint>,
     flip: FlipTracker,
     steps: usize,
@@ -159,9 +193,10 @@ struct Recorder<'a> {
 }
 
 impl<'a> Recorder<'a> {
-    fn new(cat: &'a Cat) -> Self {
+    fn new(cat: &'a Cat, start: &Start) -> Self {
         Self {
             cat,
+            l0: start.momentum(cat),
             trace: Vec::new(),
             flip: FlipTracker::default(),
             steps: 0,
@@ -169,17 +204,29 @@ impl<'a> Recorder<'a> {
         }
     }
 
-    /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from `q`, `qd`.
+    /// `quat` is body A's attitude `[w, x, y, z]`; the body rate follows from
+    /// `q`, `qd` and the body-frame momentum `lam`.
     /// False when the state is no longer finite (the motion diverged).
-    fn record(&mut self, t: f64, quat: &[f64], q: [f64; 2], qd: [f64; 2], tau: [f64; 2]) -> bool {
+    #[allow(clippy::too_many_arguments)]
+    fn record(
+        &mut self,
+        t: f64,
+        quat: &[f64],
+        q: [f64; 2],
+        qd: [f64; 2],
+        tau: [f64; 2],
+        lam: [f64; 3],
+        w: [f64; 3],
+    ) -> bool {
         self.steps += 1;
         let qa = quat_from(quat);
         let (flip, tilt) = self.flip.push(&qa);
         let ra = from_na(qa.to_rotation_matrix().matrix());
-        let l = angular_momentum(self.cat, &ra, self.cat.body_rate(q, qd), q, qd);
+        let l = angular_momentum(self.cat, &ra, w, q, qd);
+        let e = [0, 1, 2].map(|i| l[i] - self.l0[i]);
         self.drift = self
             .drift
-            .max((l[0] * l[0] + l[1] * l[1] + l[2] * l[2]).sqrt());
+            .max((e[0] * e[0] + e[1] * e[1] + e[2] * e[2]).sqrt());
         self.trace.push(TracePoint {
             t,
             flip,
@@ -192,19 +239,26 @@ impl<'a> Recorder<'a> {
             .chain(&q)
             .chain(&qd)
             .chain(&tau)
+            .chain(&lam)
             .all(|x| x.is_finite())
     }
 
+    /// `y` is the final state: attitude quaternion first, body-frame momentum last.
     fn finish(
         mut self,
-        quat: &[f64],
+        y: &[f64],
         status: OdeStatus,
         ode: &OdeSettings,
         limit: Option<f64>,
     ) -> Result<SimReport> {
-        let (flip, tilt) = self.flip.push(&quat_from(quat));
+        let (flip, tilt) = self.flip.push(&quat_from(y));
+        let cat = self.cat;
         let mut r = finish(flip, tilt, self.trace, self.steps, status, ode, limit)?;
         r.momentum_drift_nms = self.drift;
+        r.final_attitude = [y[0], y[1], y[2], y[3]];
+        let n = y.len();
+        r.final_body_momentum = [y[n - 3], y[n - 2], y[n - 1]];
+        r.land(cat, 0.0);
         Ok(r)
     }
 }
@@ -241,20 +295,49 @@ fn over_phases<const N: usize>(
     (y, OdeStatus::Done)
 }
 
-/// Attitude along a prescribed shape trajectory.
+/// Attitude along a prescribed shape trajectory, from rest upside down.
 pub fn kinematic(cat: &Cat, plan: &dyn ShapePlan, ode: &OdeSettings) -> Result<SimReport> {
-    let mut rec = Recorder::new(cat);
+    kinematic_from(cat, plan, &Start::default(), ode)
+}
+
+/// The state `[quaternion, lambda]` of an attitude-only run at release.
+fn attitude_state(cat: &Cat, start: &Start) -> [f64; 7] {
+    let (a, l) = (start.attitude, start.body_momentum(cat));
+    [a[0], a[1], a[2], a[3], l[0], l[1], l[2]]
+}
+
+/// Rate of the attitude and of the body-frame momentum (`lambda x w`).
+fn attitude_rate(y: &[f64], w: [f64; 3], lam: [f64; 3]) -> ([f64; 4], [f64; 3]) {
+    (quat_rate(y, w), cross(lam, w))
+}
+
+/// Attitude along a prescribed shape trajectory from `start`: the body
+/// rate `J^-1 lambda - A q_dot`, the body-frame momentum `lambda` turning as
+/// `lambda x w` (its world value `R_A lambda` is the conserved `L`).
+pub fn kinematic_from(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    start: &Start,
+    ode: &OdeSettings,
+) -> Result<SimReport> {
+    let mut rec = Recorder::new(cat, start);
+    let rate = |i: usize, t: f64, y: &[f64; 7]| {
+        let s = plan.state_in(i, t);
+        let lam = [y[4], y[5], y[6]];
+        (s, lam, body_rate(cat, s.q, s.qd, lam))
+    };
     let (y, status) = over_phases(
         plan,
-        [1.0, 0.0, 0.0, 0.0],
+        attitude_state(cat, start),
         ode,
         |i, t, y| {
-            let s = plan.state_in(i, t);
-            quat_rate(y, cat.body_rate(s.q, s.qd))
+            let (_, lam, w) = rate(i, t, y);
+            let (dq, dl) = attitude_rate(y, w, lam);
+            [dq[0], dq[1], dq[2], dq[3], dl[0], dl[1], dl[2]]
         },
         |i, t, y| {
-            let s = plan.state_in(i, t);
-            rec.record(t, y, s.q, s.qd, [0.0; 2])
+            let (s, lam, w) = rate(i, t, y);
+            rec.record(t, y, s.q, s.qd, [0.0; 2], lam, w)
         },
     );
     let mut r = rec.finish(&y, status, ode, None)?;
@@ -306,42 +389,74 @@ impl Controller {
     }
 }
 
-/// Full forward dynamics under feed-forward torque plus PD tracking of the plan.
+/// Full forward dynamics under feed-forward torque plus PD tracking of the
+/// plan, from rest upside down.
 pub fn dynamic(
     cat: &Cat,
     plan: &dyn ShapePlan,
     ctrl: &Controller,
     ode: &OdeSettings,
 ) -> Result<SimReport> {
+    dynamic_from(cat, plan, ctrl, ode, &Start::default())
+}
+
+/// Full forward dynamics from `start`: state `[quaternion, q, q_dot, lambda]`.
+pub fn dynamic_from(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    ctrl: &Controller,
+    ode: &OdeSettings,
+    start: &Start,
+) -> Result<SimReport> {
     let s0 = plan.state(plan.phase_bounds()[0]);
-    let applied = |i: usize, t: f64, y: &[f64; 8]| {
+    let a0 = attitude_state(cat, start);
+    let y0 = [
+        a0[0], a0[1], a0[2], a0[3], s0.q[0], s0.q[1], s0.qd[0], s0.qd[1], a0[4], a0[5], a0[6],
+    ];
+    Ok(dynamic_state(cat, plan, ctrl, ode, start, y0)?.0)
+}
+
+/// [`dynamic_from`] from the state `y0` = `[quaternion, q, q_dot, lambda]`;
+/// also returns the final state.
+fn dynamic_state(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    ctrl: &Controller,
+    ode: &OdeSettings,
+    start: &Start,
+    y0: [f64; 11],
+) -> Result<(SimReport, [f64; 11])> {
+    let applied = |i: usize, t: f64, y: &[f64; 11]| {
         let s = plan.state_in(i, t);
         let ff = plan.torque_in(cat, i, t);
         (ctrl.apply(ff, [y[4], y[5]], [y[6], y[7]], s.q, s.qd), s.q)
     };
-    let mut rec = Recorder::new(cat);
+    let mut rec = Recorder::new(cat, start);
     let (mut peak, mut track) = (0.0f64, 0.0f64);
     let (y, status) = over_phases(
         plan,
-        [1.0, 0.0, 0.0, 0.0, s0.q[0], s0.q[1], s0.qd[0], s0.qd[1]],
+        y0,
         ode,
         |i, t, y| {
             let (tau, _) = applied(i, t, y);
-            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            let (q, qd, lam) = ([y[4], y[5]], [y[6], y[7]], [y[8], y[9], y[10]]);
             let terms = ShapeTerms::first(cat, q);
-            let h = bias(&terms, qd);
-            let qdd = solve2(&terms.m, [tau[0] - h[0], tau[1] - h[1]]);
-            let dq = quat_rate(y, terms.body_rate(qd));
-            [dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1]]
+            let qdd = forward_dynamics_from(cat, &terms, q, qd, tau, lam);
+            let w = body_rate_from(cat, &terms, q, qd, lam);
+            let (dq, dl) = attitude_rate(y, w, lam);
+            [
+                dq[0], dq[1], dq[2], dq[3], qd[0], qd[1], qdd[0], qdd[1], dl[0], dl[1], dl[2],
+            ]
         },
         |i, t, y| {
             let (tau, qref) = applied(i, t, y);
-            let (q, qd) = ([y[4], y[5]], [y[6], y[7]]);
+            let (q, qd, lam) = ([y[4], y[5]], [y[6], y[7]], [y[8], y[9], y[10]]);
             peak = peak.max(ctrl.motor.norm.of(tau));
             let off = (q[0] - qref[0]).hypot(q[1] - qref[1]);
             track = track.max(off);
+            let w = body_rate_from(cat, &ShapeTerms::first(cat, q), q, qd, lam);
             // a shape a full turn away from the plan has left the schedule
-            rec.record(t, y, q, qd, tau) && off <= MAX_TRACKING_ERROR
+            rec.record(t, y, q, qd, tau, lam, w) && off <= MAX_TRACKING_ERROR
         },
     );
     let mut r = rec.finish(&y, status, ode, ctrl.motor.max_torque)?;
@@ -349,21 +464,76 @@ pub fn dynamic(
     r.max_tracking_error_rad = track;
     r.final_shape_error_rad = y[4].hypot(y[5]);
     r.final_rate_error_rad_s = y[6].hypot(y[7]);
+    Ok((r, y))
+}
+
+/// A shape held straight for a while: the plan of the landing margin.
+struct Straight(f64);
+
+impl ShapePlan for Straight {
+    fn phase_bounds(&self) -> Vec<f64> {
+        vec![0.0, self.0 / 3.0, 2.0 * self.0 / 3.0, self.0]
+    }
+    fn state_in(&self, _: usize, _: f64) -> crate::design::plan::ShapeState {
+        crate::design::plan::ShapeState {
+            q: [0.0; 2],
+            qd: [0.0; 2],
+            qdd: [0.0; 2],
+            phase: crate::design::plan::Phase::Unfold,
+        }
+    }
+}
+
+/// [`dynamic_from`], then the landing margin with the controller holding the
+/// shape straight (no feed-forward), as the motors would: the landing error is
+/// the attitude's at touchdown. The report's other numbers are the manoeuvre's.
+pub fn dynamic_landing(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    ctrl: &Controller,
+    ode: &OdeSettings,
+    start: &Start,
+    margin: f64,
+) -> Result<SimReport> {
+    let s0 = plan.state(plan.phase_bounds()[0]);
+    let a0 = attitude_state(cat, start);
+    let y0 = [
+        a0[0], a0[1], a0[2], a0[3], s0.q[0], s0.q[1], s0.qd[0], s0.qd[1], a0[4], a0[5], a0[6],
+    ];
+    let (mut r, y) = dynamic_state(cat, plan, ctrl, ode, start, y0)?;
+    if margin > 0.0 {
+        let (held, _) = dynamic_state(cat, &Straight(margin), ctrl, ode, start, y)?;
+        r.momentum_drift_nms = r.momentum_drift_nms.max(held.momentum_drift_nms);
+        let m = to_na(&from_na(
+            quat_from(&held.final_attitude)
+                .to_rotation_matrix()
+                .matrix(),
+        ));
+        r.landing_error_deg = landing_error(&m).to_degrees();
+    }
     Ok(r)
 }
 
-/// Kinematic run with the config's tolerances.
+/// Kinematic run from the config's start with its tolerances; the landing
+/// error after its `fall.margin`.
 pub fn kinematic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    kinematic(&cfg.cat(), plan, &settings(cfg))
+    let cat = cfg.cat();
+    let mut r = kinematic_from(&cat, plan, &cfg.start.start(), &settings(cfg))?;
+    r.land(&cat, cfg.fall.margin);
+    Ok(r)
 }
 
-/// Dynamic run with the config's tolerances, gains and limits.
+/// Dynamic run from the config's start with its tolerances, gains and
+/// limits; the landing error after its `fall.margin`, the motors holding the
+/// shape straight meanwhile ([`dynamic_landing`]).
 pub fn dynamic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    dynamic(
+    dynamic_landing(
         &cfg.cat(),
         plan,
         &Controller::from_config(cfg),
         &settings(cfg),
+        &cfg.start.start(),
+        cfg.fall.margin,
     )
 }
 
@@ -388,6 +558,16 @@ pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule>
         });
     }
     let s = Schedule::from_csv(text, origin)?;
+    if s.rows.len() > MAX_SCHEDULE_ROWS {
+        return Err(Error::Schedule {
+            file: origin.into(),
+            line: 1,
+            message: format!(
+                "{} rows, more than the {MAX_SCHEDULE_ROWS} a schedule may have; resample it more coarsely",
+                s.rows.len()
+            ),
+        });
+    }
     let b = s.phase_bounds();
     let (start, end) = (b[0], b[3]);
     let want = cfg.available_time();
