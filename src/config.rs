@@ -10,7 +10,9 @@ use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+mod control;
 mod start;
+pub use control::{ControlConfig, MAX_TRIALS, RobustnessConfig};
 pub use start::{LandConfig, MAX_START_RATE, StartConfig};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -36,6 +38,10 @@ pub struct Config {
     pub start: StartConfig,
     #[serde(default)]
     pub land: LandConfig,
+    #[serde(default)]
+    pub control: ControlConfig,
+    #[serde(default)]
+    pub robustness: RobustnessConfig,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -549,6 +555,8 @@ impl Config {
         )?;
         self.start.validate()?;
         self.land.validate()?;
+        self.control.validate()?;
+        self.robustness.validate()?;
         Ok(())
     }
 
