@@ -6,6 +6,7 @@
 //! 4 impossible: the motors cannot flip the cat from the configured height
 //! (the least drop height and its schedule are written).
 mod cli;
+mod robustness;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {

@@ -4,7 +4,9 @@
 //! the Monte Carlo study of `catflip robustness` ([`robustness`]).
 
 pub mod closed_loop;
+pub mod figure;
 pub mod plant;
 pub mod reference;
+pub mod robustness;
 pub mod rng;
 pub mod tvlqr;
