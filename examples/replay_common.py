@@ -25,12 +25,33 @@ def read_controls(path):
         elif line.strip():
             rows.append([float(x) for x in line.split(",")])
     data = np.array(rows)
+    vec = lambda key, default: np.array([float(x) for x in meta[key].split()]) if key in meta \
+        else np.array(default, float)
+    dt = float(meta["dt_s"])
+    # the landing margin: the replay goes on with the shape held straight (last row, at rest,
+    # no feed-forward) until touchdown
+    margin = float(meta.get("margin_s", "0"))
+    extra = int(round(margin / dt))
+    if extra > 0:
+        last = data[-1].copy()
+        for i, c in enumerate(cols):
+            if c.startswith(("qvel", "vel", "ctrl", "force")):
+                last[i] = 0.0
+        tail = np.tile(last, (extra, 1))
+        tail[:, 0] = data[-1, 0] + dt * np.arange(1, extra + 1)
+        data = np.vstack([data, tail])
     pick = lambda prefix: data[:, [i for i, c in enumerate(cols) if c.startswith(prefix)]]
     limit = None if meta["max_torque_nm"] == "none" else float(meta["max_torque_nm"])
     return {
+        "start_attitude": vec("start_attitude_wxyz", [1, 0, 0, 0]),
+        "start_body_rate": vec("start_body_rate_rad_s", [0, 0, 0]),
+        "start_base_quat": vec("start_base_quat", []),
+        "start_base_linear_velocity": vec("start_base_linear_velocity", [0, 0, 0]),
+        "start_base_angular_velocity": vec("start_base_angular_velocity", [0, 0, 0]),
+        "margin_steps": extra,
         "slope": float(meta.get("motor_slope_nm_s", "0")),
-        "dt": float(meta["dt_s"]),
-        "steps": int(meta["steps"]),
+        "dt": dt,
+        "steps": int(meta["steps"]) + extra,
         "kp": float(meta["pd_kp"]),
         "kd": float(meta["pd_kd"]),
         "limit": limit,
@@ -92,18 +113,27 @@ def wrap(a):
 
 class FlipTracker:
     """catflip's one flip convention (src/model/so3.rs FlipTracker): rotation
-    about the rear half's initial z axis (the spine), right-handed, from the
-    swing-twist split of the attitude relative to the start, unwrapped along
-    the run. Tilt: angle between the final and the initial spine."""
+    about the reference spine (catflip's world z), right-handed, from the
+    swing-twist split of the rear half's attitude in catflip's world, unwrapped
+    along the run. Tilt: angle between the spine and the reference spine.
+    `q0` is the simulator's attitude at release and `start` the release attitude
+    in catflip's world (R0), so that the attitude in catflip's world is
+    `R0 q0^-1 q`. Landing error: the belly's (rear x) angle from straight down
+    (catflip's -x), docs/model.md section 8."""
 
-    def __init__(self, q0):
-        self.q0 = np.asarray(q0, float)
+    def __init__(self, q0, start=(1.0, 0.0, 0.0, 0.0)):
+        self.q0 = quat_mul(np.asarray(q0, float), quat_conj(np.asarray(start, float)))
         self.last = 0.0
         self.acc = 0.0
         self.tilt = 0.0
+        self.landing = float("nan")
+        self.push(q0)
 
     def push(self, q):
         r = quat_mul(quat_conj(self.q0), np.asarray(q, float))
+        w, x, y, z = r
+        belly = (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
+        self.landing = math.degrees(math.atan2(math.hypot(belly[1], belly[2]), -belly[0]))
         f = 2.0 * math.atan2(r[3], r[0])
         self.acc += wrap(f - self.last)
         self.last = f
@@ -176,13 +206,19 @@ def report(engine, summary, results, flip_tol, ff_tol):
     feed-forward-only flip of optimised, unsaturated schedules."""
     print(f"{engine} replay of {summary['name']} ({summary['joint']} joint); flip in catflip's convention")
     print(f"  {'method':<9} {'mode':<5} {'flip deg':>16} {'catflip deg':>16} {'diff deg':>10} {'tilt deg':>10} "
+          f"{'landing deg':>12} {'catflip deg':>12} {'diff deg':>10} "
           f"{'shape err rad':>13} {'peak N m':>10} {'catflip N m':>11}")
     fails = []
     for name, mode, r in results:
         m = next(x for x in summary["methods"] if x["method"] == name)
         diff = r["flip_deg"] - m["flip_deg"]
+        land = m.get("landing_error_deg", float("nan"))
+        ldiff = r["landing_deg"] - land
         print(f"  {name:<9} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
-              f"{r['tilt_deg']:10.2e} {r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+              f"{r['tilt_deg']:10.2e} {r['landing_deg']:12.6f} {land:12.6f} {ldiff:10.2e} "
+              f"{r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+        if mode in flip_tol and not abs(ldiff) <= flip_tol[mode]:
+            fails.append(f"{name}: {mode} replay lands {ldiff:.3e} deg from catflip's landing (> {flip_tol[mode]:g})")
         # a schedule that asks more than the motors give (a peak over the stall torque, or
         # outside the torque-speed envelope) runs saturated: open loop it drifts
         saturating = (summary.get("max_torque_nm") is not None
@@ -198,8 +234,10 @@ def report(engine, summary, results, flip_tol, ff_tol):
             if not saturating and r["shape_error_rad"] > 1e-3:
                 fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight")
         elif mode == "ff" and ff_tol is not None and name != "analytic" and not saturating \
-                and abs(diff) > ff_tol:
+                and not r.get("spinning") and abs(diff) > ff_tol:
             fails.append(f"{name}: feed-forward replay flip differs by {diff:.3e} deg (> {ff_tol:g})")
+    print("  landing = the belly's angle from straight down at touchdown (after fall.margin); a spinning\n"
+          "  start's feed-forward-only replay is not checked (a zero-momentum schedule drifts open loop).")
     print("  modes: ff = feed-forward only, pd = feed-forward + catflip's PD. catflip = summary.json: its own\n"
           "  simulation (feed-forward + PD, the config's torque limit); a saturating schedule is compared\n"
           "  with that saturated simulation.")

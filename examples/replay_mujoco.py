@@ -36,6 +36,15 @@ def is_dc_motor(model):
 def replay(model, c, pd):
     """One replay; returns flip, tilt, final shape error and peak catflip-coordinate torque."""
     data = mujoco.MjData(model)
+    # the start: the MJCF's keyframe "start" (attitude and release velocities)
+    if model.nkey > 0:
+        mujoco.mj_resetDataKeyframe(model, data, model.key("start").id)
+        check_start(model, data, c)
+    elif model.jnt_type[0] == mujoco.mjtJoint.mjJNT_FREE and c["start_base_quat"].size:
+        # the URDF freed in memory has no keyframe: the controls' header gives the start
+        data.qpos[3:7] = c["start_base_quat"]
+        data.qvel[0:3] = c["start_base_linear_velocity"]
+        data.qvel[3:6] = c["start_base_angular_velocity"]
     mujoco.mj_forward(model, data)
     ball = model.jnt_type[1] == mujoco.mjtJoint.mjJNT_BALL
     dc = is_dc_motor(model)
@@ -44,7 +53,7 @@ def replay(model, c, pd):
                          "(ctrl_cmd = DC-motor command, ctrl_tau = torque)")
     qa, va = model.jnt_qposadr[1], model.jnt_dofadr[1]
     rear = model.body("rear").id
-    tracker = FlipTracker(data.xquat[rear].copy())
+    tracker = FlipTracker(data.xquat[rear].copy(), c["start_attitude"])
     pos, vel, ff = c["pick"]("qpos"), c["pick"]("qvel"), c["pick"]("ctrl")
     peak = 0.0
     # step index, its start time and feed-forward torque, for the control callback
@@ -105,16 +114,32 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
         peak = max(peak, peak_of(tau_v, c["norm"]))
         mujoco.mj_step(model, data)
         tracker.push(data.xquat[rear])
+        if k == c["steps"] - c["margin_steps"] - 1:
+            # the flip and tilt at the end of the manoeuvre (catflip's); the landing at touchdown
+            flip, tilt = tracker.acc, tracker.tilt
     if ball:
         shape = np.linalg.norm(quat_log(data.qpos[qa:qa + 4]))
     else:
         shape = np.linalg.norm(data.qpos[qa:qa + 2])
     return {
-        "flip_deg": math.degrees(tracker.acc),
-        "tilt_deg": math.degrees(tracker.tilt),
+        "flip_deg": math.degrees(flip),
+        "tilt_deg": math.degrees(tilt),
+        "landing_deg": tracker.landing,
         "shape_error_rad": float(shape),
         "peak_nm": peak,
+        "spinning": bool(np.any(c["start_body_rate"] != 0)),
     }
+
+
+def check_start(model, data, c):
+    """The keyframe is the start the controls' header states."""
+    want = c["start_base_quat"]
+    got = data.qpos[3:7]
+    if want.size and min(np.abs(got - want).max(), np.abs(got + want).max()) > 1e-12:
+        raise SystemExit(f"the MJCF's start attitude {got} is not the controls' {want}")
+    w = c["start_base_angular_velocity"]
+    if np.abs(data.qvel[3:6] - w).max() > 1e-12:
+        raise SystemExit(f"the MJCF's start rate {data.qvel[3:6]} is not the controls' {w}")
 
 
 def check_urdf(out, name, model, controls, mjcf_flips):

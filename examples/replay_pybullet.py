@@ -66,8 +66,14 @@ def replay(urdf, c, pd, substeps=1):
                                         physicsClientId=cid)
         # a universal joint with a torque-speed line: the clip depends on the speed
         dc = not ball and c["slope"] > 0
+        # the start from the controls' header: attitude and release velocities (world)
+        if c["start_base_quat"].size:
+            p.resetBasePositionAndOrientation(body, [0, 0, 10], list(c["start_base_quat"]),
+                                              physicsClientId=cid)
+            p.resetBaseVelocity(body, list(c["start_base_linear_velocity"]),
+                                list(c["start_base_angular_velocity"]), physicsClientId=cid)
         _, q0 = p.getBasePositionAndOrientation(body, physicsClientId=cid)
-        tracker = FlipTracker(xyzw_to_wxyz(q0))
+        tracker = FlipTracker(xyzw_to_wxyz(q0), c["start_attitude"])
         pos, vel, ff = c["pick"]("pos"), c["pick"]("vel"), c["pick"]("force")
         peak = 0.0
         for k in range(c["steps"]):
@@ -115,16 +121,21 @@ def replay(urdf, c, pd, substeps=1):
                 p.stepSimulation(physicsClientId=cid)
                 _, qb = p.getBasePositionAndOrientation(body, physicsClientId=cid)
                 tracker.push(xyzw_to_wxyz(qb))
+            if k == c["steps"] - c["margin_steps"] - 1:
+                # the flip and tilt at the end of the manoeuvre (catflip's); the landing at touchdown
+                flip, tilt = tracker.acc, tracker.tilt
         if ball:
             st = p.getJointStateMultiDof(body, joints[0], physicsClientId=cid)
             shape = np.linalg.norm(quat_log(xyzw_to_wxyz(st[0])))
         else:
             shape = np.linalg.norm([s[0] for s in p.getJointStates(body, joints, physicsClientId=cid)])
         return {
-            "flip_deg": math.degrees(tracker.acc),
-            "tilt_deg": math.degrees(tracker.tilt),
+            "flip_deg": math.degrees(flip),
+            "tilt_deg": math.degrees(tilt),
+            "landing_deg": tracker.landing,
             "shape_error_rad": float(shape),
             "peak_nm": peak,
+            "spinning": bool(np.any(c["start_body_rate"] != 0)),
         }
     finally:
         p.disconnect(cid)
@@ -147,6 +158,7 @@ def main():
         # first-order integrator: error(dt) ~ 2 (flip(dt) - flip(dt/2)); remove it (Richardson)
         # (the peak torque too: 0.027 N m designs are off by 2.7 % at dt, 0.07 % extrapolated)
         extrapolated = dict(pd, flip_deg=2.0 * half["flip_deg"] - pd["flip_deg"],
+                            landing_deg=2.0 * half["landing_deg"] - pd["landing_deg"],
                             peak_nm=2.0 * half["peak_nm"] - pd["peak_nm"])
         results += [(method, "pd", pd), (method, "pd/2", half), (method, "pd-x", extrapolated)]
     fails = report("pyBullet", summary, results, {"pd-x": args.tol_deg}, None)

@@ -101,3 +101,59 @@ impl LandConfig {
 fn norm(v: [f64; 3]) -> f64 {
     (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::Config;
+
+    const SEED: &str =
+        "name = \"s\"\n[cat]\nmass = 1.0\nlength = 1.0\nradius = 0.1\n[fall]\nheight = 10.0\n";
+
+    #[test]
+    fn out_of_range_starts_are_refused_with_the_key_and_range() {
+        for (set, key, range) in [
+            (
+                "start.rotation_deg=[0, 190, 0]",
+                "start.rotation_deg",
+                "at most 180",
+            ),
+            (
+                "start.rotation_deg=[nan, 0, 0]",
+                "start.rotation_deg[0]",
+                "finite",
+            ),
+            (
+                "start.angular_velocity=[0, 0, 60]",
+                "start.angular_velocity",
+                "at most 50",
+            ),
+            (
+                "start.angular_velocity=[0, inf, 0]",
+                "start.angular_velocity[1]",
+                "finite",
+            ),
+            ("land.max_tilt_deg=0", "land.max_tilt_deg", "(0, 90]"),
+            ("land.max_tilt_deg=91", "land.max_tilt_deg", "(0, 90]"),
+            ("start.rotation_deg=[0, 1]", "rotation_deg", "3"),
+            ("start.spin=1", "spin", "unknown"),
+        ] {
+            let e = Config::from_toml(SEED, "t", &[set.into()])
+                .expect_err(set)
+                .to_string();
+            assert!(e.contains(key) && e.contains(range), "{set}: {e}");
+        }
+        let ok = Config::from_toml(
+            SEED,
+            "t",
+            &[
+                "start.rotation_deg=[0, 180, 0]".into(),
+                "start.angular_velocity=[0, 0, 50]".into(),
+                "land.max_tilt_deg=90".into(),
+            ],
+        )
+        .unwrap();
+        assert!(!ok.start.is_default());
+        let d = Config::from_toml(SEED, "t", &[]).unwrap();
+        assert!(d.start.is_default() && d.land.max_tilt_deg.is_none());
+    }
+}

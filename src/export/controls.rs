@@ -283,7 +283,8 @@ impl Controls {
              # to be held for the step (zero-order hold, exact impulse). The last row is the final\n\
              # planned state (torque 0). Units: s, rad, rad/s, N m.\n{joint_note}\
              # dt_s = {dt:.15e}\n# steps = {n}\n# pd_kp = {kp:.15e}\n# pd_kd = {kd:.15e}\n\
-             # max_torque_nm = {lim}\n# motor_slope_nm_s = {slope:.15e}\n# peak_norm = {norm}\n{cols}\n",
+             # max_torque_nm = {lim}\n# motor_slope_nm_s = {slope:.15e}\n# peak_norm = {norm}\n{start}{cols}\n",
+            start = super::start::header_lines(cfg, self.simulator),
             sim = self.simulator.name(),
             name = cfg.name,
             joint = self.joint.name(),

@@ -111,6 +111,24 @@ pub fn mjcf(cfg: &Config) -> String {
             ),
         ),
     };
+    let start = super::start::base_start(cfg);
+    let (shape_pos, shape_vel) = match cfg.cat.joint {
+        Joint::Universal => ("0 0", "0 0"),
+        Joint::NoTwist => ("1 0 0 0", "0 0 0"),
+    };
+    let mut qpos: Vec<String> = [0.0, 0.0, cfg.fall.height]
+        .iter()
+        .chain(&start.quat)
+        .map(|x| f(*x))
+        .collect();
+    qpos.push(shape_pos.into());
+    let mut qvel: Vec<String> = start
+        .linear_velocity
+        .iter()
+        .chain(&start.angular_velocity_body)
+        .map(|x| f(*x))
+        .collect();
+    qvel.push(shape_vel.into());
     format!(
         r#"<!-- catflip: {name} ({joint} joint). Masses and inertias as in catflip's docs/model.md;
      SI units, angles in rad. Time step {dt:.9e} s = the manoeuvre time / an integer, the
@@ -118,8 +136,9 @@ pub fn mjcf(cfg: &Config) -> String {
 <mujoco model="{name}">
   <option gravity="0 0 -{g}" timestep="{dt:.15e}" integrator="RK4"/>
   <worldbody>
-    <!-- spine (the rear half's z axis) horizontal along world x; rotate about it to set the initial roll -->
-    <body name="rear" pos="0 0 {height}" euler="0 90 0">
+    <!-- the start (catflip's [start]): the rear half at W R0, spine along world x in the reference
+         pose, belly (its x) up; the keyframe "start" adds the release velocities -->
+    <body name="rear" pos="0 0 {height}" quat="{quat}">
       <freejoint name="fall"/>
 {rear_parts}      <body name="front" pos="0 0 {joint_z}">
 {joints}{front_parts}      </body>
@@ -127,8 +146,15 @@ pub fn mjcf(cfg: &Config) -> String {
   </worldbody>
   <actuator>
 {actuators}  </actuator>
+  <keyframe>
+    <!-- release: free joint at W R0 with A's velocity (world) and rate (A's frame), shape straight -->
+    <key name="start" qpos="{qpos}" qvel="{qvel}"/>
+  </keyframe>
 </mujoco>
 "#,
+        quat = start.quat.map(f).join(" "),
+        qpos = qpos.join(" "),
+        qvel = qvel.join(" "),
         name = cfg.name,
         joint = cfg.cat.joint.name(),
         g = f(cfg.fall.gravity),

@@ -12,6 +12,7 @@
 
 pub mod controls;
 pub mod mjcf;
+pub mod start;
 pub mod urdf;
 
 pub use mjcf::mjcf;
