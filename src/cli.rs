@@ -1067,6 +1067,11 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
             format!("{stem}.{}.csv", sim.name()),
             controls.to_csv(&cfg, &stem),
         );
+        // the closed loop's gains along the same schedule (issue 27)
+        out.add(
+            format!("{stem}.tvlqr.csv"),
+            catflip::control::export::gains_csv(&cfg, &s),
+        );
     }
     for w in publisher.publish(out)? {
         say!("wrote {}", w.display());

@@ -163,3 +163,56 @@ fn a_small_start_error_shrinks_as_the_linearisation_predicts() {
         );
     }
 }
+
+/// The study is deterministic for a seed, the same on any number of
+/// threads, and its shards' CSVs concatenate into the whole study's.
+#[test]
+fn the_study_is_deterministic_and_its_shards_concatenate() {
+    use catflip::control::robustness::{Study, shard_range, to_csv};
+    let (cfg, r, _) = design();
+    let _ = r;
+    let plan = catflip::design::free::optimize(cfg, catflip::design::free::Seed::Phased, |_| {})
+        .unwrap()
+        .plan;
+    let study = Study::new(cfg, &plan, 7);
+    let n = 6;
+    let whole = to_csv(&study.run(0..n, 2, |_, _| {}), true);
+    let again = to_csv(&study.run(0..n, 1, |_, _| {}), true);
+    assert_eq!(whole, again);
+    let shards: String = (1..=4)
+        .map(|k| {
+            let range = shard_range(n, k, 4);
+            let first = range.start == 0;
+            to_csv(&study.run(range, 1, |_, _| {}), first)
+        })
+        .collect();
+    assert_eq!(whole, shards);
+    // another seed draws other trials
+    let other = Study::new(cfg, &plan, 8);
+    assert_ne!(whole, to_csv(&other.run(0..n, 2, |_, _| {}), true));
+}
+
+/// Bad input is refused with the key, the value and the range; nothing is written.
+#[test]
+fn bad_input_is_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, key) in [
+        (vec!["--set", "control.delay_ms=-1"], "control.delay_ms"),
+        (vec!["--set", "robustness.delay_ms=-5"], "robustness.delay_ms"),
+        (vec!["--set", "control.rate_hz=5000"], "control.rate_hz"),
+        (vec!["--set", "robustness.mass_error=1.0"], "robustness.mass_error"),
+        (vec!["--trials", "1000001"], "--trials"),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_catflip"))
+            .args(["robustness", "configs/seed.toml", "--out"])
+            .arg(dir.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(key), "{args:?}: {err}");
+        assert!(err.contains("must be in"), "{args:?}: {err}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{args:?} wrote files");
+    }
+}

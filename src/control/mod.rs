@@ -4,6 +4,7 @@
 //! the Monte Carlo study of `catflip robustness` ([`robustness`]).
 
 pub mod closed_loop;
+pub mod export;
 pub mod figure;
 pub mod plant;
 pub mod reference;
