@@ -38,7 +38,12 @@ pub fn cmd_robustness(
     });
     let suffix = shard.suffix();
     let publisher = publisher(c, &cfg, &format!("robustness{suffix}"))?;
-    let design = catflip::design::free::optimize(&cfg, catflip::design::free::Seed::Phased, |_| {})?;
+    // the phased seed first, as `run` does; the analytic one where the phased family cannot fit
+    use catflip::design::free::{Seed, optimize};
+    let design = match optimize(&cfg, Seed::Phased, |_| {}) {
+        Ok(d) => d,
+        Err(_) => optimize(&cfg, Seed::Analytic, |_| {})?,
+    };
     let study = Study::new(&cfg, &design.plan, seed);
     let range = shard_range(trials, shard.index, shard.count);
     let quiet = c.json;
@@ -78,7 +83,9 @@ pub fn cmd_robustness(
         to_csv(&results, range.start == 0),
     );
     out.add(format!("robustness{suffix}.json"), json.clone());
-    if let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, study.max_tilt_deg())? {
+    if let Some(svg) =
+        catflip::control::figure::success_by_size(&cfg, &results, study.max_tilt_deg())?
+    {
         out.add(format!("robustness{suffix}.svg"), svg);
     }
     let written = publisher.publish(out)?;

@@ -18,9 +18,10 @@ fn design() -> &'static (Config, Reference, Tvlqr) {
     static D: OnceLock<(Config, Reference, Tvlqr)> = OnceLock::new();
     D.get_or_init(|| {
         let cfg = seed_cfg();
-        let plan = catflip::design::free::optimize(&cfg, catflip::design::free::Seed::Phased, |_| {})
-            .unwrap()
-            .plan;
+        let plan =
+            catflip::design::free::optimize(&cfg, catflip::design::free::Seed::Phased, |_| {})
+                .unwrap()
+                .plan;
         let r = Reference::new(&cfg, &plan);
         let tv = Tvlqr::new(&r, &cfg.control);
         (cfg, r, tv)
@@ -40,7 +41,12 @@ fn tilt(r: &Reference, x: &X) -> [f64; 2] {
 fn tvlqr_on_the_nominal_model_reproduces_the_design() {
     let (cfg, r, tv) = design();
     let motor = cfg.motor();
-    let open = fly(r, Feedback::JointPd { kp: 0.0, kd: 0.0 }, &motor, Flight::nominal(r));
+    let open = fly(
+        r,
+        Feedback::JointPd { kp: 0.0, kd: 0.0 },
+        &motor,
+        Flight::nominal(r),
+    );
     let closed = fly(r, Feedback::Tvlqr(tv), &motor, Flight::nominal(r));
     assert!(
         closed.max_correction_nm < 1e-9 * r.peak_torque,
@@ -49,7 +55,11 @@ fn tvlqr_on_the_nominal_model_reproduces_the_design() {
     );
     assert!((closed.error_deg - open.error_deg).abs() < 1e-9);
     // and the design lands: the nominal is belly-down
-    assert!(open.error_deg < 0.05, "nominal lands {} deg off", open.error_deg);
+    assert!(
+        open.error_deg < 0.05,
+        "nominal lands {} deg off",
+        open.error_deg
+    );
 }
 
 #[test]
@@ -68,7 +78,10 @@ fn the_period_map_linearisation_is_its_derivative() {
     };
     // the remainder is second order: halving the step quarters it
     let (r1, r2) = (rem(1e-3), rem(5e-4));
-    assert!(r1 > 0.0 && (r1 / r2 - 4.0).abs() < 0.4, "remainders {r1:e} {r2:e}");
+    assert!(
+        r1 > 0.0 && (r1 / r2 - 4.0).abs() < 0.4,
+        "remainders {r1:e} {r2:e}"
+    );
 }
 
 /// The cost-to-go is a Lyapunov function of the closed-loop linearisation:
@@ -96,7 +109,10 @@ fn the_closed_loop_linearisation_is_stable_along_the_design() {
         worst_flipped = worst_flipped.min(decrease(&flipped));
     }
     assert!(worst_ok > -1e-9, "cost-to-go grows: {worst_ok:e}");
-    assert!(worst_flipped < -1e-6, "a flipped gain passed: {worst_flipped:e}");
+    assert!(
+        worst_flipped < -1e-6,
+        "a flipped gain passed: {worst_flipped:e}"
+    );
     // the landing's sensitivity to a start error: far smaller closed loop
     let n = tv.starts.len();
     let (mut phi_cl, mut phi_ol) = (SMatrix::<f64, 10, 10>::identity(), SMatrix::identity());
@@ -126,7 +142,12 @@ fn the_closed_loop_linearisation_is_stable_along_the_design() {
 fn a_small_start_error_shrinks_as_the_linearisation_predicts() {
     let (cfg, r, tv) = design();
     let motor = cfg.motor();
-    for (rot, w) in [([0.0; 3], [0.0, 0.02, 0.0]), ([0.0; 3], [0.0, 0.01, 0.0]), ([0.0, 0.02, 0.0], [0.0; 3]), ([0.0, 0.0, 0.02], [0.0; 3])] {
+    for (rot, w) in [
+        ([0.0; 3], [0.0, 0.02, 0.0]),
+        ([0.0; 3], [0.0, 0.01, 0.0]),
+        ([0.0, 0.02, 0.0], [0.0; 3]),
+        ([0.0, 0.0, 0.02], [0.0; 3]),
+    ] {
         let y0 = release(&r.cat, &Start::new(rot, w));
         let mut f = Flight::nominal(r);
         f.release = y0;
@@ -198,9 +219,15 @@ fn bad_input_is_refused_before_anything_is_written() {
     let dir = tempfile::tempdir().unwrap();
     for (args, key) in [
         (vec!["--set", "control.delay_ms=-1"], "control.delay_ms"),
-        (vec!["--set", "robustness.delay_ms=-5"], "robustness.delay_ms"),
+        (
+            vec!["--set", "robustness.delay_ms=-5"],
+            "robustness.delay_ms",
+        ),
         (vec!["--set", "control.rate_hz=5000"], "control.rate_hz"),
-        (vec!["--set", "robustness.mass_error=1.0"], "robustness.mass_error"),
+        (
+            vec!["--set", "robustness.mass_error=1.0"],
+            "robustness.mass_error",
+        ),
         (vec!["--trials", "1000001"], "--trials"),
     ] {
         let out = std::process::Command::new(env!("CARGO_BIN_EXE_catflip"))
@@ -213,6 +240,10 @@ fn bad_input_is_refused_before_anything_is_written() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(key), "{args:?}: {err}");
         assert!(err.contains("must be in"), "{args:?}: {err}");
-        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0, "{args:?} wrote files");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "{args:?} wrote files"
+        );
     }
 }

@@ -195,11 +195,20 @@ impl RobustnessConfig {
         )?;
         for (key, v, hi) in [
             ("robustness.torque_noise", self.torque_noise, 10.0),
-            ("robustness.attitude_noise_deg", self.attitude_noise_deg, 90.0),
+            (
+                "robustness.attitude_noise_deg",
+                self.attitude_noise_deg,
+                90.0,
+            ),
             ("robustness.rate_noise_rad_s", self.rate_noise_rad_s, 100.0),
             ("robustness.pd_gain_error", self.pd_gain_error, 0.99),
         ] {
-            check(key, v, (0.0..=hi).contains(&v), &format!("must be in [0, {hi}]"))?;
+            check(
+                key,
+                v,
+                (0.0..=hi).contains(&v),
+                &format!("must be in [0, {hi}]"),
+            )?;
         }
         check(
             "robustness.worst_kept",

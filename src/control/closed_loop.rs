@@ -123,7 +123,10 @@ pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing
             }
         }
         if j % f.noise_steps == 0 && f.torque_noise > 0.0 {
-            noise = [f.torque_noise * f.rng.normal(), f.torque_noise * f.rng.normal()];
+            noise = [
+                f.torque_noise * f.rng.normal(),
+                f.torque_noise * f.rng.normal(),
+            ];
         }
         if let Some(u) = queue[j] {
             acting = u;
@@ -132,10 +135,7 @@ pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing
         let plant = f.plant;
         y = rk4(&plant, &y, r.h, |s, ys| {
             let ff = r.ff_at(j, s);
-            motor.clip(
-                [0, 1].map(|i| ff[i] + acting[i] + noise[i]),
-                [ys[6], ys[7]],
-            )
+            motor.clip([0, 1].map(|i| ff[i] + acting[i] + noise[i]), [ys[6], ys[7]])
         });
         if !y.iter().all(|v| v.is_finite()) {
             return Landing {

@@ -25,7 +25,9 @@ pub fn success_by_size(
         }),
         ("tilt", p.tilt_deg, |r| r.draw.tilt_deg),
         ("inertia", p.inertia_error, |r| {
-            r.draw.inertia_error[0].abs().max(r.draw.inertia_error[1].abs())
+            r.draw.inertia_error[0]
+                .abs()
+                .max(r.draw.inertia_error[1].abs())
         }),
     ];
     let x: Vec<f64> = (0..BINS).map(|b| (b as f64 + 0.5) / BINS as f64).collect();
@@ -45,7 +47,13 @@ pub fn success_by_size(
             }
             let ys = hits
                 .iter()
-                .map(|&(k, n)| if n == 0 { f64::NAN } else { k as f64 / n as f64 })
+                .map(|&(k, n)| {
+                    if n == 0 {
+                        f64::NAN
+                    } else {
+                        k as f64 / n as f64
+                    }
+                })
                 .collect();
             series.push((format!("{name}: {what}"), ys));
         }

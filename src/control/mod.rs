@@ -8,6 +8,6 @@ pub mod export;
 pub mod figure;
 pub mod plant;
 pub mod reference;
-pub mod robustness;
 pub mod rng;
+pub mod robustness;
 pub mod tvlqr;

@@ -30,9 +30,7 @@ pub struct Reference {
 /// The integrator state of a straight, rigid release.
 pub fn release(cat: &Cat, start: &Start) -> Y {
     let (a, l) = (start.attitude, start.body_momentum(cat));
-    [
-        a[0], a[1], a[2], a[3], 0.0, 0.0, 0.0, 0.0, l[0], l[1], l[2],
-    ]
+    [a[0], a[1], a[2], a[3], 0.0, 0.0, 0.0, 0.0, l[0], l[1], l[2]]
 }
 
 impl Reference {

@@ -21,7 +21,9 @@ impl Rng {
     /// The stream `stream` of trial `trial` in a study seeded by `seed`.
     pub fn new(seed: u64, trial: u64, stream: u64) -> Rng {
         Rng {
-            state: mix(mix(seed ^ 0x6a09_e667_f3bc_c909).wrapping_add(trial) ^ stream.rotate_left(32)),
+            state: mix(
+                mix(seed ^ 0x6a09_e667_f3bc_c909).wrapping_add(trial) ^ stream.rotate_left(32)
+            ),
             spare: None,
         }
     }

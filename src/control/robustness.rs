@@ -356,3 +356,37 @@ pub fn to_csv(results: &[TrialResult], header: bool) -> String {
 pub fn shard_range(trials: usize, k: usize, n: usize) -> std::ops::Range<usize> {
     trials * (k - 1) / n..trials * k / n
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Wilson's interval against its closed form at the ends and a textbook value.
+    #[test]
+    fn wilson_interval() {
+        // n = 10, k = 10: [n / (n + z^2), 1]
+        let z2 = 1.959_963_984_540_054f64.powi(2);
+        let [lo, hi] = wilson(10, 10);
+        assert!((lo - 10.0 / (10.0 + z2)).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
+        let [lo, hi] = wilson(0, 10);
+        assert!(lo.abs() < 1e-12 && (hi - z2 / (10.0 + z2)).abs() < 1e-12);
+        // 50 of 100: 0.4038 to 0.5962 (Wilson 1927; Newcombe 1998, table I)
+        let [lo, hi] = wilson(50, 100);
+        assert!((lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4);
+    }
+
+    #[test]
+    fn shards_tile_the_trials() {
+        for n in [0, 1, 7, 1000] {
+            for count in 1..6 {
+                let mut next = 0;
+                for k in 1..=count {
+                    let r = shard_range(n, k, count);
+                    assert_eq!(r.start, next);
+                    next = r.end;
+                }
+                assert_eq!(next, n);
+            }
+        }
+    }
+}

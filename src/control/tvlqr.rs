@@ -76,7 +76,8 @@ pub fn linearise(r: &Reference, a: usize, b: usize, scale: &SVector<f64, NX>, us
         let e = 1e-5 * scale[i];
         let mut x = X::zeros();
         x[i] = e;
-        let d = (period_map(r, a, b, &x, [0.0; 2]) - period_map(r, a, b, &(-x), [0.0; 2])) / (2.0 * e);
+        let d =
+            (period_map(r, a, b, &x, [0.0; 2]) - period_map(r, a, b, &(-x), [0.0; 2])) / (2.0 * e);
         am.set_column(i, &d);
     }
     for i in 0..2 {
@@ -103,7 +104,8 @@ fn belly(nom: &super::plant::Y) -> SMatrix<f64, 3, 3> {
 /// Places a 3x3 block at the attitude corner.
 fn attitude_cost(c: &SMatrix<f64, 3, 3>, w: f64) -> A {
     let mut m = A::zeros();
-    m.fixed_view_mut::<3, 3>(0, 0).copy_from(&(c.transpose() * c * w));
+    m.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(c.transpose() * c * w));
     m
 }
 
