@@ -677,7 +677,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 30] = [
+pub const UNITS: [(&str, &str); 50] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -708,6 +708,26 @@ pub const UNITS: [(&str, &str); 30] = [
     ("free.tolerance", "relative"),
     ("free.attitude_tolerance", "rad"),
     ("land.max_tilt_deg", "deg"),
+    ("control.rate_hz", "Hz"),
+    ("control.delay_ms", "ms"),
+    ("control.sim_rate_hz", "Hz"),
+    ("control.landing_weight", "weight"),
+    ("control.final_shape_weight", "weight"),
+    ("control.attitude_weight", "weight"),
+    ("control.shape_weight", "weight"),
+    ("control.rate_weight", "weight"),
+    ("control.torque_weight", "weight"),
+    ("control.max_correction", "design peak torques"),
+    ("robustness.tilt_deg", "deg"),
+    ("robustness.mass_error", "relative"),
+    ("robustness.inertia_error", "relative"),
+    ("robustness.length_error", "relative"),
+    ("robustness.delay_ms", "ms"),
+    ("robustness.torque_noise", "design peak torques"),
+    ("robustness.attitude_noise_deg", "deg"),
+    ("robustness.rate_noise_rad_s", "rad/s"),
+    ("robustness.pd_gain_error", "relative"),
+    ("robustness.worst_kept", "trials"),
 ];
 
 /// A config key with its unit, e.g. `fall.height (m)`.
