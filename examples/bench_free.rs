@@ -22,13 +22,9 @@ fn design(cfg: &Config, seed: Seed) -> anyhow::Result<(FreeResult, f64, f64)> {
     let t = Instant::now();
     let plan = seed.plan(cfg)?;
     let seed_s = t.elapsed().as_secs_f64();
-    let r = catflip::design::free::optimize_from(
-        cfg,
-        plan.as_ref(),
-        seed.name(),
-        cfg.free.nodes,
-        |_| {},
-    )?;
+    let r = catflip::design::free::FreeDesign::new(cfg)
+        .from_plan(plan.as_ref(), seed.name())
+        .solve()?;
     // the SCP's own time (without the verification simulations)
     Ok((r.clone(), seed_s, seed_s + r.solve_time_s))
 }

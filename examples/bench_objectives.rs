@@ -83,13 +83,9 @@ fn main() -> anyhow::Result<()> {
                     // the free-form design seeded by it, once (its own time,
                     // the seed's not counted): never worse than the phased one
                     let t = Instant::now();
-                    let fr = catflip::design::free::optimize_from(
-                        &cfg,
-                        &r.plan,
-                        "phased",
-                        cfg.free.nodes,
-                        |_| {},
-                    );
+                    let fr = catflip::design::free::FreeDesign::new(&cfg)
+                        .from_plan(&r.plan, "phased")
+                        .solve();
                     let s = t.elapsed().as_secs_f64();
                     match fr {
                         Ok(f) => println!(
@@ -105,7 +101,7 @@ fn main() -> anyhow::Result<()> {
                             f.manoeuvre_time_s,
                             f.peak_torque_nm,
                             f.scp_iterations,
-                            catflip::run::json_name(&f.status),
+                            catflip::verdict::Status::from(f.status),
                             f.objective_value / r.objective_value
                         ),
                         Err(e) => println!("{:<33} {s:>9.3}  free-form: {e}", ""),

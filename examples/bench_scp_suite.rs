@@ -46,8 +46,10 @@ fn main() -> anyhow::Result<()> {
         let nodes = nodes.unwrap_or(cfg.free.nodes);
         let t = Instant::now();
         let plan = seed.plan(&cfg)?;
-        let r =
-            catflip::design::free::optimize_from(&cfg, plan.as_ref(), seed.name(), nodes, |_| {})?;
+        let r = catflip::design::free::FreeDesign::new(&cfg)
+            .from_plan(plan.as_ref(), seed.name())
+            .nodes(nodes)
+            .solve()?;
         let s = t.elapsed().as_secs_f64();
         println!(
             "{file:<16} {norm:<10} {nodes:>5} {:<8} {:>10} {:>6} {:>10.6} {s:>7.2}",

@@ -9,7 +9,7 @@
 //! motor envelope too.
 //! `cargo run --release --example convergence_matrix [-- CONFIG[:KEY=VALUE,...]...]`
 use catflip::Config;
-use catflip::design::free::{Seed, optimize_from};
+use catflip::design::free::{FreeDesign, Seed};
 use std::time::Instant;
 
 fn main() -> anyhow::Result<()> {
@@ -67,16 +67,12 @@ fn main() -> anyhow::Result<()> {
                     let r = match seed {
                         Seed::Phased => {
                             catflip::design::phased::optimize(&cfg, |_| {}).and_then(|ph| {
-                                optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
+                                FreeDesign::new(&cfg).from_plan(&ph.plan, "phased").solve()
                             })
                         }
-                        Seed::Analytic => optimize_from(
-                            &cfg,
-                            &catflip::design::analytic::analytic_plan(&cfg),
-                            "analytic",
-                            cfg.free.nodes,
-                            |_| {},
-                        ),
+                        Seed::Analytic => FreeDesign::new(&cfg)
+                            .from_plan(&catflip::design::analytic::analytic_plan(&cfg), "analytic")
+                            .solve(),
                     };
                     let s = clock.elapsed().as_secs_f64();
                     match r {
@@ -90,7 +86,7 @@ fn main() -> anyhow::Result<()> {
                                 norm,
                                 objective,
                                 seed.name(),
-                                catflip::run::json_name(&r.status),
+                                catflip::verdict::Status::from(r.status).to_string(),
                                 significant(r.objective_value, 6),
                                 r.scp_iterations,
                                 r.certificate.criticality,

@@ -14,13 +14,15 @@ fn main() -> anyhow::Result<()> {
         "phased: peak {:.4} N m at bend {:.1} deg",
         phased.peak_torque_nm, phased.bend_deg
     );
-    let free =
-        catflip::design::free::optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |it| {
+    let free = catflip::design::free::FreeDesign::new(&cfg)
+        .from_plan(&phased.plan, "phased")
+        .on_iteration(&mut |it| {
             println!(
                 "  SCP {:3}: peak {:.5} N m, max |r| {:.1e}",
                 it.iteration, it.objective, it.infeasibility
             )
-        })?;
+        })
+        .solve()?;
     println!(
         "free-form: peak {:.4} N m ({:.1} % of phased), simulated flip error {:.1e} rad",
         free.peak_torque_nm,

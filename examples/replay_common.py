@@ -31,7 +31,8 @@ def read_controls(path):
     # the landing margin: the replay goes on with the shape held straight (last row, at rest,
     # no feed-forward) until touchdown
     margin = float(meta.get("margin_s", "0"))
-    extra = int(round(margin / dt))
+    # (steps of margin / extra each: the margin exactly, a spinning cat turns on during it)
+    extra = int(math.ceil(margin / dt - 1e-9)) if margin > 0 else 0
     if extra > 0:
         last = data[-1].copy()
         for i, c in enumerate(cols):
@@ -49,6 +50,7 @@ def read_controls(path):
         "start_base_linear_velocity": vec("start_base_linear_velocity", [0, 0, 0]),
         "start_base_angular_velocity": vec("start_base_angular_velocity", [0, 0, 0]),
         "margin_steps": extra,
+        "margin_dt": margin / extra if extra else dt,
         "slope": float(meta.get("motor_slope_nm_s", "0")),
         "dt": dt,
         "steps": int(meta["steps"]) + extra,
@@ -111,6 +113,14 @@ def wrap(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
 
 
+def landing_of(r):
+    """The belly's (rear x) angle from straight down (catflip's -x), deg, of the
+    rear half's attitude `r` (w, x, y, z) in catflip's world."""
+    w, x, y, z = r
+    belly = (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
+    return math.degrees(math.atan2(math.hypot(belly[1], belly[2]), -belly[0]))
+
+
 class FlipTracker:
     """catflip's one flip convention (src/model/so3.rs FlipTracker): rotation
     about the reference spine (catflip's world z), right-handed, from the
@@ -131,9 +141,8 @@ class FlipTracker:
 
     def push(self, q):
         r = quat_mul(quat_conj(self.q0), np.asarray(q, float))
-        w, x, y, z = r
-        belly = (1 - 2 * (y * y + z * z), 2 * (x * y + w * z), 2 * (x * z - w * y))
-        self.landing = math.degrees(math.atan2(math.hypot(belly[1], belly[2]), -belly[0]))
+        self.r = r
+        self.landing = landing_of(r)
         f = 2.0 * math.atan2(r[3], r[0])
         self.acc += wrap(f - self.last)
         self.last = f

@@ -72,6 +72,7 @@ def replay(model, c, pd):
         return run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff)
     finally:
         mujoco.set_mjcb_control(None)
+        model.opt.timestep = c["dt"]
 
 
 def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff):
@@ -112,6 +113,8 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
             tau_v = limit_catflip_torque(tau_v, qd, c)
             data.ctrl[:] = tau_v
         peak = max(peak, peak_of(tau_v, c["norm"]))
+        if k == c["steps"] - c["margin_steps"]:
+            model.opt.timestep = c["margin_dt"]
         mujoco.mj_step(model, data)
         tracker.push(data.xquat[rear])
         if k == c["steps"] - c["margin_steps"] - 1:

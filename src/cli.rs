@@ -4,6 +4,7 @@ use anyhow::Result;
 use catflip::Config;
 use catflip::design::plan::Schedule;
 use catflip::output::{Output, Publisher};
+use catflip::verdict::{self, Simulated};
 use catflip::verify::analyze::{analytic_schedule, analyze, verify};
 use catflip::verify::simulate::SimReport;
 use clap::{Args, Parser, Subcommand};
@@ -156,8 +157,13 @@ enum SeedArg {
     Analytic,
 }
 
+/// Loads and checks the config; likely unit slips are warned about on stderr.
 pub(crate) fn load(c: &Common) -> Result<Config> {
-    Ok(Config::load(&c.config, &c.set)?)
+    let cfg = Config::load(&c.config, &c.set)?;
+    for s in cfg.slips() {
+        eprintln!("warning: {s}");
+    }
+    Ok(cfg)
 }
 
 fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
@@ -228,6 +234,11 @@ pub fn run() -> Result<Status> {
     }
 }
 
+/// A number that may be absent, to `digits` decimals, else `-`.
+fn maybe(x: Option<f64>, digits: usize) -> String {
+    x.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
+}
+
 fn row(label: &str, value: String) {
     say!("  {label:<34} {value}");
 }
@@ -237,17 +248,20 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let publisher = publisher(c, &cfg, "analyze")?;
     let a = analyze(&cfg)?;
     let sched = analytic_schedule(&cfg, &a.plan);
-    let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
-    let why = catflip::run::schedule_flags(
+    let reason = catflip::run::judge(
         &cfg,
-        (a.flip_error_rad, a.tilt_deg),
+        verdict::Status::ClosedForm,
         a.peak_torque_nm,
         a.closed.bend_deg,
-        Some(usage.max_speed_rad_s),
-        usage.min_margin,
-    );
-    let reason = (!why.is_empty()).then(|| why.join("; "));
+        &sched,
+        &Simulated::Flip {
+            flip_error_rad: a.flip_error_rad,
+            tilt_deg: a.tilt_deg,
+        },
+    )
+    .reason();
     let mut v = serde_json::to_value(&a)?;
+    catflip::output::ensure_finite(&v, &[])?;
     v["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
     if let Some(r) = &reason {
         v["reason"] = r.clone().into();
@@ -397,11 +411,16 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
             p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
         ));
     }
-    let reason = catflip::verify::simulate::misses_flip(
+    let why: Vec<String> = verdict::flip_misses(
         report.flip_error_rad,
         report.tilt_deg,
         cfg.simulate.flip_tolerance,
-    );
+    )
+    .iter()
+    .map(ToString::to_string)
+    .collect();
+    let reason = (!why.is_empty()).then(|| why.join("; "));
+    catflip::output::ensure_finite(&serde_json::to_value(&report)?, &[])?;
     let mut out = Output::default();
     out.add("simulation.csv", trace);
     let written = publisher.publish(out)?;
@@ -437,20 +456,29 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
 /// Writes `<stem>.csv` and `<stem>.json`; prints the JSON and returns `None` with `--json`.
 fn write_design(
     c: &Common,
-    cfg: &Config,
     publisher: Publisher,
     stem: &str,
-    plan: &dyn catflip::design::plan::ShapePlan,
+    sched: &Schedule,
     json: serde_json::Value,
     reason: Option<String>,
 ) -> Result<Option<Vec<PathBuf>>> {
     let mut json = json;
+    catflip::output::ensure_finite(
+        &json,
+        &[
+            "peak_torque_nm",
+            "bend_deg",
+            "flip_deg",
+            "tilt_deg",
+            "sim_peak_torque_nm",
+            "phase_durations_s",
+        ],
+    )?;
     json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
     if let Some(r) = reason {
         json["reason"] = r.into();
     }
     let json = serde_json::to_string_pretty(&json)?;
-    let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
     let mut out = Output::default();
     sched.add_to(&mut out, stem);
     out.add(format!("{stem}.json"), json.clone());
@@ -486,18 +514,34 @@ fn design_rows(
     }
 }
 
-/// Why an optimiser's verified design is flagged: unconverged, or the flip missed.
-fn design_flags(cfg: &Config, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
+/// The verdict on an optimiser's design, as `run` gives it ([`catflip::run::judge`]).
+fn design_flags(
+    cfg: &Config,
+    status: verdict::Status,
+    (peak, bend): (f64, f64),
+    sched: &Schedule,
+    (flip_error_rad, tilt_deg): (f64, f64),
+) -> Option<String> {
+    catflip::run::judge(
+        cfg,
+        status,
+        peak,
+        bend,
+        sched,
+        &Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    )
+    .reason()
+}
+
+/// The name serde gives a unit enum value (`criticality`), for display only.
+fn shown<T: serde::Serialize>(v: &T) -> String {
+    match serde_json::to_value(v) {
+        Ok(serde_json::Value::String(s)) => s,
+        other => format!("{other:?}"),
     }
-    why.extend(catflip::verify::simulate::misses_flip(
-        flip_error_rad,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
-    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// `--verbose`: one line per SCP iteration, and a line where each mesh
@@ -555,24 +599,27 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
             let r = catflip::design::phased::optimize(&cfg, |e| {
                 if verbose {
                     eprintln!(
-                        "  bend {:8.3} deg   unit peak {:10.5} N m s^2   peak {:9.5} N m",
-                        e.bend_deg, e.unit_peak, e.peak_nm
+                        "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
+                        e.bend_deg,
+                        maybe(e.unit_peak, 5),
+                        maybe(e.peak_nm, 5)
                     );
                 }
             })?;
+            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
             let reason = design_flags(
                 &cfg,
-                &catflip::run::json_name(&r.status),
-                r.flip_error_rad,
-                r.tilt_deg,
+                r.status.into(),
+                (r.peak_torque_nm, r.bend_deg),
+                &sched,
+                (r.flip_error_rad, r.tilt_deg),
             );
             partial = flag("the phased design", reason.clone());
             let Some(written) = write_design(
                 c,
-                &cfg,
                 publisher,
                 "phased",
-                &r.plan,
+                &sched,
                 serde_json::to_value(&r)?,
                 reason,
             )?
@@ -583,13 +630,14 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                 "catflip optimize --mode phased: {} ({} joint), status {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                catflip::run::json_name(&r.status)
+                verdict::Status::from(r.status)
             );
             row(
                 "peak torque",
                 format!(
-                    "{:.5} N m (SOCP bound {:.5})",
-                    r.peak_torque_nm, r.socp_peak_torque_nm
+                    "{:.5} N m (SOCP bound {})",
+                    r.peak_torque_nm,
+                    maybe(r.socp_peak_torque_nm, 5)
                 ),
             );
             row(
@@ -631,24 +679,25 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
                 );
             }
-            let r = catflip::design::free::optimize_observed(
-                &cfg,
-                seed,
-                &mut IterationTable { verbose },
-            )?;
+            let r = catflip::design::free::FreeDesign::new(&cfg)
+                .seed(seed)
+                .check_mesh()
+                .observe(&mut IterationTable { verbose })
+                .solve()?;
+            let sched = Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase);
             let reason = design_flags(
                 &cfg,
-                &catflip::run::json_name(&r.status),
-                r.flip_error_rad,
-                r.tilt_deg,
+                r.status.into(),
+                (r.peak_torque_nm, r.bend_deg),
+                &sched,
+                (r.flip_error_rad, r.tilt_deg),
             );
             partial = flag("the free-form design", reason.clone());
             let Some(written) = write_design(
                 c,
-                &cfg,
                 publisher,
                 "free",
-                &r.plan,
+                &sched,
                 serde_json::to_value(&r)?,
                 reason,
             )?
@@ -659,7 +708,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                 "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
                 cfg.name,
                 cfg.cat.joint.name(),
-                catflip::run::json_name(&r.status),
+                verdict::Status::from(r.status),
                 r.seed
             );
             row(
@@ -691,7 +740,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                     cert.step,
                     cert.constraint_violation,
                     cert.criticality,
-                    catflip::run::json_name(&cert.rule)
+                    shown(&cert.rule)
                 ),
             );
             if let Some(m) = &r.mesh_check {
@@ -703,7 +752,7 @@ fn cmd_optimize(c: &Common, mode: Mode, seed: Option<SeedArg>, verbose: bool) ->
                         r.objective.unit(),
                         m.nodes,
                         100.0 * m.relative_change,
-                        catflip::run::json_name(&m.status)
+                        verdict::Status::from(m.status)
                     ),
                 );
             }
@@ -769,7 +818,8 @@ fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
             } if live => {
                 let _ = write!(
                     e,
-                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {peak_nm:.5} N m"
+                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {} N m",
+                    maybe(peak_nm, 5)
                 );
             }
             Progress::Scp(it) if live => {
@@ -807,7 +857,7 @@ fn cmd_run(c: &Common) -> Result<Status> {
         "catflip run: {} ({} joint, peak norm {})",
         s.name,
         s.joint,
-        catflip::run::json_name(&s.peak_norm)
+        s.peak_norm.name()
     );
     let header = catflip::run::TABLE_HEADER;
     let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 mod control;
+pub mod ranges;
 mod start;
 pub use control::{ControlConfig, MAX_TRIALS, RobustnessConfig};
 pub use start::{LandConfig, MAX_START_RATE, StartConfig};
@@ -254,7 +255,7 @@ fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
     } else {
         Err(Error::Invalid {
             key: key.into(),
-            value: format!("{value}"),
+            value: ranges::show(value),
             expected: expected.into(),
         })
     }
@@ -400,6 +401,7 @@ impl Config {
             f.gravity > 0.0,
             "must be > 0 m/s^2",
         )?;
+        ranges::check_fall_time(self)?;
         check("fall.margin", f.margin, f.margin >= 0.0, "must be >= 0 s")?;
         let ft = self.fall_time();
         check(
@@ -557,7 +559,14 @@ impl Config {
         self.land.validate()?;
         self.control.validate()?;
         self.robustness.validate()?;
-        Ok(())
+        ranges::check_ranges(self)?;
+        ranges::impossible(self)
+    }
+
+    /// Plausibility warnings (likely unit slips) for a valid config; see
+    /// [`ranges::slips`].
+    pub fn slips(&self) -> Vec<ranges::Slip> {
+        ranges::slips(self)
     }
 
     /// The cat with the inertia formula the config asks for.
@@ -587,7 +596,9 @@ impl Config {
         }
     }
 
-    /// `sqrt(2 h / g)`, s.
+    /// `sqrt(2 h / g)`, s. A height near `f64::MAX` makes it infinite, which
+    /// the fall-time range check refuses (kept in this form: the designs of
+    /// the bundled configs depend on its last bit).
     pub fn fall_time(&self) -> f64 {
         (2.0 * self.fall.height / self.fall.gravity).sqrt()
     }

@@ -45,6 +45,10 @@ pub enum Error {
     AllFailed(String),
     #[error("simulation failed: {0}")]
     Simulation(String),
+    /// A result that would be published with a NaN or infinite number (null
+    /// in JSON): refused rather than reported as a success.
+    #[error("the computation gave no finite number for {fields}; nothing was written")]
+    NonFinite { fields: String },
     #[error("drawing a figure failed: {0}")]
     Report(String),
     /// The output folder cannot take the results (checked before computing).

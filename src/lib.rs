@@ -18,6 +18,7 @@ pub mod output;
 pub mod report;
 pub mod run;
 pub mod sweep;
+pub mod verdict;
 pub mod verify;
 
 pub use config::Config;

@@ -16,6 +16,56 @@ use crate::error::{Error, Result};
 use std::fs::{self, File, OpenOptions};
 use std::path::{Path, PathBuf};
 
+/// The paths (`a.b[2]`) of the nulls in a JSON value: the NaN and infinite
+/// numbers serde_json writes as null. Empty when every number is finite.
+pub fn null_numbers(v: &serde_json::Value) -> Vec<String> {
+    fn walk(v: &serde_json::Value, at: String, out: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Null => out.push(at),
+            serde_json::Value::Array(xs) => {
+                for (i, x) in xs.iter().enumerate() {
+                    walk(x, format!("{at}[{i}]"), out)
+                }
+            }
+            serde_json::Value::Object(m) => {
+                for (k, x) in m {
+                    let key = if at.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{at}.{k}")
+                    };
+                    walk(x, key, out)
+                }
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk(v, String::new(), &mut out);
+    out
+}
+
+/// Refuses a JSON result with a null (NaN or infinite) number among `fields`
+/// (all of them when `fields` is empty): catflip never reports success with one.
+pub fn ensure_finite(v: &serde_json::Value, fields: &[&str]) -> Result<()> {
+    let nulls: Vec<String> = null_numbers(v)
+        .into_iter()
+        .filter(|p| {
+            fields.is_empty()
+                || fields
+                    .iter()
+                    .any(|f| p == f || p.starts_with(&format!("{f}[")))
+        })
+        .collect();
+    if nulls.is_empty() {
+        Ok(())
+    } else {
+        Err(Error::NonFinite {
+            fields: nulls.join(", "),
+        })
+    }
+}
+
 /// Files to write into one set, kept in memory until published.
 #[derive(Debug, Default)]
 pub struct Output {
@@ -30,6 +80,12 @@ impl Output {
     /// Names of the files added so far.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|f| f.0.as_str())
+    }
+
+    /// The files added so far, name and contents (for a caller that keeps
+    /// them in memory, such as the Python package's `run`).
+    pub fn files(&self) -> impl Iterator<Item = (&str, &[u8])> {
+        self.files.iter().map(|f| (f.0.as_str(), f.1.as_slice()))
     }
 
     /// Stages and publishes in one go as the set `set_path` (`<dir>/<set>`).

@@ -38,12 +38,7 @@ pub fn cmd_robustness(
     });
     let suffix = shard.suffix();
     let publisher = publisher(c, &cfg, &format!("robustness{suffix}"))?;
-    // the phased seed first, as `run` does; the analytic one where the phased family cannot fit
-    use catflip::design::free::{Seed, optimize};
-    let design = match optimize(&cfg, Seed::Phased, |_| {}) {
-        Ok(d) => d,
-        Err(_) => optimize(&cfg, Seed::Analytic, |_| {})?,
-    };
+    let design = catflip::control::robustness::design(&cfg)?;
     let study = Study::new(&cfg, &design.plan, seed);
     let range = shard_range(trials, shard.index, shard.count);
     let quiet = c.json;

@@ -9,6 +9,7 @@ use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
 use crate::output::Output;
 use crate::report::{self, MethodTrace};
+use crate::verdict::{DesignNumbers, Grade, Simulated, Status, Targets, verdict};
 use crate::verify::analyze::analyze;
 use crate::verify::simulate::{SimReport, dynamic_cfg};
 use serde::Serialize;
@@ -38,22 +39,10 @@ pub enum Progress<'a> {
     Bend {
         evaluations: usize,
         bend_deg: f64,
-        peak_nm: f64,
+        /// Absent for an objective other than the peak.
+        peak_nm: Option<f64>,
     },
     Scp(&'a ScpIteration),
-}
-
-/// How a method ended, as the summary, the table and the exit status see it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Verdict {
-    /// A result that meets its targets.
-    Ok,
-    /// A result that misses a target (unconverged, flip missed, limit broken):
-    /// kept and reported, with the reason.
-    Flagged,
-    /// No result: the method stopped with an error, given as the reason.
-    Failed,
 }
 
 /// One method's line of the summary.
@@ -61,8 +50,8 @@ pub enum Verdict {
 pub struct MethodSummary {
     pub method: &'static str,
     /// Solver status (`closed-form`, `solved`, `converged`, ...), or `failed`.
-    pub status: String,
-    pub verdict: Verdict,
+    pub status: Status,
+    pub verdict: Grade,
     /// Why the method is flagged or failed (absent when ok).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -106,8 +95,8 @@ impl MethodSummary {
     fn failed(method: &'static str, e: &crate::Error) -> MethodSummary {
         MethodSummary {
             method,
-            status: "failed".into(),
-            verdict: Verdict::Failed,
+            status: Status::Failed,
+            verdict: Grade::Failed,
             reason: Some(e.to_string()),
             result: None,
         }
@@ -164,112 +153,35 @@ impl RunResult {
     }
 }
 
-/// Why a verified design misses its targets, if it does: solver status,
-/// flip and tilt beyond `simulate.flip_tolerance`, limits broken.
-fn flags(cfg: &Config, status: &str, n: &MethodNumbers) -> Option<String> {
-    let mut why = Vec::new();
-    if !matches!(status, "closed-form" | "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(schedule_flags(
-        cfg,
-        (n.flip_error_rad, n.tilt_deg),
-        n.peak_torque_nm,
-        n.bend_deg,
-        Some(n.max_speed_rad_s),
-        n.min_envelope_margin,
-    ));
-    why.extend(crate::verify::simulate::misses_landing(
-        cfg,
-        n.landing_error_deg,
-    ));
-    (!why.is_empty()).then(|| why.join("; "))
+/// How the motors are used by a written schedule's rows.
+fn usage(cfg: &Config, schedule: &Schedule) -> crate::model::motor::MotorUse {
+    cfg.motor()
+        .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
-/// Why a schedule misses its targets whatever made it: the flip and tilt
-/// (`(flip error rad, tilt deg)` from its simulation) beyond
-/// `simulate.flip_tolerance`, then [`limits_broken`].
-pub fn schedule_flags(
+/// The verdict on a design with this status, dense peak and largest bend
+/// (deg), written as `schedule` and simulated as `simulated`: the one
+/// judgement `run`, `optimize` and `analyze` make.
+pub fn judge(
     cfg: &Config,
-    (flip_error_rad, tilt_deg): (f64, f64),
+    status: Status,
     peak_torque_nm: f64,
     bend_deg: f64,
-    max_speed_rad_s: Option<f64>,
-    envelope_margin: Option<f64>,
-) -> Vec<String> {
-    // from another start the flip about the reference spine means nothing: the landing decides
-    let mut why: Vec<String> = if cfg.start.is_default() {
-        crate::verify::simulate::misses_flip(flip_error_rad, tilt_deg, cfg.simulate.flip_tolerance)
-            .into_iter()
-            .collect()
-    } else {
-        Vec::new()
-    };
-    why.extend(limits_broken(
-        cfg,
-        peak_torque_nm,
-        bend_deg,
-        max_speed_rad_s,
-        envelope_margin,
-    ));
-    why
-}
-
-/// Whether a dense peak breaks `limits.max_torque`. Not with a torque-speed
-/// line, where a braking torque may exceed the stall torque: the envelope
-/// margin is the test then.
-pub fn over_torque_limit(cfg: &Config, peak_torque_nm: f64) -> bool {
-    cfg.limits.no_load_speed.is_none()
-        && cfg
-            .limits
-            .max_torque
-            .is_some_and(|lim| peak_torque_nm > lim * (1.0 + 1e-6))
-}
-
-/// Which of the config's limits a schedule breaks: its dense peak torque,
-/// largest bend (deg), fastest joint speed and smallest margin inside the
-/// motor envelope.
-pub fn limits_broken(
-    cfg: &Config,
-    peak_torque_nm: f64,
-    bend_deg: f64,
-    max_speed_rad_s: Option<f64>,
-    envelope_margin: Option<f64>,
-) -> Vec<String> {
-    let mut why = Vec::new();
-    if let Some(lim) = cfg.limits.max_torque
-        && over_torque_limit(cfg, peak_torque_nm)
-    {
-        why.push(format!(
-            "needs {peak_torque_nm:.4} N m, above limits.max_torque = {lim} N m"
-        ));
-    }
-    if let (Some(w), Some(s)) = (cfg.limits.max_speed, max_speed_rad_s)
-        && s > w * (1.0 + 1e-6)
-    {
-        why.push(format!(
-            "moves at {s:.4} rad/s, above limits.max_speed = {w} rad/s"
-        ));
-    }
-    // the envelope holds both (and the torque-speed line); a limit already
-    // named is not repeated
-    if let Some(m) = envelope_margin
-        && m < -1e-6
-        && why.is_empty()
-    {
-        why.push(format!(
-            "leaves the motor envelope (smallest margin {m:.3}; {})",
-            cfg.envelope_keys()
-        ));
-    }
-    if let Some(b) = cfg.limits.max_bend_deg
-        && bend_deg > b * (1.0 + 1e-6)
-    {
-        why.push(format!(
-            "bends {bend_deg:.2} deg, above limits.max_bend_deg = {b} deg"
-        ));
-    }
-    why
+    schedule: &Schedule,
+    simulated: &Simulated,
+) -> crate::verdict::Verdict {
+    let motor = usage(cfg, schedule);
+    verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status,
+            peak_torque_nm,
+            bend_deg,
+            max_speed_rad_s: Some(motor.max_speed_rad_s),
+            envelope_margin: motor.min_margin,
+        },
+        simulated,
+    )
 }
 
 /// A method's line; `sim` is its dynamic simulation, or why that failed
@@ -277,16 +189,14 @@ pub fn limits_broken(
 fn summarize(
     cfg: &Config,
     method: &'static str,
-    status: String,
+    status: Status,
     peak: f64,
     path_numbers: (f64, f64, [f64; 3]),
     sim: std::result::Result<&SimReport, &Error>,
     schedule: &Schedule,
     solve_time_s: f64,
 ) -> MethodSummary {
-    let motor = cfg
-        .motor()
-        .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)));
+    let motor = usage(cfg, schedule);
     let (bend, twist, durations) = path_numbers;
     let failed_sim;
     let (sim, sim_error) = match sim {
@@ -316,19 +226,20 @@ fn summarize(
         schedule_csv: format!("{method}.csv"),
         schedule_json: format!("{method}.schedule.json"),
     };
-    let reason = match (sim_error, flags(cfg, &status, &n)) {
-        (Some(e), _) => Some(e),
-        (None, r) => r,
+    let simulated = match sim_error {
+        Some(e) => Simulated::Failed(e),
+        None => Simulated::Landing {
+            flip_error_rad: n.flip_error_rad,
+            tilt_deg: n.tilt_deg,
+            landing_error_deg: n.landing_error_deg,
+        },
     };
+    let v = judge(cfg, status, peak, bend, schedule, &simulated);
     MethodSummary {
         method,
         status,
-        verdict: if reason.is_some() {
-            Verdict::Flagged
-        } else {
-            Verdict::Ok
-        },
-        reason,
+        verdict: v.grade(),
+        reason: v.reason(),
         result: Some(n),
     }
 }
@@ -368,7 +279,7 @@ pub fn trace(
         qd,
         tau_xy,
         peak_nm: peak,
-        over_limit: over_torque_limit(cfg, peak),
+        over_limit: Targets::of(cfg).over_torque(peak),
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),
@@ -422,7 +333,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             methods.push(summarize(
                 cfg,
                 "analytic",
-                "closed-form".into(),
+                Status::ClosedForm,
                 a.peak_torque_nm,
                 (
                     a.closed.bend_deg,
@@ -520,7 +431,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             methods.push(summarize(
                 cfg,
                 "phased",
-                json_name(&ph.status),
+                ph.status.into(),
                 ph.peak_torque_nm,
                 (ph.bend_deg, ph.twist_rad, ph.phase_durations_s),
                 Ok(ph_sim),
@@ -563,11 +474,10 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     };
     let free = match &free_impossible {
         Some(r) => Err(skipped(r)),
-        None => {
-            crate::design::free::optimize_from(cfg, seed_plan, seed_name, cfg.free.nodes, |it| {
-                progress(Progress::Scp(it))
-            })
-        }
+        None => crate::design::free::FreeDesign::new(cfg)
+            .from_plan(seed_plan, seed_name)
+            .on_iteration(&mut |it| progress(Progress::Scp(it)))
+            .solve(),
     };
     match &free {
         Ok(fr) => {
@@ -576,7 +486,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
             methods.push(summarize(
                 cfg,
                 "free",
-                json_name(&fr.status),
+                fr.status.into(),
                 fr.peak_torque_nm,
                 (fr.bend_deg, fr.twist_rad, fr.phase_durations_s),
                 Ok(&fr.sim),
@@ -603,13 +513,13 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
     if let Some(a) = answer.as_mut().filter(|a| !a.possible)
         && let Some(m) = methods
             .iter()
-            .find(|m| m.method == "free" && m.verdict == Verdict::Ok)
+            .find(|m| m.method == "free" && m.verdict == Grade::Ok)
     {
         // a verified free-form schedule inside the envelope settles it
         a.possible = true;
         a.method = m.method;
     }
-    if methods.iter().all(|m| m.verdict == Verdict::Failed) {
+    if methods.iter().all(|m| m.verdict == Grade::Failed) {
         let reasons: Vec<String> = methods
             .iter()
             .map(|m| format!("{}: {}", m.method, m.reason.as_deref().unwrap_or("")))
@@ -635,7 +545,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         plans.push(("free", &fr.plan));
     }
     crate::export::add_simulator_files(cfg, &mut output, &plans);
-    let norm_name = json_name(&cfg.norm());
+    let norm_name = cfg.norm().name().to_string();
     let iterations = free
         .as_ref()
         .map(|fr| fr.iterations.clone())
@@ -687,7 +597,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         max_torque_nm: cfg.limits.max_torque,
         outcome: if answer.as_ref().is_some_and(|a| !a.possible) {
             "impossible"
-        } else if methods.iter().all(|m| m.verdict == Verdict::Ok) {
+        } else if methods.iter().all(|m| m.verdict == Grade::Ok) {
             "ok"
         } else {
             "partial"
@@ -802,15 +712,6 @@ pub const TABLE_HEADER: [&str; 11] = [
     "verdict",
 ];
 
-/// The name serde gives a unit enum value (`per-motor`, `iteration-limit`),
-/// so the terminal says what the JSON says.
-pub fn json_name<T: Serialize>(v: &T) -> String {
-    match serde_json::to_value(v) {
-        Ok(serde_json::Value::String(s)) => s,
-        other => format!("{other:?}"),
-    }
-}
-
 /// A small number in the table: `0` for exact zero, else 3 significant digits.
 fn small(x: f64) -> String {
     if x == 0.0 {
@@ -823,11 +724,11 @@ fn small(x: f64) -> String {
 /// One line of the comparison table; a failed method shows `-` for its numbers.
 pub fn table_row(m: &MethodSummary) -> Vec<String> {
     let verdict = match (m.verdict, &m.reason) {
-        (Verdict::Ok, _) => "ok".to_string(),
-        (Verdict::Flagged, r) => format!("FLAGGED: {}", r.as_deref().unwrap_or("")),
-        (Verdict::Failed, r) => format!("FAILED: {}", r.as_deref().unwrap_or("")),
+        (Grade::Ok, _) => "ok".to_string(),
+        (Grade::Flagged, r) => format!("FLAGGED: {}", r.as_deref().unwrap_or("")),
+        (Grade::Failed, r) => format!("FAILED: {}", r.as_deref().unwrap_or("")),
     };
-    let mut row = vec![m.method.to_string(), m.status.clone()];
+    let mut row = vec![m.method.to_string(), m.status.to_string()];
     match &m.result {
         Some(n) => {
             let d = n.phase_durations_s;

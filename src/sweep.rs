@@ -15,6 +15,7 @@ use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
 use crate::error::{Error, Result};
+use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use crate::verify::analyze::peak_along;
 use serde::Serialize;
 use std::path::Path;
@@ -120,7 +121,7 @@ pub struct SweepPoint {
     pub least_height_phased_m: Option<f64>,
     pub least_height_free_m: Option<f64>,
     /// The free-form optimiser's end status (converged, iteration limit, ...).
-    pub free_status: Option<String>,
+    pub free_status: Option<Status>,
     pub error: Option<String>,
 }
 
@@ -244,7 +245,7 @@ fn point(
             let mut r = prev.clone();
             let k = (t_prev / cfg.available_time()).powi(2);
             r.peak_torque_nm *= k;
-            r.socp_peak_torque_nm *= k;
+            r.socp_peak_torque_nm = r.socp_peak_torque_nm.map(|p| p * k);
             r.objective_value *= k;
             Ok(r)
         } else if methods.phased || warm.is_none() {
@@ -279,10 +280,11 @@ fn point(
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
                     "phased",
-                    &crate::run::json_name(&ph.status),
-                    ph.flip_error_rad,
-                    ph.tilt_deg,
                     &cfg,
+                    ph.status.into(),
+                    ph.peak_torque_nm,
+                    ph.bend_deg,
+                    (ph.flip_error_rad, ph.tilt_deg),
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
@@ -296,37 +298,32 @@ fn point(
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::continue_from(&cfg, w, before, |_| {}),
-                (Ok(ph), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &ph.plan,
-                    "phased",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
-                (Err(_), None) => crate::design::free::optimize_from(
-                    &cfg,
-                    &analytic_plan(&cfg),
-                    "analytic",
-                    cfg.free.nodes,
-                    |_| {},
-                ),
+                (_, Some(w)) => crate::design::free::FreeDesign::new(&cfg)
+                    .warm(w, before)
+                    .solve(),
+                (Ok(ph), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&ph.plan, "phased")
+                    .solve(),
+                (Err(_), None) => crate::design::free::FreeDesign::new(&cfg)
+                    .from_plan(&analytic_plan(&cfg), "analytic")
+                    .solve(),
             };
             match fr {
                 Ok(fr) => {
                     errors.extend(flagged(
                         "free",
-                        &crate::run::json_name(&fr.status),
-                        fr.flip_error_rad,
-                        fr.tilt_deg,
                         &cfg,
+                        fr.status.into(),
+                        fr.peak_torque_nm,
+                        fr.bend_deg,
+                        (fr.flip_error_rad, fr.tilt_deg),
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m = limit
                         .filter(|_| !envelope)
                         .map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
-                    p.free_status = Some(crate::run::json_name(&fr.status));
+                    p.free_status = Some(fr.status.into());
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
@@ -358,24 +355,33 @@ fn point(
     (p, kept)
 }
 
-/// A kept design that misses a target (unconverged, flip missed) is named in
-/// the point's `error` column beside its numbers.
+/// A kept design that misses a target (unconverged, flip missed, bend
+/// limit broken) is named in the point's `error` column beside its numbers
+/// ([`verdict`]; a sweep's peaks are computed without the torque limit and
+/// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
-    status: &str,
-    flip_error: f64,
-    tilt_deg: f64,
     cfg: &Config,
+    status: Status,
+    peak_torque_nm: f64,
+    bend_deg: f64,
+    (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(crate::verify::simulate::misses_flip(
-        flip_error,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
+    let v = verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status,
+            peak_torque_nm,
+            bend_deg,
+            max_speed_rad_s: None,
+            envelope_margin: None,
+        },
+        &Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    );
+    let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }
 
@@ -430,17 +436,41 @@ pub fn sweep_shard(
             ),
         });
     }
+    sweep_values(
+        &spec.key,
+        &spec.arg(),
+        values,
+        load,
+        methods,
+        threads,
+        progress,
+    )
+}
+
+/// The points of a sweep of `key` over `values` (any values, in order; the
+/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
+/// value and `arg` naming the sweep in messages: what [`sweep_shard`] runs,
+/// and what a caller with its own values (the Python package) calls.
+pub fn sweep_values(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
     // a point whose config is invalid is that point's failure; when every
     // point is invalid (e.g. an unknown key) the sweep fails before any work
     let configs: Vec<Result<Config>> = values
         .iter()
         .map(|&v| {
             load(v).map_err(|e| Error::Range {
-                arg: spec.arg(),
+                arg: arg.into(),
                 message: match e {
                     // the override is internal: name the point, not a `--set`
-                    Error::Override { message, .. } => format!("at {} = {v}: {message}", spec.key),
-                    e => format!("at {} = {v}: {e}", spec.key),
+                    Error::Override { message, .. } => format!("at {key} = {v}: {message}"),
+                    e => format!("at {key} = {v}: {e}"),
                 },
             })
         })
@@ -449,7 +479,7 @@ pub fn sweep_shard(
         && configs.iter().all(|c| c.is_err())
     {
         return Err(Error::Range {
-            arg: spec.arg(),
+            arg: arg.into(),
             message: match first {
                 Error::Range { message, .. } => format!("every point is invalid; {message}"),
                 e => e.to_string(),
@@ -482,9 +512,7 @@ pub fn sweep_shard(
                     let mut bends = Vec::new();
                     let mut last_ok = false;
                     for i in chunks[c].clone() {
-                        let slot = FALL_ONLY
-                            .contains(&spec.key.as_str())
-                            .then_some(&mut phased_warm);
+                        let slot = FALL_ONLY.contains(&key).then_some(&mut phased_warm);
                         let (p, fr) = match &configs[i] {
                             Ok(cfg) => point(
                                 cfg,
@@ -571,7 +599,7 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
             cell(p.free_bend_deg),
             cell(p.least_height_phased_m),
             cell(p.least_height_free_m),
-            p.free_status.as_deref().unwrap_or(""),
+            p.free_status.map_or("", Status::name),
             p.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
         ));
     }

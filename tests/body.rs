@@ -1,18 +1,13 @@
 //! Unequal halves (`[cat.front]`): the reduced model against the bodies'
 //! own velocities, the relabelling symmetry, and identical halves as before.
 
-use catflip::Config;
+mod util;
+
 use catflip::design::phased::optimize;
 use catflip::model::dynamics::kinetic_energy;
 use catflip::model::{Cat, Half};
 use nalgebra::{Matrix3, Rotation3, Vector3};
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
-}
+use util::seed;
 
 /// Heavy short rear, light long thin front.
 const UNEQUAL: [&str; 3] = [

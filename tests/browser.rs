@@ -2,8 +2,10 @@
 //! without errors, and the animation advances. Ignored by default because it
 //! needs `chromium`; `.ci/run` installs it and runs `cargo test --release --test browser -- --ignored`.
 
-use std::path::Path;
+mod util;
+
 use std::process::Command;
+use util::{bin, seed_toml, temp_dir};
 
 /// The text of `<pre id="ID">...</pre>` in a dumped DOM.
 fn pre<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
@@ -17,16 +19,16 @@ fn pre<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
 #[test]
 #[ignore = "needs chromium (.ci/run installs it)"]
 fn report_page_renders_runs_and_animates_in_chromium() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml");
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+    let dir = temp_dir();
+    let cfg = seed_toml();
+    let o = bin()
         .args(["run", cfg.to_str().unwrap()])
         .current_dir(dir.path())
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let base = dir.path().join("output/seed/run");
-    let profile = tempfile::tempdir().unwrap();
+    let profile = temp_dir();
     let url = format!("file://{}#selftest", base.join("index.html").display());
     let out = Command::new("chromium")
         .args([

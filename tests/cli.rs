@@ -1,36 +1,15 @@
 //! The real binary on a temporary directory.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod util;
 
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_catflip"))
-}
-
-fn configs() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
-}
-
-fn run(args: &[&str], dir: &Path) -> Output {
-    bin()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs")
-}
-
-fn text(o: &Output) -> (String, String) {
-    (
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+use std::path::Path;
+use util::{bin, configs, output, temp_dir, text};
 
 #[test]
 fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
-    let o = run(&["analyze", cfg.to_str().unwrap(), "--json"], dir.path());
+    let o = output(&["analyze", cfg.to_str().unwrap(), "--json"], dir.path());
     let (out, err) = text(&o);
     assert!(o.status.success(), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -93,12 +72,12 @@ fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
 
 #[test]
 fn simulate_replays_a_written_schedule() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
-    let o = run(&["analyze", cfg.to_str().unwrap()], dir.path());
+    let o = output(&["analyze", cfg.to_str().unwrap()], dir.path());
     assert!(o.status.success());
     let sched = dir.path().join("output/seed/analyze/analytic.csv");
-    let o = run(
+    let o = output(
         &[
             "simulate",
             cfg.to_str().unwrap(),
@@ -116,7 +95,7 @@ fn simulate_replays_a_written_schedule() {
     // from another height it is refused, with the height that fits it
     let replay = |height: &str| {
         let set = format!("fall.height={height}");
-        run(
+        output(
             &[
                 "simulate",
                 cfg.to_str().unwrap(),
@@ -143,7 +122,7 @@ fn simulate_replays_a_written_schedule() {
 
 #[test]
 fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let seed = std::fs::read_to_string(configs().join("seed.toml")).unwrap();
     let cases: Vec<(&str, String, Vec<&str>, &str)> = vec![
         (
@@ -188,7 +167,7 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
         std::fs::write(&path, body).unwrap();
         let mut args = vec!["analyze", path.to_str().unwrap()];
         args.extend(extra);
-        let o = run(&args, dir.path());
+        let o = output(&args, dir.path());
         let (_, err) = text(&o);
         assert!(!o.status.success(), "{what} should fail");
         assert!(
@@ -200,11 +179,11 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
             "{what} left output behind"
         );
     }
-    let o = run(&["analyze", "no-such.toml"], dir.path());
+    let o = output(&["analyze", "no-such.toml"], dir.path());
     assert!(!o.status.success() && text(&o).1.contains("no-such.toml"));
     // a seed for the phased design, which has none, is refused, not ignored
     let seed_cfg = configs().join("seed.toml");
-    let o = run(
+    let o = output(
         &["optimize", seed_cfg.to_str().unwrap(), "--seed", "analytic"],
         dir.path(),
     );
@@ -220,7 +199,7 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
         "t_s,phase,q1_rad,q2_rad,qd1_rad_s,qd2_rad_s,tau1_nm,tau2_nm\n0,fold,0,0,0,0,x,0\n",
     )
     .unwrap();
-    let o = run(
+    let o = output(
         &[
             "simulate",
             cfg.to_str().unwrap(),
@@ -261,7 +240,7 @@ fn assert_keys(v: &serde_json::Value, keys: &[&str]) {
 fn run_json(args: &[&str], dir: &Path) -> serde_json::Value {
     let mut all = args.to_vec();
     all.push("--json");
-    let o = run(&all, dir);
+    let o = output(&all, dir);
     let (out, err) = text(&o);
     assert!(o.status.success(), "{err}");
     serde_json::from_str(&out).unwrap()
@@ -269,7 +248,7 @@ fn run_json(args: &[&str], dir: &Path) -> serde_json::Value {
 
 #[test]
 fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let v = run_json(
         &["optimize", cfg.to_str().unwrap(), "--mode", "phased"],
@@ -301,12 +280,12 @@ fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
 
 #[test]
 fn impossible_limits_fail_with_a_clear_reason_and_write_nothing() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let optimize = |config: &str, extra: &[&str]| {
         let cfg = configs().join(config);
         let mut args = vec!["optimize", cfg.to_str().unwrap()];
         args.extend(extra);
-        let o = run(&args, dir.path());
+        let o = output(&args, dir.path());
         assert!(!dir.path().join("output").exists());
         (o.status.code(), text(&o).1)
     };
@@ -340,7 +319,7 @@ fn free_from_analytic<'a>(cfg: &'a str, extra: &[&'a str]) -> Vec<&'a str> {
 
 #[test]
 fn optimize_free_reports_iterations_and_nodes() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let v = run_json(&free_from_analytic(cfg.to_str().unwrap(), &[]), dir.path());
     assert_keys(&v, &OPTIMIZE_KEYS);
@@ -361,7 +340,7 @@ fn optimize_free_reports_iterations_and_nodes() {
 #[test]
 fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
     // `catflip simulate ... | head`: the reader is gone before catflip prints
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let mut child = bin()
         .args(["simulate"])
         .arg(configs().join("seed.toml"))
@@ -377,7 +356,7 @@ fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
     assert!(o.status.success(), "{:?}: {err}", o.status);
     assert!(!err.contains("panicked"), "{err}");
     // with the pipe open, the table says what was simulated
-    let o = run(
+    let o = output(
         &[
             "simulate",
             configs().join("seed.toml").to_str().unwrap(),
@@ -395,7 +374,7 @@ fn a_closed_stdout_pipe_ends_quietly_and_pd_off_is_labelled() {
 
 #[test]
 fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let args = [
         "--verbose",
@@ -404,7 +383,7 @@ fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
         "--set",
         "free.nodes=10",
     ];
-    let o = run(
+    let o = output(
         &free_from_analytic(cfg.to_str().unwrap(), &args),
         dir.path(),
     );

@@ -18,10 +18,7 @@ fn design() -> &'static (Config, Reference, Tvlqr) {
     static D: OnceLock<(Config, Reference, Tvlqr)> = OnceLock::new();
     D.get_or_init(|| {
         let cfg = seed_cfg();
-        let plan =
-            catflip::design::free::optimize(&cfg, catflip::design::free::Seed::Phased, |_| {})
-                .unwrap()
-                .plan;
+        let plan = catflip::control::robustness::design(&cfg).unwrap().plan;
         let r = Reference::new(&cfg, &plan);
         let tv = Tvlqr::new(&r, &cfg.control);
         (cfg, r, tv)
@@ -192,9 +189,7 @@ fn the_study_is_deterministic_and_its_shards_concatenate() {
     use catflip::control::robustness::{Study, shard_range, to_csv};
     let (cfg, r, _) = design();
     let _ = r;
-    let plan = catflip::design::free::optimize(cfg, catflip::design::free::Seed::Phased, |_| {})
-        .unwrap()
-        .plan;
+    let plan = catflip::control::robustness::design(cfg).unwrap().plan;
     let study = Study::new(cfg, &plan, 7);
     let n = 6;
     let whole = to_csv(&study.run(0..n, 2, |_, _| {}), true);

@@ -1,17 +1,12 @@
 //! Phased designs inside the motor envelope (design/envelope.rs) against
 //! F7, time scaling, the unit-time peak program, and the motor model.
 
-use catflip::Config;
+mod util;
+
 use catflip::design::envelope::{height_for, torque_squared_integral, usage_of};
 use catflip::design::phased::optimize;
 use catflip::design::plan::Schedule;
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
-}
+use util::seed;
 
 #[test]
 fn time_with_a_torque_limit_alone_is_f7() {

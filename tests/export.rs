@@ -2,33 +2,11 @@
 //! the schedule in the simulator's coordinates. The engines themselves
 //! (MuJoCo, pyBullet) check the replays in `.ci/run` (examples/replay_*.py).
 
-use catflip::Config;
+mod util;
+
 use catflip::export::controls::{Controls, Simulator, time_step};
 use catflip::model::Joint;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn configs() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
-}
-
-fn config(name: &str, set: &[&str]) -> Config {
-    let ov: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-    Config::load(&configs().join(format!("{name}.toml")), &ov).unwrap()
-}
-
-fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
+use util::{config, configs, run_ok, temp_dir};
 
 fn num(s: &str) -> f64 {
     s.parse()
@@ -254,16 +232,16 @@ fn models_carry_the_masses_inertias_limits_and_actuators() {
 /// torque is linear between rows, so its integral is the trapezoid rule.
 #[test]
 fn held_torques_carry_the_schedules_impulse() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg_path = configs().join("robot-universal.toml");
     let c = cfg_path.to_str().unwrap();
-    let (ok, _, err) = run(&["analyze", c], dir.path());
+    let (ok, _, err) = run_ok(&["analyze", c], dir.path());
     assert!(ok, "{err}");
     let sched = dir
         .path()
         .join("output/robot-universal/analyze/analytic.csv");
     let base = dir.path().join("output/robot-universal/export-mjcf");
-    let (ok, out, err) = run(
+    let (ok, out, err) = run_ok(
         &["export", "mjcf", c, "--schedule", sched.to_str().unwrap()],
         dir.path(),
     );
@@ -364,12 +342,12 @@ fn ball_controls_are_quaternions_and_child_frame_rates() {
 
 #[test]
 fn export_with_a_bad_schedule_fails_and_writes_nothing() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let bad = dir.path().join("broken.csv");
     std::fs::write(&bad, "t_s,phase,q1_rad\n0,fold,0\n").unwrap();
     let cfg = configs().join("seed.toml");
     for sched in [bad.to_str().unwrap(), "missing.csv"] {
-        let (ok, _, err) = run(
+        let (ok, _, err) = run_ok(
             &["export", "mjcf", cfg.to_str().unwrap(), "--schedule", sched],
             dir.path(),
         );

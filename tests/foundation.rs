@@ -1,6 +1,7 @@
 //! Physics facts of docs/model.md section 6 checked on the library.
 
-use catflip::Config;
+mod util;
+
 use catflip::design::analytic::{analytic_plan, closed_forms, plan, turns_theta, yy_inertia_and_c};
 use catflip::design::plan::ShapePlan;
 use catflip::model::Joint;
@@ -9,13 +10,7 @@ use catflip::model::so3::flip_error;
 use catflip::verify::ode::OdeSettings;
 use catflip::verify::simulate::{Controller, dynamic, kinematic};
 use std::f64::consts::PI;
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
-}
+use util::seed;
 
 fn tight() -> OdeSettings {
     OdeSettings {

@@ -1,29 +1,23 @@
 //! The free-form optimiser: linearisation, SCP machinery, and results.
 
+mod util;
+
 use catflip::Config;
 use catflip::design::analytic::analytic_plan;
 use catflip::design::collocation::Transcription;
 use catflip::design::free::FreeProblem;
 use catflip::design::scp::{Cost, ScpIteration, ScpProblem, ScpStatus, Values};
-
-/// A bundled config. The robot's servo also has a torque-speed line, which
-/// only the envelope designs handle (tests/envelope.rs); here the robot is the
-/// peak-torque problem of the same body under its stall torque alone.
-fn cfg(name: &str, overrides: &[&str]) -> Config {
-    let p = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&p)
-        .unwrap()
-        .replace("no_load_speed", "# no_load_speed");
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, &p, &ov).unwrap()
-}
+// the bundled configs as peak-torque problems (the robot under its stall torque alone)
+use util::stall_torque_only as cfg;
 
 /// The seed config with `norm`, and its free-form design seeded by the
 /// certified phased design, at the config's nodes.
 fn seed_from_certified_phased(norm: &str) -> (Config, catflip::design::free::FreeResult) {
     let c = cfg("seed", &[&format!("limits.norm={norm}")]);
     let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-    let r = catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
+    let r = catflip::design::free::FreeDesign::new(&c)
+        .from_plan(&phased.plan, "phased")
+        .solve()
         .unwrap();
     (c, r)
 }
@@ -342,7 +336,10 @@ fn an_unmoved_cat_is_half_a_turn_from_the_flip_and_a_hopeless_limit_fails() {
     assert!((norm - std::f64::consts::PI).abs() < 1e-12, "{att:?}");
     // and a limit far below any flip's peak is a failure, not a design
     let c = cfg("seed", &["limits.max_torque=0.01"]);
-    let e = catflip::design::free::optimize(&c, catflip::design::free::Seed::Phased, |_| {});
+    let e = catflip::design::free::FreeDesign::new(&c)
+        .seed(catflip::design::free::Seed::Phased)
+        .check_mesh()
+        .solve();
     assert!(e.is_err(), "{:?}", e.map(|r| (r.status, r.flip_error_rad)));
 }
 
@@ -351,25 +348,29 @@ fn accepted_scp_steps_never_increase_the_penalised_objective() {
     let c = cfg("seed", &[]);
     let mut seen = 0;
     let mut anchor: Option<f64> = None;
-    let r = catflip::design::free::optimize(&c, catflip::design::free::Seed::Analytic, |it| {
-        if it.accepted {
-            seen += 1;
-            assert!(
-                it.merit_after <= it.merit,
-                "iteration {}: {} -> {}",
-                it.iteration,
-                it.merit,
-                it.merit_after
-            );
-        } else if let Some(a) = anchor {
-            // a step that undoes a tentative one ends where that one began
-            assert_eq!(it.merit_after, a);
-        } else {
-            assert_eq!(it.merit_after, it.merit);
-        }
-        anchor = it.tentative.then_some(it.merit);
-    })
-    .unwrap();
+    let r = catflip::design::free::FreeDesign::new(&c)
+        .seed(catflip::design::free::Seed::Analytic)
+        .check_mesh()
+        .on_iteration(&mut |it| {
+            if it.accepted {
+                seen += 1;
+                assert!(
+                    it.merit_after <= it.merit,
+                    "iteration {}: {} -> {}",
+                    it.iteration,
+                    it.merit,
+                    it.merit_after
+                );
+            } else if let Some(a) = anchor {
+                // a step that undoes a tentative one ends where that one began
+                assert_eq!(it.merit_after, a);
+            } else {
+                assert_eq!(it.merit_after, it.merit);
+            }
+            anchor = it.tentative.then_some(it.merit);
+        })
+        .solve()
+        .unwrap();
     assert!(seen > 5);
     assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
 }
@@ -384,9 +385,10 @@ fn a_tentative_step_stands_only_if_the_next_lowers_the_merit_below_its_start() {
         &["limits.norm=per-motor", "free.mesh_continuation=false"],
     );
     let plan = catflip::design::free::Seed::Analytic.plan(&c).unwrap();
-    let r =
-        catflip::design::free::optimize_from(&c, plan.as_ref(), "analytic", c.free.nodes, |_| {})
-            .unwrap();
+    let r = catflip::design::free::FreeDesign::new(&c)
+        .from_plan(plan.as_ref(), "analytic")
+        .solve()
+        .unwrap();
     assert_eq!(r.status, ScpStatus::Converged);
     let it = &r.iterations;
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-12 * a.abs().max(1.0);
@@ -436,7 +438,11 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
         catflip::design::free::Seed::Phased,
         catflip::design::free::Seed::Analytic,
     ] {
-        let r = catflip::design::free::optimize(&c, seed, |_| {}).unwrap();
+        let r = catflip::design::free::FreeDesign::new(&c)
+            .seed(seed)
+            .check_mesh()
+            .solve()
+            .unwrap();
         assert_eq!(
             r.status,
             catflip::design::scp::ScpStatus::Converged,
@@ -466,9 +472,11 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
 fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
     for norm in ["euclidean", "per-motor"] {
         let (c, certified) = seed_from_certified_phased(norm);
-        let coarse =
-            catflip::design::free::optimize(&c, catflip::design::free::Seed::Phased, |_| {})
-                .unwrap();
+        let coarse = catflip::design::free::FreeDesign::new(&c)
+            .seed(catflip::design::free::Seed::Phased)
+            .check_mesh()
+            .solve()
+            .unwrap();
         for r in [&certified, &coarse] {
             assert_eq!(
                 r.status,
@@ -494,7 +502,10 @@ fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
 #[test]
 fn per_motor_seed_design_at_120_nodes_is_within_half_a_percent_of_the_ipopt_optimum() {
     let c = cfg("seed", &["limits.norm=per-motor", "free.nodes=120"]);
-    let r = catflip::design::free::optimize_from(&c, &analytic_plan(&c), "analytic", 120, |_| {})
+    let r = catflip::design::free::FreeDesign::new(&c)
+        .from_plan(&analytic_plan(&c), "analytic")
+        .nodes(120)
+        .solve()
         .unwrap();
     assert_eq!(r.status, ScpStatus::Converged);
     let ipopt = 0.31637;
@@ -539,7 +550,11 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
         let c = cfg("seed", &[&norm_key]);
         let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
         let run = |c: &Config| {
-            catflip::design::free::optimize_from(c, &phased.plan, "phased", 40, |_| {}).unwrap()
+            catflip::design::free::FreeDesign::new(c)
+                .from_plan(&phased.plan, "phased")
+                .nodes(40)
+                .solve()
+                .unwrap()
         };
         let (direct, continued) = (run(&direct_cfg), run(&c));
         for r in [&direct, &continued] {
@@ -558,14 +573,12 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
         // what the observer was shown is what the result records, each
         // mesh announced before its iterations
         let mut seen = Seen::default();
-        let again = catflip::design::free::optimize_from_observed(
-            &c,
-            &phased.plan,
-            "phased",
-            40,
-            &mut seen,
-        )
-        .unwrap();
+        let again = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&phased.plan, "phased")
+            .nodes(40)
+            .observe(&mut seen)
+            .solve()
+            .unwrap();
         let shown = seen.iterations;
         let meshes: Vec<(usize, usize)> = again
             .mesh_levels
@@ -600,10 +613,16 @@ fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
     for name in ["seed", "domestic-cat"] {
         let c = cfg(name, &[]);
         let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let a =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
-        let b =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 80, |_| {}).unwrap();
+        let a = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&phased.plan, "phased")
+            .nodes(40)
+            .solve()
+            .unwrap();
+        let b = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&phased.plan, "phased")
+            .nodes(80)
+            .solve()
+            .unwrap();
         let rel = (a.peak_torque_nm - b.peak_torque_nm).abs() / b.peak_torque_nm;
         assert!(
             rel < 0.01,
@@ -620,9 +639,10 @@ fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
     for name in ["seed", "domestic-cat", "robot-universal"] {
         let c = cfg(name, &[]);
         let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let free =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", c.free.nodes, |_| {})
-                .unwrap();
+        let free = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&phased.plan, "phased")
+            .solve()
+            .unwrap();
         assert!(
             free.peak_torque_nm <= phased.peak_torque_nm,
             "{name}: {} > {}",
@@ -638,8 +658,11 @@ fn bend_limit_holds_in_both_optimisers() {
     let c = cfg("seed", &["limits.max_bend_deg=30"]);
     let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
     assert!(phased.bend_deg <= 30.0 + 1e-9, "{}", phased.bend_deg);
-    let free =
-        catflip::design::free::optimize_from(&c, &phased.plan, "phased", 20, |_| {}).unwrap();
+    let free = catflip::design::free::FreeDesign::new(&c)
+        .from_plan(&phased.plan, "phased")
+        .nodes(20)
+        .solve()
+        .unwrap();
     // held by the subproblems' cones to the interior point's tolerance and
     // by the second-order correction to first order (its KKT step keeps
     // the cone's active set linearised): 30.0000011 deg seen; 1e-5 deg is
@@ -647,23 +670,32 @@ fn bend_limit_holds_in_both_optimisers() {
     assert!(free.bend_deg <= 30.0 + 1e-5, "{}", free.bend_deg);
     assert!(free.flip_error_rad.abs() < 1e-3);
     // the limit costs torque against the unconstrained design (optimum bend ~ 42 deg)
-    let open =
-        catflip::design::free::optimize_from(&cfg("seed", &[]), &phased.plan, "phased", 20, |_| {})
-            .unwrap();
+    let open = catflip::design::free::FreeDesign::new(&cfg("seed", &[]))
+        .from_plan(&phased.plan, "phased")
+        .nodes(20)
+        .solve()
+        .unwrap();
     assert!(free.peak_torque_nm > open.peak_torque_nm);
 }
 
 #[test]
 fn a_torque_limit_that_cannot_bind_changes_nothing() {
-    // issue 10 row 6: 1e9 / 1e12 N m entered the conic data and broke Clarabel
+    // a limit of 1e9 / 1e12 N m once entered the conic data and broke Clarabel;
+    // 1e9 N m is now the largest limit the config accepts
     let open = cfg("seed", &[]);
     let phased = catflip::design::phased::optimize(&open, |_| {}).unwrap();
-    let a =
-        catflip::design::free::optimize_from(&open, &phased.plan, "phased", 40, |_| {}).unwrap();
-    for lim in ["1e9", "1e12"] {
+    let a = catflip::design::free::FreeDesign::new(&open)
+        .from_plan(&phased.plan, "phased")
+        .nodes(40)
+        .solve()
+        .unwrap();
+    for lim in ["1e6", "1e9"] {
         let c = cfg("seed", &[&format!("limits.max_torque={lim}")]);
-        let b =
-            catflip::design::free::optimize_from(&c, &phased.plan, "phased", 40, |_| {}).unwrap();
+        let b = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&phased.plan, "phased")
+            .nodes(40)
+            .solve()
+            .unwrap();
         assert_eq!(
             b.status,
             catflip::design::scp::ScpStatus::Converged,
@@ -680,19 +712,26 @@ fn a_torque_limit_that_cannot_bind_changes_nothing() {
 
 #[test]
 fn extreme_drop_heights_solve_the_same_dimensionless_problem() {
-    // issue 10 row 7 (1e-9 m was "Unbounded"). F3: peak * T^2 does not depend
+    // a drop of 1e-9 m was once "Unbounded"; the config now accepts falls of
+    // 1 ms to 30 s, so the ends of that range. F3: peak * T^2 does not depend
     // on the time available, so the designs agree after scaling.
     let c10 = cfg("seed", &[]);
     let phased = catflip::design::phased::optimize(&c10, |_| {}).unwrap();
     let nodes = 40;
-    let base =
-        catflip::design::free::optimize_from(&c10, &phased.plan, "phased", nodes, |_| {}).unwrap();
+    let base = catflip::design::free::FreeDesign::new(&c10)
+        .from_plan(&phased.plan, "phased")
+        .nodes(nodes)
+        .solve()
+        .unwrap();
     let unit = |c: &catflip::Config, peak: f64| peak * c.available_time().powi(2);
-    for h in ["1e-9", "1e4"] {
+    for h in ["4.9e-6", "4410"] {
         let c = cfg("seed", &[&format!("fall.height={h}")]);
         let ph = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let r =
-            catflip::design::free::optimize_from(&c, &ph.plan, "phased", nodes, |_| {}).unwrap();
+        let r = catflip::design::free::FreeDesign::new(&c)
+            .from_plan(&ph.plan, "phased")
+            .nodes(nodes)
+            .solve()
+            .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged, "{h}");
         let (x, y) = (unit(&c, r.peak_torque_nm), unit(&c10, base.peak_torque_nm));
         assert!((x - y).abs() < 1e-3 * y, "{h}: {x} vs {y}");
@@ -702,13 +741,16 @@ fn extreme_drop_heights_solve_the_same_dimensionless_problem() {
 
 #[test]
 fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
-    // issue 10 row 5: 1 deg needs hundreds of turns of the bend direction
+    // 1 deg needs hundreds of turns of the bend direction
     let c = cfg(
         "seed",
         &["limits.max_bend_deg=1", "phased.bend_min_deg=0.5"],
     );
     let t = std::time::Instant::now();
-    let e = catflip::design::free::optimize(&c, catflip::design::free::Seed::Analytic, |_| {})
+    let e = catflip::design::free::FreeDesign::new(&c)
+        .seed(catflip::design::free::Seed::Analytic)
+        .check_mesh()
+        .solve()
         .unwrap_err()
         .to_string();
     assert!(t.elapsed().as_secs_f64() < 1.0, "not fast");

@@ -1,22 +1,21 @@
 //! Free-form designs for every objective inside the motor envelope, against
 //! F7, time scaling, the motor model and the phased designs.
 
+mod util;
+
 use catflip::Config;
 use catflip::design::envelope::{height_for, usage_of};
-use catflip::design::free::{FreeResult, optimize_from};
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
-}
+use catflip::design::free::{FreeDesign, FreeResult};
+use util::seed;
 
 /// The free-form design seeded by the phased design of the same objective
 /// (the mesh check left out).
 fn free(cfg: &Config) -> FreeResult {
     let phased = catflip::design::phased::optimize(cfg, |_| {}).unwrap();
-    let r = optimize_from(cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+    let r = FreeDesign::new(cfg)
+        .from_plan(&phased.plan, "phased")
+        .solve()
+        .unwrap();
     assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
     r
 }
@@ -86,7 +85,10 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
             "limits.no_load_speed=8",
         ]);
         let phased = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let r = optimize_from(&cfg, &phased.plan, "phased", cfg.free.nodes, |_| {}).unwrap();
+        let r = FreeDesign::new(&cfg)
+            .from_plan(&phased.plan, "phased")
+            .solve()
+            .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
         let margin = usage_of(&cfg, &r.plan).min_margin.unwrap();
         assert!(margin >= -1e-6, "{objective}: margin {margin}");

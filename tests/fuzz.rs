@@ -5,10 +5,12 @@
 //! line) and random strings from the characters the formats use. A fixed
 //! seed keeps failures reproducible; the failing input is printed.
 
+mod util;
+
 use catflip::Config;
 use catflip::design::plan::Schedule;
 use catflip::sweep::SweepSpec;
-use std::path::Path;
+use util::config_text;
 
 /// xorshift64*: no dependency, repeatable.
 struct Rng(u64);
@@ -129,11 +131,6 @@ fn random_text(rng: &mut Rng) -> String {
     (0..rng.below(30)).map(|_| rng.pick(PIECES)).collect()
 }
 
-fn seed_text() -> String {
-    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml"))
-        .unwrap()
-}
-
 /// Runs `f`, and on a panic reports the input that caused it.
 fn no_panic<T>(what: &str, input: &str, f: impl FnOnce() -> catflip::Result<T>) {
     let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f));
@@ -150,7 +147,7 @@ fn no_panic<T>(what: &str, input: &str, f: impl FnOnce() -> catflip::Result<T>) 
 #[test]
 fn config_file_and_set_parsers_never_panic() {
     let mut rng = Rng(0xC0FF_EE00_1234_5678);
-    let base = seed_text();
+    let base = config_text("seed");
     let keys = [
         "cat.mass",
         "cat.joint",
@@ -220,7 +217,7 @@ fn set_range_parser_never_panics_and_accepts_only_what_it_can_run() {
 #[test]
 fn schedule_reader_never_panics() {
     let mut rng = Rng(0xFEED_FACE_CAFE_BEEF);
-    let cfg = Config::from_toml(&seed_text(), "seed", &[]).unwrap();
+    let cfg = Config::from_toml(&config_text("seed"), "seed", &[]).unwrap();
     // a short valid schedule of the seed's fall
     let plan = catflip::design::analytic::analytic_plan(&cfg);
     let base = Schedule::sample(&cfg.cat(), &plan, 4).to_csv();

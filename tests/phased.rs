@@ -1,6 +1,7 @@
 //! The phased optimiser against independent code paths.
 
-use catflip::Config;
+mod util;
+
 use catflip::design::analytic::plan as cosine_plan;
 use catflip::design::path::Path;
 use catflip::design::phased::{design_at, optimize, twist_for};
@@ -10,18 +11,8 @@ use catflip::error::Error;
 use catflip::model::Joint;
 use catflip::verify::analyze::peak_along;
 use catflip::verify::simulate::kinematic;
-
-/// A bundled config. The robot's servo also has a torque-speed line, which
-/// only the envelope designs handle (tests/envelope.rs); here the robot is the
-/// peak-torque problem of the same body under its stall torque alone.
-fn cfg(name: &str, overrides: &[&str]) -> Config {
-    let p = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    let text = std::fs::read_to_string(&p)
-        .unwrap()
-        .replace("no_load_speed", "# no_load_speed");
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, &p, &ov).unwrap()
-}
+// the bundled configs as peak-torque problems (the robot under its stall torque alone)
+use util::stall_torque_only as cfg;
 
 #[test]
 fn socp_peak_matches_inverse_dynamics_along_the_reconstruction_and_converges_in_k() {
@@ -128,7 +119,7 @@ fn optimum_never_exceeds_the_cosine_schedule_at_the_same_bend_and_split() {
             "{name}: {}",
             r.improvement_factor
         );
-        assert!(r.optimum_same_split_nm <= r.analytic_peak_same_bend_nm);
+        assert!(r.optimum_same_split_nm.unwrap() <= r.analytic_peak_same_bend_nm);
         assert!(
             r.flip_error_rad.abs() < 1e-5,
             "{name}: flip error {}",

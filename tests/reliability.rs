@@ -1,31 +1,12 @@
-//! Issue 10: every failure named, nothing half-written, no result thrown away.
-//! Each test runs the real binary on a temporary folder; the row numbers are
-//! the issue's table.
+//! Every failure named, nothing half-written, no result thrown away.
+//! Each test runs the real binary on a temporary folder.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+mod util;
+
+use std::path::Path;
+use std::process::{Command, Stdio};
 use std::time::Duration;
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_catflip"))
-}
-
-fn seed() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/seed.toml")
-}
-
-fn run(args: &[&str], dir: &Path) -> (Option<i32>, String, String) {
-    let o: Output = bin()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs");
-    (
-        o.status.code(),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
+use util::{bin, run, schedule_peak, seed_toml, temp_dir};
 
 /// A tiny deterministic generator (xorshift64*), so runs are repeatable.
 struct Rng(u64);
@@ -39,19 +20,6 @@ impl Rng {
     fn below(&mut self, n: u64) -> u64 {
         self.next() % n
     }
-}
-
-/// Peak of `|tau|` over a schedule CSV's rows, and the row count.
-fn csv_peak(text: &str) -> (f64, usize) {
-    let mut n = 0;
-    let mut peak = 0.0f64;
-    for l in text.lines().skip(1) {
-        let f: Vec<&str> = l.split(',').collect();
-        let (a, b): (f64, f64) = (f[8].parse().unwrap(), f[9].parse().unwrap());
-        peak = peak.max(a.hypot(b));
-        n += 1;
-    }
-    (peak, n)
 }
 
 /// Reads an `analyze` set through its link's target; `None` when there is
@@ -72,7 +40,7 @@ fn read_analyze_set(link: &Path) -> Option<f64> {
     let sched = read("analytic.schedule.json")?;
     let v: serde_json::Value = serde_json::from_str(&json).expect("analyze.json parses");
     let s: serde_json::Value = serde_json::from_str(&sched).expect("schedule JSON parses");
-    let (peak, rows) = csv_peak(&csv);
+    let (peak, rows) = schedule_peak(&csv, false);
     let jp = v["peak_torque_nm"].as_f64().unwrap();
     // the three files describe one schedule: same rows, same peak (the JSON samples more densely)
     assert_eq!(
@@ -107,7 +75,7 @@ fn analyze_cmd(dir: &Path, theta: f64) -> Command {
     let mut c = bin();
     c.args([
         "analyze",
-        seed().to_str().unwrap(),
+        seed_toml().to_str().unwrap(),
         "--set",
         &format!("analytic.theta_deg={theta}"),
     ])
@@ -118,8 +86,8 @@ fn analyze_cmd(dir: &Path, theta: f64) -> Command {
 }
 
 #[test]
-fn row12_sigkill_at_random_moments_never_leaves_a_partial_set() {
-    let dir = tempfile::tempdir().unwrap();
+fn sigkill_at_random_moments_never_leaves_a_partial_set() {
+    let dir = temp_dir();
     let base = dir.path().join("output/seed");
     let link = base.join("analyze");
     let mut rng = Rng(0x5eed_1234);
@@ -145,7 +113,7 @@ fn row12_sigkill_at_random_moments_never_leaves_a_partial_set() {
         );
     }
     // a finished run publishes and removes every leftover of the killed ones
-    let (code, _, err) = run(&["analyze", seed().to_str().unwrap()], dir.path());
+    let (code, _, err) = run(&["analyze", seed_toml().to_str().unwrap()], dir.path());
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(read_analyze_set(&link), Some(45.0));
     let target = std::fs::read_link(&link).unwrap();
@@ -162,8 +130,8 @@ fn row12_sigkill_at_random_moments_never_leaves_a_partial_set() {
 }
 
 #[test]
-fn row11_concurrent_writers_publish_whole_sets_while_a_reader_watches() {
-    let dir = tempfile::tempdir().unwrap();
+fn concurrent_writers_publish_whole_sets_while_a_reader_watches() {
+    let dir = temp_dir();
     let base = dir.path().join("output/seed");
     let link = base.join("analyze");
     let thetas = [40.0, 50.0, 60.0];
@@ -201,8 +169,8 @@ fn row11_concurrent_writers_publish_whole_sets_while_a_reader_watches() {
 
 #[test]
 fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
-    let dir = tempfile::tempdir().unwrap();
-    let c = seed();
+    let dir = temp_dir();
+    let c = seed_toml();
     let c = c.to_str().unwrap();
     let (code, _, err) = run(&["run", c, "--set", "free.nodes=12"], dir.path());
     assert_eq!(code, Some(0), "{err}");
@@ -240,14 +208,14 @@ fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
 }
 
 #[test]
-fn row14_unwritable_out_fails_before_computing_with_one_message() {
-    let dir = tempfile::tempdir().unwrap();
+fn unwritable_out_fails_before_computing_with_one_message() {
+    let dir = temp_dir();
     let file = dir.path().join("a-file");
     std::fs::write(&file, "x").unwrap();
     let (code, out, err) = run(
         &[
             "run",
-            seed().to_str().unwrap(),
+            seed_toml().to_str().unwrap(),
             "--out",
             file.to_str().unwrap(),
         ],
@@ -269,7 +237,7 @@ fn row14_unwritable_out_fails_before_computing_with_one_message() {
         let (code, _, err) = run(
             &[
                 "run",
-                seed().to_str().unwrap(),
+                seed_toml().to_str().unwrap(),
                 "--out",
                 ro.to_str().unwrap(),
             ],
@@ -287,11 +255,11 @@ fn row14_unwritable_out_fails_before_computing_with_one_message() {
 fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     // under a 0.5 N m limit from 12 m the phased optimum (0.565 N m) is
     // impossible, the analytic schedule saturates, the free-form design fits
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let (code, out, err) = run(
         &[
             "run",
-            seed().to_str().unwrap(),
+            seed_toml().to_str().unwrap(),
             "--set",
             "limits.max_torque=0.5",
             "--set",
@@ -325,7 +293,10 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(f["verdict"], "ok", "{f}");
     let base = dir.path().join("output/seed/run");
     // the kept design meets the limit on every written row
-    let (peak, _) = csv_peak(&std::fs::read_to_string(base.join("free.csv")).unwrap());
+    let (peak, _) = schedule_peak(
+        &std::fs::read_to_string(base.join("free.csv")).unwrap(),
+        false,
+    );
     assert!(peak <= 0.5 * (1.0 + 1e-6), "{peak}");
     assert!(!base.join("phased.csv").exists());
     let summary: serde_json::Value =
@@ -339,14 +310,17 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(ans["possible"], true, "{ans}");
     assert_eq!(ans["method"], "free", "{ans}");
     assert!(ans["least_height_m"].as_f64().unwrap() <= 12.0, "{ans}");
-    let (lpeak, _) = csv_peak(&std::fs::read_to_string(base.join("least-height.csv")).unwrap());
+    let (lpeak, _) = schedule_peak(
+        &std::fs::read_to_string(base.join("least-height.csv")).unwrap(),
+        false,
+    );
     assert!(lpeak <= 0.5 * (1.0 + 1e-6), "{lpeak}");
     // the time designs start from the phased schedule and from the analytic
     // one: the answer is no longer than the analytic seed's design alone
     let (code, out, err) = run(
         &[
             "optimize",
-            seed().to_str().unwrap(),
+            seed_toml().to_str().unwrap(),
             "--mode",
             "free",
             "--seed",
@@ -370,11 +344,11 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
 
 #[test]
 fn an_unconverged_design_is_flagged_in_table_and_exit_status() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let (code, out, err) = run(
         &[
             "run",
-            seed().to_str().unwrap(),
+            seed_toml().to_str().unwrap(),
             "--set",
             "free.max_iterations=2",
         ],
@@ -394,7 +368,7 @@ fn an_unconverged_design_is_flagged_in_table_and_exit_status() {
 
 /// Writes the seed's analytic schedule (as `analyze` writes it) and returns its text.
 fn analytic_csv(dir: &Path, extra: &[&str]) -> String {
-    let c = seed();
+    let c = seed_toml();
     let mut args = vec!["analyze", c.to_str().unwrap()];
     args.extend(extra);
     args.extend(["--out", "sched-src"]);
@@ -427,7 +401,7 @@ fn map_rows(csv: &str, f: impl Fn(&mut Vec<f64>)) -> String {
 fn simulate(dir: &Path, schedule: &str, extra: &[&str]) -> (Option<i32>, String, String) {
     let p = dir.join("schedule.csv");
     std::fs::write(&p, schedule).unwrap();
-    let c = seed();
+    let c = seed_toml();
     let mut args = vec![
         "simulate",
         c.to_str().unwrap(),
@@ -439,8 +413,8 @@ fn simulate(dir: &Path, schedule: &str, extra: &[&str]) -> (Option<i32>, String,
 }
 
 #[test]
-fn row2_huge_torques_fail_naming_the_divergence_and_write_nothing() {
-    let dir = tempfile::tempdir().unwrap();
+fn huge_torques_fail_naming_the_divergence_and_write_nothing() {
+    let dir = temp_dir();
     let csv = analytic_csv(dir.path(), &[]);
     // the unchanged schedule replays (control)
     let (code, _, err) = simulate(dir.path(), &csv, &["--json"]);
@@ -464,8 +438,8 @@ fn row2_huge_torques_fail_naming_the_divergence_and_write_nothing() {
 }
 
 #[test]
-fn row3_a_million_row_resampling_is_refused_at_once_with_the_bound() {
-    let dir = tempfile::tempdir().unwrap();
+fn a_million_row_resampling_is_refused_at_once_with_the_bound() {
+    let dir = temp_dir();
     let csv = analytic_csv(dir.path(), &[]);
     // linear resampling of each phase to 333,334 rows: the same schedule, 1e6 rows
     let rows: Vec<Vec<&str>> = csv
@@ -510,8 +484,8 @@ fn row3_a_million_row_resampling_is_refused_at_once_with_the_bound() {
 }
 
 #[test]
-fn row13_a_schedule_for_another_fall_is_refused_naming_both_durations() {
-    let dir = tempfile::tempdir().unwrap();
+fn a_schedule_for_another_fall_is_refused_naming_both_durations() {
+    let dir = temp_dir();
     // designed for a 1 m drop (0.452 s), replayed on the seed's 10 m drop (1.429 s)
     let short = analytic_csv(dir.path(), &["--set", "fall.height=1"]);
     let (code, _, err) = simulate(dir.path(), &short, &[]);
@@ -530,9 +504,9 @@ fn row13_a_schedule_for_another_fall_is_refused_naming_both_durations() {
 }
 
 #[test]
-fn row9_split_needs_exactly_three_numbers() {
-    let dir = tempfile::tempdir().unwrap();
-    let c = seed();
+fn analytic_split_needs_exactly_three_numbers() {
+    let dir = temp_dir();
+    let c = seed_toml();
     let c = c.to_str().unwrap();
     let (code, _, err) = run(
         &[
@@ -545,7 +519,7 @@ fn row9_split_needs_exactly_three_numbers() {
     );
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("analytic.split"), "{err}");
-    let text = std::fs::read_to_string(seed())
+    let text = std::fs::read_to_string(seed_toml())
         .unwrap()
         .replace("split = [0.2, 0.6, 0.2]", "split = [0.2, 0.6, 0.2, -7.0]");
     let bad = dir.path().join("bad.toml");
@@ -557,9 +531,9 @@ fn row9_split_needs_exactly_three_numbers() {
 }
 
 #[test]
-fn row10_config_errors_point_at_the_users_line_or_the_set_argument() {
-    let dir = tempfile::tempdir().unwrap();
-    let text = std::fs::read_to_string(seed()).unwrap();
+fn config_errors_point_at_the_users_line_or_the_set_argument() {
+    let dir = temp_dir();
+    let text = std::fs::read_to_string(seed_toml()).unwrap();
     let line = |needle: &str, t: &str| t.lines().position(|l| l.contains(needle)).unwrap() + 1;
     let cases = [
         (
@@ -590,7 +564,7 @@ fn row10_config_errors_point_at_the_users_line_or_the_set_argument() {
     // an error in an override names the argument
     for arg in ["cat.masss=1", "cat.mass=heavy", "fall=3"] {
         let (code, _, err) = run(
-            &["analyze", seed().to_str().unwrap(), "--set", arg],
+            &["analyze", seed_toml().to_str().unwrap(), "--set", arg],
             dir.path(),
         );
         assert_eq!(code, Some(2), "{err}");
@@ -600,11 +574,11 @@ fn row10_config_errors_point_at_the_users_line_or_the_set_argument() {
 }
 
 #[test]
-fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
-    let dir = tempfile::tempdir().unwrap();
-    let c = seed();
+fn sweeps_bound_the_count_keep_good_points_and_check_threads() {
+    let dir = temp_dir();
+    let c = seed_toml();
     let c = c.to_str().unwrap();
-    // row 1: a billion points is refused before any work
+    // a billion points is refused before any work
     let (code, _, err) = run(
         &[
             "sweep",
@@ -621,7 +595,7 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
         err.contains("--set-range") && err.contains("10000"),
         "{err}"
     );
-    // row 16
+    // no threads
     let (code, _, err) = run(
         &[
             "sweep",
@@ -636,7 +610,7 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--threads"), "{err}");
     assert!(!dir.path().join("output").exists());
-    // row 15: bad points are their own failures, the good ones are computed
+    // bad points are their own failures, the good ones are computed
     let (code, out, err) = run(
         &[
             "sweep",
@@ -675,11 +649,11 @@ fn rows1_15_16_sweeps_bound_the_count_keep_good_points_and_check_threads() {
 
 #[test]
 fn a_sweep_keeps_every_method_and_flags_an_unconverged_one_per_point() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let (code, out, err) = run(
         &[
             "sweep",
-            seed().to_str().unwrap(),
+            seed_toml().to_str().unwrap(),
             "--set-range",
             "fall.height=5:10:2",
             "--set",

@@ -1,53 +1,14 @@
 //! The main job, sweeps and exports, through the real binary and the library.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod util;
 
-fn configs() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
-}
-
-fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
-
-/// Peak of the torque columns of a schedule CSV in the given norm.
-fn csv_peak(text: &str, per_motor: bool) -> f64 {
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
-    assert_eq!(header[0], "t_s");
-    let i1 = header.iter().position(|h| *h == "tau1_nm").unwrap();
-    let mut last_t = f64::NEG_INFINITY;
-    let mut peak = 0.0f64;
-    for l in lines {
-        let f: Vec<&str> = l.split(',').collect();
-        let t: f64 = f[0].parse().unwrap();
-        assert!(t >= last_t, "time column must not decrease");
-        last_t = t;
-        let (a, b): (f64, f64) = (f[i1].parse().unwrap(), f[i1 + 1].parse().unwrap());
-        peak = peak.max(if per_motor {
-            a.abs().max(b.abs())
-        } else {
-            a.hypot(b)
-        });
-    }
-    peak
-}
+use util::{configs, run_ok, schedule_peak, temp_dir};
 
 #[test]
 fn run_writes_a_complete_consistent_report() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
-    let (ok, out, err) = run(&["run", cfg.to_str().unwrap()], dir.path());
+    let (ok, out, err) = run_ok(&["run", cfg.to_str().unwrap()], dir.path());
     assert!(ok, "{err}");
     assert!(
         out.contains("analytic") && out.contains("phased") && out.contains("free"),
@@ -64,7 +25,7 @@ fn run_writes_a_complete_consistent_report() {
         let peak = m["peak_torque_nm"].as_f64().unwrap();
         // the schedule file agrees with the JSON peak (the JSON samples more densely)
         let csv = std::fs::read_to_string(base.join(m["schedule_csv"].as_str().unwrap())).unwrap();
-        let p = csv_peak(&csv, false);
+        let p = schedule_peak(&csv, false).0;
         assert!(
             p <= peak * (1.0 + 1e-6) && p >= 0.98 * peak,
             "{name}: CSV {p} vs JSON {peak}"
@@ -187,9 +148,10 @@ fn sweep_agrees_with_single_runs() {
             catflip::verify::analyze::dense_samples(&cfg),
         );
         let ph = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let fr =
-            catflip::design::free::optimize_from(&cfg, &ph.plan, "phased", cfg.free.nodes, |_| {})
-                .unwrap();
+        let fr = catflip::design::free::FreeDesign::new(&cfg)
+            .from_plan(&ph.plan, "phased")
+            .solve()
+            .unwrap();
         assert!((p.analytic_peak_nm.unwrap() - a).abs() <= 1e-12 * a);
         assert!((p.phased_peak_nm.unwrap() - ph.peak_torque_nm).abs() <= 1e-12 * a);
         // a sweep continues from its neighbour's free-form design, a single
@@ -210,10 +172,10 @@ fn sweep_agrees_with_single_runs() {
 
 #[test]
 fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let c = cfg.to_str().unwrap();
-    let (ok, _, err) = run(
+    let (ok, _, err) = run_ok(
         &[
             "sweep",
             c,
@@ -264,7 +226,7 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
         peaks.iter().cloned().fold(0.0, f64::max) / peaks.iter().cloned().fold(f64::MAX, f64::min);
     assert_eq!(svg.contains("log scale"), spread > 20.0, "spread {spread}");
     for bad in ["cat.mass=1:2", "cat.masss=1:2:3", "cat.mass=-1:2:3"] {
-        let (ok, _, err) = run(&["sweep", c, "--set-range", bad], dir.path());
+        let (ok, _, err) = run_ok(&["sweep", c, "--set-range", bad], dir.path());
         assert!(!ok && !err.is_empty(), "{bad} should fail");
     }
 }
@@ -274,9 +236,9 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
 /// problem is shown where a user looks: table, page, figure, terminal names.
 #[test]
 fn run_shows_an_exceeded_limit_and_an_unconverged_optimiser() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
-    let (_, out, err) = run(
+    let (_, out, err) = run_ok(
         &[
             "run",
             cfg.to_str().unwrap(),

@@ -1,27 +1,9 @@
 //! Sweeps: continuation chunks, shards through the real binary, progress.
 
+mod util;
+
 use catflip::sweep::{CHUNK, Shard, progress_line};
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn configs() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")
-}
-
-/// Runs the binary; `true` when its files were written (exit 0, or 3 for a
-/// partial sweep whose failed points are recorded in the error column).
-fn run(args: &[&str], dir: &Path) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .unwrap();
-    (
-        matches!(o.status.code(), Some(0 | 3)),
-        String::from_utf8_lossy(&o.stdout).into(),
-        String::from_utf8_lossy(&o.stderr).into(),
-    )
-}
+use util::{bin, configs, run_written, temp_dir};
 
 #[test]
 fn shards_partition_the_grid_into_whole_contiguous_chunks() {
@@ -62,7 +44,7 @@ fn progress_line_estimates_the_time_left_from_the_mean_time_per_point() {
 /// single-machine CSV (continuation included: 11 points are two chunks).
 #[test]
 fn sharded_sweep_concatenates_into_the_single_machine_result() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let c = cfg.to_str().unwrap();
     let common = [
@@ -79,7 +61,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     ];
     let mut args = common.to_vec();
     args.extend(["--threads", "2", "--out", "full"]);
-    let (ok, _, err) = run(&args, dir.path());
+    let (ok, _, err) = run_written(&args, dir.path());
     assert!(ok, "{err}");
     let full = std::fs::read_to_string(
         dir.path()
@@ -92,7 +74,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
         let mut args = common.to_vec();
         let shard = format!("{k}/3");
         args.extend(["--threads", "1", "--shard", &shard, "--out", "shards"]);
-        let (ok, _, err) = run(&args, dir.path());
+        let (ok, _, err) = run_written(&args, dir.path());
         assert!(ok, "{err}");
         // 11 points are two chunks of 10: the first of three shards is empty, and says so
         assert_eq!(err.contains("holds no points"), k == 1, "{k}: {err}");
@@ -113,7 +95,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
         let (status, error) = (cells[cells.len() - 2], cells[cells.len() - 1]);
         assert!(!status.is_empty() || !error.is_empty(), "{line}");
     }
-    let (ok, _, err) = run(&[&common[..], &["--shard", "4/3"]].concat(), dir.path());
+    let (ok, _, err) = run_written(&[&common[..], &["--shard", "4/3"]].concat(), dir.path());
     assert!(!ok && err.contains("--shard"), "{err}");
 }
 
@@ -121,7 +103,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
 /// per point `(value, swept peak, swept bend, peak designed afresh at that
 /// value)`.
 fn phased_sweep_against_fresh_designs(key: &str, range: &str) -> Vec<(f64, f64, f64, f64)> {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let set_range = format!("{key}={range}");
     let args = [
@@ -136,7 +118,7 @@ fn phased_sweep_against_fresh_designs(key: &str, range: &str) -> Vec<(f64, f64, 
         "--out",
         "out",
     ];
-    let (ok, _, err) = run(&args, dir.path());
+    let (ok, _, err) = run_written(&args, dir.path());
     assert!(ok, "{err}");
     let name = format!("sweep-{}", key.replace('.', "_"));
     let csv =
@@ -261,10 +243,10 @@ fn whole_ends_and_steps_give_whole_grid_values() {
 /// input before any work, naming the key and the value; a whole grid runs.
 #[test]
 fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let sweep = |range: &str| {
-        Command::new(env!("CARGO_BIN_EXE_catflip"))
+        bin()
             .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
             .args(["--methods", "phased", "--out", "out"])
             .current_dir(dir.path())

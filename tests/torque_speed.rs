@@ -3,8 +3,9 @@
 //! no-load speed, and a schedule the JSON calls inside the envelope is drawn
 //! inside it (one that leaves it is drawn outside: the check can fail).
 
-use std::path::Path;
-use std::process::Command;
+mod util;
+
+use util::{bin, config_path, temp_dir};
 
 /// `(pixel, value)` of each numeric tick label, by text anchor ("end": y
 /// axis, "middle": x axis), for the panel whose pixel rows are `rows`.
@@ -63,10 +64,10 @@ fn elements<'a>(svg: &'a str, tag: &str, needles: &[&str]) -> Vec<&'a str> {
 
 #[test]
 fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
-    let dir = tempfile::tempdir().unwrap();
-    let cfg = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs/robot-universal.toml");
+    let dir = temp_dir();
+    let cfg = config_path("robot-universal");
     // from 6 m the phased design fits the servo (the analytic one does not)
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+    let o = bin()
         .args(["run", cfg.to_str().unwrap(), "--set", "fall.height=6"])
         .args(["--set", "free.nodes=20", "--out"])
         .arg(dir.path())

@@ -20,6 +20,15 @@ pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
 /// The controllers a study compares, in the order of the CSV's columns.
 pub const CONTROLLERS: [&str; 2] = ["open-loop", "tvlqr"];
 
+/// The design a study flies: the free-form one from the phased seed, as
+/// `run` makes it, or from the analytic seed where the phased family cannot fit.
+pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
+    use crate::design::free::{FreeDesign, Seed};
+    FreeDesign::new(cfg)
+        .solve()
+        .or_else(|_| FreeDesign::new(cfg).seed(Seed::Analytic).solve())
+}
+
 /// One trial's draws.
 #[derive(Debug, Clone, Copy, Serialize)]
 pub struct Draw {

@@ -5,7 +5,83 @@
 //! objective has kinks (a phase taking over the peak); it assumes
 //! unimodality inside the bracket.
 
-use crate::error::Result;
+use crate::config::Config;
+use crate::design::analytic::turns_theta;
+use crate::error::{Error, Result};
+use serde::Serialize;
+use std::f64::consts::PI;
+
+/// One evaluation of the bend search, as reported to an observer: at the
+/// search's accuracy ([`ConicSettings::SEARCH`](crate::design::conic::ConicSettings::SEARCH),
+/// within about 1e-6 of the certified value the chosen bend is solved to).
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct BendEvaluation {
+    pub bend_deg: f64,
+    /// The objective at this bend, in its unit (`design.objective`; infinite
+    /// where no timing fits the motor envelope).
+    pub value: f64,
+    /// The peak if the manoeuvre took 1 s, N m s^2 (the unit-time peak
+    /// program only: absent inside a motor envelope).
+    pub unit_peak: Option<f64>,
+    /// The peak at this bend, N m (absent for another objective).
+    pub peak_nm: Option<f64>,
+}
+
+/// The coarse bend scan over `[lo, hi]` rad: `phased.scan_points` even
+/// points plus the one-turn bend (F6) and the config's bend where inside.
+pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
+    let cat = cfg.cat();
+    let n = cfg.phased.scan_points;
+    let mut xs: Vec<f64> = (0..n)
+        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
+        .collect();
+    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
+    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
+    for b in [one_turn, seed_bend] {
+        if b > lo && b < hi {
+            xs.push(b);
+        }
+    }
+    xs
+}
+
+/// The bend range the config allows, rad.
+pub fn bend_range(cfg: &Config) -> Result<(f64, f64)> {
+    let lo = cfg.phased.bend_min_deg.to_radians();
+    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
+    if hi <= lo {
+        return Err(Error::Invalid {
+            key: "limits.max_bend_deg".into(),
+            value: format!("{}", cfg.max_bend().to_degrees()),
+            expected: format!(
+                "must exceed phased.bend_min_deg = {}",
+                cfg.phased.bend_min_deg
+            ),
+        });
+    }
+    Ok((lo, hi))
+}
+
+/// Where a neighbouring design (a sweep's previous point) puts the best
+/// bend: the local search starts there, `step` either side.
+#[derive(Debug, Clone, Copy)]
+pub struct BendHint {
+    pub bend: f64,
+    pub step: f64,
+}
+
+impl BendHint {
+    /// The prediction from the last two points' bends (linear
+    /// extrapolation), or from the last alone; the bracket is as wide as
+    /// the last change, and at least a degree.
+    pub fn from_neighbours(last: f64, before: Option<f64>) -> Self {
+        let change = before.map_or(0.0, |b| last - b);
+        BendHint {
+            bend: last + change,
+            step: change.abs().max(1f64.to_radians()),
+        }
+    }
+}
 
 /// A design at one bend, ranked by its score (lower is better; `f64::INFINITY`
 /// for a bend at which the design is impossible).

@@ -60,19 +60,17 @@
 //! that its equilibration matches the bend's data.
 
 use crate::config::Config;
-use crate::design::analytic::plan as cosine_plan;
+use crate::design::bend_search::{BendEvaluation, bend_range, bend_scan};
 use crate::design::bend_search::{Scored, scan_then_brent};
 use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::design::objective::Objective;
 use crate::design::path::{GridTiming, Path, PhasedPlan, Timing};
-use crate::design::phased::{BendEvaluation, PhasedResult, bend_range, bend_scan, twist_for};
 use crate::design::plan::{Schedule, ShapePlan};
 use crate::design::timing::path_coefficients;
+use crate::design::twist::twist_for;
 use crate::error::{Error, Result};
 use crate::model::motor::{Motor, MotorUse};
 use crate::model::{Cat, TorqueNorm};
-use crate::verify::analyze::{dense_samples, peak_along};
-use crate::verify::simulate::dynamic_cfg;
 use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
 use std::time::Instant;
 
@@ -769,8 +767,22 @@ fn verified_design(
 /// about 1e-4 relative), the final design iterates to 1e-5.
 const COARSE_TANGENT_TOL: f64 = 1e-3;
 
+/// A phased design inside the motor envelope: the chosen bend's verified
+/// design and plan (the phased optimiser reconstructs and simulates it).
+#[derive(Debug, Clone)]
+pub struct EnvelopeResult {
+    pub status: SolveStatus,
+    pub objective: Objective,
+    pub bend: f64,
+    pub twist: f64,
+    /// The verified plan, on time for the fall.
+    pub plan: PhasedPlan,
+    pub evaluations: Vec<BendEvaluation>,
+    pub solve_time_s: f64,
+}
+
 /// The phased optimiser inside the motor envelope, for `design.objective`.
-pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Result<EnvelopeResult> {
     let start = Instant::now();
     let cat = cfg.cat();
     let objective = cfg.design.objective;
@@ -791,12 +803,8 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
         let e = BendEvaluation {
             bend_deg: d.bend.to_degrees(),
             value: d.value,
-            unit_peak: f64::NAN,
-            peak_nm: if objective == Objective::PeakTorque {
-                d.value
-            } else {
-                f64::NAN
-            },
+            unit_peak: None,
+            peak_nm: (objective == Objective::PeakTorque).then_some(d.value),
         };
         observe(&e);
         evals.push(e);
@@ -826,45 +834,14 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
     let Some((design, plan)) = found else {
         return Err(unreachable_here(cfg, fastest_bend));
     };
-    let solve_time = start.elapsed().as_secs_f64();
-    let time: f64 = plan.durations.iter().sum();
-    let (peak, _) = peak_along(cfg, &plan, dense_samples(cfg));
-    let value = match objective {
-        Objective::PeakTorque => peak,
-        Objective::Time => time,
-        Objective::Energy => torque_squared_integral(&cat, &plan, dense_samples(cfg)),
-    };
-    let split = cfg.analytic.split.map(|f| f * time);
-    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);
-    let sim = dynamic_cfg(cfg, &plan)?;
-    Ok(PhasedResult {
-        mode: "phased",
+    Ok(EnvelopeResult {
         status: design.status,
         objective,
-        objective_value: value,
-        manoeuvre_time_s: time,
-        peak_torque_nm: peak,
-        socp_peak_torque_nm: f64::NAN,
-        unit_peak_nm_s2: peak * time * time,
-        bend_deg: design.bend.to_degrees(),
-        theta_deg: 180.0 - design.bend.to_degrees(),
-        twist_rad: design.twist,
-        phase_durations_s: plan.durations,
-        phase_unit_peaks_nm_s2: [f64::NAN; 3],
-        analytic_peak_same_bend_nm: analytic_peak,
-        optimum_same_split_nm: f64::NAN,
-        improvement_factor: analytic_peak / peak,
-        flip_deg: sim.flip_deg,
-        flip_error_rad: sim.flip_error_rad,
-        tilt_deg: sim.tilt_deg,
-        sim_peak_torque_nm: sim.peak_torque_nm,
-        momentum_drift_nms: sim.momentum_drift_nms,
-        nodes: cfg.phased.nodes,
-        evaluations: evals,
-        solve_time_s: solve_time,
+        bend: design.bend,
+        twist: design.twist,
         plan,
-        design: None,
-        sim: Some(sim),
+        evaluations: evals,
+        solve_time_s: start.elapsed().as_secs_f64(),
     })
 }
 
@@ -887,7 +864,9 @@ fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
             .flatten()
             .map(|(_, plan)| plan.durations.iter().sum::<f64>())
     } else {
-        optimize(&timed, |_| {}).ok().map(|r| r.manoeuvre_time_s)
+        optimize(&timed, |_| {})
+            .ok()
+            .map(|r| r.plan.durations.iter().sum::<f64>())
     };
     let least = least_time.map(|t| height_for(cfg, t));
     Error::Unreachable {

@@ -1039,19 +1039,8 @@ impl Observer for Numbered<'_> {
 /// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
 /// order (`mesh_levels`), and the observer sees them numbered on. A fine
 /// design the coarse one cannot start is solved from the seed.
-pub fn optimize_from(
-    cfg: &Config,
-    seed_plan: &dyn crate::design::plan::ShapePlan,
-    seed: &str,
-    nodes: usize,
-    mut observe: impl FnMut(&ScpIteration),
-) -> Result<FreeResult> {
-    optimize_from_observed(cfg, seed_plan, seed, nodes, &mut observe)
-}
-
-/// [`optimize_from`] with an [`Observer`], which is also told where each
-/// mesh begins.
-pub fn optimize_from_observed(
+/// The observer is also told where each mesh begins.
+fn from_plan(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
     seed: &str,
@@ -1441,7 +1430,7 @@ fn inside_envelope(
 /// Runs the SCP from a start `z0` in physical units (see [`design`]), keeps
 /// the schedule inside the motor envelope (see [`inside_envelope`]) and
 /// verifies it by simulation.
-pub fn optimize_start(
+fn optimize_start(
     cfg: &Config,
     z0: &[f64],
     warm: Option<&WarmStart>,
@@ -1556,7 +1545,7 @@ fn infeasible(cfg: &Config, node_peak: f64) -> crate::error::Error {
 /// starts next to it. With the design `before` `prev` (one grid step
 /// further back) the start is the secant predictor `2 prev - before`,
 /// which moves it along the solution path as well.
-pub fn continue_from(
+fn continue_from(
     cfg: &Config,
     prev: &FreeResult,
     before: Option<&FreeResult>,
@@ -1696,34 +1685,114 @@ pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
     })
 }
 
-/// The free-form optimiser with the config's nodes and the chosen seed.
-pub fn optimize(
-    cfg: &Config,
-    seed: Seed,
-    mut observe: impl FnMut(&ScpIteration),
-) -> Result<FreeResult> {
-    optimize_observed(cfg, seed, &mut observe)
+/// Where a free-form design starts.
+#[derive(Clone, Copy)]
+pub enum Start<'a> {
+    /// A seed the design makes itself (the phased design's schedule or the
+    /// analytic one).
+    Seed(Seed),
+    /// A given schedule, named in the result (`phased`, `analytic`, ...).
+    Plan(&'a dyn ShapePlan, &'a str),
+    /// A neighbouring design (continuation, in the optimiser's
+    /// dimensionless units) and the one before it (the secant predictor).
+    Warm(&'a FreeResult, Option<&'a FreeResult>),
 }
 
-/// [`optimize`] with an [`Observer`], which is also told where each mesh
-/// begins.
-pub fn optimize_observed(
-    cfg: &Config,
-    seed: Seed,
-    observe: &mut dyn Observer,
-) -> Result<FreeResult> {
-    check_resolvable(cfg, cfg.free.nodes)?;
-    let plan = match seed.plan(cfg) {
-        // the phased family's least height is not the free-form design's:
-        // say so rather than pass it on as the answer
-        Err(crate::error::Error::Unreachable { reason }) => {
-            return Err(crate::error::Error::SeedUnfit { reason });
+/// The free-form optimiser, configured step by step:
+/// `FreeDesign::new(&cfg).seed(Seed::Analytic).observe(&mut table).solve()`.
+/// By default it starts from the phased seed at `free.nodes` per phase,
+/// without the mesh check.
+pub struct FreeDesign<'a> {
+    cfg: &'a Config,
+    start: Start<'a>,
+    nodes: usize,
+    mesh_check: bool,
+    observer: Option<&'a mut dyn Observer>,
+}
+
+impl<'a> FreeDesign<'a> {
+    pub fn new(cfg: &'a Config) -> Self {
+        FreeDesign {
+            cfg,
+            start: Start::Seed(Seed::Phased),
+            nodes: cfg.free.nodes,
+            mesh_check: false,
+            observer: None,
         }
-        r => r?,
-    };
-    let mut r = optimize_from_observed(cfg, plan.as_ref(), seed.name(), cfg.free.nodes, observe)?;
-    r.mesh_check = Some(mesh_check(cfg, &r)?);
-    Ok(r)
+    }
+
+    /// Start from a seed the design makes ([`Seed::plan`]).
+    pub fn seed(mut self, seed: Seed) -> Self {
+        self.start = Start::Seed(seed);
+        self
+    }
+
+    /// Start from a given schedule, named `name` in the result.
+    pub fn from_plan(mut self, plan: &'a dyn ShapePlan, name: &'a str) -> Self {
+        self.start = Start::Plan(plan, name);
+        self
+    }
+
+    /// Start from a neighbouring design, `before` the one before it
+    /// (continuation; the mesh is always `free.nodes`).
+    pub fn warm(mut self, prev: &'a FreeResult, before: Option<&'a FreeResult>) -> Self {
+        self.start = Start::Warm(prev, before);
+        self
+    }
+
+    /// Collocation nodes per phase (default `free.nodes`).
+    pub fn nodes(mut self, nodes: usize) -> Self {
+        self.nodes = nodes;
+        self
+    }
+
+    /// Re-optimise at twice the nodes as a check ([`mesh_check`]).
+    pub fn check_mesh(mut self) -> Self {
+        self.mesh_check = true;
+        self
+    }
+
+    /// Who sees each iteration (and, with mesh continuation, each mesh).
+    pub fn observe(mut self, observer: &'a mut dyn Observer) -> Self {
+        self.observer = Some(observer);
+        self
+    }
+
+    /// [`FreeDesign::observe`] with a closure that sees the iterations only.
+    pub fn on_iteration<F: FnMut(&ScpIteration)>(self, f: &'a mut F) -> Self {
+        self.observe(f)
+    }
+
+    pub fn solve(self) -> Result<FreeResult> {
+        let cfg = self.cfg;
+        let mut quiet = |_: &ScpIteration| {};
+        let observe: &mut dyn Observer = match self.observer {
+            Some(o) => o,
+            None => &mut quiet,
+        };
+        let mut r = match self.start {
+            Start::Seed(seed) => {
+                check_resolvable(cfg, self.nodes)?;
+                let plan = match seed.plan(cfg) {
+                    // the phased family's least height is not the free-form
+                    // design's: say so rather than pass it on as the answer
+                    Err(crate::error::Error::Unreachable { reason }) => {
+                        return Err(crate::error::Error::SeedUnfit { reason });
+                    }
+                    r => r?,
+                };
+                from_plan(cfg, plan.as_ref(), seed.name(), self.nodes, observe)?
+            }
+            Start::Plan(plan, name) => from_plan(cfg, plan, name, self.nodes, observe)?,
+            Start::Warm(prev, before) => {
+                continue_from(cfg, prev, before, |it| observe.iteration(it))?
+            }
+        };
+        if self.mesh_check {
+            r.mesh_check = Some(mesh_check(cfg, &r)?);
+        }
+        Ok(r)
+    }
 }
 
 #[cfg(test)]

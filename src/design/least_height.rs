@@ -10,6 +10,7 @@ use crate::design::objective::Objective;
 use crate::design::plan::Schedule;
 use crate::design::scp::ScpIteration;
 use crate::error::Result;
+use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use serde::Serialize;
 
 /// The answer, and the schedule that achieves the least height.
@@ -32,7 +33,7 @@ pub struct HeightAnswer {
     /// The status of that design's solver (`solved`, `converged`, or e.g.
     /// `iteration-limit` for a verified free-form schedule that is not
     /// proven the shortest).
-    pub status: String,
+    pub status: Status,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
     /// The least-height schedule.
@@ -56,7 +57,7 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
         least_height_m: least,
         least_time_s: r.manoeuvre_time_s,
         method: "phased",
-        status: crate::run::json_name(&r.status),
+        status: r.status.into(),
         flip_error_rad: r.flip_error_rad,
         schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     }))
@@ -64,7 +65,7 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
 
 /// Whether a drop from `height` is within the configured one (to rounding).
 pub fn fits(cfg: &Config, height: f64) -> bool {
-    height <= cfg.fall.height * (1.0 + 1e-9)
+    height <= cfg.fall.height * (1.0 + crate::verdict::tolerance::HEIGHT)
 }
 
 /// The least drop heights of both design families, each from its `time`
@@ -87,7 +88,7 @@ pub struct Heights {
 pub fn heights(
     cfg: &Config,
     with_free: bool,
-    observe: impl FnMut(&ScpIteration),
+    mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Option<Heights>> {
     let Some(mut answer) = self::answer(cfg)? else {
         return Ok(None);
@@ -111,10 +112,14 @@ pub fn heights(
     let analytic_plan = crate::design::analytic::analytic_plan(cfg);
     let (from_phased, from_analytic) = std::thread::scope(|s| {
         let analytic = s.spawn(|| {
-            free::optimize_from(&timed, &analytic_plan, "analytic", cfg.free.nodes, |_| {})
+            free::FreeDesign::new(&timed)
+                .from_plan(&analytic_plan, "analytic")
+                .solve()
         });
-        let phased =
-            free::optimize_from(&timed, &answer.schedule, "phased", cfg.free.nodes, observe);
+        let phased = free::FreeDesign::new(&timed)
+            .from_plan(&answer.schedule, "phased")
+            .on_iteration(&mut observe)
+            .solve();
         let analytic = analytic
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
@@ -148,17 +153,24 @@ pub fn heights(
 /// least height found is an upper bound either way), so a design that ran
 /// out of iterations still counts, and says so in its status.
 pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
-    let margin = crate::design::envelope::usage_of(cfg, &fr.plan)
-        .min_margin
-        .unwrap_or(1.0);
+    let usage = crate::design::envelope::usage_of(cfg, &fr.plan);
+    let v = verdict(
+        &Targets::of(cfg),
+        &DesignNumbers {
+            status: fr.status.into(),
+            peak_torque_nm: fr.peak_torque_nm,
+            bend_deg: fr.bend_deg,
+            max_speed_rad_s: Some(usage.max_speed_rad_s),
+            envelope_margin: usage.min_margin,
+        },
+        &Simulated::Flip {
+            flip_error_rad: fr.flip_error_rad,
+            tilt_deg: fr.tilt_deg,
+        },
+    );
     fr.certificate.constraint_violation <= cfg.free.attitude_tolerance
-        && margin >= -1e-6
-        && crate::verify::simulate::misses_flip(
-            fr.flip_error_rad,
-            fr.tilt_deg,
-            cfg.simulate.flip_tolerance,
-        )
-        .is_none()
+        && v.within_envelope()
+        && v.flips()
 }
 
 impl HeightAnswer {
@@ -173,18 +185,14 @@ impl HeightAnswer {
         self.least_height_m = crate::design::envelope::height_for(cfg, fr.manoeuvre_time_s);
         self.possible = fits(cfg, self.least_height_m);
         self.method = "free";
-        self.status = crate::run::json_name(&fr.status);
+        self.status = fr.status.into();
         self.flip_error_rad = fr.flip_error_rad;
         self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
     }
 
     /// One plain sentence for the terminal and the report.
     pub fn sentence(&self) -> String {
-        let proven = matches!(
-            self.status.as_str(),
-            "solved" | "almost-solved" | "converged"
-        );
-        let what = if proven {
+        let what = if self.status.is_proven() {
             format!("the {} time-optimal schedule", self.method)
         } else {
             format!(

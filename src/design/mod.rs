@@ -15,3 +15,4 @@ pub mod phased;
 pub mod plan;
 pub mod scp;
 pub mod timing;
+pub mod twist;

@@ -11,19 +11,20 @@
 //! this point's ([`BendHint`]), and a local bracket replaces the scan.
 
 use crate::config::Config;
-use crate::design::analytic::{plan as cosine_plan, turns_theta, yy_inertia_and_c};
+use crate::design::analytic::plan as cosine_plan;
+pub use crate::design::bend_search::{BendEvaluation, BendHint, bend_range, bend_scan};
 use crate::design::bend_search::{Scored, bracket_then_brent, scan_then_brent};
 use crate::design::conic::SolveStatus;
 use crate::design::objective::Objective;
 use crate::design::path::{Path, PhasedPlan, Timing};
 use crate::design::timing::{PhaseTiming, TimingProblem};
+pub use crate::design::twist::twist_for;
+use crate::design::twist::{TWIST_TOL, twist_to};
 use crate::error::{Error, Result};
 use crate::model::{Cat, Joint};
 use crate::verify::analyze::peak_along;
-use crate::verify::ode::OdeSettings;
-use crate::verify::simulate::{SimReport, dynamic_cfg, kinematic};
+use crate::verify::simulate::{SimReport, dynamic_cfg};
 use serde::Serialize;
-use std::f64::consts::PI;
 use std::time::Instant;
 
 /// A phased design at one bend.
@@ -71,20 +72,6 @@ impl BendDesign {
     }
 }
 
-/// Twist of the bend direction that flips the cat by exactly pi.
-///
-/// `no-twist` with identical halves: `pi / C` (F1, exact). `universal` (F4)
-/// or unequal halves: F1 is only approximate, so the twist is root-found on
-/// the integrated attitude, starting from `pi / C` with the mean half; by F2
-/// the timing is irrelevant and a unit-time cosine plan is used.
-pub fn twist_for(cat: &Cat, bend: f64) -> Result<f64> {
-    twist_to(cat, bend, TWIST_TOL)
-}
-
-/// The flip error (rad) [`twist_for`] root-finds the twist to, and the
-/// relative tolerance of the attitude's integration.
-const TWIST_TOL: f64 = 1e-11;
-
 /// The same for the free-form design's phased seed ([`seed_plan`]): the
 /// free-form design corrects the attitude itself. 1e-8 cut the robot's
 /// seed under its stall torque alone (issue 11's bench case) by a third of
@@ -92,60 +79,6 @@ const TWIST_TOL: f64 = 1e-11;
 /// bend the search tries). A config with a motor envelope is seeded by the
 /// envelope design, which keeps 1e-11.
 const SEED_TWIST_TOL: f64 = 1e-8;
-
-/// [`twist_for`] to the flip error `tol` (rad).
-fn twist_to(cat: &Cat, bend: f64, tol: f64) -> Result<f64> {
-    let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), PI - bend);
-    let guess = PI / c;
-    if cat.joint == Joint::NoTwist && cat.is_symmetric() {
-        return Ok(guess);
-    }
-    let ode = OdeSettings {
-        rtol: tol,
-        atol: 1e-2 * tol,
-        ..Default::default()
-    };
-    let flip = |tw: f64| -> Result<f64> {
-        let r = kinematic(cat, &cosine_plan(bend, tw, [1.0, 1.0, 1.0]), &ode)?;
-        Ok(r.trace.last().map(|p| p.flip).unwrap_or(0.0))
-    };
-    let f0 = flip(guess)?;
-    let target = PI * f0.signum();
-    let (mut x0, mut y0) = (guess, f0 - target);
-    let mut x1 = guess * target / f0;
-    for _ in 0..30 {
-        let y1 = flip(x1)? - target;
-        if y1.abs() < tol {
-            return Ok(x1);
-        }
-        let x2 = x1 - y1 * (x1 - x0) / (y1 - y0);
-        (x0, y0, x1) = (x1, y1, x2);
-    }
-    Err(Error::Unreachable {
-        reason: format!(
-            "no twist angle flips the {} cat by pi at bend {:.2} deg; narrow phased.bend_min_deg / bend_max_deg",
-            if cat.is_symmetric() {
-                "universal-joint"
-            } else {
-                "unequal-halves"
-            },
-            bend.to_degrees()
-        ),
-    })
-}
-
-/// One evaluation of the bend search, as reported to an observer: at the
-/// search's accuracy ([`ConicSettings::SEARCH`](crate::design::conic::ConicSettings::SEARCH),
-/// within about 1e-6 of the certified value the chosen bend is solved to).
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct BendEvaluation {
-    pub bend_deg: f64,
-    /// The objective at this bend, in its unit (`design.objective`; infinite
-    /// where no timing fits the motor envelope).
-    pub value: f64,
-    pub unit_peak: f64,
-    pub peak_nm: f64,
-}
 
 /// Designs the phases at one bend.
 ///
@@ -205,19 +138,22 @@ pub struct PhasedResult {
     /// densely), N m: what the motors must give.
     pub peak_torque_nm: f64,
     /// The SOCPs' certified bound on the grid and midpoints, N m; it differs from
-    /// `peak_torque_nm` by the grid's second-order error.
-    pub socp_peak_torque_nm: f64,
+    /// `peak_torque_nm` by the grid's second-order error (the unit-time peak
+    /// program only: absent inside a motor envelope).
+    pub socp_peak_torque_nm: Option<f64>,
     /// Peak if the manoeuvre took 1 s (F7: `T_min = sqrt(P / tau_max)`), N m s^2.
     pub unit_peak_nm_s2: f64,
     pub bend_deg: f64,
     pub theta_deg: f64,
     pub twist_rad: f64,
     pub phase_durations_s: [f64; 3],
-    pub phase_unit_peaks_nm_s2: [f64; 3],
+    /// Each phase's peak if it took 1 s (unit-time program only).
+    pub phase_unit_peaks_nm_s2: Option<[f64; 3]>,
     /// The seed's cosine schedule at the same bend and the config's split, N m.
     pub analytic_peak_same_bend_nm: f64,
-    /// Least peak at the same bend with the config's split, N m.
-    pub optimum_same_split_nm: f64,
+    /// Least peak at the same bend with the config's split, N m
+    /// (unit-time program only).
+    pub optimum_same_split_nm: Option<f64>,
     /// `analytic_peak_same_bend_nm / peak_torque_nm`.
     pub improvement_factor: f64,
     /// From the dynamic simulation (feed-forward + PD).
@@ -237,65 +173,9 @@ pub struct PhasedResult {
     pub sim: Option<SimReport>,
 }
 
-/// The coarse bend scan over `[lo, hi]` rad: `phased.scan_points` even
-/// points plus the one-turn bend (F6) and the config's bend where inside.
-pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
-    let cat = cfg.cat();
-    let n = cfg.phased.scan_points;
-    let mut xs: Vec<f64> = (0..n)
-        .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
-        .collect();
-    let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
-    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
-    for b in [one_turn, seed_bend] {
-        if b > lo && b < hi {
-            xs.push(b);
-        }
-    }
-    xs
-}
-
-/// The bend range the config allows, rad.
-pub fn bend_range(cfg: &Config) -> Result<(f64, f64)> {
-    let lo = cfg.phased.bend_min_deg.to_radians();
-    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
-    if hi <= lo {
-        return Err(Error::Invalid {
-            key: "limits.max_bend_deg".into(),
-            value: format!("{}", cfg.max_bend().to_degrees()),
-            expected: format!(
-                "must exceed phased.bend_min_deg = {}",
-                cfg.phased.bend_min_deg
-            ),
-        });
-    }
-    Ok((lo, hi))
-}
-
 impl Scored for BendDesign {
     fn score(&self) -> f64 {
         self.unit_peak()
-    }
-}
-
-/// Where a neighbouring design (a sweep's previous point) puts the best
-/// bend: the local search starts there, `step` either side.
-#[derive(Debug, Clone, Copy)]
-pub struct BendHint {
-    pub bend: f64,
-    pub step: f64,
-}
-
-impl BendHint {
-    /// The prediction from the last two points' bends (linear
-    /// extrapolation), or from the last alone; the bracket is as wide as
-    /// the last change, and at least a degree.
-    pub fn from_neighbours(last: f64, before: Option<f64>) -> Self {
-        let change = before.map_or(0.0, |b| last - b);
-        BendHint {
-            bend: last + change,
-            step: change.abs().max(1f64.to_radians()),
-        }
     }
 }
 
@@ -335,8 +215,8 @@ fn search_bend_to(
         let e = BendEvaluation {
             bend_deg: b.to_degrees(),
             value: d.unit_peak() / (t * t),
-            unit_peak: d.unit_peak(),
-            peak_nm: d.unit_peak() / (t * t),
+            unit_peak: Some(d.unit_peak()),
+            peak_nm: Some(d.unit_peak() / (t * t)),
         };
         observe(&e);
         evals.push(e);
@@ -379,7 +259,7 @@ pub fn least_height(cfg: &Config, unit_peak: f64, tau_max: f64) -> f64 {
 /// Checks a design's peak against `limits.max_torque`.
 pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Result<()> {
     if let Some(lim) = cfg.limits.max_torque
-        && peak > lim * (1.0 + 1e-9)
+        && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
         return Err(Error::Unreachable {
             reason: format!(
@@ -405,7 +285,7 @@ pub fn optimize_near(
     observe: impl FnMut(&BendEvaluation),
 ) -> Result<PhasedResult> {
     if cfg.uses_envelope() {
-        return crate::design::envelope::optimize(cfg, observe);
+        return finish_envelope(cfg, crate::design::envelope::optimize(cfg, observe)?);
     }
     let start = Instant::now();
     let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
@@ -455,6 +335,57 @@ pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
     Ok(design.plan(design.durations(cfg.available_time())))
 }
 
+/// Reconstruction, comparison and verification of a design inside the
+/// motor envelope.
+fn finish_envelope(
+    cfg: &Config,
+    r: crate::design::envelope::EnvelopeResult,
+) -> Result<PhasedResult> {
+    let plan = r.plan;
+    let time: f64 = plan.durations.iter().sum();
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let (peak, _) = peak_along(cfg, &plan, dense);
+    let value = match r.objective {
+        Objective::PeakTorque => peak,
+        Objective::Time => time,
+        Objective::Energy => {
+            crate::design::envelope::torque_squared_integral(&cfg.cat(), &plan, dense)
+        }
+    };
+    let split = cfg.analytic.split.map(|f| f * time);
+    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(r.bend, r.twist, split), 2000);
+    let sim = dynamic_cfg(cfg, &plan)?;
+    Ok(PhasedResult {
+        mode: "phased",
+        status: r.status,
+        objective: r.objective,
+        objective_value: value,
+        manoeuvre_time_s: time,
+        peak_torque_nm: peak,
+        socp_peak_torque_nm: None,
+        unit_peak_nm_s2: peak * time * time,
+        bend_deg: r.bend.to_degrees(),
+        theta_deg: 180.0 - r.bend.to_degrees(),
+        twist_rad: r.twist,
+        phase_durations_s: plan.durations,
+        phase_unit_peaks_nm_s2: None,
+        analytic_peak_same_bend_nm: analytic_peak,
+        optimum_same_split_nm: None,
+        improvement_factor: analytic_peak / peak,
+        flip_deg: sim.flip_deg,
+        flip_error_rad: sim.flip_error_rad,
+        tilt_deg: sim.tilt_deg,
+        sim_peak_torque_nm: sim.peak_torque_nm,
+        momentum_drift_nms: sim.momentum_drift_nms,
+        nodes: cfg.phased.nodes,
+        evaluations: r.evaluations,
+        solve_time_s: r.solve_time_s,
+        plan,
+        design: None,
+        sim: Some(sim),
+    })
+}
+
 /// Reconstruction, comparison and verification of a chosen design.
 pub fn finish(
     cfg: &Config,
@@ -484,15 +415,15 @@ pub fn finish(
         objective_value: peak,
         manoeuvre_time_s: t,
         peak_torque_nm: peak,
-        socp_peak_torque_nm: socp_peak,
+        socp_peak_torque_nm: Some(socp_peak),
         unit_peak_nm_s2: peak * t * t,
         bend_deg: design.bend.to_degrees(),
         theta_deg: 180.0 - design.bend.to_degrees(),
         twist_rad: design.twist,
         phase_durations_s: durations,
-        phase_unit_peaks_nm_s2: design.phases.each_ref().map(|p| p.unit_peak),
+        phase_unit_peaks_nm_s2: Some(design.phases.each_ref().map(|p| p.unit_peak)),
         analytic_peak_same_bend_nm: analytic_peak,
-        optimum_same_split_nm: design.peak_with(split),
+        optimum_same_split_nm: Some(design.peak_with(split)),
         improvement_factor: analytic_peak / peak,
         flip_deg: sim.flip_deg,
         flip_error_rad: sim.flip_error_rad,

@@ -16,28 +16,29 @@
 //! Steps are judged on the exact penalty
 //! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| / L - 1))`:
 //! `rho = (phi(z) - phi(z + dz)) / (phi(z) - L(dz))` with `L` the subproblem's
-//! model value. When `rho < 0.75` a second-order correction is tried and
-//! kept if it lowers `phi`: first the subproblem's own KKT system with the
+//! model value. When `rho` falls short ([`Correction::below`]) a
+//! second-order correction is tried and kept if it lowers `phi`: first the subproblem's own KKT system with the
 //! rows' linearisation errors (one factorisation, see
-//! [`sensitivity_correction`]), and when that recovers less than half the
-//! predicted decrease, a conic one (one more conic solve, or two when the
+//! [`sensitivity_correction`]), and when that recovers less than
+//! [`Correction::sensitivity_accept`] of the predicted decrease, a conic one (one more conic solve, or two when the
 //! bounded one fails, see [`correction`]); a cheap one that falls short
 //! stands in only when the conic one fails. The model's Hessian is scaled by the steps' `rho`
-//! ([`Multipliers::adapt_curvature`]). Accepted when `rho > 0.1` (so an
-//! accepted step never increases `phi`); the radius falls to half the model's step
-//! when `rho < 0.1` and doubles when `rho > 0.5`, except right after a
-//! rejected step. For a peak cost a step that would be rejected is first
-//! taken tentatively (the watchdog, [`ScpSettings::watchdog`]): the next
+//! ([`Multipliers::adapt_curvature`]). Accepted when `rho` exceeds
+//! [`TrustRegion::accept`] (so an accepted step never increases `phi`); the
+//! radius falls to a share of the model's step below it and grows above
+//! [`TrustRegion::grow_above`], except right after a rejected step. For a
+//! peak cost a step that would be rejected is first taken tentatively (the
+//! watchdog, [`ScpSettings::watchdog`]): the next
 //! step must then lower `phi` below the point before it, or both are undone.
 //! Stop: criticality (the predicted decrease at unit radius relative to
 //! `phi`, without removing a violation already within `feasibility`, see
 //! [`ScpIteration::criticality_within`]) below `tolerance`, or a merit
 //! that fell by less than `tolerance` (relative) per iteration on average
 //! over the last `window` iterations, with `max |r| <= feasibility` (converged; the certificate
-//! names the rule); the penalty grows tenfold when the
-//! model stalls while still infeasible (and, for a linear cost, when the
-//! violation stagnates, see [`ScpSettings::stagnation`]); an iteration limit or a collapsed
-//! trust region (stalled) end the run.
+//! names the rule); the penalty grows when the model stalls while still
+//! infeasible (and, for a linear cost, when the violation stagnates, see
+//! [`Penalty::stagnation`]); an iteration limit, a penalty grown past
+//! [`Penalty::infeasible`] or a collapsed trust region end the run.
 
 use crate::design::conic::{Cone, ConicData, ConicSettings, ConicSolver, solve_reusing_with};
 use crate::error::{Error, Result};
@@ -132,88 +133,400 @@ pub trait ScpProblem {
     }
 }
 
-/// Driver settings; defaults in each field's doc.
-#[derive(Debug, Clone, Copy, Serialize)]
-pub struct ScpSettings {
-    /// Iteration limit (default 150).
-    pub max_iterations: usize,
-    /// Converged when the criticality (predicted decrease at unit trust radius
-    /// relative to the merit) is below this (default 1e-4).
-    pub tolerance: f64,
-    /// Largest `|r|` accepted as feasible (default 1e-6).
-    pub feasibility: f64,
-    /// Initial trust radius in scaled units (default 0.5).
-    pub initial_radius: f64,
-    /// Iterations over which the merit must fall by `tolerance` (relative)
-    /// per iteration on average to keep going (default 10).
-    pub window: usize,
-    /// Penalty weight relative to the initial cost (for a peak cost at least
-    /// the limit, which has its unit) (default 2): the exact L1
-    /// penalty needs only `w > |multiplier|`; a larger one makes the merit's
-    /// model more curved and the steps shorter. It grows tenfold when needed.
-    pub weight: f64,
-    /// For a linear cost (least time): iterations over which a violation
-    /// above 100x `feasibility` that fell by less than a fifth while the
-    /// cost moved by less than 1 % raises the penalty tenfold, at most twice
-    /// (default 5; 0: never).
-    /// The cost has no curvature, so near the optimum it barely moves while
-    /// a weight below the constraints' multipliers settles on an infeasible
-    /// minimum of the merit: the robot's least-time designs crawled 40
-    /// iterations at a violation of 2e-4 before the criticality rule
-    /// raised the weight. Over `examples/convergence_matrix` the twelve
-    /// least-time designs took 474 iterations instead of 546 (the robot's
-    /// four 203 instead of 272, the others unchanged), and the robot's
-    /// least drop height fell from 3.560 to 3.545 m. Below 100x
-    /// `feasibility` the criticality rule's policy holds (the next steps
-    /// remove a small violation at this weight). On peak and energy costs
-    /// the rule cost iterations (energy 25 to 35), so they keep the
-    /// criticality rule alone.
-    pub stagnation: usize,
-    /// The watchdog (default on): a step the merit would reject is taken
-    /// once, tentatively, and the next step from there must bring the merit
-    /// below the point before it by a tenth of that point's predicted
-    /// decrease; otherwise both are undone and the radius is cut as for a
-    /// rejection. The merit's kinks (the peak's active set, the attitude's
-    /// curvature) reject steps that the next linearisation would complete.
-    /// Over `examples/bench_scp_suite` 294 SCP iterations instead of 375
-    /// (143 G instructions instead of 187 G), all converged, with 9 of the
-    /// 16 peaks lower (the seed's per-motor design from the analytic seed
-    /// 0.32165 instead of 0.32553 N m, the domestic cat's 1.5345 instead of
-    /// 1.5624), 2 equal and the others at most 0.3 % higher (the domestic
-    /// cat's per-motor design from the phased seed, 1.5504 against 1.5461).
-    /// Not at a converged point, where rho is noise. Peak costs only: on the
-    /// time and energy costs of `examples/convergence_matrix` it cost
-    /// iterations (energy 25 to 45, the robot's least time 35 to 62).
-    /// Re-armed only by an accepted step:
-    /// armed after every step, the robot's impossible 2 m peak design ran
-    /// to the iteration limit instead of failing with its least height.
-    pub watchdog: bool,
-    /// Rounds of the sensitivity correction tried before the conic one
-    /// (default 3; 0: the conic correction alone), see
-    /// [`sensitivity_correction`].
-    pub correction_rounds: usize,
-    /// Whether the model's curvature is scaled by the steps' `rho` (default
-    /// on), see [`Multipliers::adapt_curvature`].
-    pub adapt_curvature: bool,
-    /// How exactly the subproblems and corrections are solved (default
-    /// [`ConicSettings::MODEL`]).
-    pub conic: ConicSettings,
+/// Declares a settings struct whose defaults sit on its fields
+/// (`pub name: Type = default,`): the `Default` impl is made from them and
+/// each field's doc ends with its default, so a default is written once.
+macro_rules! settings {
+    (
+        $(#[$meta:meta])*
+        pub struct $name:ident {
+            $($(#[$doc:meta])* pub $field:ident: $ty:ty = $default:expr,)*
+        }
+    ) => {
+        $(#[$meta])*
+        pub struct $name {
+            $(
+                $(#[$doc])*
+                #[doc = ""]
+                #[doc = concat!("Default: `", stringify!($default), "`.")]
+                pub $field: $ty,
+            )*
+        }
+
+        impl Default for $name {
+            fn default() -> Self {
+                Self {
+                    $($field: $default,)*
+                }
+            }
+        }
+    };
 }
 
-impl Default for ScpSettings {
-    fn default() -> Self {
-        Self {
-            max_iterations: 150,
-            tolerance: 1e-4,
-            feasibility: 1e-6,
-            initial_radius: 0.5,
-            window: 10,
-            weight: 2.0,
-            stagnation: 5,
-            watchdog: true,
-            correction_rounds: 3,
-            adapt_curvature: true,
-            conic: ConicSettings::MODEL,
+settings! {
+    /// Driver settings: each field's default follows it, and
+    /// [`ScpSettings::validate`] checks them before a solve. The groups hold
+    /// the rules of the method's parts: the trust region, the penalty, the
+    /// watchdog, the second-order correction and the model's curvature.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct ScpSettings {
+        /// Iteration limit (failed subproblems and tentative steps count).
+        pub max_iterations: usize = 150,
+        /// Converged when the criticality (predicted decrease at unit trust
+        /// radius relative to the merit, see
+        /// [`ScpIteration::criticality_within`]) is below this, or when the
+        /// merit fell by less than this (relative) per iteration on average
+        /// over the last `window` iterations.
+        pub tolerance: f64 = 1e-4,
+        /// Largest violation accepted as feasible (`max |r|`, and the
+        /// limits' `max |g| / L - 1`).
+        pub feasibility: f64 = 1e-6,
+        /// Iterations over which the merit must fall by `tolerance`
+        /// (relative) per iteration on average to keep going.
+        pub window: usize = 10,
+        /// How the trust radius moves.
+        pub trust: TrustRegion = TrustRegion::default(),
+        /// The exact penalty's weight and when it grows.
+        pub penalty: Penalty = Penalty::default(),
+        /// Tentative steps for a peak cost.
+        pub watchdog: Watchdog = Watchdog::default(),
+        /// The second-order correction of a step the merit would reject.
+        pub correction: Correction = Correction::default(),
+        /// The scale of the model's Hessian.
+        pub curvature: Curvature = Curvature::default(),
+        /// How exactly the subproblems and corrections are solved.
+        pub conic: ConicSettings = ConicSettings::MODEL,
+    }
+}
+
+settings! {
+    /// The trust region: steps are judged by `rho`, the merit's actual
+    /// decrease over the model's predicted one.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct TrustRegion {
+        /// Initial radius in scaled units (the problem's
+        /// [`ScpProblem::scales`]).
+        pub initial_radius: f64 = 0.5,
+        /// A step is accepted when the model predicted a decrease and `rho`
+        /// exceeds this (so an accepted step never increases the merit);
+        /// below it the radius is cut.
+        pub accept: f64 = 0.1,
+        /// The radius grows when `rho` exceeds this, except right after a
+        /// rejected step: the radius that was just cut would be grown back
+        /// to one that failed.
+        pub grow_above: f64 = 0.5,
+        /// The factor by which the radius grows.
+        pub growth: f64 = 2.0,
+        /// The largest radius.
+        pub max_radius: f64 = 1e3,
+        /// After a rejection the radius is this share of the model's step (a
+        /// radius still above an interior step would only give the same step
+        /// again), or of the radius when the model predicted no decrease
+        /// (its step says nothing).
+        pub cut: f64 = 0.5,
+        /// The least share of the radius that the model's step counts for in
+        /// a cut (with `cut`, the radius falls at most twentyfold).
+        pub least_cut: f64 = 0.1,
+        /// A subproblem the conic solver could not finish (numerical
+        /// trouble) is a rejected step whose radius is multiplied by this:
+        /// a smaller trust region is a better-conditioned subproblem.
+        pub failure_cut: f64 = 0.25,
+        /// Failed subproblems in a row that are taken as rejections; the
+        /// next one ends the solve with its error.
+        pub max_failures: usize = 4,
+        /// The run has stalled when the radius falls below this.
+        pub min_radius: f64 = 1e-10,
+        /// A neighbour's radius (a warm start) is used down to this.
+        pub warm_floor: f64 = 1e-3,
+    }
+}
+
+settings! {
+    /// The exact penalty `phi = cost + w (|r|_1 + max(0, max_k |g_k| / L - 1))`
+    /// and when its weight `w` grows.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct Penalty {
+        /// The weight relative to the initial cost (for a peak cost at least
+        /// the limit, which has its unit): the exact L1 penalty needs only
+        /// `w > |multiplier|`; a larger one makes the merit's model more
+        /// curved and the steps shorter.
+        pub weight: f64 = 2.0,
+        /// The factor of each raise of the weight.
+        pub growth: f64 = 10.0,
+        /// A neighbour's weight (a warm start) is kept up to this multiple
+        /// of the start weight: its constraints' multipliers are nearly
+        /// these, and a weight below them lets the merit trade violation for
+        /// cost until the stopping rules raise it again.
+        pub max_carried: f64 = 1e3,
+        /// Locally infeasible when the weight exceeds this multiple of the
+        /// start weight `weight` (not of a carried one: from a weight
+        /// carried `max_carried` times up, three raises are left).
+        pub infeasible: f64 = 1e6,
+        /// Violations up to this multiple of `feasibility` are nearly
+        /// feasible: at a critical point the next steps remove them at this
+        /// weight (raising it would only shrink the steps); above it the
+        /// penalty is too weak and is raised.
+        pub nearly_feasible: f64 = 100.0,
+        /// Critical points in a row at a nearly feasible violation after
+        /// which the weight is raised all the same.
+        pub patience: usize = 3,
+        /// For a linear cost (least time): iterations over which a violation
+        /// above `nearly_feasible` that fell by less than `stagnation_fall`
+        /// while the cost moved by less than `stagnation_cost` raises the
+        /// weight (0: never). The cost has no curvature, so near the optimum
+        /// it barely moves while a weight below the constraints' multipliers
+        /// settles on an infeasible minimum of the merit. Peak and energy
+        /// costs keep the criticality rule alone.
+        pub stagnation: usize = 5,
+        /// The share of its value a stagnating violation keeps over
+        /// `stagnation` iterations (it fell by less than a fifth).
+        pub stagnation_fall: f64 = 0.8,
+        /// The relative change of the cost below which it stagnates.
+        pub stagnation_cost: f64 = 1e-2,
+        /// The stagnation rule raises the weight while it is below this
+        /// multiple of its start (twice, with tenfold raises).
+        pub stagnation_cap: f64 = 50.0,
+    }
+}
+
+settings! {
+    /// The watchdog: a step the merit would reject is taken once,
+    /// tentatively, and the next step from there must bring the merit below
+    /// the point before it; otherwise both are undone and the radius is cut
+    /// as for a rejection. The merit's kinks (the peak's active set, the
+    /// attitude's curvature) reject steps that the next linearisation would
+    /// complete. Peak costs only; not at a converged point, where `rho` is
+    /// noise; re-armed only by an accepted step.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct Watchdog {
+        /// Whether tentative steps are taken.
+        pub enabled: bool = true,
+        /// The share of the point before a tentative step's predicted
+        /// decrease that the next step must achieve from it.
+        pub decrease: f64 = 0.1,
+    }
+}
+
+settings! {
+    /// The second-order correction of a step whose `rho` falls short: the
+    /// sensitivity correction ([`sensitivity_correction`]) first, the conic
+    /// one ([`correction`]) when it recovers too little.
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct Correction {
+        /// A correction is tried when `rho` is below this.
+        pub below: f64 = 0.75,
+        /// Rounds of the sensitivity correction tried before the conic one
+        /// (0: the conic correction alone).
+        pub rounds: usize = 3,
+        /// The share of the predicted decrease a sensitivity correction must
+        /// recover to stand in for the conic correction (a weak cheap
+        /// correction keeps the path off the better conic one).
+        pub sensitivity_accept: f64 = 0.5,
+        /// Weight of the conic correction's slacks against its scaled step
+        /// `|dc|^2 / 2`. A residual component along a direction of scaled
+        /// gain `s` is removed while it is below about `W s^2`: all of it
+        /// where the constraints are well conditioned (`s ~ 0.5`), none
+        /// along the attitude's tilt, whose first-order gain all but
+        /// vanishes at the designs (`s ~ 1e-7`; a hard correction took a
+        /// huge step there, or 70 to 200 interior-point iterations to find
+        /// none).
+        pub slack_weight: f64 = 10.0,
+    }
+}
+
+settings! {
+    /// The scale of the model's Hessian, see [`Multipliers::adapt_curvature`].
+    #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+    pub struct Curvature {
+        /// Whether the scale follows the steps' `rho`.
+        pub adapt: bool = true,
+        /// The least scale.
+        pub min: f64 = 0.1,
+        /// The least factor of one fall (after an accepted step with
+        /// `rho > 1` the scale is multiplied by `2 - rho`, at least this).
+        pub fall: f64 = 0.25,
+        /// The factor of a rise after a rejected step (at most 1).
+        pub rise: f64 = 2.0,
+    }
+}
+
+impl ScpSettings {
+    /// Checks every setting's range; the error names the setting.
+    pub fn validate(&self) -> Result<()> {
+        let (t, p, w, c, k) = (
+            &self.trust,
+            &self.penalty,
+            &self.watchdog,
+            &self.correction,
+            &self.curvature,
+        );
+        let positive = |x: f64| x.is_finite() && x > 0.0;
+        let share = |x: f64| x.is_finite() && x > 0.0 && x < 1.0;
+        let checks: [(&str, f64, bool, &str); 26] = [
+            (
+                "max_iterations",
+                self.max_iterations as f64,
+                self.max_iterations >= 1,
+                "at least 1",
+            ),
+            (
+                "tolerance",
+                self.tolerance,
+                share(self.tolerance),
+                "in (0, 1)",
+            ),
+            (
+                "feasibility",
+                self.feasibility,
+                positive(self.feasibility),
+                "positive",
+            ),
+            ("window", self.window as f64, self.window >= 1, "at least 1"),
+            (
+                "trust.initial_radius",
+                t.initial_radius,
+                positive(t.initial_radius),
+                "positive",
+            ),
+            ("trust.accept", t.accept, share(t.accept), "in (0, 1)"),
+            (
+                "trust.grow_above",
+                t.grow_above,
+                t.grow_above >= t.accept && t.grow_above < 1.0,
+                "in [trust.accept, 1)",
+            ),
+            (
+                "trust.growth",
+                t.growth,
+                t.growth.is_finite() && t.growth > 1.0,
+                "above 1",
+            ),
+            (
+                "trust.max_radius",
+                t.max_radius,
+                t.max_radius.is_finite() && t.max_radius >= t.initial_radius,
+                "at least trust.initial_radius",
+            ),
+            ("trust.cut", t.cut, share(t.cut), "in (0, 1)"),
+            (
+                "trust.least_cut",
+                t.least_cut,
+                t.least_cut > 0.0 && t.least_cut <= 1.0,
+                "in (0, 1]",
+            ),
+            (
+                "trust.failure_cut",
+                t.failure_cut,
+                share(t.failure_cut),
+                "in (0, 1)",
+            ),
+            (
+                "trust.min_radius",
+                t.min_radius,
+                positive(t.min_radius) && t.min_radius < t.warm_floor.min(t.initial_radius),
+                "positive, below trust.warm_floor and trust.initial_radius",
+            ),
+            (
+                "trust.warm_floor",
+                t.warm_floor,
+                positive(t.warm_floor) && t.warm_floor <= t.initial_radius,
+                "positive, at most trust.initial_radius",
+            ),
+            ("penalty.weight", p.weight, positive(p.weight), "positive"),
+            (
+                "penalty.growth",
+                p.growth,
+                p.growth.is_finite() && p.growth > 1.0,
+                "above 1",
+            ),
+            (
+                "penalty.max_carried",
+                p.max_carried,
+                p.max_carried >= 1.0,
+                "at least 1",
+            ),
+            (
+                "penalty.infeasible",
+                p.infeasible,
+                p.infeasible.is_finite() && p.infeasible > p.max_carried,
+                "above penalty.max_carried",
+            ),
+            (
+                "penalty.nearly_feasible",
+                p.nearly_feasible,
+                p.nearly_feasible >= 1.0,
+                "at least 1",
+            ),
+            (
+                "penalty.stagnation_fall",
+                p.stagnation_fall,
+                share(p.stagnation_fall),
+                "in (0, 1)",
+            ),
+            (
+                "penalty.stagnation_cost",
+                p.stagnation_cost,
+                share(p.stagnation_cost),
+                "in (0, 1)",
+            ),
+            (
+                "penalty.stagnation_cap",
+                p.stagnation_cap,
+                p.stagnation_cap >= 1.0,
+                "at least 1",
+            ),
+            (
+                "watchdog.decrease",
+                w.decrease,
+                share(w.decrease),
+                "in (0, 1)",
+            ),
+            (
+                "correction.below",
+                c.below,
+                c.below >= t.accept && c.below <= 1.0,
+                "in [trust.accept, 1]",
+            ),
+            (
+                "correction.sensitivity_accept",
+                c.sensitivity_accept,
+                c.sensitivity_accept > 0.0 && c.sensitivity_accept <= 1.0,
+                "in (0, 1]",
+            ),
+            (
+                "correction.slack_weight",
+                c.slack_weight,
+                positive(c.slack_weight),
+                "positive",
+            ),
+        ];
+        let curvature: [(&str, f64, bool, &str); 3] = [
+            (
+                "curvature.min",
+                k.min,
+                k.min > 0.0 && k.min <= 1.0,
+                "in (0, 1]",
+            ),
+            (
+                "curvature.fall",
+                k.fall,
+                k.fall > 0.0 && k.fall <= 1.0,
+                "in (0, 1]",
+            ),
+            (
+                "curvature.rise",
+                k.rise,
+                k.rise.is_finite() && k.rise > 1.0,
+                "above 1",
+            ),
+        ];
+        match checks.iter().chain(&curvature).find(|c| !c.2) {
+            Some(&(key, value, _, expected)) => Err(Error::Invalid {
+                key: format!("scp.{key}"),
+                value: format!("{value}"),
+                expected: expected.into(),
+            }),
+            None => Ok(()),
         }
     }
 }
@@ -364,6 +677,10 @@ pub struct ScpResult {
     pub iterations: Vec<ScpIteration>,
     pub certificate: Certificate,
     pub warm: WarmStart,
+    /// Why the run ended (the status and the certificate's rule follow).
+    pub termination: Termination,
+    /// Wall time of the run, s.
+    pub seconds: f64,
 }
 
 /// Largest norm over the terms (each of length `d`).
@@ -489,9 +806,89 @@ fn held_by_epigraph(p: &dyn ScpProblem) -> bool {
     p.limited_are_terms() && p.cost() == Cost::Peak
 }
 
-/// The convex subproblem at `z`: variables `[dz, t, nu+, nu-, sigma]` (`t`
-/// the peak epigraph, zero for other costs; `sigma` the limits' elastic
-/// slack, present when the problem has limits). Returns the data, the
+/// The subproblem's variables, in order: the step `dz` (one per decision
+/// variable), the peak epigraph `t` (zero for other costs), the virtual
+/// controls `nu+` and `nu-` (one each per residual) and, when the problem
+/// has limits, their elastic slack `sigma`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct Layout {
+    /// Decision variables.
+    n: usize,
+    /// Residuals.
+    m: usize,
+    /// Whether `sigma` is present.
+    limited: bool,
+}
+
+impl Layout {
+    /// The layout of the subproblem of `p` linearised as `lin`.
+    fn of(p: &dyn ScpProblem, lin: &Linearization) -> Self {
+        Self {
+            n: p.dim(),
+            m: lin.residual.len(),
+            limited: p.limit().is_some(),
+        }
+    }
+
+    /// Number of variables.
+    fn len(&self) -> usize {
+        self.n + 1 + 2 * self.m + usize::from(self.limited)
+    }
+
+    /// Columns of the step `dz`.
+    fn dz(&self) -> std::ops::Range<usize> {
+        0..self.n
+    }
+
+    /// Column of the epigraph `t`.
+    fn t(&self) -> usize {
+        self.n
+    }
+
+    /// Column of `nu+` of residual `i`.
+    fn nu_plus(&self, i: usize) -> usize {
+        self.n + 1 + i
+    }
+
+    /// Column of `nu-` of residual `i`.
+    fn nu_minus(&self, i: usize) -> usize {
+        self.n + 1 + self.m + i
+    }
+
+    /// Columns of every virtual control, `nu+` then `nu-`.
+    fn virtual_controls(&self) -> std::ops::Range<usize> {
+        self.nu_plus(0)..self.nu_minus(self.m)
+    }
+
+    /// Column of the limits' slack `sigma` (only with limits).
+    fn sigma(&self) -> usize {
+        debug_assert!(self.limited, "no limits: no slack");
+        self.n + 1 + 2 * self.m
+    }
+
+    /// The step `dz` in a solution `x`.
+    fn step<'x>(&self, x: &'x [f64]) -> &'x [f64] {
+        &x[self.dz()]
+    }
+
+    /// The epigraph `t` in a solution.
+    fn epigraph(&self, x: &[f64]) -> f64 {
+        x[self.t()]
+    }
+
+    /// The virtual control `nu+ - nu-` of residual `i` in a solution: the
+    /// model's residual `r + J dz` there.
+    fn virtual_control(&self, x: &[f64], i: usize) -> f64 {
+        x[self.nu_plus(i)] - x[self.nu_minus(i)]
+    }
+
+    /// The limits' slack `sigma` in a solution (zero without limits).
+    fn slack(&self, x: &[f64]) -> f64 {
+        if self.limited { x[self.sigma()] } else { 0.0 }
+    }
+}
+
+/// The convex subproblem at `z`, in the variables of [`Layout`]. Returns the data, the
 /// model's constant (`cost(z)` for costs without an epigraph), and the rows
 /// of the terms and of the limited terms.
 #[allow(clippy::too_many_arguments)]
@@ -504,16 +901,14 @@ fn subproblem(
     w: f64,
     hessian: &Triplets,
 ) -> (ConicData, f64, TermRows, TermRows) {
-    let n = p.dim();
-    let m = lin.residual.len();
+    let v = Layout::of(p, lin);
+    let (n, m, t) = (v.n, v.m, v.t());
     let limit = p.limit();
-    let (t, np, nm) = (n, n + 1, n + 1 + m);
-    let sigma = n + 1 + 2 * m;
-    let mut d = ConicData::new(n + 1 + 2 * m + usize::from(limit.is_some()));
+    let mut d = ConicData::new(v.len());
     let cost = p.cost();
     for i in 0..m {
-        d.q[np + i] = w;
-        d.q[nm + i] = w;
+        d.q[v.nu_plus(i)] = w;
+        d.q[v.nu_minus(i)] = w;
     }
     // a light proximal term keeps the step unique where the model is flat
     let mut p_diag = vec![0.0; d.n];
@@ -558,8 +953,8 @@ fn subproblem(
         rows[r].push((c, v));
     }
     for (i, mut row) in rows.into_iter().enumerate() {
-        row.push((np + i, -1.0));
-        row.push((nm + i, 1.0));
+        row.push((v.nu_plus(i), -1.0));
+        row.push((v.nu_minus(i), 1.0));
         d.row(&row, -lin.residual[i]);
     }
     if cost != Cost::Peak {
@@ -586,32 +981,32 @@ fn subproblem(
         Some(l) if held_by_epigraph(p) => {
             // |f + F dz| <= t <= L (1 + sigma): the limit's multiplier
             // reaches the terms through t
-            d.q[sigma] = w;
-            d.row(&[(t, 1.0), (sigma, -l)], l);
+            d.q[v.sigma()] = w;
+            d.row(&[(t, 1.0), (v.sigma(), -l)], l);
             d.cone(Cone::Nonneg(1));
             Vec::new()
         }
         Some(_) => {
-            d.q[sigma] = w;
+            d.q[v.sigma()] = w;
             norm_rows(
                 &mut d,
                 &lin.limited,
                 &lin.limited_jac,
                 dim,
                 p.norm(),
-                (&[(sigma, 1.0)], 1.0),
+                (&[(v.sigma(), 1.0)], 1.0),
             )
         }
         None => Vec::new(),
     };
     // nu >= 0, sigma >= 0, trust region
-    for i in 0..2 * m {
-        d.row(&[(np + i, -1.0)], 0.0);
+    for j in v.virtual_controls() {
+        d.row(&[(j, -1.0)], 0.0);
     }
     if limit.is_some() {
-        d.row(&[(sigma, -1.0)], 0.0);
+        d.row(&[(v.sigma(), -1.0)], 0.0);
     }
-    for i in 0..n {
+    for i in v.dz() {
         d.row(&[(i, 1.0)], radius * scales[i]);
         d.row(&[(i, -1.0)], radius * scales[i]);
     }
@@ -623,17 +1018,6 @@ fn subproblem(
 /// with which the row's dual multiplies the term in the Lagrangian.
 type TermRows = Vec<Vec<(usize, f64)>>;
 
-/// Weight of the correction's slacks against its scaled step `|dc|^2 / 2`.
-/// A residual component along a direction of scaled gain `s` is removed
-/// while it is below about `W s^2`: all of it where the constraints are
-/// well conditioned (`s ~ 0.5`), none along the attitude's tilt, whose
-/// first-order gain all but vanishes at the designs (`s ~ 1e-7`; a hard
-/// correction took a huge step there, or 70 to 200 interior-point
-/// iterations to find none). Over `examples/bench_scp_suite` the elastic
-/// correction took 386 SCP iterations instead of 417 and 10 % fewer
-/// instructions (weights 1 to 100 all gave 386 to 391).
-const CORRECTION_SLACK_WEIGHT: f64 = 10.0;
-
 /// Second-order correction at the trial point `z+ = z + dz`: the least
 /// scaled-norm `dc` with `J dc = (r + J dz) - r(z+)` (back onto the model's
 /// prediction of the residual) that keeps the exact constraints. This undoes
@@ -642,9 +1026,9 @@ const CORRECTION_SLACK_WEIGHT: f64 = 10.0;
 /// the terms at `z+` are also brought back under the model's bounds,
 /// `|f(z+) + F dc| <= t` (peak cost) and `|g(z+) + G dc| <= L + sigma`
 /// (limits), the same curvature effect on the norm rows. Both are elastic
-/// (slacks weighted by [`CORRECTION_SLACK_WEIGHT`]), so the correction
-/// always exists; the merit judges it. The solution's first `n` entries are
-/// `dc`.
+/// (slacks weighted by `slack_weight`, [`Correction::slack_weight`]), so
+/// the correction always exists; the merit judges it. The solution's first
+/// `n` entries are `dc`.
 fn correction(
     p: &dyn ScpProblem,
     z_trial: &[f64],
@@ -652,6 +1036,7 @@ fn correction(
     target_minus_actual: &[f64],
     scales: &[f64],
     bounds: Option<(&Values, f64, f64)>,
+    slack_weight: f64,
 ) -> ConicData {
     let n = p.dim();
     let m = target_minus_actual.len();
@@ -663,7 +1048,7 @@ fn correction(
     pd.resize(n + extra, 0.0);
     d.p_diag = Some(pd);
     for i in n..n + extra {
-        d.q[i] = CORRECTION_SLACK_WEIGHT;
+        d.q[i] = slack_weight;
     }
     let mut rows: Vec<Vec<(usize, f64)>> = vec![Vec::new(); m];
     for &(r, c, v) in &lin.residual_jac {
@@ -708,13 +1093,6 @@ fn correction(
     d
 }
 
-/// The share of the predicted decrease a sensitivity correction must
-/// recover to stand in for the conic correction (over
-/// `examples/bench_scp_suite`, measured when chosen: 0.3 and 0.5 gave 207
-/// and 208 SCP iterations, 0.75 gave 223, 0.1 gave 287; a weak cheap
-/// correction keeps the path off the better conic one).
-const SENSITIVITY_ACCEPT: f64 = 0.5;
-
 /// One subproblem as built: its point, linearisation, data, the rows of
 /// its terms and limits ([`subproblem`]'s), and the penalty weight.
 struct Model<'a> {
@@ -758,8 +1136,7 @@ impl Model<'_> {
 /// the error at the corrected point, the best merit kept. One
 /// factorisation and a few triangular solves, where the conic correction
 /// ([`correction`]) is a whole interior-point solve (about 20
-/// factorisations). Over `examples/bench_scp_suite` (with the curvature
-/// scale) 208 SCP iterations instead of 264, with 1 round 287, with 5 208.
+/// factorisations).
 fn sensitivity_correction(
     p: &dyn ScpProblem,
     model: &Model,
@@ -815,178 +1192,778 @@ struct Solvers {
     bounded_correction: Option<ConicSolver>,
 }
 
-/// One SCP iteration at `z`: linearise, solve the convex subproblem, try a
-/// second-order correction, and judge the trial point. Returns the record
-/// (with `accepted` decided) and the trial point.
-fn iterate(
-    p: &dyn ScpProblem,
-    z: &[f64],
-    radius: f64,
-    w: f64,
-    iteration: usize,
-    scales: &[f64],
-    solvers: &mut Solvers,
-    mult: &mut Multipliers,
+/// The convex subproblem at the state's point, as built: its linearisation,
+/// data, constant and rows ([`subproblem`]'s) and its variables.
+struct Subproblem {
+    lin: Linearization,
+    data: ConicData,
+    constant: f64,
+    term_rows: TermRows,
+    limit_rows: TermRows,
+    layout: Layout,
+}
+
+/// Where the SCP stands between iterations: the iterate and everything the
+/// rules carry from one iteration to the next.
+struct State {
+    /// The iterate.
+    z: Vec<f64>,
+    /// The merit at `z` for `weight`.
     here: Merit,
-    settings: &ScpSettings,
-) -> Result<(ScpIteration, Vec<f64>, Merit)> {
-    let (phi, cost, inf) = here;
-    let lin = linearize(p, z);
-    mult.terms.resize(lin.terms.len(), 0.0);
-    mult.limited.resize(lin.limited.len(), 0.0);
-    // the multipliers of the relative limits are L times the problem's
-    let u_abs: Vec<f64> = mult
-        .limited
-        .iter()
-        .map(|x| x / p.limit().unwrap_or(1.0))
-        .collect();
-    let mut hessian = p.hessian(z, &mult.terms, &u_abs);
-    hessian.iter_mut().for_each(|e| e.2 *= mult.curvature);
-    let (data, constant, term_rows, limit_rows) =
-        subproblem(p, z, &lin, scales, radius, w, &hessian);
-    let clock = Instant::now();
-    let (st, x, obj) = solve_reusing_with(&mut solvers.subproblem, &data, settings.conic)?;
-    let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
-    if !st.ok() {
-        return Err(Error::Solver {
-            what: format!("SCP subproblem {iteration}"),
-            status: format!("{st:?}"),
-            hint: "try another seed (--seed), more free.nodes, or report the config".into(),
-        });
+    /// The trust radius (scaled units).
+    radius: f64,
+    /// The penalty weight, in the cost's unit.
+    weight: f64,
+    /// The weight at the start: the stagnation rule's raises count from it.
+    weight_start: f64,
+    /// The penalty's scale: the cost at the start; for a peak cost at least
+    /// the limit. The weight's bounds are multiples of it.
+    scale: f64,
+    /// The multipliers and curvature scale of the next subproblem's Hessian.
+    multipliers: Multipliers,
+    solvers: Solvers,
+    /// The watchdog's point before a tentative step.
+    anchor: Option<Anchor>,
+    /// Whether the watchdog may take a tentative step (re-armed by an
+    /// accepted step).
+    armed: bool,
+    /// Whether the last step was rejected: the radius does not grow right
+    /// after one.
+    last_rejected: bool,
+    /// Failed subproblems in a row.
+    failures: usize,
+    /// The merit after each judged iteration at this weight (the progress
+    /// rule's window).
+    merits: Vec<f64>,
+    /// `(violation, cost)` after each judged iteration at this weight
+    /// (rejected steps count: at an infeasible minimum of the merit the
+    /// steps there are rejected while the radius shrinks).
+    history: Vec<(f64, f64)>,
+    /// Critical points in a row at a nearly feasible violation.
+    nearly: usize,
+    /// A raise of the weight the last iteration decided: applied before the
+    /// next one (or at the end), so that the stopping rules see the
+    /// iteration's own weight and history.
+    raise: bool,
+}
+
+impl State {
+    /// Back to the point before a tentative step.
+    fn restore(&mut self, a: Anchor) {
+        (self.z, self.here, self.radius, self.multipliers) = (a.z, a.merit, a.cut, a.multipliers);
     }
-    let (n, m) = (p.dim(), lin.residual.len());
-    // the terms' and limits' multipliers, for the next subproblem's curvature
-    if let Some(sv) = &solvers.subproblem {
-        let dual = sv.duals();
-        for (v, rows) in [
-            (&mut mult.terms, &term_rows),
-            (&mut mult.limited, &limit_rows),
-        ] {
-            for (yr, rows) in v.iter_mut().zip(rows) {
-                *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+}
+
+/// What one call of [`Scp::next_iter`] did.
+enum Step {
+    /// The subproblem failed and counts as a rejection (no record).
+    Failed,
+    /// A tentative step, or the step after it that undid both (see
+    /// [`ScpSettings::watchdog`]): recorded, not judged by the stopping rules.
+    Watchdog(ScpIteration),
+    /// A step judged by the merit: recorded, then the stopping rules.
+    Judged(ScpIteration),
+}
+
+/// Why a solve ended (argmin's termination reason).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Termination {
+    /// Converged: the criticality fell below the tolerance at a feasible point.
+    Criticality,
+    /// Converged: the merit stopped falling (by the tolerance per iteration
+    /// over the window) at a feasible point.
+    Progress,
+    /// The constraints stayed violated while the penalty weight outgrew its
+    /// bound.
+    Infeasible,
+    /// The trust region collapsed without converging.
+    Stalled,
+    /// The iteration limit.
+    IterationLimit,
+}
+
+impl Termination {
+    /// The reason in words.
+    pub fn text(self) -> &'static str {
+        match self {
+            Termination::Criticality => "converged: criticality below the tolerance",
+            Termination::Progress => "converged: the merit stopped falling",
+            Termination::Infeasible => {
+                "locally infeasible: the constraints stayed violated as the penalty grew"
+            }
+            Termination::Stalled => "stalled: the trust region collapsed",
+            Termination::IterationLimit => "the iteration limit",
+        }
+    }
+
+    /// The run's status.
+    pub fn status(self) -> ScpStatus {
+        match self {
+            Termination::Criticality | Termination::Progress => ScpStatus::Converged,
+            Termination::Infeasible => ScpStatus::Infeasible,
+            Termination::Stalled => ScpStatus::Stalled,
+            Termination::IterationLimit => ScpStatus::IterationLimit,
+        }
+    }
+
+    /// The certificate's rule ([`StopRule::None`] unless converged).
+    pub fn rule(self) -> StopRule {
+        match self {
+            Termination::Criticality => StopRule::Criticality,
+            Termination::Progress => StopRule::Progress,
+            _ => StopRule::None,
+        }
+    }
+}
+
+impl std::fmt::Display for Termination {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.text())
+    }
+}
+
+/// The SCP as a solver (argmin's `Solver`): [`Scp::next_iter`] is one
+/// iteration on a [`State`], [`Scp::terminate`] its stopping rules; the
+/// [`Executor`] runs the loop.
+struct Scp<'a> {
+    p: &'a dyn ScpProblem,
+    s: &'a ScpSettings,
+    scales: Vec<f64>,
+    /// Whether the cost is linear (the stagnation rule's cost).
+    linear_cost: bool,
+}
+
+impl<'a> Scp<'a> {
+    fn new(p: &'a dyn ScpProblem, s: &'a ScpSettings) -> Self {
+        Self {
+            p,
+            s,
+            scales: p.scales(),
+            linear_cost: matches!(p.cost(), Cost::Linear(_)),
+        }
+    }
+
+    /// The state at `z0`, with a neighbour's weight, radius and multipliers.
+    fn init(&self, z0: Vec<f64>, warm: Option<&WarmStart>) -> State {
+        let (p, s) = (self.p, self.s);
+        // the penalty's scale: the cost at the start; for a peak cost at
+        // least the limit, which is in the cost's unit (a torque-speed line
+        // can make it many times the cost). A time or energy cost has
+        // another unit: there the limit's size (torque) says nothing about
+        // the multipliers, and a weight hundreds of times the cost makes the
+        // merit all penalty
+        let (_, cost0, _) = merit(p, &z0, 0.0);
+        let scale = match p.cost() {
+            Cost::Peak => cost0.abs().max(p.limit().unwrap_or(0.0)),
+            Cost::Linear(_) | Cost::SumOfSquares => cost0.abs(),
+        }
+        .max(1e-12);
+        // at least a neighbour's weight (see Penalty::max_carried): a
+        // weight below its multipliers lets the merit drift to violations
+        // that the stopping rules must then raise it out of
+        let start = s.penalty.weight * scale;
+        let weight = start.max(
+            warm.map_or(0.0, |ws| ws.weight)
+                .min(s.penalty.max_carried * s.penalty.weight * scale),
+        );
+        let radius = warm.map_or(s.trust.initial_radius, |w| {
+            w.radius.clamp(s.trust.warm_floor, s.trust.initial_radius)
+        });
+        let multipliers = warm.map_or_else(Multipliers::default, |w| Multipliers {
+            // a neighbour's curvature scale belongs to its tail
+            curvature: 1.0,
+            ..w.multipliers.clone()
+        });
+        let here = merit(p, &z0, weight);
+        State {
+            z: z0,
+            here,
+            radius,
+            weight,
+            weight_start: weight,
+            scale,
+            multipliers,
+            solvers: Solvers::default(),
+            anchor: None,
+            armed: true,
+            last_rejected: false,
+            failures: 0,
+            merits: Vec::new(),
+            history: Vec::new(),
+            nearly: 0,
+            raise: false,
+        }
+    }
+
+    /// One iteration: a pending raise of the weight, the step, the
+    /// watchdog, then (for a judged step) acceptance, the trust region, the
+    /// history and the penalty's next weight.
+    fn next_iter(&self, state: &mut State, iteration: usize) -> Result<Step> {
+        self.raise_weight(state);
+        let (mut rec, trial, there) = match self.step(state, iteration) {
+            Ok(x) => {
+                state.failures = 0;
+                x
+            }
+            Err(Error::Solver { .. }) if state.failures < self.s.trust.max_failures => {
+                self.failed(state);
+                return Ok(Step::Failed);
+            }
+            Err(e) => return Err(e),
+        };
+        if let Some(a) = state.anchor.take() {
+            // the step after a tentative one: judged against the anchor
+            rec.accepted = rec.predicted > 0.0
+                && a.merit.0 - there.0 >= self.s.watchdog.decrease * a.predicted;
+            if !rec.accepted {
+                self.undo(state, a, &mut rec);
+                return Ok(Step::Watchdog(rec));
+            }
+        } else if self.tentative(state, &rec, &there) {
+            rec.tentative = true;
+            state.anchor = Some(Anchor {
+                z: std::mem::replace(&mut state.z, trial),
+                merit: std::mem::replace(&mut state.here, there),
+                predicted: rec.predicted,
+                cut: self.cut(&rec),
+                multipliers: state.multipliers.clone(),
+                bounded: rec.bounded(),
+            });
+            return Ok(Step::Watchdog(rec));
+        }
+        if rec.accepted {
+            (state.z, state.here) = (trial, there);
+            state.armed = true;
+        }
+        if self.s.curvature.adapt {
+            state.multipliers.adapt_curvature(&rec, &self.s.curvature);
+        }
+        self.update_radius(state, &rec);
+        let (phi, cost, inf) = state.here;
+        state.merits.push(phi);
+        state.history.push((inf, cost));
+        self.decide_weight(state, &rec);
+        Ok(Step::Judged(rec))
+    }
+
+    /// The convex model at the state's point.
+    fn model(&self, state: &mut State) -> Subproblem {
+        let (p, z, mult) = (self.p, &state.z, &mut state.multipliers);
+        let lin = linearize(p, z);
+        mult.terms.resize(lin.terms.len(), 0.0);
+        mult.limited.resize(lin.limited.len(), 0.0);
+        // the multipliers of the relative limits are L times the problem's
+        let u_abs: Vec<f64> = mult
+            .limited
+            .iter()
+            .map(|x| x / p.limit().unwrap_or(1.0))
+            .collect();
+        let mut hessian = p.hessian(z, &mult.terms, &u_abs);
+        hessian.iter_mut().for_each(|e| e.2 *= mult.curvature);
+        let (data, constant, term_rows, limit_rows) = subproblem(
+            p,
+            z,
+            &lin,
+            &self.scales,
+            state.radius,
+            state.weight,
+            &hessian,
+        );
+        let layout = Layout::of(p, &lin);
+        Subproblem {
+            lin,
+            data,
+            constant,
+            term_rows,
+            limit_rows,
+            layout,
+        }
+    }
+
+    /// Solves the model: its solution, objective and solve time (ms); the
+    /// terms' and limits' multipliers are kept for the next model's
+    /// curvature.
+    fn solve_model(
+        &self,
+        state: &mut State,
+        sub: &Subproblem,
+        iteration: usize,
+    ) -> Result<(Vec<f64>, f64, f64)> {
+        let clock = Instant::now();
+        let (st, x, obj) =
+            solve_reusing_with(&mut state.solvers.subproblem, &sub.data, self.s.conic)?;
+        let solve_ms = clock.elapsed().as_secs_f64() * 1e3;
+        if !st.ok() {
+            return Err(Error::Solver {
+                what: format!("SCP subproblem {iteration}"),
+                status: format!("{st:?}"),
+                hint: "try another seed (--seed), more free.nodes, or report the config".into(),
+            });
+        }
+        let mult = &mut state.multipliers;
+        if let Some(sv) = &state.solvers.subproblem {
+            let dual = sv.duals();
+            for (v, rows) in [
+                (&mut mult.terms, &sub.term_rows),
+                (&mut mult.limited, &sub.limit_rows),
+            ] {
+                for (yr, rows) in v.iter_mut().zip(rows) {
+                    *yr = rows.iter().map(|&(row, sign)| sign * dual[row]).sum();
+                }
+            }
+            if sub.limit_rows.is_empty() {
+                // no rows of their own (none, or held by `t`): the terms'
+                // multipliers carry the limit, and a neighbour's must not linger
+                mult.limited.fill(0.0);
             }
         }
-        if limit_rows.is_empty() {
-            // no rows of their own (none, or held by `t`): the terms'
-            // multipliers carry the limit, and a neighbour's must not linger
-            mult.limited.fill(0.0);
-        }
+        Ok((x, obj, solve_ms))
     }
-    // model value: the cost's constant plus the solver's objective
-    // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
-    let predicted = phi - (constant + obj);
-    let model_step = scaled_max(x[..n].iter().copied(), scales);
-    let mut trial: Vec<f64> = z.iter().zip(&x[..n]).map(|(a, b)| a + b).collect();
-    let at = evaluate(p, &trial);
-    let mut there = merit_of(p, &trial, &at, w);
-    if predicted > 0.0 && phi - there.0 < 0.75 * predicted {
+
+    /// One step from the state's point: the model, its solution, a
+    /// second-order correction when the merit falls short of the model, and
+    /// the record with `accepted` judged by `rho` (the watchdog may revise
+    /// it). Returns the record, the trial point and its merit.
+    fn step(&self, state: &mut State, iteration: usize) -> Result<(ScpIteration, Vec<f64>, Merit)> {
+        let (p, s) = (self.p, self.s);
+        let sub = self.model(state);
+        let (x, obj, solve_ms) = self.solve_model(state, &sub, iteration)?;
+        let (phi, cost, inf) = state.here;
+        let v = sub.layout;
+        // model value: the cost's constant plus the solver's objective
+        // (t or the cost's linear/quadratic model, w |nu|_1 + w sigma, 1/2 dz' P dz)
+        let predicted = phi - (sub.constant + obj);
+        let model_step = scaled_max(v.step(&x).iter().copied(), &self.scales);
+        let mut trial: Vec<f64> = state.z.iter().zip(v.step(&x)).map(|(a, b)| a + b).collect();
+        let at = evaluate(p, &trial);
+        let mut there = merit_of(p, &trial, &at, state.weight);
+        if predicted > 0.0 && phi - there.0 < s.correction.below * predicted {
+            (trial, there) = self.correct(state, &sub, &x, predicted, trial, &at, there);
+        }
+        let step = scaled_max(trial.iter().zip(&state.z).map(|(a, b)| a - b), &self.scales);
+        let actual = phi - there.0;
+        let rho = if predicted > 0.0 {
+            actual / predicted
+        } else {
+            0.0
+        };
+        // a trial point the model cannot evaluate (a non-finite merit) is a
+        // rejection that cuts the radius, not a NaN that neither cuts nor grows it
+        let rho = if rho.is_nan() { f64::NEG_INFINITY } else { rho };
+        let accepted = predicted > 0.0 && rho > s.trust.accept;
+        let rec = ScpIteration {
+            iteration,
+            merit: phi,
+            objective: cost,
+            infeasibility: inf,
+            radius: state.radius,
+            weight: state.weight,
+            predicted,
+            actual,
+            rho,
+            accepted,
+            tentative: false,
+            merit_after: if accepted { there.0 } else { phi },
+            step,
+            model_step,
+            solve_ms,
+        };
+        Ok((rec, trial, there))
+    }
+
+    /// The second-order correction of the trial point `trial` (values `at`,
+    /// merit `there`) of the model's solution `x`: the sensitivity
+    /// correction first, the conic one (with the terms' bounds, then
+    /// without when the solver fails on that one) when it recovers too
+    /// little. A cheap correction that falls short is kept only when the
+    /// conic one fails: it took the path to worse points. Returns the point
+    /// kept and its merit.
+    fn correct(
+        &self,
+        state: &mut State,
+        sub: &Subproblem,
+        x: &[f64],
+        predicted: f64,
+        trial: Vec<f64>,
+        at: &Values,
+        there: Merit,
+    ) -> (Vec<f64>, Merit) {
+        let (p, s, v) = (self.p, self.s, sub.layout);
+        let phi = state.here.0;
         // back onto the model's residual at the trial point, r + J dz = nu+ - nu-
-        let rhs: Vec<f64> = (0..m)
-            .map(|i| x[n + 1 + i] - x[n + 1 + m + i] - at.residual[i])
+        let rhs: Vec<f64> = (0..v.m)
+            .map(|i| v.virtual_control(x, i) - at.residual[i])
             .collect();
-        // with the terms' bounds first (t, L + sigma from the subproblem);
-        // without them when the solver fails on that one
+        // the terms' bounds: t, L + sigma from the subproblem
         let has_bounds = p.cost() == Cost::Peak || p.limit().is_some();
-        let sigma = 1.0
-            + if p.limit().is_some() {
-                x[n + 1 + 2 * m]
-            } else {
-                0.0
-            };
-        // the cheap correction first, the conic one when it falls short
-        let cheap = match solvers.subproblem.as_mut() {
-            Some(solver) if settings.correction_rounds > 0 => {
+        let sigma = 1.0 + v.slack(x);
+        let cheap = match state.solvers.subproblem.as_mut() {
+            Some(solver) if s.correction.rounds > 0 => {
                 let model = Model {
-                    z,
-                    lin: &lin,
-                    data: &data,
-                    term_rows: &term_rows,
-                    limit_rows: &limit_rows,
-                    w,
+                    z: &state.z,
+                    lin: &sub.lin,
+                    data: &sub.data,
+                    term_rows: &sub.term_rows,
+                    limit_rows: &sub.limit_rows,
+                    w: state.weight,
                 };
-                sensitivity_correction(p, &model, &x[..n], &at, solver, settings.correction_rounds)
+                sensitivity_correction(p, &model, v.step(x), at, solver, s.correction.rounds)
             }
             _ => None,
         };
-        // a cheap correction that falls short is kept only when the conic
-        // one fails: compared with the conic one, it took the path to worse
-        // points (the seed's per-motor design from the analytic seed 38
-        // iterations to 0.32342 N m instead of 18 to 0.32567, the robot's 14
-        // and 18 instead of 12 and 13)
         let mut best: Option<(Vec<f64>, Merit)> = None;
         let mut fallback = None;
         if let Some((corrected, at_c)) = cheap
             && at_c.0 < there.0
         {
-            if phi - at_c.0 > SENSITIVITY_ACCEPT * predicted {
+            if phi - at_c.0 > s.correction.sensitivity_accept * predicted {
                 best = Some((corrected, at_c));
             } else {
                 fallback = Some((corrected, at_c));
             }
         }
-        let done = best.is_some();
-        let tries = [
-            (true, &mut solvers.bounded_correction),
-            (false, &mut solvers.correction),
-        ];
-        for (with_bounds, slot) in tries {
-            if done {
-                break;
-            }
-            if with_bounds && !has_bounds {
-                continue;
-            }
-            let bounds = with_bounds.then_some((&at, x[n], sigma));
-            let cd = correction(p, &trial, &lin, &rhs, scales, bounds);
-            if let Ok((cs, dc, _)) = solve_reusing_with(slot, &cd, settings.conic)
-                && cs.ok()
-            {
-                let corrected: Vec<f64> = trial.iter().zip(&dc[..n]).map(|(a, b)| a + b).collect();
-                let at_c = merit(p, &corrected, w);
-                if at_c.0 < there.0 {
-                    best = Some((corrected, at_c));
+        if best.is_none() {
+            let tries = [
+                (true, &mut state.solvers.bounded_correction),
+                (false, &mut state.solvers.correction),
+            ];
+            for (with_bounds, slot) in tries {
+                if with_bounds && !has_bounds {
+                    continue;
                 }
-                fallback = None;
-                break;
+                let bounds = with_bounds.then_some((at, v.epigraph(x), sigma));
+                let cd = correction(
+                    p,
+                    &trial,
+                    &sub.lin,
+                    &rhs,
+                    &self.scales,
+                    bounds,
+                    s.correction.slack_weight,
+                );
+                if let Ok((cs, dc, _)) = solve_reusing_with(slot, &cd, s.conic)
+                    && cs.ok()
+                {
+                    let corrected: Vec<f64> =
+                        trial.iter().zip(&dc[..v.n]).map(|(a, b)| a + b).collect();
+                    let at_c = merit(p, &corrected, state.weight);
+                    if at_c.0 < there.0 {
+                        best = Some((corrected, at_c));
+                    }
+                    fallback = None;
+                    break;
+                }
             }
         }
-        if let Some(b) = best.or(fallback) {
-            (trial, there) = b;
+        best.or(fallback).unwrap_or((trial, there))
+    }
+
+    /// A subproblem the conic solver could not finish: a rejected step (a
+    /// smaller trust region is a better-conditioned subproblem); a
+    /// tentative point the solver cannot step from is undone.
+    fn failed(&self, state: &mut State) {
+        state.failures += 1;
+        state.radius *= self.s.trust.failure_cut;
+        if let Some(a) = state.anchor.take() {
+            state.restore(a);
+            state.armed = false;
+        }
+        state.last_rejected = true;
+        state.solvers.subproblem = None;
+    }
+
+    /// Whether the watchdog takes a step the merit would reject,
+    /// tentatively: for a peak cost, when armed, for a finite trial merit,
+    /// and not at a converged point, where `rho` is noise (the rules stop
+    /// there).
+    fn tentative(&self, state: &State, rec: &ScpIteration, there: &Merit) -> bool {
+        let s = self.s;
+        s.watchdog.enabled
+            && self.p.cost() == Cost::Peak
+            && state.armed
+            && rec.predicted > 0.0
+            && rec.rho < s.trust.accept
+            && there.0.is_finite()
+            && !(rec.criticality_within(s.feasibility) <= s.tolerance
+                && state.here.2 <= s.feasibility)
+    }
+
+    /// The step after a tentative one fell short: both are undone (the
+    /// record's `merit_after` is the anchor's, where the iterate is again),
+    /// the radius cut as for the anchor's rejection, its curvature restored
+    /// and scaled for that rejection.
+    fn undo(&self, state: &mut State, a: Anchor, rec: &mut ScpIteration) {
+        rec.merit_after = a.merit.0;
+        let bounded = a.bounded;
+        state.restore(a);
+        state.armed = false;
+        if self.s.curvature.adapt && !bounded {
+            // the anchor's own step was the rejected one
+            state.multipliers.reject_curvature(&self.s.curvature);
+        }
+        state.last_rejected = true;
+    }
+
+    /// The radius after rejecting `rec`'s step: a share of the model's step
+    /// (see [`TrustRegion::cut`]).
+    fn cut(&self, rec: &ScpIteration) -> f64 {
+        let t = &self.s.trust;
+        rec.radius
+            * if rec.predicted > 0.0 {
+                t.cut * (rec.model_step / rec.radius).clamp(t.least_cut, 1.0)
+            } else {
+                t.cut
+            }
+    }
+
+    /// The trust region after a judged step: cut below
+    /// [`TrustRegion::accept`], grown above [`TrustRegion::grow_above`]
+    /// except right after a rejection.
+    fn update_radius(&self, state: &mut State, rec: &ScpIteration) {
+        let t = &self.s.trust;
+        if rec.rho < t.accept {
+            state.radius = self.cut(rec);
+        } else if rec.rho > t.grow_above && !state.last_rejected {
+            state.radius = (state.radius * t.growth).min(t.max_radius);
+        }
+        state.last_rejected = !rec.accepted;
+    }
+
+    /// Whether a linear cost's violation stagnates at this weight (see
+    /// [`Penalty::stagnation`]).
+    fn stagnates(&self, state: &State) -> bool {
+        let (s, k) = (self.s, self.s.penalty.stagnation);
+        let (_, cost_now, inf_now) = state.here;
+        k > 0
+            && self.linear_cost
+            && state.history.len() > k
+            && inf_now > s.penalty.nearly_feasible * s.feasibility
+            && state.weight < s.penalty.stagnation_cap * state.weight_start
+            && {
+                let (inf_then, cost_then) = state.history[state.history.len() - 1 - k];
+                inf_now > s.penalty.stagnation_fall * inf_then
+                    && (cost_now - cost_then).abs() < s.penalty.stagnation_cost * cost_now.abs()
+            }
+    }
+
+    /// Whether `rec`'s criticality is within the tolerance (and the
+    /// violation does not stagnate).
+    fn critical(&self, state: &State, rec: &ScpIteration) -> bool {
+        !self.stagnates(state) && rec.criticality_within(self.s.feasibility) <= self.s.tolerance
+    }
+
+    /// Whether the merit fell by less than `tolerance` (relative) per
+    /// iteration, on average over the window (and the violation does not
+    /// stagnate).
+    fn slow(&self, state: &State) -> bool {
+        let (s, m) = (self.s, &state.merits);
+        let phi_now = state.here.0;
+        !self.stagnates(state)
+            && m.len() > s.window
+            && m[m.len() - 1 - s.window] - phi_now <= s.tolerance * s.window as f64 * phi_now.abs()
+    }
+
+    /// Whether the violation is within `feasibility`.
+    fn feasible(&self, state: &State) -> bool {
+        state.here.2 <= self.s.feasibility
+    }
+
+    /// The penalty after a judged step: raised when the violation
+    /// stagnates, or when the model is critical while infeasible beyond
+    /// [`Penalty::nearly_feasible`] or for longer than
+    /// [`Penalty::patience`]; a nearly feasible critical point keeps the
+    /// weight (the next steps remove a small violation at this weight, and
+    /// raising it would only shrink the steps).
+    fn decide_weight(&self, state: &mut State, rec: &ScpIteration) {
+        let pen = &self.s.penalty;
+        if self.critical(state, rec) || self.slow(state) {
+            if self.feasible(state) {
+                // converged: the rules stop here
+                state.raise = false;
+                return;
+            }
+            state.nearly += 1;
+            state.raise = state.here.2 > pen.nearly_feasible * self.s.feasibility
+                || state.nearly > pen.patience;
+        } else {
+            state.nearly = 0;
+            state.raise = self.stagnates(state);
         }
     }
-    let step = scaled_max(trial.iter().zip(z).map(|(a, b)| a - b), scales);
-    let actual = phi - there.0;
-    let rho = if predicted > 0.0 {
-        actual / predicted
-    } else {
-        0.0
-    };
-    // a trial point the model cannot evaluate (a non-finite merit) is a
-    // rejection that cuts the radius, not a NaN that neither cuts nor grows it
-    let rho = if rho.is_nan() { f64::NEG_INFINITY } else { rho };
-    let accepted = predicted > 0.0 && rho > 0.1;
-    let rec = ScpIteration {
-        iteration,
-        merit: phi,
-        objective: cost,
-        infeasibility: inf,
-        radius,
-        weight: w,
-        predicted,
-        actual,
-        rho,
-        accepted,
-        tentative: false,
-        merit_after: if accepted { there.0 } else { phi },
-        step,
-        model_step,
-        solve_ms,
-    };
-    Ok((rec, trial, there))
+
+    /// Applies a raise of the weight decided by the last iteration: the
+    /// merit at the new weight, a new history.
+    fn raise_weight(&self, state: &mut State) {
+        if !std::mem::take(&mut state.raise) {
+            return;
+        }
+        state.weight *= self.s.penalty.growth;
+        state.here = merit(self.p, &state.z, state.weight);
+        state.merits.clear();
+        state.history.clear();
+        state.nearly = 0;
+    }
+
+    /// The stopping rules after a judged step, in order.
+    fn terminate(&self, state: &State, rec: &ScpIteration) -> Option<Termination> {
+        converged_by_criticality(self, state, rec)
+            .or_else(|| converged_by_progress(self, state))
+            .or_else(|| infeasible(self, state))
+            .or_else(|| stalled(self, state))
+    }
+
+    /// The result at the end: a pending raise applied, a tentative step
+    /// the run ended on undone.
+    fn finish(
+        &self,
+        mut state: State,
+        termination: Termination,
+        iterations: Vec<ScpIteration>,
+        seconds: f64,
+    ) -> ScpResult {
+        self.raise_weight(&mut state);
+        if let Some(a) = state.anchor.take() {
+            state.restore(a);
+        }
+        let (_, objective, infeasibility) = state.here;
+        let last = iterations.last().copied();
+        let certificate = Certificate {
+            step: last.map_or(0.0, |l| l.step),
+            constraint_violation: infeasibility,
+            criticality: last.map_or(0.0, |l| l.criticality_within(self.s.feasibility)),
+            radius: state.radius,
+            weight: state.weight / state.scale,
+            rule: termination.rule(),
+        };
+        ScpResult {
+            z: state.z,
+            status: termination.status(),
+            termination,
+            objective,
+            infeasibility,
+            iterations,
+            certificate,
+            warm: WarmStart {
+                multipliers: state.multipliers,
+                radius: state.radius,
+                weight: state.weight,
+            },
+            seconds,
+        }
+    }
 }
 
-/// The driver: runs [`iterate`] from `z0`, owns the trust radius, the penalty
-/// weight and the stopping rules, and reports each iteration to `observe`.
+/// Converged by criticality: within the tolerance at a feasible point.
+fn converged_by_criticality(scp: &Scp, state: &State, rec: &ScpIteration) -> Option<Termination> {
+    (scp.critical(state, rec) && scp.feasible(state)).then_some(Termination::Criticality)
+}
+
+/// Converged by progress: the merit stopped falling at a feasible point.
+fn converged_by_progress(scp: &Scp, state: &State) -> Option<Termination> {
+    (scp.slow(state) && scp.feasible(state)).then_some(Termination::Progress)
+}
+
+/// Locally infeasible: the raise the iteration decided takes the weight past
+/// [`Penalty::infeasible`] times its start.
+fn infeasible(scp: &Scp, state: &State) -> Option<Termination> {
+    let pen = &scp.s.penalty;
+    (state.raise && state.weight * pen.growth > pen.infeasible * pen.weight * state.scale)
+        .then_some(Termination::Infeasible)
+}
+
+/// Stalled: the trust radius fell below [`TrustRegion::min_radius`].
+fn stalled(scp: &Scp, state: &State) -> Option<Termination> {
+    (state.radius < scp.s.trust.min_radius).then_some(Termination::Stalled)
+}
+
+/// What a solve reports as it runs (argmin's observers): each iteration
+/// and, for a problem solved on a sequence of meshes, where each begins.
+/// Any `FnMut(&ScpIteration)` is an observer that ignores the meshes.
+pub trait Observer {
+    fn iteration(&mut self, it: &ScpIteration);
+    /// The SCP begins on a mesh of `nodes` per phase (mesh continuation
+    /// only: each coarse mesh, then the finest; again if the finest starts
+    /// over from the seed, numbered on from the coarse meshes: the failed
+    /// attempt is not on the record).
+    fn mesh(&mut self, _nodes: usize) {}
+}
+
+impl<F: FnMut(&ScpIteration)> Observer for F {
+    fn iteration(&mut self, it: &ScpIteration) {
+        self(it)
+    }
+}
+
+/// Runs the SCP (argmin's `Executor`): owns the loop, the iteration
+/// numbers (numbered on from [`Executor::numbered_from`] across the solves
+/// of one design: meshes, re-solves), the clock and the observer.
+#[derive(Clone, Copy)]
+pub struct Executor<'a> {
+    settings: &'a ScpSettings,
+    warm: Option<&'a WarmStart>,
+    first: usize,
+}
+
+impl<'a> Executor<'a> {
+    pub fn new(settings: &'a ScpSettings) -> Self {
+        Self {
+            settings,
+            warm: None,
+            first: 0,
+        }
+    }
+
+    /// Starts from a neighbouring solve's multipliers, radius and weight.
+    pub fn warm(self, warm: Option<&'a WarmStart>) -> Self {
+        Self { warm, ..self }
+    }
+
+    /// Numbers the iterations from `first` (the iterations of the solves
+    /// before this one).
+    pub fn numbered_from(self, first: usize) -> Self {
+        Self { first, ..self }
+    }
+
+    /// Solves `p` from `z0`, reporting each recorded iteration to
+    /// `observer`; every iteration counts towards the limit (failed
+    /// subproblems, unrecorded, keep their numbers).
+    pub fn run(
+        &self,
+        p: &dyn ScpProblem,
+        z0: Vec<f64>,
+        observer: &mut dyn Observer,
+    ) -> Result<ScpResult> {
+        self.settings.validate()?;
+        let clock = Instant::now();
+        let scp = Scp::new(p, self.settings);
+        let mut state = scp.init(z0, self.warm);
+        let mut iterations = Vec::new();
+        let mut termination = Termination::IterationLimit;
+        for k in 0..self.settings.max_iterations {
+            let rec = match scp.next_iter(&mut state, self.first + k)? {
+                Step::Failed => continue,
+                Step::Watchdog(rec) => {
+                    observer.iteration(&rec);
+                    iterations.push(rec);
+                    continue;
+                }
+                Step::Judged(rec) => rec,
+            };
+            observer.iteration(&rec);
+            iterations.push(rec);
+            if let Some(reason) = scp.terminate(&state, &rec) {
+                termination = reason;
+                break;
+            }
+        }
+        let seconds = clock.elapsed().as_secs_f64();
+        Ok(scp.finish(state, termination, iterations, seconds))
+    }
+}
+
+/// Solves `p` from `z0` (see [`Executor`]), reporting each iteration to
+/// `observe`.
 pub fn solve(
     p: &dyn ScpProblem,
     z0: Vec<f64>,
@@ -994,6 +1971,17 @@ pub fn solve(
     observe: impl FnMut(&ScpIteration),
 ) -> Result<ScpResult> {
     solve_warm(p, z0, None, settings, observe)
+}
+
+/// [`solve`] with the multipliers, radius and weight of a neighbouring solve.
+pub fn solve_warm(
+    p: &dyn ScpProblem,
+    z0: Vec<f64>,
+    warm: Option<&WarmStart>,
+    settings: &ScpSettings,
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<ScpResult> {
+    Executor::new(settings).warm(warm).run(p, z0, &mut observe)
 }
 
 /// The point before a tentative step (the watchdog).
@@ -1017,7 +2005,7 @@ struct Anchor {
 pub struct Multipliers {
     pub terms: Vec<f64>,
     pub limited: Vec<f64>,
-    /// Scale of the model's Hessian, in `[MIN_CURVATURE, 1]` (see
+    /// Scale of the model's Hessian, in `[Curvature::min, 1]` (see
     /// [`Multipliers::adapt_curvature`]).
     pub curvature: f64,
 }
@@ -1032,10 +2020,6 @@ impl Default for Multipliers {
     }
 }
 
-/// The least scale of the model's curvature (0.01 took 303 SCP iterations
-/// on `examples/bench_scp_suite` instead of 264).
-const MIN_CURVATURE: f64 = 0.1;
-
 impl Multipliers {
     /// The model's Hessian is the positive semidefinite part of the terms'
     /// curvature: it misses the attitude's (a holonomy, indefinite) and the
@@ -1044,28 +2028,26 @@ impl Multipliers {
     /// whose minimum lies inside the trust region is `1/kappa` too curved
     /// for `rho = 2 - 1/kappa`: steps that fall short, converging linearly).
     /// After an accepted step inside the trust region with `rho > 1` the
-    /// scale is multiplied by `2 - rho` (at least a quarter per step); after
-    /// a rejected step inside it, doubled (at most 1). `rho` is the
-    /// iteration's, after any second-order correction (as measured: the
-    /// correction removes the constraints' curvature, not the cost's). Over
-    /// `examples/bench_scp_suite` (before the sensitivity correction) 264
-    /// SCP iterations instead of 294, every peak lower or equal (the
-    /// robot's per-motor design 0.05303 instead of 0.05309 N m). A warm
-    /// start begins again at 1.
-    fn adapt_curvature(&mut self, rec: &ScpIteration) {
+    /// scale is multiplied by `2 - rho` (at least [`Curvature::fall`] per
+    /// step, down to [`Curvature::min`]); after a rejected step inside it,
+    /// multiplied by [`Curvature::rise`] (at most 1). `rho` is the
+    /// iteration's, after any second-order correction (the correction
+    /// removes the constraints' curvature, not the cost's). A warm start
+    /// begins again at 1.
+    fn adapt_curvature(&mut self, rec: &ScpIteration, c: &Curvature) {
         if rec.bounded() {
             return;
         }
         if rec.accepted && rec.rho > 1.0 {
-            self.curvature = (self.curvature * (2.0 - rec.rho).max(0.25)).max(MIN_CURVATURE);
+            self.curvature = (self.curvature * (2.0 - rec.rho).max(c.fall)).max(c.min);
         } else if !rec.accepted {
-            self.reject_curvature();
+            self.reject_curvature(c);
         }
     }
 
     /// A step inside the trust region was rejected: the model was too flat.
-    fn reject_curvature(&mut self) {
-        self.curvature = (self.curvature * 2.0).min(1.0);
+    fn reject_curvature(&mut self, c: &Curvature) {
+        self.curvature = (self.curvature * c.rise).min(1.0);
     }
 }
 
@@ -1079,269 +2061,6 @@ pub struct WarmStart {
     /// The penalty weight at the end, in the cost's unit (not relative to
     /// the solve's start, which differs between neighbours).
     pub weight: f64,
-}
-
-/// [`solve`] with the multipliers and radius of a neighbouring solve.
-pub fn solve_warm(
-    p: &dyn ScpProblem,
-    z0: Vec<f64>,
-    warm: Option<&WarmStart>,
-    settings: &ScpSettings,
-    mut observe: impl FnMut(&ScpIteration),
-) -> Result<ScpResult> {
-    let scales = p.scales();
-    let mut z = z0;
-    // the penalty's scale: the cost at the start; for a peak cost at least
-    // the limit, which is in the cost's unit (a torque-speed line can make
-    // it many times the cost). A time or energy cost has another unit: there
-    // the limit's size (torque) said nothing about the multipliers, and a
-    // weight hundreds of times the cost made the merit all penalty (the
-    // domestic cat's least time took 150 iterations instead of 53)
-    let (_, cost0, _) = merit(p, &z, 0.0);
-    let scale = match p.cost() {
-        Cost::Peak => cost0.abs().max(p.limit().unwrap_or(0.0)),
-        Cost::Linear(_) | Cost::SumOfSquares => cost0.abs(),
-    }
-    .max(1e-12);
-    // at least a neighbour's weight: its constraints' multipliers are
-    // nearly these, and a weight below them lets the merit trade violation
-    // for cost until the stopping rules raise it again (the robot's energy
-    // designs from 7 m, re-solved with the envelope tightened by what the
-    // mesh missed, restarted each re-solve at the default weight and
-    // drifted to violations of 6e-2: 253, 104, 116 and 73 SCP iterations
-    // instead of 47, 47, 49 and 50; sweeps are unchanged)
-    let mut w = (settings.weight * scale).max(
-        warm.map_or(0.0, |ws| ws.weight)
-            .min(1e3 * settings.weight * scale),
-    );
-    // the stagnation rule's two raises count from where the weight started;
-    // the infeasibility bound (1e6 times the default) does not move: from a
-    // weight carried 1e3 times up three raises are left, and the robot's
-    // impossible 2 m designs, whose re-solves inside the envelope start
-    // there, ended in a failed subproblem at 1e6 times the carried weight
-    let w_start = w;
-    let mut radius = warm.map_or(settings.initial_radius, |w| {
-        w.radius.clamp(1e-3, settings.initial_radius)
-    });
-    let mut solvers = Solvers::default();
-    let mut iterations = Vec::new();
-    let mut status = ScpStatus::IterationLimit;
-    let mut mult = warm.map_or_else(Multipliers::default, |w| Multipliers {
-        // a neighbour's curvature scale belongs to its tail
-        curvature: 1.0,
-        ..w.multipliers.clone()
-    });
-    let mut window = Vec::new();
-    let mut rule = StopRule::None;
-    let mut failures = 0;
-    let mut nearly = 0;
-    let mut stagnant: Vec<(f64, f64)> = Vec::new();
-    let linear_cost = matches!(p.cost(), Cost::Linear(_));
-    // the merit at z for the weight w, kept across iterations
-    let mut here = merit(p, &z, w);
-    let mut last_rejected = false;
-    // the watchdog's point before a tentative step (see ScpSettings::watchdog)
-    let mut anchor: Option<Anchor> = None;
-    let mut armed = true;
-    for it in 0..settings.max_iterations {
-        let step = iterate(
-            p,
-            &z,
-            radius,
-            w,
-            it,
-            &scales,
-            &mut solvers,
-            &mut mult,
-            here,
-            settings,
-        );
-        let (mut rec, trial, there) = match step {
-            Ok(x) => {
-                failures = 0;
-                x
-            }
-            // a subproblem the conic solver could not finish (numerical
-            // trouble) is a rejected step: a smaller trust region is a
-            // better-conditioned subproblem
-            Err(Error::Solver { .. }) if failures < 4 => {
-                failures += 1;
-                radius *= 0.25;
-                if let Some(a) = anchor.take() {
-                    // a tentative point the solver cannot step from is undone
-                    (z, here, radius, mult) = (a.z, a.merit, a.cut, a.multipliers);
-                    armed = false;
-                }
-                last_rejected = true;
-                solvers.subproblem = None;
-                continue;
-            }
-            Err(e) => return Err(e),
-        };
-        // the radius after a rejection: half the model's step (a radius
-        // still above an interior step would only give the same step again;
-        // the seed's per-motor design from the phased seed rejected one step
-        // eight times, radius 8 down to 0.03); half the radius when the
-        // model predicted no decrease (its step says nothing), and at most
-        // a twentieth of it
-        let cut = |rec: &ScpIteration| {
-            rec.radius
-                * if rec.predicted > 0.0 {
-                    0.5 * (rec.model_step / rec.radius).clamp(0.1, 1.0)
-                } else {
-                    0.5
-                }
-        };
-        let mut undone = false;
-        if let Some(a) = anchor.take() {
-            // the step after a tentative one: judged against the anchor
-            rec.accepted = rec.predicted > 0.0 && a.merit.0 - there.0 >= 0.1 * a.predicted;
-            if !rec.accepted {
-                // both undone (the record's merit_after is the anchor's,
-                // where the iterate is again); the radius cut as for the
-                // anchor's rejection, its curvature restored
-                rec.merit_after = a.merit.0;
-                (z, here, radius, mult) = (a.z, a.merit, a.cut, a.multipliers);
-                undone = true;
-                armed = false;
-                if settings.adapt_curvature && !a.bounded {
-                    // the anchor's own step was the rejected one
-                    mult.reject_curvature();
-                }
-            }
-        } else if settings.watchdog
-            && p.cost() == Cost::Peak
-            && armed
-            && rec.predicted > 0.0
-            && rec.rho < 0.1
-            && there.0.is_finite()
-            // not at a converged point, where rho is noise: the rules below stop there
-            && !(rec.criticality_within(settings.feasibility) <= settings.tolerance
-                && here.2 <= settings.feasibility)
-        {
-            rec.tentative = true;
-            observe(&rec);
-            iterations.push(rec);
-            anchor = Some(Anchor {
-                z: std::mem::replace(&mut z, trial),
-                merit: std::mem::replace(&mut here, there),
-                predicted: rec.predicted,
-                cut: cut(&rec),
-                multipliers: mult.clone(),
-                bounded: rec.bounded(),
-            });
-            continue;
-        }
-        observe(&rec);
-        iterations.push(rec);
-        if rec.accepted {
-            (z, here) = (trial, there);
-            armed = true;
-        }
-        if settings.adapt_curvature && !undone {
-            mult.adapt_curvature(&rec);
-        }
-        if undone {
-            last_rejected = true;
-            continue;
-        }
-        if rec.rho < 0.1 {
-            radius = cut(&rec);
-        } else if rec.rho > 0.5 && !last_rejected {
-            // not right after a rejection: the radius that was just cut
-            // would be doubled back to one that failed (the seed's
-            // per-motor design from the phased seed alternated 0.125 /
-            // 0.25 three times); over examples/bench_scp_suite 364
-            // iterations instead of 387
-            radius = (radius * 2.0).min(1e3);
-        }
-        last_rejected = !rec.accepted;
-        let (phi_now, _, inf_now) = here;
-        window.push(phi_now);
-        // (violation, cost) after each iteration at this weight (rejected
-        // steps count: at an infeasible minimum of the merit the steps
-        // there are rejected while the radius shrinks)
-        stagnant.push((inf_now, here.1));
-        let k = settings.stagnation;
-        let stagnates = k > 0
-            && linear_cost
-            && stagnant.len() > k
-            && inf_now > 100.0 * settings.feasibility
-            && w < 50.0 * w_start
-            && {
-                let (inf_then, cost_then) = stagnant[stagnant.len() - 1 - k];
-                inf_now > 0.8 * inf_then && (here.1 - cost_then).abs() < 1e-2 * here.1.abs()
-            };
-        let critical =
-            !stagnates && rec.criticality_within(settings.feasibility) <= settings.tolerance;
-        // the merit fell by less than `tolerance` (relative) per iteration,
-        // on average over the window
-        let slow = !stagnates
-            && window.len() > settings.window
-            && window[window.len() - 1 - settings.window] - phi_now
-                <= settings.tolerance * settings.window as f64 * phi_now.abs();
-        let mut raise = stagnates;
-        if critical || slow {
-            if inf_now <= settings.feasibility {
-                status = ScpStatus::Converged;
-                rule = if critical {
-                    StopRule::Criticality
-                } else {
-                    StopRule::Progress
-                };
-                break;
-            }
-            // nearly feasible at a critical point: the next steps remove a
-            // small violation at this weight (raising it would only shrink
-            // the steps); stuck infeasible otherwise: the penalty is too weak
-            nearly += 1;
-            raise = inf_now > 100.0 * settings.feasibility || nearly > 3;
-        } else {
-            nearly = 0;
-        }
-        if raise {
-            w *= 10.0;
-            here = merit(p, &z, w);
-            window.clear();
-            stagnant.clear();
-            nearly = 0;
-            if w > 1e6 * settings.weight * scale {
-                status = ScpStatus::Infeasible;
-                break;
-            }
-        }
-        if radius < 1e-10 {
-            status = ScpStatus::Stalled;
-            break;
-        }
-    }
-    if let Some(a) = anchor {
-        // the iteration limit ended the run on a tentative step
-        (z, here, radius, mult) = (a.z, a.merit, a.cut, a.multipliers);
-    }
-    let (_, objective, infeasibility) = here;
-    let last = iterations.last().copied();
-    let certificate = Certificate {
-        step: last.map_or(0.0, |l| l.step),
-        constraint_violation: infeasibility,
-        criticality: last.map_or(0.0, |l| l.criticality_within(settings.feasibility)),
-        radius,
-        weight: w / scale,
-        rule,
-    };
-    Ok(ScpResult {
-        z,
-        status,
-        objective,
-        infeasibility,
-        iterations,
-        certificate,
-        warm: WarmStart {
-            multipliers: mult,
-            radius,
-            weight: w,
-        },
-    })
 }
 
 #[cfg(test)]
@@ -1455,8 +2174,11 @@ mod tests {
         // is least at z0 = 1 / (2 w), far outside the circle
         let solve_with = |stagnation| {
             let settings = ScpSettings {
-                weight: 0.1,
-                stagnation,
+                penalty: Penalty {
+                    weight: 0.1,
+                    stagnation,
+                    ..Default::default()
+                },
                 ..Default::default()
             };
             solve(&circle(), vec![0.6, 0.8], &settings, |_| {}).unwrap()
@@ -1480,7 +2202,10 @@ mod tests {
         // from its optimum at the default weight, the merit would first
         // walk off the circle towards z0 = 1 / (2 w) = 5
         let settings = ScpSettings {
-            weight: 0.1,
+            penalty: Penalty {
+                weight: 0.1,
+                ..Default::default()
+            },
             ..Default::default()
         };
         let first = solve(&circle(), vec![0.6, 0.8], &settings, |_| {}).unwrap();
@@ -1575,7 +2300,8 @@ mod tests {
         let p = degenerate(true);
         let z = [0.0, 0.0];
         let lin = p.linearize(&z);
-        let d = correction(&p, &z, &lin, &[0.1, 1e-6], &p.scales(), None);
+        let weight = Correction::default().slack_weight;
+        let d = correction(&p, &z, &lin, &[0.1, 1e-6], &p.scales(), None, weight);
         let (st, x, _) = ConicSolver::with_settings(&d, ConicSettings::MODEL)
             .unwrap()
             .solve();
@@ -1584,7 +2310,15 @@ mod tests {
         assert!(x[1].abs() < 1e-3, "r1 left alone: dc1 = {}", x[1]);
         // with a gain the weight can afford, r1 is removed too
         let p = degenerate(false);
-        let d = correction(&p, &z, &p.linearize(&z), &[0.1, 0.2], &p.scales(), None);
+        let d = correction(
+            &p,
+            &z,
+            &p.linearize(&z),
+            &[0.1, 0.2],
+            &p.scales(),
+            None,
+            weight,
+        );
         let (_, x, _) = ConicSolver::with_settings(&d, ConicSettings::MODEL)
             .unwrap()
             .solve();
@@ -1755,33 +2489,338 @@ mod tests {
 
     #[test]
     fn the_curvature_scale_follows_rho_inside_the_trust_region() {
+        let c = Curvature::default();
+        let min_curvature = c.min;
         let mut m = Multipliers::default();
         let mut rec = record(1e-3, 1.0, false);
         // rho 1.5: the model was twice as curved as the merit
         rec.rho = 1.5;
-        m.adapt_curvature(&rec);
+        m.adapt_curvature(&rec, &c);
         assert!((m.curvature - 0.5).abs() < 1e-15);
-        // at most a quarter per step, never below MIN_CURVATURE
+        // at most a quarter per step, never below the least scale
         rec.rho = 1.95;
-        m.adapt_curvature(&rec);
+        m.adapt_curvature(&rec, &c);
         assert!((m.curvature - 0.125).abs() < 1e-15);
-        m.adapt_curvature(&rec);
-        assert_eq!(m.curvature, MIN_CURVATURE);
+        m.adapt_curvature(&rec, &c);
+        assert_eq!(m.curvature, min_curvature);
         // a step the trust region bounded says nothing about the curvature
         let bounded = ScpIteration {
             rho: 1.9,
             ..record(1e-3, 1.0, true)
         };
-        m.adapt_curvature(&bounded);
-        assert_eq!(m.curvature, MIN_CURVATURE);
+        m.adapt_curvature(&bounded, &c);
+        assert_eq!(m.curvature, min_curvature);
         // a rejected step inside the region: the model was too flat
         rec.accepted = false;
         rec.rho = 0.0;
-        m.adapt_curvature(&rec);
-        assert!((m.curvature - 2.0 * MIN_CURVATURE).abs() < 1e-15);
+        m.adapt_curvature(&rec, &c);
+        assert!((m.curvature - 2.0 * min_curvature).abs() < 1e-15);
         for _ in 0..10 {
-            m.adapt_curvature(&rec);
+            m.adapt_curvature(&rec, &c);
         }
         assert_eq!(m.curvature, 1.0);
+    }
+    #[test]
+    fn the_default_settings_are_valid_and_a_bad_one_is_named() {
+        ScpSettings::default().validate().unwrap();
+        let bad = [
+            ScpSettings {
+                tolerance: 0.0,
+                ..Default::default()
+            },
+            ScpSettings {
+                trust: TrustRegion {
+                    grow_above: 0.05,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            ScpSettings {
+                penalty: Penalty {
+                    infeasible: 10.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+            ScpSettings {
+                curvature: Curvature {
+                    min: 0.0,
+                    ..Default::default()
+                },
+                ..Default::default()
+            },
+        ];
+        let keys = [
+            "scp.tolerance",
+            "scp.trust.grow_above",
+            "scp.penalty.infeasible",
+            "scp.curvature.min",
+        ];
+        for (settings, key) in bad.iter().zip(keys) {
+            match settings.validate() {
+                Err(Error::Invalid { key: k, .. }) => assert_eq!(k, key),
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+        // a solve checks them first
+        let r = solve(&circle(), vec![0.6, 0.8], &bad[0], |_| {});
+        assert!(matches!(r, Err(Error::Invalid { .. })));
+    }
+
+    #[test]
+    fn the_layout_names_each_block_of_the_subproblems_variables() {
+        let v = Layout {
+            n: 3,
+            m: 2,
+            limited: true,
+        };
+        assert_eq!(v.len(), 3 + 1 + 2 * 2 + 1);
+        assert_eq!(v.dz(), 0..3);
+        assert_eq!(v.t(), 3);
+        assert_eq!((v.nu_plus(0), v.nu_plus(1)), (4, 5));
+        assert_eq!((v.nu_minus(0), v.nu_minus(1)), (6, 7));
+        assert_eq!(v.virtual_controls(), 4..8);
+        assert_eq!(v.sigma(), 8);
+        let x: Vec<f64> = (0..v.len()).map(|i| (i * i) as f64).collect();
+        assert_eq!(v.step(&x), &[0.0, 1.0, 4.0]);
+        assert_eq!(v.epigraph(&x), 9.0);
+        assert_eq!(v.virtual_control(&x, 1), 25.0 - 49.0);
+        assert_eq!(v.slack(&x), 64.0);
+        let free = Layout {
+            limited: false,
+            ..v
+        };
+        assert_eq!(free.len(), 8);
+        assert_eq!(free.slack(&x[..8]), 0.0);
+        // the subproblem is built on it: its variables and the step's bounds
+        let p = Peaked {
+            norm: TorqueNorm::Euclidean,
+            on_epigraph: false,
+        };
+        let z = [0.3, 0.9];
+        let lin = p.linearize(&z);
+        let v = Layout::of(&p, &lin);
+        assert_eq!((v.n, v.m, v.limited), (2, 1, true));
+        let (data, ..) = subproblem(&p, &z, &lin, &p.scales(), 0.5, 3.0, &Vec::new());
+        assert_eq!(data.n, v.len());
+        assert_eq!(data.q[v.nu_plus(0)], 3.0);
+        assert_eq!(data.q[v.nu_minus(0)], 3.0);
+        assert_eq!(data.q[v.sigma()], 3.0);
+        assert_eq!(data.q[v.t()], 1.0);
+    }
+    /// The state on the circle at its optimum `(1, 0)`: feasible, merit
+    /// -1 (the cost), weight 2 (the scale is the cost's size, 1).
+    fn at_optimum(scp: &Scp) -> State {
+        let state = scp.init(vec![1.0, 0.0], None);
+        assert_eq!(state.here, (-1.0, -1.0, 0.0));
+        assert_eq!((state.scale, state.weight), (1.0, 2.0));
+        state
+    }
+
+    #[test]
+    fn the_criticality_rule_stops_a_feasible_critical_point_only() {
+        let (p, s) = (circle(), ScpSettings::default());
+        let scp = Scp::new(&p, &s);
+        let state = at_optimum(&scp);
+        // criticality 1e-5 / 2 below the tolerance 1e-4
+        let critical = record(1e-5, 1.0, false);
+        assert_eq!(
+            converged_by_criticality(&scp, &state, &critical),
+            Some(Termination::Criticality)
+        );
+        // the model still predicts a decrease of 1 % of the merit
+        assert_eq!(
+            converged_by_criticality(&scp, &state, &record(2e-2, 1.0, false)),
+            None
+        );
+        // critical, but the violation is above `feasibility`
+        let infeasible = State {
+            here: (-1.0, -1.0, 1e-3),
+            ..at_optimum(&scp)
+        };
+        assert_eq!(converged_by_criticality(&scp, &infeasible, &critical), None);
+    }
+
+    #[test]
+    fn the_progress_rule_stops_a_feasible_merit_that_stopped_falling() {
+        let (p, s) = (circle(), ScpSettings::default());
+        let scp = Scp::new(&p, &s);
+        let flat = State {
+            merits: vec![-1.0; s.window + 1],
+            ..at_optimum(&scp)
+        };
+        assert_eq!(
+            converged_by_progress(&scp, &flat),
+            Some(Termination::Progress)
+        );
+        // a window too short to judge
+        let short = State {
+            merits: vec![-1.0; s.window],
+            ..at_optimum(&scp)
+        };
+        assert_eq!(converged_by_progress(&scp, &short), None);
+        // the merit fell by 10 % over the window: 1e-2 per iteration
+        let mut falling = State {
+            merits: vec![-1.0; s.window + 1],
+            ..at_optimum(&scp)
+        };
+        falling.merits[0] = -0.9;
+        assert_eq!(converged_by_progress(&scp, &falling), None);
+        // flat but infeasible
+        let infeasible = State {
+            here: (-1.0, -1.0, 1e-3),
+            ..flat
+        };
+        assert_eq!(converged_by_progress(&scp, &infeasible), None);
+    }
+
+    #[test]
+    fn the_infeasibility_rule_stops_when_a_raise_would_pass_the_bound() {
+        let (p, s) = (circle(), ScpSettings::default());
+        let scp = Scp::new(&p, &s);
+        // the bound: 1e6 times the start weight 2 (scale 1)
+        let near = State {
+            weight: 2e5,
+            raise: true,
+            ..at_optimum(&scp)
+        };
+        assert_eq!(infeasible(&scp, &near), None);
+        let past = State {
+            weight: 2e5 + 1.0,
+            raise: true,
+            ..at_optimum(&scp)
+        };
+        assert_eq!(infeasible(&scp, &past), Some(Termination::Infeasible));
+        // no raise pending: the weight stays
+        let kept = State {
+            raise: false,
+            ..past
+        };
+        assert_eq!(infeasible(&scp, &kept), None);
+    }
+
+    #[test]
+    fn the_stall_rule_stops_a_collapsed_trust_region() {
+        let (p, s) = (circle(), ScpSettings::default());
+        let scp = Scp::new(&p, &s);
+        let collapsed = State {
+            radius: 0.5 * s.trust.min_radius,
+            ..at_optimum(&scp)
+        };
+        assert_eq!(stalled(&scp, &collapsed), Some(Termination::Stalled));
+        assert_eq!(stalled(&scp, &at_optimum(&scp)), None);
+        // the rules in order: converged before stalled
+        assert_eq!(
+            scp.terminate(&collapsed, &record(1e-5, 1.0, false)),
+            Some(Termination::Criticality)
+        );
+        assert_eq!(
+            scp.terminate(&collapsed, &record(2e-2, 1.0, false)),
+            Some(Termination::Stalled)
+        );
+        assert_eq!(
+            scp.terminate(&at_optimum(&scp), &record(2e-2, 1.0, false)),
+            None
+        );
+    }
+
+    #[test]
+    fn a_stagnating_violation_raises_the_weight_and_a_nearly_feasible_one_does_not() {
+        let (p, s) = (circle(), ScpSettings::default());
+        let scp = Scp::new(&p, &s);
+        let k = s.penalty.stagnation;
+        // a violation of 1e-3 (above 100x feasibility) that did not fall
+        let stuck = State {
+            here: (-1.0, -1.0, 1e-3),
+            history: vec![(1e-3, -1.0); k + 1],
+            ..at_optimum(&scp)
+        };
+        assert!(scp.stagnates(&stuck));
+        // it also keeps the criticality rule from declaring a critical point
+        let critical = ScpIteration {
+            infeasibility: 1e-3,
+            ..record(1e-5, 1.0, false)
+        };
+        assert!(!scp.critical(&stuck, &critical));
+        let mut raised = stuck;
+        scp.decide_weight(&mut raised, &record(2e-2, 1.0, false));
+        assert!(raised.raise);
+        scp.raise_weight(&mut raised);
+        assert_eq!(raised.weight, 2.0 * s.penalty.growth);
+        assert!(!raised.raise && raised.history.is_empty());
+        // a violation that fell by half in the window does not stagnate
+        let mut falling = State {
+            here: (-1.0, -1.0, 1e-3),
+            history: vec![(2e-3, -1.0); k + 1],
+            ..at_optimum(&scp)
+        };
+        assert!(!scp.stagnates(&falling));
+        scp.decide_weight(&mut falling, &record(2e-2, 1.0, false));
+        assert!(!falling.raise);
+        // critical at a nearly feasible violation: the weight is kept up to
+        // `patience` times in a row, then raised
+        let mut nearly = State {
+            here: (-1.0, -1.0, 1e-5),
+            ..at_optimum(&scp)
+        };
+        for _ in 0..s.penalty.patience {
+            scp.decide_weight(&mut nearly, &critical);
+            assert!(!nearly.raise);
+        }
+        scp.decide_weight(&mut nearly, &critical);
+        assert!(nearly.raise);
+    }
+
+    #[test]
+    fn each_termination_names_its_status_and_rule() {
+        let all = [
+            Termination::Criticality,
+            Termination::Progress,
+            Termination::Infeasible,
+            Termination::Stalled,
+            Termination::IterationLimit,
+        ];
+        let status = all.map(|t| t.status());
+        assert_eq!(
+            status,
+            [
+                ScpStatus::Converged,
+                ScpStatus::Converged,
+                ScpStatus::Infeasible,
+                ScpStatus::Stalled,
+                ScpStatus::IterationLimit
+            ]
+        );
+        assert_eq!(
+            all.map(|t| t.rule())[..2],
+            [StopRule::Criticality, StopRule::Progress]
+        );
+        assert!(all[2..].iter().all(|t| t.rule() == StopRule::None));
+        let texts: std::collections::BTreeSet<_> = all.iter().map(|t| t.to_string()).collect();
+        assert_eq!(texts.len(), all.len());
+        // a solve reports its reason
+        let r = solve(&circle(), vec![0.6, 0.8], &ScpSettings::default(), |_| {}).unwrap();
+        assert_eq!(r.termination.status(), r.status);
+        assert_eq!(r.termination.rule(), r.certificate.rule);
+    }
+
+    #[test]
+    fn the_executor_numbers_iterations_on_from_its_first() {
+        let settings = ScpSettings::default();
+        let mut seen = Vec::new();
+        let r = Executor::new(&settings)
+            .numbered_from(7)
+            .run(&circle(), vec![0.6, 0.8], &mut |it: &ScpIteration| {
+                seen.push(it.iteration)
+            })
+            .unwrap();
+        let recorded: Vec<usize> = r.iterations.iter().map(|it| it.iteration).collect();
+        assert_eq!(seen, recorded);
+        assert_eq!(recorded, (7..7 + recorded.len()).collect::<Vec<_>>());
+        // the same solve from 0 (solve's numbering) otherwise
+        let plain = solve(&circle(), vec![0.6, 0.8], &settings, |_| {}).unwrap();
+        assert_eq!(plain.iterations.len(), recorded.len());
+        assert_eq!(plain.z, r.z);
+        assert!(r.seconds >= 0.0);
     }
 }

@@ -53,8 +53,8 @@ impl Simulator {
         }
     }
 
-    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::mjcf::dc_motor`]).
-    fn columns(self, joint: Joint, dc: bool) -> &'static str {
+    /// `dc`: the MJCF's DC-motor actuators, whose `ctrl` is `tau + k qd` ([`super::common::dc_motor`]).
+    pub fn columns(self, joint: Joint, dc: bool) -> &'static str {
         match (self, joint) {
             (Simulator::Mujoco, Joint::NoTwist) => {
                 "t_s,qpos_w,qpos_x,qpos_y,qpos_z,qvel_x,qvel_y,qvel_z,ctrl_tau_x,ctrl_tau_y,ctrl_tau_z"
@@ -215,7 +215,7 @@ impl Controls {
         let b = plan.phase_bounds();
         let (dt, n) = time_step(b[3] - b[0], sim.target_step());
         // MuJoCo's DC-motor actuators take the command tau + k qd
-        let slope = match (sim, super::mjcf::dc_motor(cfg)) {
+        let slope = match (sim, super::common::dc_motor(cfg)) {
             (Simulator::Mujoco, Some(_)) => cfg.motor().slope(),
             _ => 0.0,
         };

@@ -1,7 +1,7 @@
 //! The cat as an MJCF model for MuJoCo.
 
+use super::common::{Half, dc_motor, f, halves, torque_limit};
 use super::controls::{Simulator, time_step};
-use super::{Half, f, halves, torque_limit};
 use crate::config::Config;
 use crate::model::Joint;
 
@@ -40,7 +40,7 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         }
         s.push('.');
     }
-    if let Some(w) = super::speed_limit(cfg) {
+    if let Some(w) = super::common::speed_limit(cfg) {
         let why = if cfg.limits.max_speed.is_some() {
             "limits.max_speed"
         } else {
@@ -49,26 +49,6 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push_str(&format!("\n     Joint speed limit {w} rad/s ({why})."));
     }
     s
-}
-
-/// Attributes of a hinge's `<general>` actuator that is the linear DC motor
-/// `|tau + k qd| <= T` (universal joint with a torque-speed line): gain 1,
-/// affine bias `-k qd`, `ctrl` (the voltage in N m, `tau + k qd`) limited to
-/// `[-T, T]`. MuJoCo recomputes the bias at each RK4 stage, so a saturated
-/// motor follows `T - k qd` continuously as catflip's simulation does.
-/// `None` without a torque-speed line (a plain `<motor>` then says it all).
-pub(crate) fn dc_motor(cfg: &Config) -> Option<String> {
-    let m = cfg.motor();
-    let t = m.max_torque?;
-    if m.slope() == 0.0 || cfg.cat.joint != Joint::Universal {
-        return None;
-    }
-    Some(format!(
-        " gaintype=\"fixed\" gainprm=\"1\" biastype=\"affine\" biasprm=\"0 0 {nk}\" ctrllimited=\"true\" ctrlrange=\"{a} {b}\"",
-        nk = f(-m.slope()),
-        a = f(-t),
-        b = f(t)
-    ))
 }
 
 /// MJCF (MuJoCo) text of the cat of `cfg`, dropped from the config's height.

@@ -10,41 +10,20 @@
 //! `no-twist`: a ball joint whose relative rotation is `exp(hat(q1, q2, 0))`,
 //! driven by three motors about the front half's own axes (see [`controls`]).
 
+mod common;
 pub mod controls;
 pub mod mjcf;
 pub mod start;
 pub mod urdf;
+
+pub use common::halves;
 
 pub use mjcf::mjcf;
 pub use urdf::urdf;
 
 use crate::config::Config;
 use crate::design::plan::ShapePlan;
-use crate::model::Half;
 use crate::output::Output;
-
-/// The rear (A) and front (B) halves, from the one place that knows them
-/// (each half's mass, length, radius and inertia: [`Half`]).
-pub fn halves(cfg: &Config) -> [Half; 2] {
-    let cat = cfg.cat();
-    [cat.rear, cat.front]
-}
-
-/// Largest joint torque the exports allow, N m (the config's stall torque).
-pub(crate) fn torque_limit(cfg: &Config) -> Option<f64> {
-    cfg.limits.max_torque
-}
-
-/// Joint speed limit for the model files, rad/s: the config's hard limit, else
-/// the motor's no-load speed (it cannot drive faster), else none.
-pub(crate) fn speed_limit(cfg: &Config) -> Option<f64> {
-    cfg.limits.max_speed.or(cfg.limits.no_load_speed)
-}
-
-/// Numbers in model files: the shortest text that reads back to the same f64.
-pub(crate) fn f(x: f64) -> String {
-    format!("{x}")
-}
 
 /// Everything `catflip run` writes for the simulators: both models and, per
 /// method, the MuJoCo and pyBullet controls (`<method>.mujoco.csv`,

@@ -1,7 +1,7 @@
 //! The cat as a URDF for pyBullet (the seed's simulator); the universal one
 //! also loads in MuJoCo.
 
-use super::{f, halves, speed_limit, torque_limit};
+use super::common::{f, halves, speed_limit, torque_limit};
 use crate::config::Config;
 use crate::model::Half;
 use crate::model::Joint;

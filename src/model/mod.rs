@@ -67,6 +67,13 @@ impl TorqueNorm {
             TorqueNorm::PerMotor => tau[0].abs().max(tau[1].abs()),
         }
     }
+    /// The name the config and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            TorqueNorm::Euclidean => "euclidean",
+            TorqueNorm::PerMotor => "per-motor",
+        }
+    }
     pub fn default_for(joint: Joint) -> Self {
         match joint {
             Joint::NoTwist => TorqueNorm::Euclidean,

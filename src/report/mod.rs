@@ -36,7 +36,7 @@ pub struct MethodTrace {
     /// samples may fall just short of it.
     pub peak_nm: f64,
     /// Whether that peak breaks `limits.max_torque` by the verdicts' rule
-    /// ([`crate::run::over_torque_limit`]).
+    /// ([`crate::verdict::Targets::over_torque`]).
     pub over_limit: bool,
     pub phase_bounds: Vec<f64>,
     /// Attitude about the initial spine from the forward simulation.

@@ -152,46 +152,6 @@ fn failure(
 /// schedule for good: more than a full turn (a saturated motor lags by less).
 const MAX_TRACKING_ERROR: f64 = 2.0 * std::f64::consts::PI;
 
-/// Why a simulated flip misses its target (flip error or spine tilt beyond
-/// `tol`, rad), if it does; NaN counts as a miss.
-pub fn misses_flip(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
-    let mut why = Vec::new();
-    // NaN compares false: a failed number is a miss
-    let beyond = |x: f64| x.is_nan() || x.abs() > tol;
-    if beyond(flip_error_rad) {
-        why.push(format!(
-            "misses the flip by {flip_error_rad:.3e} rad (simulate.flip_tolerance = {tol:e} rad)"
-        ));
-    }
-    if beyond(tilt_deg.to_radians()) {
-        why.push(format!(
-            "tilts the spine by {tilt_deg:.3} deg = {:.3e} rad (simulate.flip_tolerance = {tol:e} rad)",
-            tilt_deg.to_radians()
-        ));
-    }
-    (!why.is_empty()).then(|| why.join("; "))
-}
-
-/// Why a simulated landing misses belly-down, if it does: with
-/// `land.max_tilt_deg` set or a start other than today's, the landing error
-/// beyond `land.max_tilt_deg` (default: `simulate.flip_tolerance`). Today's
-/// problem keeps today's check alone ([`misses_flip`]).
-pub fn misses_landing(cfg: &Config, landing_error_deg: f64) -> Option<String> {
-    if cfg.land.max_tilt_deg.is_none() && cfg.start.is_default() {
-        return None;
-    }
-    let (tol, key) = match cfg.land.max_tilt_deg {
-        Some(t) => (t, "land.max_tilt_deg"),
-        None => (
-            cfg.simulate.flip_tolerance.to_degrees(),
-            "land.max_tilt_deg, by default simulate.flip_tolerance",
-        ),
-    };
-    // NaN compares false: a failed number is a miss
-    (landing_error_deg.is_nan() || landing_error_deg > tol)
-        .then(|| format!("lands {landing_error_deg:.3} deg from belly-down ({key} = {tol:.4} deg)"))
-}
-
 fn finish(
     flip: f64,
     tilt: f64,

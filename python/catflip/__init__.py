@@ -1,0 +1,87 @@
+"""catflip: torque schedules that turn a falling two-body cat right side up.
+
+The Python face of the catflip Rust library (the same code as the ``catflip``
+command line, called in-process): configs with the CLI's keys and checks,
+the analytic, phased and free-form designs as numpy arrays, their forward
+simulation, the robot's least drop height, sweeps, and the MuJoCo / pyBullet
+models and controls. Every solve releases the GIL; every object is safe to
+share between threads. See docs/python.md.
+"""
+
+from ._catflip import (
+    CatflipError,
+    Config,
+    ConfigError,
+    Controls,
+    Design,
+    DesignError,
+    ImpossibleError,
+    LeastHeight,
+    Run,
+    Simulation,
+    controls,
+    design,
+    export_mjcf,
+    export_urdf,
+    least_height,
+    run,
+    simulate,
+)
+from ._catflip import sweep_columns as _sweep_columns
+
+__all__ = [
+    "CatflipError",
+    "Config",
+    "ConfigError",
+    "Controls",
+    "Design",
+    "DesignError",
+    "ImpossibleError",
+    "LeastHeight",
+    "Run",
+    "Simulation",
+    "controls",
+    "design",
+    "export_mjcf",
+    "export_urdf",
+    "least_height",
+    "run",
+    "simulate",
+    "sweep",
+]
+
+SWEEP_METHODS = ("analytic", "phased", "free")
+
+
+def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
+    """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``.
+
+    Each value is set on ``config`` as ``config.set(key, value)`` would (the
+    same checks: an invalid value is that point's ``error``, all invalid is a
+    ``ConfigError``), and every point is designed by each of ``methods``.
+    Neighbouring points continue from each other in chunks of 10, computed
+    ``threads`` chunks at a time (default: one per core), with the GIL released.
+
+    Returns the CSV's columns: ``value``, ``analytic_peak_nm``,
+    ``phased_peak_nm``, ``free_peak_nm``, ``phased_bend_deg``,
+    ``free_bend_deg``, ``least_height_phased_m``, ``least_height_free_m``
+    (float64 arrays of shape ``(len(values),)``, NaN where a method gave no
+    number), ``free_status`` and ``error`` (lists of str or None). As a
+    ``pandas.DataFrame`` when pandas is installed and ``frame`` is not False
+    (``frame=True`` requires pandas), else as a dict of those columns; the
+    dict also holds ``"csv"``, the text of the CLI's ``sweep-<key>.csv``.
+    """
+    import numpy as np
+
+    values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
+    columns, csv = _sweep_columns(config, key, values, list(methods), threads)
+    if frame is None or frame:
+        try:
+            import pandas as pd
+        except ImportError:
+            if frame:
+                raise
+        else:
+            return pd.DataFrame(columns)
+    columns["csv"] = csv
+    return columns

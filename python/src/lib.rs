@@ -1,0 +1,1280 @@
+//! The Python module `catflip._catflip`: thin calls into the catflip library.
+//!
+//! One file on purpose: every function here takes the user's objects, calls
+//! one high-level library function with the GIL released, and hands the
+//! result back as numpy arrays and plain Python values. When the library's
+//! entry points move, only the calls in this file change. The public
+//! Python names, their docstrings and their stubs live in `catflip/`.
+
+use catflip::config::Config as Cfg;
+use catflip::design::plan::{Schedule, ShapePlan};
+use catflip::verify::simulate::SimReport;
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyTypeError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
+use std::path::PathBuf;
+use std::sync::Mutex;
+
+create_exception!(
+    catflip,
+    CatflipError,
+    PyException,
+    "Base of catflip's errors."
+);
+create_exception!(
+    catflip,
+    ConfigError,
+    CatflipError,
+    "Bad input: config, key, value or file (the CLI's exit status 2)."
+);
+create_exception!(
+    catflip,
+    DesignError,
+    CatflipError,
+    "A computation failed: solver, simulation (the CLI's exit status 1)."
+);
+create_exception!(
+    catflip,
+    ImpossibleError,
+    DesignError,
+    "The motors cannot flip the cat from this height; the message gives the least height."
+);
+
+/// The library's error as the exception of its kind, with the CLI's message.
+fn err(e: catflip::Error) -> PyErr {
+    use catflip::Error as E;
+    let msg = e.to_string();
+    match e {
+        E::Unreachable { .. } | E::SeedUnfit { .. } => ImpossibleError::new_err(msg),
+        e if e.is_bad_input() => ConfigError::new_err(msg),
+        _ => DesignError::new_err(msg),
+    }
+}
+
+fn json_loads<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    py.import("json")?.call_method1("loads", (v.to_string(),))
+}
+
+/// `rows` x 2 (or x k) float64 array from fixed-size rows.
+fn matrix<'py, const K: usize>(py: Python<'py>, rows: &[[f64; K]]) -> Bound<'py, PyArray2<f64>> {
+    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+    Array2::from_shape_vec((rows.len(), K), flat)
+        .expect("rows of equal length")
+        .into_pyarray(py)
+}
+
+fn matrix_vec<'py>(py: Python<'py>, rows: &[Vec<f64>]) -> Bound<'py, PyArray2<f64>> {
+    let k = rows.first().map_or(0, Vec::len);
+    let flat: Vec<f64> = rows.iter().flatten().copied().collect();
+    Array2::from_shape_vec((rows.len(), k), flat)
+        .expect("rows of equal length")
+        .into_pyarray(py)
+}
+
+fn vector<'py>(py: Python<'py>, v: Vec<f64>) -> Bound<'py, PyArray1<f64>> {
+    PyArray1::from_vec(py, v)
+}
+
+// --- Config -----------------------------------------------------------------
+
+/// The user's text and overrides: every change re-reads them as the CLI
+/// would (`catflip CMD FILE --set ... --set ...`), so the messages match.
+#[derive(Clone)]
+struct Source {
+    text: String,
+    origin: String,
+    overrides: Vec<String>,
+}
+
+impl Source {
+    fn load(&self, extra: Option<&str>) -> catflip::Result<Cfg> {
+        let mut ov = self.overrides.clone();
+        ov.extend(extra.map(String::from));
+        Cfg::from_toml(&self.text, &self.origin, &ov)
+    }
+}
+
+struct Snapshot {
+    source: Source,
+    cfg: Cfg,
+}
+
+/// A checked catflip configuration: the CLI's TOML keys, defaults and checks.
+///
+/// Safe to share between threads: `set` takes a lock, and every computation
+/// works on a copy taken when it starts.
+#[pyclass(frozen, module = "catflip")]
+struct Config {
+    inner: Mutex<Snapshot>,
+}
+
+impl Config {
+    fn from_source(source: Source) -> PyResult<Config> {
+        let cfg = source.load(None).map_err(err)?;
+        Ok(Config {
+            inner: Mutex::new(Snapshot { source, cfg }),
+        })
+    }
+
+    /// A consistent copy to compute with (the lock is not held during solves).
+    fn snapshot(&self) -> (Source, Cfg) {
+        let s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+        (s.source.clone(), s.cfg.clone())
+    }
+}
+
+/// A Python value as the TOML text of a `--set KEY=VALUE`.
+fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    if v.is_instance_of::<PyBool>() {
+        return Ok(if v.extract::<bool>()? {
+            "true"
+        } else {
+            "false"
+        }
+        .into());
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(v.extract::<i64>()?.to_string());
+    }
+    if v.is_instance_of::<PyFloat>() || v.hasattr("__float__")? && !v.is_instance_of::<PyString>() {
+        let x: f64 = v.extract()?;
+        return Ok(if x.is_nan() {
+            "nan".into()
+        } else if x.is_infinite() {
+            if x > 0.0 { "inf" } else { "-inf" }.into()
+        } else {
+            format!("{x:?}")
+        });
+    }
+    if v.is_instance_of::<PyString>() {
+        let s: String = v.extract()?;
+        return Ok(serde_json::to_string(&s).expect("a string serialises"));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let items: PyResult<Vec<String>> = v.try_iter()?.map(|x| toml_text(&x?)).collect();
+        return Ok(format!("[{}]", items?.join(", ")));
+    }
+    Err(PyTypeError::new_err(format!(
+        "a config value is a number, true/false, a string or a list, not {}",
+        v.get_type().name()?
+    )))
+}
+
+#[pymethods]
+impl Config {
+    /// Reads and checks a TOML config file (as `catflip CMD FILE`); raises ConfigError.
+    #[staticmethod]
+    fn from_toml(path: PathBuf) -> PyResult<Config> {
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            err(catflip::Error::ConfigRead {
+                path: path.clone(),
+                message: e.to_string(),
+            })
+        })?;
+        Config::from_source(Source {
+            text,
+            origin: path.display().to_string(),
+            overrides: Vec::new(),
+        })
+    }
+
+    /// Checks a config given as TOML text; `origin` names it in messages.
+    #[staticmethod]
+    #[pyo3(signature = (text, origin = "<string>"))]
+    fn from_text(text: String, origin: &str) -> PyResult<Config> {
+        Config::from_source(Source {
+            text,
+            origin: origin.into(),
+            overrides: Vec::new(),
+        })
+    }
+
+    /// Checks a config given as a dict of the TOML's tables (`{"name": ..., "cat": {...}, "fall": {...}}`).
+    #[staticmethod]
+    fn from_dict(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Config> {
+        let json: String = py.import("json")?.call_method1("dumps", (d,))?.extract()?;
+        let value: serde_json::Value =
+            serde_json::from_str(&json).map_err(|e| ConfigError::new_err(e.to_string()))?;
+        let table = toml::Value::try_from(value).map_err(|e| {
+            ConfigError::new_err(format!(
+                "config dict: {e} (leave an unset key out rather than giving None)"
+            ))
+        })?;
+        let text = toml::to_string(&table).map_err(|e| ConfigError::new_err(e.to_string()))?;
+        Config::from_source(Source {
+            text,
+            origin: "dict".into(),
+            overrides: Vec::new(),
+        })
+    }
+
+    /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;
+    /// on a ConfigError the config is left as it was.
+    fn set(&self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+        let arg = format!("{key}={}", toml_text(value)?);
+        let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+        let cfg = s.source.load(Some(&arg)).map_err(err)?;
+        s.source.overrides.push(arg);
+        s.cfg = cfg;
+        Ok(())
+    }
+
+    /// An independent copy (later `set`s on either leave the other alone).
+    fn copy(&self) -> Config {
+        let (source, cfg) = self.snapshot();
+        Config {
+            inner: Mutex::new(Snapshot { source, cfg }),
+        }
+    }
+
+    /// Every key with its value, defaults included, as nested dicts.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_loads(
+            py,
+            &serde_json::to_value(self.snapshot().1).expect("a config serialises"),
+        )
+    }
+
+    /// Every key with its value, defaults included, as TOML text.
+    fn to_toml(&self) -> String {
+        toml::to_string(&self.snapshot().1).expect("a config serialises")
+    }
+
+    /// The config's `name` (the CLI's output folder `output/<name>/`).
+    #[getter]
+    fn name(&self) -> String {
+        self.snapshot().1.name
+    }
+
+    /// The `KEY=VALUE` overrides applied so far by `set`, in order.
+    #[getter]
+    fn overrides(&self) -> Vec<String> {
+        self.snapshot().0.overrides
+    }
+
+    /// `sqrt(2 h / g)`, s.
+    #[getter]
+    fn fall_time(&self) -> f64 {
+        self.snapshot().1.fall_time()
+    }
+
+    /// Time for the manoeuvre: fall time minus `fall.margin`, s.
+    #[getter]
+    fn manoeuvre_time(&self) -> f64 {
+        self.snapshot().1.available_time()
+    }
+
+    fn __repr__(&self) -> String {
+        let (s, c) = self.snapshot();
+        format!(
+            "Config(name={:?}, origin={:?}, overrides={:?})",
+            c.name, s.origin, s.overrides
+        )
+    }
+}
+
+// --- Design -----------------------------------------------------------------
+
+/// Why a design misses its targets: its solver status and the flip
+/// (mirrors the CLI's `design_flags`).
+fn design_flags(cfg: &Cfg, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
+    let mut why: Vec<String> = Vec::new();
+    if !matches!(status, "solved" | "converged") {
+        why.push(format!("solver status {status}"));
+    }
+    why.extend(catflip::verify::simulate::misses_flip(
+        flip_error_rad,
+        tilt_deg,
+        cfg.simulate.flip_tolerance,
+    ));
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
+fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_json::Value {
+    json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
+    if let Some(r) = reason {
+        json["reason"] = r.clone().into();
+    }
+    json
+}
+
+type Plan = Box<dyn ShapePlan + Send + Sync>;
+
+/// A designed schedule: what `catflip optimize --mode free|phased` (or `analyze`) writes.
+///
+/// Immutable; the arrays are fresh copies on each access. N rows: 3 phases
+/// of `simulate.samples_per_phase + 1` samples (a phase junction appears twice).
+#[pyclass(frozen, module = "catflip")]
+struct Design {
+    method: &'static str,
+    source: Source,
+    cfg: Cfg,
+    plan: Plan,
+    schedule: Schedule,
+    /// The CLI's `<method>.json` (`analyze.json` for the analytic schedule).
+    json: serde_json::Value,
+    status: String,
+    reason: Option<String>,
+    peak: f64,
+    durations: [f64; 3],
+}
+
+fn run_design(
+    cfg: &Cfg,
+    method: &str,
+    seed: Option<&str>,
+) -> PyResult<(
+    Plan,
+    serde_json::Value,
+    String,
+    Option<String>,
+    f64,
+    [f64; 3],
+)> {
+    let no_seed = |what: &str| {
+        ConfigError::new_err(format!(
+            "seed applies to method=\"free\" ({what} has no seed); leave seed out or use method=\"free\""
+        ))
+    };
+    match method {
+        "free" => {
+            let seed = match seed.unwrap_or("phased") {
+                "phased" => catflip::design::free::Seed::Phased,
+                "analytic" => catflip::design::free::Seed::Analytic,
+                other => {
+                    return Err(ConfigError::new_err(format!(
+                        "unknown seed `{other}`; use \"phased\" or \"analytic\""
+                    )));
+                }
+            };
+            let r = catflip::design::free::optimize(cfg, seed, |_| {}).map_err(err)?;
+            let status = catflip::run::json_name(&r.status);
+            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
+            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
+            Ok((
+                Box::new(r.plan),
+                json,
+                status,
+                reason,
+                r.peak_torque_nm,
+                r.phase_durations_s,
+            ))
+        }
+        "phased" => {
+            if seed.is_some() {
+                return Err(no_seed("the phased design"));
+            }
+            let r = catflip::design::phased::optimize(cfg, |_| {}).map_err(err)?;
+            let status = catflip::run::json_name(&r.status);
+            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
+            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
+            Ok((
+                Box::new(r.plan),
+                json,
+                status,
+                reason,
+                r.peak_torque_nm,
+                r.phase_durations_s,
+            ))
+        }
+        "analytic" => {
+            if seed.is_some() {
+                return Err(no_seed("the analytic schedule"));
+            }
+            // mirrors the CLI's `analyze`: a miss is flagged in the analysis
+            let a = catflip::verify::analyze::analyze(cfg).map_err(err)?;
+            let sched = catflip::verify::analyze::analytic_schedule(cfg, &a.plan);
+            let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
+            let why = catflip::run::schedule_flags(
+                cfg,
+                (a.flip_error_rad, a.tilt_deg),
+                a.peak_torque_nm,
+                a.closed.bend_deg,
+                Some(usage.max_speed_rad_s),
+                usage.min_margin,
+            );
+            let reason = (!why.is_empty()).then(|| why.join("; "));
+            let json = with_verdict(serde_json::to_value(&a).expect("serialises"), &reason);
+            Ok((
+                Box::new(a.plan),
+                json,
+                "closed-form".into(),
+                reason,
+                a.peak_torque_nm,
+                a.closed.phase_durations_s,
+            ))
+        }
+        other => Err(ConfigError::new_err(format!(
+            "unknown method `{other}`; use \"free\", \"phased\" or \"analytic\""
+        ))),
+    }
+}
+
+/// Designs a torque schedule, as the CLI's `optimize --mode METHOD [--seed SEED]`
+/// (`analyze` for `method="analytic"`), with the GIL released.
+///
+/// `objective` (`"peak-torque"`, `"time"`, `"energy"`) overrides `design.objective`;
+/// `seed` (`"phased"` default, `"analytic"`) applies to `method="free"` only.
+/// Raises ConfigError, ImpossibleError (the motors cannot flip the cat from
+/// `fall.height`) or DesignError, with the CLI's messages.
+#[pyfunction]
+#[pyo3(signature = (config, method = "free", objective = None, seed = None))]
+fn design(
+    py: Python<'_>,
+    config: &Config,
+    method: &str,
+    objective: Option<&str>,
+    seed: Option<&str>,
+) -> PyResult<Design> {
+    let (mut source, mut cfg) = config.snapshot();
+    if let Some(o) = objective {
+        let arg = format!(
+            "design.objective={}",
+            serde_json::to_string(o).expect("serialises")
+        );
+        cfg = source.load(Some(&arg)).map_err(err)?;
+        source.overrides.push(arg);
+    }
+    let method = match method {
+        "free" => "free",
+        "phased" => "phased",
+        "analytic" => "analytic",
+        other => {
+            return Err(ConfigError::new_err(format!(
+                "unknown method `{other}`; use \"free\", \"phased\" or \"analytic\""
+            )));
+        }
+    };
+    let seed = seed.map(String::from);
+    py.detach(move || {
+        let (plan, json, status, reason, peak, durations) =
+            run_design(&cfg, method, seed.as_deref())?;
+        let schedule = Schedule::sample(&cfg.cat(), plan.as_ref(), cfg.simulate.samples_per_phase);
+        Ok(Design {
+            method,
+            source,
+            cfg,
+            plan,
+            schedule,
+            json,
+            status,
+            reason,
+            peak,
+            durations,
+        })
+    })
+}
+
+#[pymethods]
+impl Design {
+    #[getter]
+    /// `free`, `phased` or `analytic`.
+    fn method(&self) -> &'static str {
+        self.method
+    }
+    /// Solver status: `converged`, `iteration-limit`, `stalled` (free), `solved` (phased), `closed-form` (analytic).
+    #[getter]
+    fn status(&self) -> &str {
+        &self.status
+    }
+    #[getter]
+    fn verdict(&self) -> &'static str {
+        if self.reason.is_some() {
+            "flagged"
+        } else {
+            "ok"
+        }
+    }
+    #[getter]
+    fn reason(&self) -> Option<String> {
+        self.reason.clone()
+    }
+    /// Peak joint torque of the schedule (inverse dynamics, sampled densely), N m.
+    #[getter]
+    fn peak(&self) -> f64 {
+        self.peak
+    }
+    /// `integral |tau|^2 dt` over the rows, N^2 m^2 s.
+    #[getter]
+    fn energy(&self) -> f64 {
+        self.schedule.torque_squared_integral()
+    }
+    /// Phase durations (fold, twist, unfold), s.
+    #[getter]
+    fn durations(&self) -> (f64, f64, f64) {
+        let d = self.durations;
+        (d[0], d[1], d[2])
+    }
+    /// Manoeuvre time, s.
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.plan.duration()
+    }
+    /// The free-form optimiser's stopping certificate (step, constraint_violation, criticality, radius, weight, rule); None for the other methods.
+    #[getter]
+    fn certificate<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        match self.json.get("certificate") {
+            Some(c) => Ok(Some(json_loads(py, c)?)),
+            None => Ok(None),
+        }
+    }
+    /// Flip of the design's own simulation, deg (dynamic for free and phased, kinematic for analytic).
+    #[getter]
+    fn flip_deg(&self) -> f64 {
+        self.json["flip_deg"].as_f64().unwrap_or(f64::NAN)
+    }
+    /// The config the design was made with (with `objective` applied).
+    #[getter]
+    fn config(&self) -> Config {
+        Config {
+            inner: Mutex::new(Snapshot {
+                source: self.source.clone(),
+                cfg: self.cfg.clone(),
+            }),
+        }
+    }
+    /// Sample times, s: float64, shape (N,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.schedule.rows.iter().map(|r| r.t).collect())
+    }
+    /// Phase of each row, 0 fold, 1 twist, 2 unfold: int64, shape (N,).
+    #[getter]
+    fn phase<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<i64>> {
+        let p = |r: &catflip::design::plan::Row| {
+            catflip::design::plan::Phase::ALL
+                .iter()
+                .position(|x| *x == r.phase)
+                .unwrap() as i64
+        };
+        PyArray1::from_vec(py, self.schedule.rows.iter().map(p).collect())
+    }
+    /// Joint angles q1, q2, rad: float64, shape (N, 2).
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.schedule.rows.iter().map(|r| r.q).collect::<Vec<_>>(),
+        )
+    }
+    /// Joint rates, rad/s: float64, shape (N, 2).
+    #[getter]
+    fn qd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.schedule.rows.iter().map(|r| r.qd).collect::<Vec<_>>(),
+        )
+    }
+    /// Joint accelerations, rad/s^2: float64, shape (N, 2).
+    #[getter]
+    fn qdd<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.schedule.rows.iter().map(|r| r.qdd).collect::<Vec<_>>(),
+        )
+    }
+    /// Joint torques tau1, tau2, N m: float64, shape (N, 2).
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.schedule.rows.iter().map(|r| r.tau).collect::<Vec<_>>(),
+        )
+    }
+    /// The summary `to_json()` gives, as a dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_loads(py, &self.json)
+    }
+    /// The CLI's `free.json` / `phased.json` / `analyze.json`, with `verdict` and `reason`.
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.json).expect("serialises")
+    }
+    /// The CLI's `<method>.csv` schedule.
+    fn to_csv(&self) -> String {
+        self.schedule.to_csv()
+    }
+    /// The CLI's `<method>.schedule.json`.
+    fn schedule_json(&self) -> String {
+        self.schedule.to_json()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Design(method={:?}, status={:?}, verdict={:?}, peak={:.6} N m, {} rows)",
+            self.method,
+            self.status,
+            self.verdict(),
+            self.peak,
+            self.schedule.rows.len()
+        )
+    }
+}
+
+// --- Simulation -------------------------------------------------------------
+
+/// A forward simulation in the full free-floating model (feed-forward, PD if `simulate.pd`,
+/// the motor envelope), as `catflip simulate`. Trace arrays have one row per integrator step (M rows).
+#[pyclass(frozen, module = "catflip")]
+struct Simulation {
+    report: SimReport,
+    source: String,
+    reason: Option<String>,
+}
+
+/// What `simulate` runs: a design's plan, a schedule file, or the analytic plan.
+enum Subject {
+    Design(Py<Design>),
+    File(PathBuf, String),
+    Analytic,
+}
+
+/// Simulates `design` (a Design, a schedule CSV path, or None for the analytic
+/// schedule) on `config`'s cat, as `catflip simulate [--schedule FILE]`, with the GIL released.
+/// `config` may differ from the design's (model error). Raises ConfigError, DesignError.
+#[pyfunction]
+#[pyo3(signature = (config, design = None))]
+fn simulate(
+    py: Python<'_>,
+    config: &Config,
+    design: Option<&Bound<'_, PyAny>>,
+) -> PyResult<Simulation> {
+    let (_, cfg) = config.snapshot();
+    let subject = match design {
+        None => Subject::Analytic,
+        Some(d) => match d.cast::<Design>() {
+            Ok(d) => Subject::Design(d.clone().unbind()),
+            Err(_) => {
+                let p: PathBuf = d.extract().map_err(|_| {
+                    PyTypeError::new_err(
+                        "design must be a catflip.Design, a schedule CSV path or None",
+                    )
+                })?;
+                let text = std::fs::read_to_string(&p).map_err(|e| {
+                    err(catflip::Error::Usage(format!(
+                        "cannot read schedule {}: {e}",
+                        p.display()
+                    )))
+                })?;
+                Subject::File(p, text)
+            }
+        },
+    };
+    py.detach(move || {
+        let (source, report) = match &subject {
+            Subject::Design(d) => {
+                let d = d.get();
+                (
+                    format!("{} design", d.method),
+                    catflip::verify::analyze::verify(&cfg, d.plan.as_ref()),
+                )
+            }
+            Subject::File(p, text) => {
+                let origin = p.display().to_string();
+                let s =
+                    catflip::verify::simulate::read_schedule(&cfg, text, &origin).map_err(err)?;
+                (origin, catflip::verify::analyze::verify(&cfg, &s))
+            }
+            Subject::Analytic => {
+                let plan = catflip::design::analytic::analytic_plan(&cfg);
+                (
+                    "analytic schedule".into(),
+                    catflip::verify::analyze::verify(&cfg, &plan),
+                )
+            }
+        };
+        let report = report.map_err(err)?;
+        let reason = catflip::verify::simulate::misses_flip(
+            report.flip_error_rad,
+            report.tilt_deg,
+            cfg.simulate.flip_tolerance,
+        );
+        Ok(Simulation {
+            report,
+            source,
+            reason,
+        })
+    })
+}
+
+#[pymethods]
+impl Simulation {
+    /// Final rotation about the initial spine, unwrapped, deg.
+    #[getter]
+    fn flip_deg(&self) -> f64 {
+        self.report.flip_deg
+    }
+    /// `pi - |flip|`, rad.
+    #[getter]
+    fn flip_error_rad(&self) -> f64 {
+        self.report.flip_error_rad
+    }
+    /// Angle between the final and the initial spine, deg.
+    #[getter]
+    fn tilt_deg(&self) -> f64 {
+        self.report.tilt_deg
+    }
+    /// `|q(T)|`: how far from straight the cat ends, rad.
+    #[getter]
+    fn final_shape_error_rad(&self) -> f64 {
+        self.report.final_shape_error_rad
+    }
+    /// Largest angular momentum recomputed from the bodies' velocities, N m s.
+    #[getter]
+    fn momentum_drift_nms(&self) -> f64 {
+        self.report.momentum_drift_nms
+    }
+    /// Largest joint torque applied, N m (config's norm).
+    #[getter]
+    fn peak_torque_nm(&self) -> f64 {
+        self.report.peak_torque_nm
+    }
+    #[getter]
+    fn verdict(&self) -> &'static str {
+        if self.reason.is_some() {
+            "flagged"
+        } else {
+            "ok"
+        }
+    }
+    #[getter]
+    fn reason(&self) -> Option<String> {
+        self.reason.clone()
+    }
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.report.trace.iter().map(|p| p.t).collect())
+    }
+    /// Flip at each step, rad: float64, shape (M,).
+    #[getter]
+    fn flip<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.report.trace.iter().map(|p| p.flip).collect())
+    }
+    /// Tilt at each step, rad: float64, shape (M,).
+    #[getter]
+    fn tilt<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.report.trace.iter().map(|p| p.tilt).collect())
+    }
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.report.trace.iter().map(|p| p.q).collect::<Vec<_>>(),
+        )
+    }
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self.report.trace.iter().map(|p| p.tau).collect::<Vec<_>>(),
+        )
+    }
+    /// Rear half's attitude quaternion (w, x, y, z): float64, shape (M, 4).
+    #[getter]
+    fn attitude<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self
+                .report
+                .trace
+                .iter()
+                .map(|p| p.attitude)
+                .collect::<Vec<_>>(),
+        )
+    }
+    /// The CLI's `simulate --json`.
+    fn to_json(&self) -> String {
+        let mut v = serde_json::to_value(&self.report).expect("serialises");
+        v["source"] = self.source.clone().into();
+        serde_json::to_string_pretty(&with_verdict(v, &self.reason)).expect("serialises")
+    }
+    /// `to_json()` as a dict.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        py.import("json")?.call_method1("loads", (self.to_json(),))
+    }
+    /// The CLI's `simulation.csv`.
+    fn to_csv(&self) -> String {
+        let mut s = String::from("t_s,flip_rad,tilt_rad,q1_rad,q2_rad,tau1_nm,tau2_nm\n");
+        for p in &self.report.trace {
+            s.push_str(&format!(
+                "{:.9},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n",
+                p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
+            ));
+        }
+        s
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Simulation(source={:?}, flip_deg={:.6}, tilt_deg={:.3e}, verdict={:?})",
+            self.source,
+            self.report.flip_deg,
+            self.report.tilt_deg,
+            self.verdict()
+        )
+    }
+}
+
+// --- least height, sweep, run -----------------------------------------------
+
+/// The robot builder's answer: can the motors flip the cat from `fall.height`, and the least drop height
+/// found (`run`'s least-height stage).
+#[pyclass(frozen, module = "catflip")]
+struct LeastHeight {
+    answer: catflip::design::least_height::HeightAnswer,
+    phased_m: f64,
+}
+
+#[pymethods]
+impl LeastHeight {
+    /// Whether the least height found is within `fall.height`.
+    #[getter]
+    fn possible(&self) -> bool {
+        self.answer.possible
+    }
+    /// The configured drop height, m.
+    #[getter]
+    fn height_m(&self) -> f64 {
+        self.answer.height_m
+    }
+    /// The least drop height found, m (an upper bound on the true one).
+    #[getter]
+    fn least_height_m(&self) -> f64 {
+        self.answer.least_height_m
+    }
+    /// The phased time design's least height, m.
+    #[getter]
+    fn phased_least_height_m(&self) -> f64 {
+        self.phased_m
+    }
+    /// The shortest manoeuvre found inside the motor envelope, s.
+    #[getter]
+    fn least_time_s(&self) -> f64 {
+        self.answer.least_time_s
+    }
+    /// Which design settles the answer: `phased` or `free`.
+    #[getter]
+    fn method(&self) -> &'static str {
+        self.answer.method
+    }
+    /// That design's solver status.
+    #[getter]
+    fn status(&self) -> String {
+        self.answer.status.clone()
+    }
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.answer.schedule.rows.iter().map(|r| r.t).collect())
+    }
+    #[getter]
+    fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self
+                .answer
+                .schedule
+                .rows
+                .iter()
+                .map(|r| r.q)
+                .collect::<Vec<_>>(),
+        )
+    }
+    #[getter]
+    fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(
+            py,
+            &self
+                .answer
+                .schedule
+                .rows
+                .iter()
+                .map(|r| r.tau)
+                .collect::<Vec<_>>(),
+        )
+    }
+    /// The answer in one sentence, as the CLI's table prints it.
+    fn sentence(&self) -> String {
+        self.answer.sentence()
+    }
+    /// The `answer` object of `summary.json`.
+    fn to_json(&self) -> String {
+        serde_json::to_string_pretty(&self.answer).expect("serialises")
+    }
+    /// The schedule at the least height, as `least-height.csv`.
+    fn to_csv(&self) -> String {
+        self.answer.schedule.to_csv()
+    }
+    fn __repr__(&self) -> String {
+        format!("LeastHeight({})", self.answer.sentence())
+    }
+}
+
+/// The least drop height at which the config's motors flip the cat (the phased and
+/// free-form `time` designs inside the motor envelope), or None when the config sets no
+/// motor limit. GIL released.
+#[pyfunction]
+fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>> {
+    let (_, cfg) = config.snapshot();
+    py.detach(move || {
+        let h = catflip::design::least_height::heights(&cfg, true, |_| {}).map_err(err)?;
+        Ok(h.map(|h| LeastHeight {
+            answer: h.answer,
+            phased_m: h.phased_m,
+        }))
+    })
+}
+
+/// Columns of a sweep: floats (NaN where a method gave none) and texts.
+/// The columns of `catflip.sweep` (use that).
+#[pyfunction]
+#[pyo3(signature = (config, key, values, methods, threads = None))]
+fn sweep_columns<'py>(
+    py: Python<'py>,
+    config: &Config,
+    key: String,
+    values: Vec<f64>,
+    methods: Vec<String>,
+    threads: Option<usize>,
+) -> PyResult<(Bound<'py, PyDict>, String)> {
+    let (source, _) = config.snapshot();
+    let mut m = catflip::sweep::Methods {
+        analytic: false,
+        phased: false,
+        free: false,
+    };
+    for name in &methods {
+        match name.as_str() {
+            "analytic" => m.analytic = true,
+            "phased" => m.phased = true,
+            "free" => m.free = true,
+            other => {
+                return Err(ConfigError::new_err(format!(
+                    "unknown method `{other}` in methods; use analytic, phased and/or free"
+                )));
+            }
+        }
+    }
+    if threads == Some(0) {
+        return Err(ConfigError::new_err(
+            "threads=0: at least one point must be computed at a time; give 1 or more, or None for one per core",
+        ));
+    }
+    let threads =
+        threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
+    let arg = format!(
+        "{key}=[{}]",
+        values
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let (points, csv) = py.detach(|| {
+        let points = catflip::sweep::sweep_values(
+            &key,
+            &arg,
+            &values,
+            |v| source.load(Some(&format!("{key}={v}"))),
+            m,
+            threads,
+            |_, _| {},
+        )
+        .map_err(err)?;
+        let csv = catflip::sweep::to_csv(&key, &points);
+        Ok::<_, PyErr>((points, csv))
+    })?;
+    let d = PyDict::new(py);
+    let col = |f: &dyn Fn(&catflip::sweep::SweepPoint) -> Option<f64>| {
+        points
+            .iter()
+            .map(|p| f(p).unwrap_or(f64::NAN))
+            .collect::<Vec<f64>>()
+    };
+    d.set_item(
+        "value",
+        vector(py, points.iter().map(|p| p.value).collect()),
+    )?;
+    d.set_item("analytic_peak_nm", vector(py, col(&|p| p.analytic_peak_nm)))?;
+    d.set_item("phased_peak_nm", vector(py, col(&|p| p.phased_peak_nm)))?;
+    d.set_item("free_peak_nm", vector(py, col(&|p| p.free_peak_nm)))?;
+    d.set_item("phased_bend_deg", vector(py, col(&|p| p.phased_bend_deg)))?;
+    d.set_item("free_bend_deg", vector(py, col(&|p| p.free_bend_deg)))?;
+    d.set_item(
+        "least_height_phased_m",
+        vector(py, col(&|p| p.least_height_phased_m)),
+    )?;
+    d.set_item(
+        "least_height_free_m",
+        vector(py, col(&|p| p.least_height_free_m)),
+    )?;
+    d.set_item(
+        "free_status",
+        points
+            .iter()
+            .map(|p| p.free_status.clone())
+            .collect::<Vec<_>>(),
+    )?;
+    d.set_item(
+        "error",
+        points.iter().map(|p| p.error.clone()).collect::<Vec<_>>(),
+    )?;
+    Ok((d, csv))
+}
+
+/// A whole `catflip run`, kept in memory: the summary and every file it would write.
+#[pyclass(frozen, module = "catflip")]
+struct Run {
+    summary: serde_json::Value,
+    files: Vec<(String, Vec<u8>)>,
+    partial: bool,
+    impossible: bool,
+}
+
+/// The CLI's main job, `catflip run`, in memory (nothing written), with the GIL released.
+/// Raises DesignError when every method fails.
+#[pyfunction]
+fn run(py: Python<'_>, config: &Config) -> PyResult<Run> {
+    let (_, cfg) = config.snapshot();
+    py.detach(move || {
+        let r = catflip::run::run(&cfg, |_| {}).map_err(err)?;
+        Ok(Run {
+            summary: serde_json::to_value(&r.summary).expect("serialises"),
+            files: r
+                .output
+                .files()
+                .map(|(n, c)| (n.to_string(), c.to_vec()))
+                .collect(),
+            partial: r.is_partial(),
+            impossible: r.is_impossible(),
+        })
+    })
+}
+
+#[pymethods]
+impl Run {
+    /// `summary.json` as a dict.
+    #[getter]
+    fn summary<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        json_loads(py, &self.summary)
+    }
+    /// `ok`, `partial` (some method flagged or failed: exit 3) or `impossible` (exit 4).
+    #[getter]
+    fn outcome(&self) -> String {
+        self.summary["outcome"].as_str().unwrap_or("").into()
+    }
+    /// Whether some method is flagged or failed.
+    #[getter]
+    fn partial(&self) -> bool {
+        self.partial
+    }
+    /// Whether the motors cannot flip the cat from `fall.height`.
+    #[getter]
+    fn impossible(&self) -> bool {
+        self.impossible
+    }
+    /// Names of the files `catflip run` writes.
+    #[getter]
+    fn names(&self) -> Vec<String> {
+        self.files.iter().map(|f| f.0.clone()).collect()
+    }
+    /// One of the files `catflip run` writes, as text.
+    fn file(&self, name: &str) -> PyResult<String> {
+        let f = self.files.iter().find(|f| f.0 == name).ok_or_else(|| {
+            pyo3::exceptions::PyKeyError::new_err(format!(
+                "{name}: not a file of this run; see Run.names"
+            ))
+        })?;
+        Ok(String::from_utf8_lossy(&f.1).into_owned())
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Run(outcome={:?}, {} files)",
+            self.outcome(),
+            self.files.len()
+        )
+    }
+}
+
+// --- simulators -------------------------------------------------------------
+
+/// The cat as MuJoCo MJCF text (`catflip export mjcf`).
+#[pyfunction]
+fn export_mjcf(config: &Config) -> String {
+    catflip::export::mjcf(&config.snapshot().1)
+}
+
+/// The cat as URDF text (`catflip export urdf`).
+#[pyfunction]
+fn export_urdf(config: &Config) -> String {
+    catflip::export::urdf(&config.snapshot().1)
+}
+
+/// A design's controls at a simulator's time step: what `<method>.mujoco.csv` /
+/// `<method>.pybullet.csv` hold (n steps, n + 1 rows: the last is the final planned state).
+#[pyclass(frozen, module = "catflip")]
+struct Controls {
+    controls: catflip::export::controls::Controls,
+    cfg: Cfg,
+    method: &'static str,
+}
+
+/// A design's controls for `simulator` (`"mujoco"` or `"pybullet"`), in its joint
+/// coordinates and actuators, as `catflip run` writes them.
+#[pyfunction]
+#[pyo3(signature = (design, simulator = "mujoco"))]
+fn controls(py: Python<'_>, design: Py<Design>, simulator: &str) -> PyResult<Controls> {
+    use catflip::export::controls::Simulator;
+    let sim = match simulator {
+        "mujoco" => Simulator::Mujoco,
+        "pybullet" => Simulator::Pybullet,
+        other => {
+            return Err(ConfigError::new_err(format!(
+                "unknown simulator `{other}`; use \"mujoco\" or \"pybullet\""
+            )));
+        }
+    };
+    py.detach(move || {
+        let d = design.get();
+        Ok(Controls {
+            controls: catflip::export::controls::Controls::sample(&d.cfg, d.plan.as_ref(), sim),
+            cfg: d.cfg.clone(),
+            method: d.method,
+        })
+    })
+}
+
+#[pymethods]
+impl Controls {
+    /// `mujoco` or `pybullet`.
+    #[getter]
+    fn simulator(&self) -> &'static str {
+        self.controls.simulator.name()
+    }
+    /// Time step, s.
+    #[getter]
+    fn dt(&self) -> f64 {
+        self.controls.dt
+    }
+    /// Number of steps n.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.controls.rows.len() - 1
+    }
+    /// `k` of MuJoCo's DC-motor actuators (the torque columns are then the command `tau + k qd`); 0 otherwise.
+    #[getter]
+    fn slope(&self) -> f64 {
+        self.controls.slope
+    }
+    /// The CSV's column names (`t_s`, then position, velocity, torque columns).
+    #[getter]
+    fn columns(&self) -> Vec<String> {
+        self.controls
+            .simulator
+            .columns(self.controls.joint, self.controls.slope > 0.0)
+            .split(',')
+            .map(String::from)
+            .collect()
+    }
+    /// catflip's PD stiffness, N m/rad.
+    #[getter]
+    fn kp(&self) -> f64 {
+        catflip::verify::simulate::Controller::from_config(&self.cfg).kp
+    }
+    /// catflip's PD damping, N m s/rad.
+    #[getter]
+    fn kd(&self) -> f64 {
+        catflip::verify::simulate::Controller::from_config(&self.cfg).kd
+    }
+    /// `limits.max_torque`, N m, or None.
+    #[getter]
+    fn max_torque(&self) -> Option<f64> {
+        self.cfg.limits.max_torque
+    }
+    /// Peak norm: `euclidean` or `per-motor`.
+    #[getter]
+    fn norm(&self) -> String {
+        catflip::run::json_name(&self.cfg.norm())
+    }
+    /// Step start times, s: float64, shape (n + 1,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.controls.rows.iter().map(|r| r.t).collect())
+    }
+    /// Planned joint position at each row: float64, shape (n + 1, 4) (ball: quaternion, MuJoCo w x y z, pyBullet x y z w) or (n + 1, 2) (universal).
+    #[getter]
+    fn pos<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix_vec(
+            py,
+            &self
+                .controls
+                .rows
+                .iter()
+                .map(|r| r.pos.clone())
+                .collect::<Vec<_>>(),
+        )
+    }
+    /// Planned joint velocity: float64, shape (n + 1, 3) (ball) or (n + 1, 2).
+    #[getter]
+    fn vel<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix_vec(
+            py,
+            &self
+                .controls
+                .rows
+                .iter()
+                .map(|r| r.vel.clone())
+                .collect::<Vec<_>>(),
+        )
+    }
+    /// Torque (or DC command) held over each step, N m: float64, shape (n + 1, 3) or (n + 1, 2); 0 on the last row.
+    #[getter]
+    fn torque<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix_vec(
+            py,
+            &self
+                .controls
+                .rows
+                .iter()
+                .map(|r| r.torque.clone())
+                .collect::<Vec<_>>(),
+        )
+    }
+    /// The CLI's `<method>.<simulator>.csv`.
+    #[pyo3(signature = (method = None))]
+    fn to_csv(&self, method: Option<&str>) -> String {
+        self.controls
+            .to_csv(&self.cfg, method.unwrap_or(self.method))
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Controls(simulator={:?}, dt={:.6e} s, steps={})",
+            self.simulator(),
+            self.controls.dt,
+            self.steps()
+        )
+    }
+}
+
+#[pymodule]
+fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("CatflipError", py.get_type::<CatflipError>())?;
+    m.add("ConfigError", py.get_type::<ConfigError>())?;
+    m.add("DesignError", py.get_type::<DesignError>())?;
+    m.add("ImpossibleError", py.get_type::<ImpossibleError>())?;
+    m.add_class::<Config>()?;
+    m.add_class::<Design>()?;
+    m.add_class::<Simulation>()?;
+    m.add_class::<LeastHeight>()?;
+    m.add_class::<Run>()?;
+    m.add_class::<Controls>()?;
+    m.add_function(wrap_pyfunction!(design, m)?)?;
+    m.add_function(wrap_pyfunction!(simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(least_height, m)?)?;
+    m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(export_mjcf, m)?)?;
+    m.add_function(wrap_pyfunction!(export_urdf, m)?)?;
+    m.add_function(wrap_pyfunction!(controls, m)?)?;
+    Ok(())
+}

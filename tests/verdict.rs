@@ -1,0 +1,45 @@
+//! One verdict: `catflip optimize` and `catflip run` judge the same method on
+//! the same config alike, on every bundled config.
+
+use std::path::Path;
+use std::process::Command;
+
+fn json(args: &[&str], out: &Path) -> Option<serde_json::Value> {
+    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+        .args(args)
+        .args(["--json", "--out"])
+        .arg(out)
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .output()
+        .unwrap();
+    serde_json::from_slice(&o.stdout).ok()
+}
+
+#[test]
+fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
+    let dir = tempfile::tempdir().unwrap();
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(configs).unwrap() {
+        let path = entry.unwrap().path();
+        let cfg = format!("configs/{}", path.file_name().unwrap().to_str().unwrap());
+        let run = json(&["run", &cfg], dir.path()).expect("run prints its summary");
+        for mode in ["phased", "free"] {
+            let m = run["methods"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .find(|m| m["method"] == mode)
+                .unwrap();
+            // a method that fails prints no design (an error, exit 1)
+            let (verdict, status) = match json(&["optimize", &cfg, "--mode", mode], dir.path()) {
+                Some(o) => (o["verdict"].clone(), o["status"].clone()),
+                None => ("failed".into(), "failed".into()),
+            };
+            assert_eq!(m["verdict"], verdict, "{cfg} {mode}: run {m}");
+            assert_eq!(m["status"], status, "{cfg} {mode}");
+            checked += 1;
+        }
+    }
+    assert!(checked >= 6, "{checked} methods checked");
+}
