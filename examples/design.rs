@@ -1,5 +1,6 @@
 //! Design a torque schedule with the library: phased optimum, then the
-//! free-form optimum seeded by it, verified by simulation and written as CSV.
+//! free-form optimum seeded by it, verified by simulation and written inside the
+//! project, to `output/<name>/example-design/` (CSV and JSON).
 //! `cargo run --release --example design [-- configs/domestic-cat.toml]`
 use catflip::Config;
 use catflip::design::plan::Schedule;
@@ -29,9 +30,15 @@ fn main() -> anyhow::Result<()> {
         100.0 * free.peak_torque_nm / phased.peak_torque_nm,
         free.flip_error_rad
     );
-    let csv = Schedule::sample(&cfg.cat(), &free.plan, cfg.simulate.samples_per_phase).to_csv();
-    let out = std::env::temp_dir().join(format!("{}-free.csv", cfg.name));
-    std::fs::write(&out, csv)?;
-    println!("schedule written to {}", out.display());
+    // inside the project, published like the commands' sets: output/<name>/example-design/
+    let mut out = catflip::output::Output::default();
+    Schedule::sample(&cfg.cat(), &free.plan, cfg.simulate.samples_per_phase)
+        .add_to(&mut out, "free");
+    let set = std::path::Path::new("output")
+        .join(&cfg.name)
+        .join("example-design");
+    for f in out.commit(&set)? {
+        println!("schedule written to {}", f.display());
+    }
     Ok(())
 }

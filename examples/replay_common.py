@@ -1,12 +1,17 @@
 """Shared parts of replay_mujoco.py and replay_pybullet.py: reading catflip's
-exported controls and summary, rotation helpers, the flip convention, and the
-comparison table. Needs numpy only."""
+exported controls and summary (from a `catflip run` folder, or made in-process
+by the catflip Python package from a config), rotation helpers, the flip
+convention, and the comparison table. Needs numpy only (and the catflip
+package for a config)."""
 
 import argparse
+import atexit
 import json
 import math
 import pathlib
+import shutil
 import sys
+import tempfile
 
 import numpy as np
 
@@ -193,7 +198,11 @@ def parse_args(engine, default_tol):
         description=f"Replay catflip's exported schedules in {engine}, feed-forward only and "
         "feed-forward + PD, and compare with catflip's summary.json."
     )
-    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run")
+    p.add_argument("output", help="catflip's output folder of one config, e.g. output/seed/run; or, "
+                   "with the catflip Python package installed (pip install ./python), a config such "
+                   "as configs/seed.toml, run in-process (the same files, not written)")
+    p.add_argument("--set", dest="overrides", action="append", default=[], metavar="KEY=VALUE",
+                   help="with a config: override a key, as catflip's --set (repeatable)")
     p.add_argument("--methods", default=None,
                    help="comma-separated methods (default: all in summary.json)")
     p.add_argument("--tol-deg", type=float, default=default_tol,
@@ -202,6 +211,32 @@ def parse_args(engine, default_tol):
                    help="largest |flip - catflip's flip| of the feed-forward-only replay of an "
                    "optimised, unsaturated schedule, deg (default 0.05)")
     return p.parse_args()
+
+
+def run_folder(arg, overrides):
+    """The folder of `catflip run`'s files: `arg` itself (the CSV route), or for a
+    `.toml` config the files of `catflip.run(config)`, made in-process by the Python
+    package and put in a temporary folder, so that both routes read the same files."""
+    path = pathlib.Path(arg)
+    if path.suffix != ".toml":
+        if overrides:
+            raise SystemExit("--set applies to a config; a run folder is replayed as it was written")
+        return path
+    try:
+        import catflip
+    except ImportError:
+        raise SystemExit(f"{arg} is a config: replaying it needs the catflip Python package "
+                         "(pip install ./python, docs/python.md); or give the folder `catflip run` wrote")
+    try:
+        run = catflip.run(catflip.Config.from_toml(path, overrides))
+    except catflip.CatflipError as e:
+        raise SystemExit(f"error: {e}")
+    folder = pathlib.Path(tempfile.mkdtemp(prefix="catflip-run-"))
+    atexit.register(shutil.rmtree, folder, True)
+    for name in run.names:
+        (folder / name).write_text(run.file(name))
+    print(f"{arg}: designed in-process by the catflip package (catflip.run, {run.outcome})", file=sys.stderr)
+    return folder
 
 
 def load_summary(out):

@@ -4,6 +4,11 @@
     catflip run configs/seed.toml
     python examples/replay_mujoco.py output/seed/run
 
+or, with the catflip Python package installed (pip install ./python), from the
+config, designed in-process (the same files, so the same output):
+
+    python examples/replay_mujoco.py configs/seed.toml [--set KEY=VALUE]
+
 Loads output/<name>/run/<name>.mjcf.xml and each output/<name>/run/<method>.mujoco.csv
 as catflip wrote them, steps MuJoCo at the model's time step (the CSV's), and
 holds each row's torque over its step: once feed-forward only, once
@@ -25,7 +30,8 @@ import mujoco
 import numpy as np
 
 from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
-                           peak_of, quat_log, read_controls, reference, report, right_jacobian)
+                           peak_of, quat_log, read_controls, reference, report, right_jacobian,
+                           run_folder)
 
 
 def is_dc_motor(model):
@@ -189,7 +195,7 @@ def check_urdf(out, name, model, controls, mjcf_flips):
 
 def main():
     args = parse_args("MuJoCo", 1e-3)
-    out = pathlib.Path(args.output)
+    out = run_folder(args.output, args.overrides)
     summary = load_summary(out)
     name = summary["name"]
     model = mujoco.MjModel.from_xml_path(str(out / f"{name}.mjcf.xml"))

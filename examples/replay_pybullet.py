@@ -4,6 +4,11 @@
     catflip run configs/seed.toml
     python examples/replay_pybullet.py output/seed/run
 
+or, with the catflip Python package installed (pip install ./python), from the
+config, designed in-process (the same files, so the same output):
+
+    python examples/replay_pybullet.py configs/seed.toml [--set KEY=VALUE]
+
 Loads output/<name>/run/<name>.urdf with URDF_USE_INERTIA_FROM_FILE (without it
 pyBullet recomputes the inertias from the collision cylinders) and each
 output/<name>/run/<method>.pybullet.csv as catflip wrote them; sets the links'
@@ -28,7 +33,8 @@ import pybullet as p
 
 from replay_common import (FlipTracker, finish, landing_of, limit_catflip_torque, load_summary, parse_args,
                            quat_conj, quat_mul,
-                           peak_of, quat_log, read_controls, reference, report, right_jacobian)
+                           peak_of, quat_log, read_controls, reference, report, right_jacobian,
+                           run_folder)
 
 # pyBullet integrates with semi-implicit Euler: its flip error is first order in
 # the step (1 to 3 deg at catflip's 0.25 ms step on the seed and robot configs,
@@ -148,7 +154,7 @@ def replay(urdf, c, pd, substeps=1):
 
 def main():
     args = parse_args("pyBullet", PYBULLET_TOL_DEG)
-    out = pathlib.Path(args.output)
+    out = run_folder(args.output, args.overrides)
     summary = load_summary(out)
     urdf = out / f"{summary['name']}.urdf"
     # every method that produced a schedule (a failed one has none)

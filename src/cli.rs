@@ -70,7 +70,8 @@ enum Command {
     Simulate {
         #[command(flatten)]
         common: Common,
-        /// Schedule CSV to apply (as written by catflip); its torque is the feed-forward.
+        /// Schedule to apply, as catflip writes it: `<method>.csv` or the same
+        /// rows as `<method>.schedule.json`; its torque is the feed-forward.
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
@@ -92,6 +93,10 @@ enum Command {
         /// whole sweep's.
         #[arg(long, value_name = "K/N")]
         shard: Option<String>,
+        /// Continue an interrupted sweep (same range, shard, methods and
+        /// config) from the partial set it published.
+        #[arg(long)]
+        resume: bool,
     },
     /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
@@ -171,9 +176,13 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
 }
 
 /// Starts the command's output set `<out>/<name>/<set>` before any work, so
-/// that an unwritable `--out` fails at once.
+/// that an unwritable `--out` fails at once. With `--set` overrides the set
+/// is named after them too ([`catflip::output::set_name`]).
 pub(crate) fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
-    Ok(Publisher::begin(&out_dir(c, cfg), set)?)
+    Ok(Publisher::begin(
+        &out_dir(c, cfg),
+        &catflip::output::set_name(set, &c.set),
+    )?)
 }
 
 /// How a command that finished ended: the exit status tells them apart.
@@ -186,6 +195,9 @@ pub enum Status {
     /// The motors cannot flip the cat from the configured height; the least
     /// height and its schedule were written (exit 4).
     Impossible,
+    /// A signal stopped the command; what it finished was published as a
+    /// partial set (exit 130).
+    Interrupted,
 }
 
 fn status_of(partial: bool) -> Status {
@@ -210,7 +222,8 @@ pub fn run() -> Result<Status> {
             methods,
             threads,
             shard,
-        } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref()),
+            resume,
+        } => cmd_sweep(&common, &range, &methods, threads, shard.as_deref(), resume),
         Command::Export {
             format,
             common,
@@ -917,6 +930,7 @@ fn cmd_sweep(
     methods: &[String],
     threads: Option<usize>,
     shard: Option<&str>,
+    resume: bool,
 ) -> Result<Status> {
     let cfg = load(c)?;
     let spec: catflip::sweep::SweepSpec = range.parse()?;
@@ -982,33 +996,94 @@ fn cmd_sweep(
     // a live bar on a terminal, plain lines otherwise
     let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let clock = std::time::Instant::now();
-    let points = catflip::sweep::sweep_shard(
-        &c.config,
-        &c.set,
-        &spec,
-        m,
-        threads,
-        shard,
-        |done, total| {
-            if quiet {
-                return;
-            }
-            let line = catflip::sweep::progress_line(
-                &spec.key,
-                done,
-                total,
-                clock.elapsed().as_secs_f64(),
-            );
-            if live {
-                eprint!("\r  {line}");
-            } else {
-                eprintln!("  {line}");
-            }
-        },
-    )?;
+    let state = catflip::sweep::resume::SweepState::new(&spec, shard, m, &cfg);
+    let kept = if resume {
+        let old = state.resume_from(&publisher.link(), &key)?;
+        eprintln!(
+            "resuming: {} of {} points kept from {}",
+            old.finished().len(),
+            old.points.len(),
+            publisher.link().display()
+        );
+        old.points
+    } else {
+        state.points.clone()
+    };
+    // the points land in a store this thread reads when a signal stops the sweep
+    let store = std::sync::Arc::new(std::sync::Mutex::new(kept));
+    let interrupt = catflip::interrupt::Interrupt::catch()?;
+    let work = {
+        let (config, set, spec, store) =
+            (c.config.clone(), c.set.clone(), spec.clone(), store.clone());
+        move || {
+            catflip::sweep::sweep_shard_into(
+                &config,
+                &set,
+                &spec,
+                m,
+                threads,
+                shard,
+                &store,
+                |done, total| {
+                    if quiet {
+                        return;
+                    }
+                    let line = catflip::sweep::progress_line(
+                        &spec.key,
+                        done,
+                        total,
+                        clock.elapsed().as_secs_f64(),
+                    );
+                    if live {
+                        eprint!("\r  {line}");
+                    } else {
+                        eprintln!("  {line}");
+                    }
+                },
+            )
+        }
+    };
+    let outcome = catflip::interrupt::supervise(&interrupt, work);
     if !quiet && live {
         eprintln!();
     }
+    let slots = store.lock().unwrap_or_else(|p| p.into_inner()).clone();
+    let state = state.with_points(slots);
+    if let catflip::interrupt::Outcome::Finished(r) = outcome {
+        r?;
+    } else {
+        // published as a partial set, the unfinished points left running
+        let points = state.finished();
+        let mut out = Output::default();
+        out.add(
+            format!("sweep-{key}.csv"),
+            catflip::sweep::to_csv(&spec.key, &points),
+        );
+        if !points.is_empty() {
+            for (name, svg) in
+                catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)?
+            {
+                out.add(name, svg);
+            }
+        }
+        out.add(
+            catflip::sweep::resume::SweepState::file_name(&key),
+            state.to_json(),
+        );
+        let dir = publisher.link();
+        publisher.publish(out)?;
+        if c.json {
+            say!("{}", serde_json::to_string_pretty(&points)?);
+        }
+        eprintln!(
+            "interrupted: {} of {} points finished, published as a partial set in {} (its state file says \"status\": \"partial\"); the same command with --resume continues it; exit status 130",
+            points.len(),
+            state.points.len(),
+            dir.display()
+        );
+        return Ok(Status::Interrupted);
+    }
+    let points = state.finished();
     let partial = points.iter().any(|p| p.error.is_some());
     let mut out = Output::default();
     out.add(
@@ -1018,6 +1093,10 @@ fn cmd_sweep(
     for (name, svg) in catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)? {
         out.add(name, svg);
     }
+    out.add(
+        catflip::sweep::resume::SweepState::file_name(&key),
+        state.to_json(),
+    );
     let written = publisher.publish(out)?;
     if partial {
         eprintln!(

@@ -13,6 +13,7 @@ pub mod control;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod interrupt;
 pub mod model;
 pub mod output;
 pub mod report;

@@ -4,7 +4,8 @@
 //! 2 bad input (config, arguments, files, output folder), nothing computed or
 //! written; 3 partial: results written, but some are flagged or failed;
 //! 4 impossible: the motors cannot flip the cat from the configured height
-//! (the least drop height and its schedule are written).
+//! (the least drop height and its schedule are written); 130 interrupted
+//! (a sweep publishes the points it finished as a partial set).
 mod cli;
 mod robustness;
 
@@ -13,6 +14,9 @@ fn main() -> std::process::ExitCode {
         Ok(cli::Status::Ok) => std::process::ExitCode::SUCCESS,
         Ok(cli::Status::Partial) => std::process::ExitCode::from(3),
         Ok(cli::Status::Impossible) => std::process::ExitCode::from(4),
+        Ok(cli::Status::Interrupted) => {
+            std::process::ExitCode::from(catflip::interrupt::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("error: {e:#}");
             let bad_input = e

@@ -1,16 +1,24 @@
 //! All-or-nothing output that holds under SIGKILL and concurrent writers.
 //!
 //! Each command publishes one *set* of files, `<dir>/<set>` (e.g.
-//! `output/seed/run`). The set is a symbolic link to a hidden folder
-//! `<dir>/.<set>.<id>` that was written completely before the link was
-//! switched to it with `rename(2)`, which replaces a link atomically: a reader
-//! sees the old set or the new one, never a mix. Commands have separate sets,
-//! so `optimize` never overwrites the files `run` described in its summary.
+//! `output/seed/run`), an ordinary folder: `cp -r` and `tar` copy it whole.
+//! It is written completely in a hidden staging folder `<dir>/.<set>.<id>`
+//! first and then swapped in with one `renameat2(RENAME_EXCHANGE)` (Linux), which
+//! exchanges the two names atomically: a reader sees the old set or the new
+//! one, never a mix, and the set never goes missing. The old set, now under
+//! the hidden name, is removed. Commands have separate sets, so `optimize`
+//! never overwrites the files `run` described in its summary.
+//!
+//! Where the exchange is not available (other systems, file systems without
+//! it) the set is a symbolic link to its hidden folder, switched with
+//! `rename(2)`, which replaces a link atomically.
 //!
 //! While a process stages, it holds an advisory lock on `<dir>/.<set>.<id>.lock`;
 //! the lock dies with the process (also under SIGKILL), so the next command
 //! knows a staging folder without a held lock is a leftover and removes it.
-//! Hidden names are never taken for results.
+//! Hidden names are never taken for results; a published folder carries the
+//! hidden marker file [`MARKER`], so that catflip never replaces a folder it
+//! did not write.
 
 use crate::error::{Error, Result};
 use std::fs::{self, File, OpenOptions};
@@ -64,6 +72,36 @@ pub fn ensure_finite(v: &serde_json::Value, fields: &[&str]) -> Result<()> {
             fields: nulls.join(", "),
         })
     }
+}
+
+/// The set a command publishes with `--set` overrides: `<base>@<overrides>`
+/// (e.g. `run@cat.joint=no-twist`), so that runs of one config with other
+/// overrides keep their own reports side by side; `<base>` without any.
+/// Characters other than letters, digits and `._=,+-` become `_`; a long
+/// name keeps its first 80 characters and a hash of the whole.
+pub fn set_name(base: &str, overrides: &[String]) -> String {
+    if overrides.is_empty() {
+        return base.to_string();
+    }
+    let all = overrides.join(",");
+    let slug: String = all
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._=,+-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if slug.len() <= 100 {
+        return format!("{base}@{slug}");
+    }
+    // FNV-1a: stable across runs and builds, unlike std's hasher
+    let hash = all.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!("{base}@{}~{hash:016x}", &slug[..80])
 }
 
 /// Files to write into one set, kept in memory until published.
@@ -122,7 +160,15 @@ pub struct Publisher {
     /// Folders `begin` created, innermost last.
     created: Vec<PathBuf>,
     published: bool,
+    /// Published by exchange: the set is a folder, the staging name is gone.
+    exchanged: bool,
+    /// Publish by the link scheme even where the exchange works (tests of the fallback).
+    links_only: bool,
 }
+
+/// The hidden file that marks a folder as a set catflip published.
+pub const MARKER: &str = ".catflip-set";
+const MARKER_TEXT: &str = "A set of files published by catflip; its next run of the same command replaces the folder whole.\n";
 
 impl Publisher {
     /// Prepares the set `<dir>/<set>`: creates `dir` if needed, checks it takes
@@ -144,13 +190,18 @@ impl Publisher {
             _lock: lock,
             created,
             published: false,
+            exchanged: false,
+            links_only: false,
         };
         if let Ok(m) = fs::symlink_metadata(p.link())
             && !m.file_type().is_symlink()
+            && !(m.is_dir() && p.link().join(MARKER).is_file())
         {
             return Err(Error::OutputDir {
                 path: p.link(),
-                message: "exists and is not a set published by catflip (a link to a hidden folder); move it away".into(),
+                message: format!(
+                    "exists and is not a set published by catflip (a folder holding {MARKER}, or a link to a hidden folder); move it away"
+                ),
             });
         }
         fs::create_dir(p.staging()).map_err(|e| oerr(&p.staging(), e))?;
@@ -181,23 +232,49 @@ impl Publisher {
         Ok(out.files.iter().map(|(n, _)| self.link().join(n)).collect())
     }
 
-    /// Writes the files and switches the link to the staging folder.
+    /// Writes the files and puts the staging folder in the set's place.
     fn switch(&mut self, out: &Output) -> Result<()> {
         let staging = self.staging();
-        for (name, bytes) in &out.files {
+        let marker = [(MARKER.to_string(), MARKER_TEXT.as_bytes().to_vec())];
+        for (name, bytes) in out.files.iter().chain(&marker) {
             let path = staging.join(name);
             fs::write(&path, bytes).map_err(|e| Error::Write {
                 path: self.link().join(name),
                 message: e.to_string(),
             })?;
         }
-        let own = self.folder_name(&self.id);
-        let tmp_link = self.dir.join(format!("{own}.link"));
-        let _ = fs::remove_file(&tmp_link);
         let werr = |e: std::io::Error| Error::Write {
             path: self.link(),
             message: e.to_string(),
         };
+        let exchanged = if self.links_only {
+            Ok(false)
+        } else {
+            exchange::publish(&staging, &self.link())
+        };
+        match exchanged {
+            Ok(true) => {
+                // the staging name now holds the set we replaced, if any
+                // (a folder, or the link of the fallback scheme)
+                match fs::symlink_metadata(&staging) {
+                    Ok(m) if m.is_dir() => {
+                        let _ = fs::remove_dir_all(&staging);
+                    }
+                    Ok(_) => {
+                        let _ = fs::remove_file(&staging);
+                    }
+                    Err(_) => {}
+                }
+                self.published = true;
+                self.exchanged = true;
+                return Ok(());
+            }
+            Ok(false) => {}
+            Err(e) => return Err(werr(e)),
+        }
+        let own = self.folder_name(&self.id);
+        let tmp_link = self.dir.join(format!("{own}.link"));
+        let _ = fs::remove_file(&tmp_link);
         symlink(Path::new(&own), &tmp_link).map_err(werr)?;
         fs::rename(&tmp_link, self.link()).map_err(|e| {
             let _ = fs::remove_file(&tmp_link);
@@ -220,7 +297,7 @@ impl Publisher {
         // A writer that switched the link after ours, while we still held the
         // lock, skipped our set as live; it is superseded, and only we see it.
         let own = self.folder_name(&self.id);
-        if fs::read_link(self.link()).ok().as_deref() != Some(Path::new(&own)) {
+        if !self.exchanged && fs::read_link(self.link()).ok().as_deref() != Some(Path::new(&own)) {
             let _ = fs::remove_dir_all(self.staging());
         }
     }
@@ -330,6 +407,70 @@ fn same_file(_f: &File, path: &Path) -> bool {
     path.exists()
 }
 
+/// The atomic exchange of the staging folder with the published set.
+mod exchange {
+    use std::path::Path;
+
+    /// Puts `staging` at `set`: exchanged with the set there, or renamed to
+    /// it when there is none. `Ok(false)` when this system or file system
+    /// cannot (the caller falls back to the link scheme).
+    #[cfg(target_os = "linux")]
+    pub fn publish(staging: &Path, set: &Path) -> std::io::Result<bool> {
+        use std::os::unix::ffi::OsStrExt;
+        let c = |p: &Path| {
+            std::ffi::CString::new(p.as_os_str().as_bytes())
+                .map_err(|_| std::io::Error::other("a path with a NUL byte"))
+        };
+        let (from, to) = (c(staging)?, c(set)?);
+        let rename2 = |flags: libc::c_uint| {
+            // SAFETY: two valid NUL-terminated paths, relative to the working folder
+            let r = unsafe {
+                libc::syscall(
+                    libc::SYS_renameat2,
+                    libc::AT_FDCWD,
+                    from.as_ptr(),
+                    libc::AT_FDCWD,
+                    to.as_ptr(),
+                    flags,
+                )
+            };
+            if r == 0 {
+                Ok(())
+            } else {
+                Err(std::io::Error::last_os_error())
+            }
+        };
+        let unsupported = |e: &std::io::Error| {
+            matches!(
+                e.raw_os_error(),
+                Some(libc::EINVAL | libc::ENOSYS | libc::EOPNOTSUPP)
+            )
+        };
+        // a set appearing or going between the two attempts tries again
+        for _ in 0..100 {
+            let flags = if std::fs::symlink_metadata(set).is_ok() {
+                libc::RENAME_EXCHANGE
+            } else {
+                libc::RENAME_NOREPLACE
+            };
+            match rename2(flags) {
+                Ok(()) => return Ok(true),
+                Err(e) if unsupported(&e) => return Ok(false),
+                Err(e) if matches!(e.raw_os_error(), Some(libc::EEXIST | libc::ENOENT)) => {}
+                Err(e) => return Err(e),
+            }
+        }
+        Err(std::io::Error::other(
+            "other commands kept replacing the set; try again",
+        ))
+    }
+
+    #[cfg(not(target_os = "linux"))]
+    pub fn publish(_staging: &Path, _set: &Path) -> std::io::Result<bool> {
+        Ok(false)
+    }
+}
+
 #[cfg(unix)]
 fn symlink(target: &Path, link: &Path) -> std::io::Result<()> {
     std::os::unix::fs::symlink(target, link)
@@ -399,39 +540,89 @@ mod tests {
         o
     }
 
-    /// A switches the link, B switches it after and cleans up while A still
+    fn begin(dir: &Path, links_only: bool) -> Publisher {
+        let mut p = Publisher::begin(dir, "s").unwrap();
+        p.links_only = links_only;
+        p
+    }
+
+    /// The hidden folders a published set keeps: the link's target in the
+    /// link scheme, none for a folder published by exchange.
+    fn live(dir: &Path) -> Vec<String> {
+        match fs::read_link(dir.join("s")) {
+            Ok(t) => vec![t.to_string_lossy().into_owned()],
+            Err(_) => vec![],
+        }
+    }
+
+    /// A switches the set, B switches it after and cleans up while A still
     /// holds its lock (so B skips A as live): A must then remove its own set.
     #[test]
     fn a_writer_superseded_while_it_held_its_lock_removes_its_own_set() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut a = Publisher::begin(dir.path(), "s").unwrap();
-        let b = Publisher::begin(dir.path(), "s").unwrap();
-        a.switch(&one_file("A")).unwrap();
-        b.publish(one_file("B")).unwrap();
-        assert_eq!(hidden_sets(dir.path()).len(), 2, "B skipped A as live");
-        a.retire();
-        let left = hidden_sets(dir.path());
-        assert_eq!(left.len(), 1, "{left:?}");
-        assert_eq!(
-            fs::read_to_string(dir.path().join("s/a.txt")).unwrap(),
-            "B",
-            "the last switch is published"
-        );
-        assert_eq!(
-            Path::new(&left[0]),
-            fs::read_link(dir.path().join("s")).unwrap()
-        );
+        for links_only in [false, true] {
+            let dir = tempfile::tempdir().unwrap();
+            let mut a = begin(dir.path(), links_only);
+            let b = begin(dir.path(), links_only);
+            a.switch(&one_file("A")).unwrap();
+            b.publish(one_file("B")).unwrap();
+            if links_only {
+                assert_eq!(hidden_sets(dir.path()).len(), 2, "B skipped A as live");
+            }
+            a.retire();
+            assert_eq!(
+                fs::read_to_string(dir.path().join("s/a.txt")).unwrap(),
+                "B",
+                "the last switch is published"
+            );
+            assert_eq!(
+                hidden_sets(dir.path()),
+                live(dir.path()),
+                "links {links_only}"
+            );
+            // an ordinary folder where the exchange works, a link otherwise
+            assert_eq!(dir.path().join("s").is_symlink(), links_only);
+        }
     }
 
     /// In the other order (A's lock gone before B cleans up) B removes A.
     #[test]
     fn a_superseded_set_without_a_lock_is_removed_by_the_next_writer() {
+        for links_only in [false, true] {
+            let dir = tempfile::tempdir().unwrap();
+            let a = begin(dir.path(), links_only);
+            let b = begin(dir.path(), links_only);
+            a.publish(one_file("A")).unwrap();
+            b.publish(one_file("B")).unwrap();
+            assert_eq!(hidden_sets(dir.path()), live(dir.path()));
+            assert_eq!(hidden_sets(dir.path()).len(), usize::from(links_only));
+            assert_eq!(fs::read_to_string(dir.path().join("s/a.txt")).unwrap(), "B");
+        }
+    }
+
+    /// A set of the link scheme (older catflip, or a file system without
+    /// the exchange) is replaced by a folder, its hidden target removed; a
+    /// folder catflip did not write is refused.
+    #[test]
+    fn a_linked_set_becomes_a_folder_and_a_foreign_folder_is_kept() {
         let dir = tempfile::tempdir().unwrap();
-        let a = Publisher::begin(dir.path(), "s").unwrap();
-        let b = Publisher::begin(dir.path(), "s").unwrap();
-        a.publish(one_file("A")).unwrap();
-        b.publish(one_file("B")).unwrap();
-        assert_eq!(hidden_sets(dir.path()).len(), 1);
-        assert_eq!(fs::read_to_string(dir.path().join("s/a.txt")).unwrap(), "B");
+        begin(dir.path(), true).publish(one_file("A")).unwrap();
+        assert!(dir.path().join("s").is_symlink());
+        begin(dir.path(), false).publish(one_file("B")).unwrap();
+        let s = dir.path().join("s");
+        assert!(s.is_dir() && !s.is_symlink());
+        assert!(s.join(MARKER).is_file());
+        assert_eq!(fs::read_to_string(s.join("a.txt")).unwrap(), "B");
+        assert!(
+            hidden_sets(dir.path()).is_empty(),
+            "{:?}",
+            hidden_sets(dir.path())
+        );
+        fs::create_dir(dir.path().join("mine")).unwrap();
+        fs::write(dir.path().join("mine/x"), "x").unwrap();
+        let e = Publisher::begin(dir.path(), "mine")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("not a set published by catflip"), "{e}");
+        assert_eq!(fs::read_to_string(dir.path().join("mine/x")).unwrap(), "x");
     }
 }

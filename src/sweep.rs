@@ -17,8 +17,10 @@ use crate::design::phased::least_height;
 use crate::error::{Error, Result};
 use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use crate::verify::analyze::peak_along;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::path::Path;
+
+pub mod resume;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
@@ -55,6 +57,11 @@ impl std::str::FromStr for SweepSpec {
             .map_err(|_| bad("COUNT must be a whole number"))?;
         if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
+        }
+        if count == 1 && from != to {
+            return Err(bad(&format!(
+                "COUNT 1 computes FROM alone, not the range to {to}: give {from}:{from}:1 for one point, or a COUNT of 2 or more"
+            )));
         }
         if count > MAX_POINTS {
             return Err(bad(&format!(
@@ -110,7 +117,7 @@ pub struct Methods {
 
 /// One point of a sweep. Peaks are computed without the torque limit; with a
 /// limit, the least drop height at which each design meets it (F7) is given.
-#[derive(Debug, Clone, Default, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct SweepPoint {
     pub value: f64,
     pub analytic_peak_nm: Option<f64>,
@@ -415,9 +422,37 @@ pub fn sweep_shard(
     shard: Shard,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<Vec<SweepPoint>> {
+    let store = Mutex::new(Vec::new());
+    sweep_shard_into(
+        path, overrides, spec, methods, threads, shard, &store, progress,
+    )?;
+    Ok(store
+        .into_inner()
+        .unwrap()
+        .into_iter()
+        .map(|p| p.expect("every point ran"))
+        .collect())
+}
+
+/// [`sweep_shard`] into `store`, one slot a point of the shard, which the
+/// caller may read while it runs (an interrupted sweep publishes the points
+/// finished so far, [`crate::interrupt`]). Slots already filled (a resumed
+/// sweep, [`resume`]) are kept: a chunk whose every point is filled is
+/// skipped, a chunk filled in part is computed again from its start, so
+/// that each point has the same continuation as in an uninterrupted sweep.
+pub fn sweep_shard_into(
+    path: &Path,
+    overrides: &[String],
+    spec: &SweepSpec,
+    methods: Methods,
+    threads: usize,
+    shard: Shard,
+    store: &Mutex<Vec<Option<SweepPoint>>>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<()> {
     let all = spec.values();
     let range = shard.points(all.len());
-    let values = &all[range];
+    let values = &all[range.clone()];
     let load = |v: f64| {
         let mut ov = overrides.to_vec();
         ov.push(format!("{}={}", spec.key, v));
@@ -436,32 +471,27 @@ pub fn sweep_shard(
             ),
         });
     }
-    sweep_values(
+    let configs = checked_configs(&spec.key, &spec.arg(), &all, &load)?;
+    compute_into(
         &spec.key,
-        &spec.arg(),
         values,
-        load,
+        &configs[range],
         methods,
         threads,
+        store,
         progress,
     )
 }
 
-/// The points of a sweep of `key` over `values` (any values, in order; the
-/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
-/// value and `arg` naming the sweep in messages: what [`sweep_shard`] runs,
-/// and what a caller with its own values (the Python package) calls.
-pub fn sweep_values(
+/// The configs at `values`, or the sweep's error before any work: a point
+/// whose config is invalid (outside the key's range) fails the whole sweep,
+/// over the whole grid so that every shard agrees.
+fn checked_configs(
     key: &str,
     arg: &str,
     values: &[f64],
     load: impl Fn(f64) -> Result<Config>,
-    methods: Methods,
-    threads: usize,
-    progress: impl Fn(usize, usize) + Sync,
-) -> Result<Vec<SweepPoint>> {
-    // a point whose config is invalid is that point's failure; when every
-    // point is invalid (e.g. an unknown key) the sweep fails before any work
+) -> Result<Vec<Result<Config>>> {
     let configs: Vec<Result<Config>> = values
         .iter()
         .map(|&v| {
@@ -475,25 +505,70 @@ pub fn sweep_values(
             })
         })
         .collect();
-    if let Some(Err(first)) = configs.first()
-        && configs.iter().all(|c| c.is_err())
-    {
+    let bad = configs.iter().filter(|c| c.is_err()).count();
+    if let Some(Err(first)) = configs.iter().find(|c| c.is_err()) {
+        let message = match first {
+            Error::Range { message, .. } => message.clone(),
+            e => e.to_string(),
+        };
         return Err(Error::Range {
             arg: arg.into(),
-            message: match first {
-                Error::Range { message, .. } => format!("every point is invalid; {message}"),
-                e => e.to_string(),
+            message: if bad == configs.len() {
+                format!("every point is invalid; {message}")
+            } else {
+                format!(
+                    "{bad} of {} points are invalid, the first {message}; choose FROM and TO inside the key's range",
+                    configs.len()
+                )
             },
         });
     }
+    Ok(configs)
+}
+
+/// The points of a sweep of `key` over `values` (any values, in order; the
+/// chunks of [`CHUNK`] continue along them), `load` giving the config at a
+/// value and `arg` naming the sweep in messages: what a caller with its own
+/// values (the Python package) calls.
+pub fn sweep_values(
+    key: &str,
+    arg: &str,
+    values: &[f64],
+    load: impl Fn(f64) -> Result<Config>,
+    methods: Methods,
+    threads: usize,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<Vec<SweepPoint>> {
+    let configs = checked_configs(key, arg, values, load)?;
+    let store = Mutex::new(Vec::new());
+    compute_into(key, values, &configs, methods, threads, &store, progress)?;
+    Ok(store.into_inner().unwrap().into_iter().flatten().collect())
+}
+
+/// Computes the points at `values` (with their `configs`) into `store`,
+/// chunk by chunk; chunks whose every slot is filled are skipped.
+fn compute_into(
+    key: &str,
+    values: &[f64],
+    configs: &[Result<Config>],
+    methods: Methods,
+    threads: usize,
+    store: &Mutex<Vec<Option<SweepPoint>>>,
+    progress: impl Fn(usize, usize) + Sync,
+) -> Result<()> {
     // shards start on chunk boundaries, so local chunks are global chunks
-    let chunks: Vec<std::ops::Range<usize>> = (0..values.len())
-        .step_by(CHUNK)
-        .map(|a| a..(a + CHUNK).min(values.len()))
-        .collect();
+    let results = store;
+    let chunks: Vec<std::ops::Range<usize>> = {
+        let mut kept = results.lock().unwrap();
+        kept.resize(values.len(), None);
+        (0..values.len())
+            .step_by(CHUNK)
+            .map(|a| a..(a + CHUNK).min(values.len()))
+            .filter(|c| kept[c.clone()].iter().any(|p| p.is_none()))
+            .collect()
+    };
     let next = AtomicUsize::new(0);
-    let done = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<SweepPoint>>> = Mutex::new(vec![None; values.len()]);
+    let done = AtomicUsize::new(values.len() - chunks.iter().map(|c| c.len()).sum::<usize>());
     std::thread::scope(|s| {
         for _ in 0..threads.max(1).min(chunks.len()) {
             s.spawn(|| {
@@ -549,12 +624,7 @@ pub fn sweep_values(
             });
         }
     });
-    Ok(results
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|p| p.expect("every point ran"))
-        .collect())
+    Ok(())
 }
 
 /// A progress line for `done` of `total` points after `elapsed` seconds:

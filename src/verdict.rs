@@ -6,7 +6,7 @@
 use crate::config::Config;
 use crate::design::conic::SolveStatus;
 use crate::design::scp::ScpStatus;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::fmt;
 
 /// The tolerances of every judgement, in one place.
@@ -28,7 +28,7 @@ pub mod tolerance {
 }
 
 /// How a design's solver ended, for every method.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Status {
     /// The analytic schedule: closed forms, nothing to converge.

@@ -227,3 +227,430 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
     );
     assert!(o.status.success(), "{}", stderr(&o));
 }
+
+/// The sweep of the interrupt tests: 20 points, two continuation chunks,
+/// one thread, so that the chunks run in order (about 0.2 s a point).
+fn sweep_args(out: &str) -> Vec<String> {
+    [
+        "sweep",
+        &config("seed.toml"),
+        "--set-range",
+        "cat.mass=0.5:2.4:20",
+        "--methods",
+        "analytic,phased",
+        "--threads",
+        "1",
+        "--set",
+        "phased.nodes=10",
+        "--out",
+        out,
+    ]
+    .map(String::from)
+    .to_vec()
+}
+
+/// Starts the sweep, waits for the progress line that shows `points` done,
+/// sends `signal`; returns the exit status, the time from the signal to the
+/// exit, and stderr.
+fn interrupt_after(
+    dir: &Path,
+    args: &[String],
+    points: usize,
+    signal: &str,
+) -> (Option<i32>, std::time::Duration, String) {
+    use std::io::BufRead;
+    let mut child = bin()
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
+    let mut text = String::new();
+    let needle = format!(" {points}/");
+    loop {
+        let mut line = String::new();
+        assert!(err.read_line(&mut line).unwrap() > 0, "ended early: {text}");
+        text.push_str(&line);
+        if line.contains(&needle) {
+            break;
+        }
+    }
+    let sent = std::time::Instant::now();
+    let pid = child.id().to_string();
+    assert!(
+        Command::new("kill")
+            .args([signal, &pid])
+            .status()
+            .unwrap()
+            .success()
+    );
+    let status = child.wait().unwrap();
+    let took = sent.elapsed();
+    let mut rest = String::new();
+    std::io::Read::read_to_string(&mut err, &mut rest).unwrap();
+    (status.code(), took, text + &rest)
+}
+
+fn read(p: PathBuf) -> String {
+    std::fs::read_to_string(&p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = |out: &str| {
+        dir.path()
+            .join(out)
+            .join("seed/sweep-cat_mass@phased.nodes=10")
+    };
+    let o = run(
+        &sweep_args("whole")
+            .iter()
+            .map(|s| s.as_str())
+            .collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = read(set("whole").join("sweep-cat_mass.csv"));
+    // SIGINT after the first chunk (10 points) and one more point
+    let args = sweep_args("part");
+    let (code, took, err) = interrupt_after(dir.path(), &args, 11, "-INT");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < std::time::Duration::from_secs(1),
+        "stopped after {took:?}"
+    );
+    assert!(
+        err.contains("interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    let csv = read(set("part").join("sweep-cat_mass.csv"));
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("sweep-cat_mass.state.json"))).unwrap();
+    assert_eq!(state["status"], "partial");
+    let done = state["points"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|p| !p.is_null())
+        .count();
+    assert!((11..20).contains(&done), "{done}");
+    assert_eq!(csv.lines().count(), done + 1);
+    // the finished points are the uninterrupted sweep's, row for row
+    for row in csv.lines() {
+        assert!(whole.lines().any(|w| w == row), "{row}");
+    }
+    // no staging folder or lock left behind
+    let leftovers: Vec<PathBuf> = tree(&dir.path().join("part"))
+        .into_iter()
+        .filter(|p| {
+            p.to_string_lossy().ends_with(".lock") || p.to_string_lossy().ends_with(".link")
+        })
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // a resume with another grid is refused, and leaves the partial set
+    let mut other = args.clone();
+    other[3] = "cat.mass=0.5:2.4:21".into();
+    other.push("--resume".into());
+    let o = run(
+        &other.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("other settings") && stderr(&o).contains("the range"),
+        "{}",
+        stderr(&o)
+    );
+    // another --set is another sweep (its own set): nothing to resume there
+    let mut same = args.clone();
+    same.extend(["--set".into(), "cat.radius=0.11".into(), "--resume".into()]);
+    let o = run(
+        &same.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("no sweep to resume"), "{}", stderr(&o));
+    // an edited config file is refused by the state's record of the config
+    let edited = dir.path().join("seed.toml");
+    let text = read(PathBuf::from(config("seed.toml")));
+    std::fs::write(&edited, text.replace("radius = 0.1 ", "radius = 0.11 ")).unwrap();
+    let mut changed = args.clone();
+    changed[1] = edited.display().to_string();
+    changed.push("--resume".into());
+    let o = run(
+        &changed.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("the config"), "{}", stderr(&o));
+    // --resume computes the rest only, and the result is the whole sweep's
+    let mut resume = args.clone();
+    resume.push("--resume".into());
+    let o = run(
+        &resume.iter().map(|s| s.as_str()).collect::<Vec<_>>(),
+        dir.path(),
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("resuming: {done} of 20 points kept")),
+        "{err}"
+    );
+    assert!(
+        !err.contains(" 1/20 points"),
+        "recomputed the kept chunk: {err}"
+    );
+    assert_eq!(read(set("part").join("sweep-cat_mass.csv")), whole);
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("sweep-cat_mass.state.json"))).unwrap();
+    assert_eq!(state["status"], "complete");
+}
+
+#[test]
+fn sigterm_stops_a_sweep_too() {
+    let dir = tempfile::tempdir().unwrap();
+    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < std::time::Duration::from_secs(1),
+        "stopped after {took:?}"
+    );
+    let state = read(
+        dir.path()
+            .join("t/seed/sweep-cat_mass@phased.nodes=10/sweep-cat_mass.state.json"),
+    );
+    assert!(state.contains("\"partial\""), "{state}");
+}
+
+/// Files under `dir` (relative, sorted) with their contents.
+fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
+    let mut v: Vec<(PathBuf, Vec<u8>)> = tree(dir)
+        .into_iter()
+        .filter(|p| p.is_file())
+        .map(|p| {
+            (
+                p.strip_prefix(dir).unwrap().to_path_buf(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+#[test]
+fn a_report_is_an_ordinary_folder_that_copies_and_runs_keep_their_own() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = config("seed.toml");
+    let plain = ["run", &seed, "--set", "free.nodes=12"];
+    let o = run(&plain, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = dir.path().join("output/seed/run@free.nodes=12");
+    assert_eq!(
+        report,
+        dir.path()
+            .join("output/seed")
+            .join(catflip::output::set_name("run", &["free.nodes=12".into()]))
+    );
+    let meta = std::fs::symlink_metadata(&report).unwrap();
+    assert!(meta.is_dir() && !meta.file_type().is_symlink(), "{meta:?}");
+    // no hidden staging folder or lock left beside it
+    let hidden: Vec<PathBuf> = tree(&dir.path().join("output/seed"))
+        .into_iter()
+        .filter(|p| p.parent() == Some(&dir.path().join("output/seed")))
+        .filter(|p| p.file_name().unwrap().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+    let original = contents(&report);
+    assert!(original.iter().any(|(p, _)| p == Path::new("index.html")));
+    // cp -r and tar give working copies: the same files, and every file the
+    // page refers to is there
+    let copy = dir.path().join("copy");
+    assert!(
+        Command::new("cp")
+            .arg("-r")
+            .arg(&report)
+            .arg(&copy)
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert_eq!(contents(&copy), original);
+    let html = read(copy.join("index.html"));
+    for part in html.split("src=\"").skip(1) {
+        let target = part.split('"').next().unwrap();
+        if !target.starts_with("data:") && !target.contains("://") && !target.starts_with('#') {
+            assert!(
+                copy.join(target).is_file(),
+                "index.html refers to missing {target}"
+            );
+        }
+    }
+    let tgz = dir.path().join("r.tgz");
+    let ok = Command::new("tar")
+        .arg("czf")
+        .arg(&tgz)
+        .arg("-C")
+        .arg(dir.path().join("output/seed"))
+        .arg("run@free.nodes=12")
+        .status()
+        .unwrap();
+    assert!(ok.success());
+    let x = dir.path().join("x");
+    std::fs::create_dir(&x).unwrap();
+    assert!(
+        Command::new("tar")
+            .arg("xzf")
+            .arg(&tgz)
+            .arg("-C")
+            .arg(&x)
+            .status()
+            .unwrap()
+            .success()
+    );
+    assert_eq!(contents(&x.join("run@free.nodes=12")), original);
+    // the issue's item 5: a run with another override keeps its own report,
+    // and the plain run's is untouched
+    let twist = [
+        "run",
+        &seed,
+        "--set",
+        "free.nodes=12",
+        "--set",
+        "cat.joint=no-twist",
+    ];
+    let o = run(&twist, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let other = dir
+        .path()
+        .join("output/seed/run@free.nodes=12,cat.joint=no-twist");
+    assert!(other.join("summary.json").is_file());
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .contains("run@free.nodes=12,cat.joint=no-twist/index.html")
+    );
+    assert_eq!(
+        contents(&report),
+        original,
+        "the first run's report changed"
+    );
+    // running the same again replaces its own report whole (by exchange)
+    let o = run(&plain, dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(std::fs::symlink_metadata(&report).unwrap().is_dir());
+    let names = |d: &Path| contents(d).into_iter().map(|(p, _)| p).collect::<Vec<_>>();
+    assert_eq!(names(&report), names(&copy));
+    // a folder catflip did not write is never replaced
+    let mine = dir.path().join("output/seed/analyze");
+    std::fs::create_dir_all(&mine).unwrap();
+    std::fs::write(mine.join("notes.txt"), "mine").unwrap();
+    let o = run(&["analyze", &seed], dir.path());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("not a set published by catflip"),
+        "{}",
+        stderr(&o)
+    );
+    assert_eq!(read(mine.join("notes.txt")), "mine");
+}
+
+#[test]
+fn the_small_inconsistencies_are_fixed() {
+    let dir = tempfile::tempdir().unwrap();
+    let seed = config("seed.toml");
+    // a JSON schedule replays as its CSV does
+    let o = run(&["analyze", &seed], dir.path());
+    assert!(o.status.success());
+    let base = dir.path().join("output/seed/analyze");
+    let replay = |file: &str| {
+        let path = base.join(file).display().to_string();
+        let o = run(
+            &[
+                "simulate",
+                &seed,
+                "--schedule",
+                &path,
+                "--json",
+                "--out",
+                "sim",
+            ],
+            dir.path(),
+        );
+        assert!(o.status.success(), "{file}: {}", stderr(&o));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["flip_error_rad"].as_f64().unwrap()
+    };
+    let (from_csv, from_json) = (replay("analytic.csv"), replay("analytic.schedule.json"));
+    assert!(from_json.abs() < 1e-6, "{from_json}");
+    // the CSV rounds to 12 digits, the JSON keeps every bit: the same flip to 1e-9
+    assert!(
+        (from_csv - from_json).abs() < 1e-9,
+        "{from_csv} vs {from_json}"
+    );
+    // a broken JSON schedule names the row and points at the CSV
+    let bad = dir.path().join("bad.schedule.json");
+    let text = read(base.join("analytic.schedule.json")).replacen("\"fold\"", "\"folding\"", 1);
+    std::fs::write(&bad, text).unwrap();
+    let o = run(
+        &[
+            "simulate",
+            &seed,
+            "--schedule",
+            bad.to_str().unwrap(),
+            "--out",
+            "bad",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("row 0") && stderr(&o).contains("folding"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!dir.path().join("bad").exists());
+    // one point of a range is refused, one point given as FROM:FROM:1 runs
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=1:10:1"],
+        &["--set-range", "COUNT 1", "1:1:1"],
+    );
+    let o = run(
+        &[
+            "sweep",
+            &seed,
+            "--set-range",
+            "fall.height=1:1:1",
+            "--methods",
+            "analytic",
+            "--out",
+            "one",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    // values outside the key's range are refused up front, like free.nodes=40:50:4
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=-1:10:4"],
+        &[
+            "--set-range",
+            "fall.height=-1:10:4",
+            "1 of 4 points",
+            "fall.height = -1",
+        ],
+    );
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=1:1e4:3"],
+        &["2 of 3 points", "fall.height", "30 s"],
+    );
+    // venv/ is ignored
+    let ignore = read(Path::new(env!("CARGO_MANIFEST_DIR")).join(".gitignore"));
+    assert!(
+        ignore
+            .lines()
+            .any(|l| l.trim() == "/venv/" || l.trim() == "venv/"),
+        "{ignore}"
+    );
+}

@@ -3,7 +3,7 @@
 
 mod util;
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::Duration;
 use util::{bin, run, schedule_peak, seed_toml, temp_dir};
@@ -22,18 +22,24 @@ impl Rng {
     }
 }
 
-/// Reads an `analyze` set through its link's target; `None` when there is
-/// no link yet, or the set was superseded (the link moved on) and removed
-/// while reading. Panics when a file of the set the link still points at is
-/// missing (the live set incomplete, or deleted), or the files come from
-/// different runs. Returns the set's `theta_deg`.
+/// Reads an `analyze` set as one folder: opened once, its files read
+/// through that handle (the folder's own, wherever a later writer moves its
+/// name; in the link scheme, the link's target). `None` when there is no set
+/// yet, or the set was superseded and removed while reading. Panics when a
+/// file of the set still published is missing (the live set incomplete, or
+/// deleted), or the files come from different runs. Returns the set's
+/// `theta_deg`.
 fn read_analyze_set(link: &Path) -> Option<f64> {
-    let target = std::fs::read_link(link).ok()?;
-    let dir = link.parent().unwrap().join(&target);
+    use std::os::unix::fs::MetadataExt;
+    use std::os::unix::io::AsRawFd;
+    let handle = std::fs::File::open(link).ok()?;
+    let ino = handle.metadata().ok()?.ino();
+    let dir = PathBuf::from(format!("/proc/self/fd/{}", handle.as_raw_fd()));
+    let superseded = || std::fs::metadata(link).map(|m| m.ino()).ok() != Some(ino);
     let read = |name: &str| match std::fs::read_to_string(dir.join(name)) {
         Ok(t) => Some(t),
-        Err(_) if std::fs::read_link(link).ok().as_ref() != Some(&target) => None,
-        Err(e) => panic!("{} (the link's target) lost {name}: {e}", dir.display()),
+        Err(_) if superseded() => None,
+        Err(e) => panic!("{} (the published set) lost {name}: {e}", link.display()),
     };
     let json = read("analyze.json")?;
     let csv = read("analytic.csv")?;
@@ -57,32 +63,55 @@ fn read_analyze_set(link: &Path) -> Option<f64> {
     Some(v["theta_deg"].as_f64().unwrap())
 }
 
-/// Entries of `<out>/seed` other than hidden ones and published links.
-fn visible_non_links(base: &Path) -> Vec<String> {
+/// Entries of `<out>/seed` other than hidden ones and published sets
+/// (folders with catflip's marker, or links of the fallback scheme).
+fn visible_non_sets(base: &Path) -> Vec<String> {
     let Ok(rd) = std::fs::read_dir(base) else {
         return vec![];
     };
     rd.filter_map(|e| {
         let e = e.ok()?;
         let name = e.file_name().into_string().ok()?;
-        let link = e.file_type().ok()?.is_symlink();
-        (!name.starts_with('.') && !link).then_some(name)
+        let set =
+            e.file_type().ok()?.is_symlink() || e.path().join(catflip::output::MARKER).is_file();
+        (!name.starts_with('.') && !set).then_some(name)
     })
     .collect()
 }
 
+/// The hidden folders a published set keeps: its link's target in the
+/// fallback scheme, none for a folder published by exchange.
+fn live_hidden(link: &Path) -> Vec<String> {
+    std::fs::read_link(link)
+        .map(|t| vec![t.to_string_lossy().into_owned()])
+        .unwrap_or_default()
+}
+
+/// `analyze` of the seed at another angle between the halves, from a config
+/// file of its own (the same name, so every angle publishes the same set;
+/// with `--set` each would have its own).
 fn analyze_cmd(dir: &Path, theta: f64) -> Command {
+    let text = std::fs::read_to_string(seed_toml())
+        .unwrap()
+        .replace("theta_deg = 45.0", &format!("theta_deg = {theta:?}"));
+    let cfg = dir.join(format!("seed-theta-{theta}.toml"));
+    std::fs::write(&cfg, text).unwrap();
     let mut c = bin();
-    c.args([
-        "analyze",
-        seed_toml().to_str().unwrap(),
-        "--set",
-        &format!("analytic.theta_deg={theta}"),
-    ])
-    .current_dir(dir)
-    .stdout(Stdio::null())
-    .stderr(Stdio::null());
+    c.args(["analyze", cfg.to_str().unwrap()])
+        .current_dir(dir)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null());
     c
+}
+
+/// The set a command writes with these arguments' `--set` overrides.
+fn set_of(base: &str, args: &[&str]) -> String {
+    let sets: Vec<String> = args
+        .windows(2)
+        .filter(|w| w[0] == "--set")
+        .map(|w| w[1].to_string())
+        .collect();
+    catflip::output::set_name(base, &sets)
 }
 
 #[test]
@@ -107,16 +136,15 @@ fn sigkill_at_random_moments_never_leaves_a_partial_set() {
             last_complete = got;
         }
         assert!(
-            visible_non_links(&base).is_empty(),
-            "only links and hidden staging folders: {:?}",
-            visible_non_links(&base)
+            visible_non_sets(&base).is_empty(),
+            "only published sets and hidden staging folders: {:?}",
+            visible_non_sets(&base)
         );
     }
     // a finished run publishes and removes every leftover of the killed ones
     let (code, _, err) = run(&["analyze", seed_toml().to_str().unwrap()], dir.path());
     assert_eq!(code, Some(0), "{err}");
     assert_eq!(read_analyze_set(&link), Some(45.0));
-    let target = std::fs::read_link(&link).unwrap();
     let hidden: Vec<String> = std::fs::read_dir(&base)
         .unwrap()
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
@@ -124,7 +152,7 @@ fn sigkill_at_random_moments_never_leaves_a_partial_set() {
         .collect();
     assert_eq!(
         hidden,
-        vec![target.to_str().unwrap().to_string()],
+        live_hidden(&link),
         "leftovers remain (last complete set before: {last_complete:?})"
     );
 }
@@ -158,13 +186,13 @@ fn concurrent_writers_publish_whole_sets_while_a_reader_watches() {
     }
     // after the first round a set is always published: the reader read some
     assert!(seen > 0, "the reader never saw a whole set");
-    // superseded sets are removed by the writers: one hidden folder per link
+    // superseded sets are removed by the writers: at most the link's target
     let hidden: Vec<String> = std::fs::read_dir(&base)
         .unwrap()
         .filter_map(|e| e.ok()?.file_name().into_string().ok())
         .filter(|n| n.starts_with('.'))
         .collect();
-    assert_eq!(hidden.len(), 1, "{hidden:?}");
+    assert_eq!(hidden, live_hidden(&link), "{hidden:?}");
 }
 
 #[test]
@@ -174,7 +202,7 @@ fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
     let c = c.to_str().unwrap();
     let (code, _, err) = run(&["run", c, "--set", "free.nodes=12"], dir.path());
     assert_eq!(code, Some(0), "{err}");
-    let run_dir = dir.path().join("output/seed/run");
+    let run_dir = dir.path().join("output/seed/run@free.nodes=12");
     let before: Vec<(String, String)> = ["phased.csv", "analytic.csv", "free.csv", "summary.json"]
         .iter()
         .map(|f| {
@@ -201,10 +229,14 @@ fn commands_write_separate_sets_so_a_run_report_keeps_describing_its_files() {
     }
     assert!(
         dir.path()
-            .join("output/seed/optimize-phased/phased.csv")
+            .join("output/seed/optimize-phased@analytic.theta_deg=60/phased.csv")
             .exists()
     );
-    assert!(dir.path().join("output/seed/analyze/analytic.csv").exists());
+    assert!(
+        dir.path()
+            .join("output/seed/analyze@analytic.theta_deg=60/analytic.csv")
+            .exists()
+    );
 }
 
 #[test]
@@ -291,7 +323,9 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(a["verdict"], "flagged");
     assert!(a["reason"].as_str().unwrap().contains("limits.max_torque"));
     assert_eq!(f["verdict"], "ok", "{f}");
-    let base = dir.path().join("output/seed/run");
+    let base = dir
+        .path()
+        .join("output/seed/run@limits.max_torque=0.5,fall.height=12");
     // the kept design meets the limit on every written row
     let (peak, _) = schedule_peak(
         &std::fs::read_to_string(base.join("free.csv")).unwrap(),
@@ -374,7 +408,8 @@ fn analytic_csv(dir: &Path, extra: &[&str]) -> String {
     args.extend(["--out", "sched-src"]);
     let (code, _, err) = run(&args, dir);
     assert_eq!(code, Some(0), "{err}");
-    std::fs::read_to_string(dir.join("sched-src/seed/analyze/analytic.csv")).unwrap()
+    let set = set_of("analyze", extra);
+    std::fs::read_to_string(dir.join(format!("sched-src/seed/{set}/analytic.csv"))).unwrap()
 }
 
 /// Rewrites every data row of a schedule CSV with `f`.
@@ -610,7 +645,8 @@ fn sweeps_bound_the_count_keep_good_points_and_check_threads() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--threads"), "{err}");
     assert!(!dir.path().join("output").exists());
-    // bad points are their own failures, the good ones are computed
+    // points outside the key's range are refused up front, naming the
+    // first, before any work; a range inside is computed
     let (code, out, err) = run(
         &[
             "sweep",
@@ -623,21 +659,34 @@ fn sweeps_bound_the_count_keep_good_points_and_check_threads() {
         ],
         dir.path(),
     );
-    assert_eq!(code, Some(3), "{err}");
+    assert_eq!(code, Some(2), "{err}");
+    assert!(out.is_empty(), "{out}");
+    assert!(
+        err.contains("--set-range cat.mass=-1:1:5")
+            && err.contains("3 of 5 points")
+            && err.contains("cat.mass = -1"),
+        "{err}"
+    );
+    assert!(!err.contains("`--set "), "{err}");
+    assert!(!dir.path().join("output").exists());
+    let (code, out, err) = run(
+        &[
+            "sweep",
+            c,
+            "--set-range",
+            "cat.mass=0.25:1.25:5",
+            "--methods",
+            "analytic",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{err}");
     let pts: Vec<serde_json::Value> = serde_json::from_str(&out).unwrap();
     assert_eq!(pts.len(), 5);
-    for p in &pts[..3] {
-        let e = p["error"].as_str().unwrap();
-        let v = p["value"].as_f64().unwrap();
-        assert!(
-            e.contains("--set-range cat.mass=-1:1:5") && e.contains(&format!("cat.mass = {v}")),
-            "{e}"
-        );
-        assert!(!e.contains("`--set "), "{e}");
-    }
     // the analytic peak is linear in the mass (same path, inertia scales)
     let p = |i: usize| pts[i]["analytic_peak_nm"].as_f64().unwrap();
-    assert!((p(4) - 2.0 * p(3)).abs() < 1e-9 * p(4), "{} {}", p(3), p(4));
+    assert!((p(3) - 2.0 * p(1)).abs() < 1e-9 * p(3), "{} {}", p(1), p(3));
     // every point invalid (an unknown key) is bad input
     let (code, _, err) = run(&["sweep", c, "--set-range", "cat.masss=1:2:3"], dir.path());
     assert_eq!(code, Some(2), "{err}");

@@ -191,7 +191,7 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
     assert!(ok, "{err}");
     let csv = std::fs::read_to_string(
         dir.path()
-            .join("output/seed/sweep-cat_mass/sweep-cat_mass.csv"),
+            .join("output/seed/sweep-cat_mass@limits.max_torque=0.5/sweep-cat_mass.csv"),
     )
     .unwrap();
     let rows: Vec<&str> = csv.lines().collect();
@@ -200,7 +200,9 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
     // with a torque limit, the least drop height of F7 is there
     assert!(
         dir.path()
-            .join("output/seed/sweep-cat_mass/sweep-cat_mass-least-height.svg")
+            .join(
+                "output/seed/sweep-cat_mass@limits.max_torque=0.5/sweep-cat_mass-least-height.svg"
+            )
             .exists()
     );
     let h: f64 = rows[2].split(',').nth(6).unwrap().parse().unwrap();
@@ -209,7 +211,7 @@ fn sweep_cli_writes_csv_and_plot_and_rejects_bad_ranges() {
     // 20 (the seed's schedule against the optimum) go on a log axis
     let svg = std::fs::read_to_string(
         dir.path()
-            .join("output/seed/sweep-cat_mass/sweep-cat_mass.svg"),
+            .join("output/seed/sweep-cat_mass@limits.max_torque=0.5/sweep-cat_mass.svg"),
     )
     .unwrap();
     assert!(svg.contains("cat.mass (kg)"));
@@ -249,7 +251,9 @@ fn run_shows_an_exceeded_limit_and_an_unconverged_optimiser() {
         ],
         dir.path(),
     );
-    let base = dir.path().join("output/seed/run");
+    let base = dir
+        .path()
+        .join("output/seed/run@limits.max_torque=5,free.max_iterations=3");
     let summary: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(base.join("summary.json"))
             .unwrap_or_else(|e| panic!("{e}: {err}")),

@@ -65,7 +65,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     assert!(ok, "{err}");
     let full = std::fs::read_to_string(
         dir.path()
-            .join("full/seed/sweep-cat_radius/sweep-cat_radius.csv"),
+            .join("full/seed/sweep-cat_radius@free.nodes=10,phased.nodes=12/sweep-cat_radius.csv"),
     )
     .unwrap();
     assert_eq!(full.lines().count(), 12);
@@ -79,7 +79,7 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
         // 11 points are two chunks of 10: the first of three shards is empty, and says so
         assert_eq!(err.contains("holds no points"), k == 1, "{k}: {err}");
         let part = std::fs::read_to_string(dir.path().join(format!(
-            "shards/seed/sweep-cat_radius.shard-{k}-of-3/sweep-cat_radius.shard-{k}-of-3.csv"
+            "shards/seed/sweep-cat_radius.shard-{k}-of-3@free.nodes=10,phased.nodes=12/sweep-cat_radius.shard-{k}-of-3.csv"
         )))
         .unwrap();
         let skip = if k == 1 { 0 } else { 1 };
@@ -121,8 +121,11 @@ fn phased_sweep_against_fresh_designs(key: &str, range: &str) -> Vec<(f64, f64, 
     let (ok, _, err) = run_written(&args, dir.path());
     assert!(ok, "{err}");
     let name = format!("sweep-{}", key.replace('.', "_"));
-    let csv =
-        std::fs::read_to_string(dir.path().join(format!("out/seed/{name}/{name}.csv"))).unwrap();
+    let csv = std::fs::read_to_string(
+        dir.path()
+            .join(format!("out/seed/{name}@phased.nodes=12/{name}.csv")),
+    )
+    .unwrap();
     let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
     let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
     let (peak, bend) = (col("phased_peak_nm"), col("phased_bend_deg"));

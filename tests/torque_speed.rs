@@ -78,7 +78,9 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
-    let base = dir.path().join("robot-universal/run");
+    let base = dir
+        .path()
+        .join("robot-universal/run@fall.height=6,free.nodes=20");
     let svg = std::fs::read_to_string(base.join("torque_speed.svg")).unwrap();
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     assert!(html.contains("<img src=\"torque_speed.svg\""));

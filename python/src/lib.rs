@@ -38,6 +38,12 @@ create_exception!(
 );
 create_exception!(
     catflip,
+    UnitSlipWarning,
+    pyo3::exceptions::PyUserWarning,
+    "A config value that is valid but likely a unit slip (the CLI's `warning:` lines)."
+);
+create_exception!(
+    catflip,
     ImpossibleError,
     DesignError,
     "The motors cannot flip the cat from this height; the message gives the least height."
@@ -111,9 +117,19 @@ struct Config {
     inner: Mutex<Snapshot>,
 }
 
+/// The config's likely unit slips, as Python warnings (the CLI's `warning: ...` lines).
+fn warn_slips(py: Python<'_>, cfg: &Cfg) -> PyResult<()> {
+    for slip in cfg.slips() {
+        let text = std::ffi::CString::new(slip.to_string()).unwrap_or_default();
+        PyErr::warn(py, &py.get_type::<UnitSlipWarning>(), &text, 1)?;
+    }
+    Ok(())
+}
+
 impl Config {
-    fn from_source(source: Source) -> PyResult<Config> {
+    fn from_source(py: Python<'_>, source: Source) -> PyResult<Config> {
         let cfg = source.load(None).map_err(err)?;
+        warn_slips(py, &cfg)?;
         Ok(Config {
             inner: Mutex::new(Snapshot { source, cfg }),
         })
@@ -151,7 +167,17 @@ fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
     }
     if v.is_instance_of::<PyString>() {
         let s: String = v.extract()?;
-        return Ok(serde_json::to_string(&s).expect("a string serialises"));
+        // as the user would type it after `--set KEY=` when the CLI reads it as
+        // that string (so the messages are the CLI's), else quoted
+        let plain = toml::from_str::<toml::Table>(&format!("v = {s}")).is_err()
+            && s.trim() == s
+            && !s.is_empty()
+            && !s.contains(['\n', '\r']);
+        return Ok(if plain {
+            s
+        } else {
+            serde_json::to_string(&s).expect("a string serialises")
+        });
     }
     if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
         let items: PyResult<Vec<String>> = v.try_iter()?.map(|x| toml_text(&x?)).collect();
@@ -165,31 +191,43 @@ fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
 
 #[pymethods]
 impl Config {
-    /// Reads and checks a TOML config file (as `catflip CMD FILE`); raises ConfigError.
+    /// Reads and checks a TOML config file with the CLI's `--set KEY=VALUE` `overrides`
+    /// (as `catflip CMD FILE --set ...`); raises ConfigError.
     #[staticmethod]
-    fn from_toml(path: PathBuf) -> PyResult<Config> {
+    #[pyo3(signature = (path, overrides = None))]
+    fn from_toml(
+        py: Python<'_>,
+        path: PathBuf,
+        overrides: Option<Vec<String>>,
+    ) -> PyResult<Config> {
         let text = std::fs::read_to_string(&path).map_err(|e| {
             err(catflip::Error::ConfigRead {
                 path: path.clone(),
                 message: e.to_string(),
             })
         })?;
-        Config::from_source(Source {
-            text,
-            origin: path.display().to_string(),
-            overrides: Vec::new(),
-        })
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: path.display().to_string(),
+                overrides: overrides.unwrap_or_default(),
+            },
+        )
     }
 
     /// Checks a config given as TOML text; `origin` names it in messages.
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
-    fn from_text(text: String, origin: &str) -> PyResult<Config> {
-        Config::from_source(Source {
-            text,
-            origin: origin.into(),
-            overrides: Vec::new(),
-        })
+    fn from_text(py: Python<'_>, text: String, origin: &str) -> PyResult<Config> {
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: origin.into(),
+                overrides: Vec::new(),
+            },
+        )
     }
 
     /// Checks a config given as a dict of the TOML's tables (`{"name": ..., "cat": {...}, "fall": {...}}`).
@@ -204,22 +242,40 @@ impl Config {
             ))
         })?;
         let text = toml::to_string(&table).map_err(|e| ConfigError::new_err(e.to_string()))?;
-        Config::from_source(Source {
-            text,
-            origin: "dict".into(),
-            overrides: Vec::new(),
-        })
+        Config::from_source(
+            py,
+            Source {
+                text,
+                origin: "dict".into(),
+                overrides: Vec::new(),
+            },
+        )
     }
 
     /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;
     /// on a ConfigError the config is left as it was.
-    fn set(&self, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
+    fn set(&self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
         let arg = format!("{key}={}", toml_text(value)?);
-        let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        let cfg = s.source.load(Some(&arg)).map_err(err)?;
-        s.source.overrides.push(arg);
-        s.cfg = cfg;
-        Ok(())
+        let cfg = {
+            let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
+            let cfg = s.source.load(Some(&arg)).map_err(err)?;
+            s.source.overrides.push(arg);
+            s.cfg = cfg.clone();
+            cfg
+        };
+        // outside the lock: a warnings filter may run Python code
+        warn_slips(py, &cfg)
+    }
+
+    /// The config's likely unit slips (the CLI's warnings), in words.
+    #[getter]
+    fn slips(&self) -> Vec<String> {
+        self.snapshot()
+            .1
+            .slips()
+            .iter()
+            .map(ToString::to_string)
+            .collect()
     }
 
     /// An independent copy (later `set`s on either leave the other alone).
@@ -249,7 +305,7 @@ impl Config {
         self.snapshot().1.name
     }
 
-    /// The `KEY=VALUE` overrides applied so far by `set`, in order.
+    /// The `KEY=VALUE` overrides applied so far (`from_toml`'s, then each `set`), in order.
     #[getter]
     fn overrides(&self) -> Vec<String> {
         self.snapshot().0.overrides
@@ -278,19 +334,27 @@ impl Config {
 
 // --- Design -----------------------------------------------------------------
 
-/// Why a design misses its targets: its solver status and the flip
-/// (mirrors the CLI's `design_flags`).
-fn design_flags(cfg: &Cfg, status: &str, flip_error_rad: f64, tilt_deg: f64) -> Option<String> {
-    let mut why: Vec<String> = Vec::new();
-    if !matches!(status, "solved" | "converged") {
-        why.push(format!("solver status {status}"));
-    }
-    why.extend(catflip::verify::simulate::misses_flip(
-        flip_error_rad,
-        tilt_deg,
-        cfg.simulate.flip_tolerance,
-    ));
-    (!why.is_empty()).then(|| why.join("; "))
+/// The verdict on a design, as the CLI's `optimize` and `analyze` give it
+/// (`catflip::run::judge`): solver status, the flip, the limits.
+fn judged(
+    cfg: &Cfg,
+    status: catflip::verdict::Status,
+    (peak, bend): (f64, f64),
+    schedule: &Schedule,
+    (flip_error_rad, tilt_deg): (f64, f64),
+) -> Option<String> {
+    catflip::run::judge(
+        cfg,
+        status,
+        peak,
+        bend,
+        schedule,
+        &catflip::verdict::Simulated::Flip {
+            flip_error_rad,
+            tilt_deg,
+        },
+    )
+    .reason()
 }
 
 fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_json::Value {
@@ -301,13 +365,23 @@ fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_j
     json
 }
 
+/// The fields an optimiser's JSON must have finite, as the CLI's `write_design`.
+const FINITE: [&str; 6] = [
+    "peak_torque_nm",
+    "bend_deg",
+    "flip_deg",
+    "tilt_deg",
+    "sim_peak_torque_nm",
+    "phase_durations_s",
+];
+
 type Plan = Box<dyn ShapePlan + Send + Sync>;
 
+#[pyclass(frozen, module = "catflip")]
 /// A designed schedule: what `catflip optimize --mode free|phased` (or `analyze`) writes.
 ///
 /// Immutable; the arrays are fresh copies on each access. N rows: 3 phases
 /// of `simulate.samples_per_phase + 1` samples (a phase junction appears twice).
-#[pyclass(frozen, module = "catflip")]
 struct Design {
     method: &'static str,
     source: Source,
@@ -322,95 +396,121 @@ struct Design {
     durations: [f64; 3],
 }
 
+/// The library's design for `method`, judged and sampled as the CLI does.
 fn run_design(
-    cfg: &Cfg,
-    method: &str,
+    cfg: Cfg,
+    source: Source,
+    method: &'static str,
     seed: Option<&str>,
-) -> PyResult<(
-    Plan,
-    serde_json::Value,
-    String,
-    Option<String>,
-    f64,
-    [f64; 3],
-)> {
+) -> PyResult<Design> {
+    use catflip::verdict::Status;
     let no_seed = |what: &str| {
         ConfigError::new_err(format!(
             "seed applies to method=\"free\" ({what} has no seed); leave seed out or use method=\"free\""
         ))
     };
-    match method {
-        "free" => {
-            let seed = match seed.unwrap_or("phased") {
-                "phased" => catflip::design::free::Seed::Phased,
-                "analytic" => catflip::design::free::Seed::Analytic,
-                other => {
-                    return Err(ConfigError::new_err(format!(
-                        "unknown seed `{other}`; use \"phased\" or \"analytic\""
-                    )));
+    let sample =
+        |plan: &dyn ShapePlan| Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+    let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
+        match method {
+            "free" => {
+                let seed = match seed.unwrap_or("phased") {
+                    "phased" => catflip::design::free::Seed::Phased,
+                    "analytic" => catflip::design::free::Seed::Analytic,
+                    other => {
+                        return Err(ConfigError::new_err(format!(
+                            "unknown seed `{other}`; use \"phased\" or \"analytic\""
+                        )));
+                    }
+                };
+                let r = catflip::design::free::optimize(&cfg, seed, |_| {}).map_err(err)?;
+                let sched = sample(&r.plan);
+                let status = Status::from(r.status);
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (r.peak_torque_nm, r.bend_deg),
+                    &sched,
+                    (r.flip_error_rad, r.tilt_deg),
+                );
+                let json = serde_json::to_value(&r).expect("serialises");
+                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
+                (
+                    Box::new(r.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    r.peak_torque_nm,
+                    r.phase_durations_s,
+                )
+            }
+            "phased" => {
+                if seed.is_some() {
+                    return Err(no_seed("the phased design"));
                 }
-            };
-            let r = catflip::design::free::optimize(cfg, seed, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok((
-                Box::new(r.plan),
-                json,
-                status,
-                reason,
-                r.peak_torque_nm,
-                r.phase_durations_s,
-            ))
-        }
-        "phased" => {
-            if seed.is_some() {
-                return Err(no_seed("the phased design"));
+                let r = catflip::design::phased::optimize(&cfg, |_| {}).map_err(err)?;
+                let sched = sample(&r.plan);
+                let status = Status::from(r.status);
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (r.peak_torque_nm, r.bend_deg),
+                    &sched,
+                    (r.flip_error_rad, r.tilt_deg),
+                );
+                let json = serde_json::to_value(&r).expect("serialises");
+                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
+                (
+                    Box::new(r.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    r.peak_torque_nm,
+                    r.phase_durations_s,
+                )
             }
-            let r = catflip::design::phased::optimize(cfg, |_| {}).map_err(err)?;
-            let status = catflip::run::json_name(&r.status);
-            let reason = design_flags(cfg, &status, r.flip_error_rad, r.tilt_deg);
-            let json = with_verdict(serde_json::to_value(&r).expect("serialises"), &reason);
-            Ok((
-                Box::new(r.plan),
-                json,
-                status,
-                reason,
-                r.peak_torque_nm,
-                r.phase_durations_s,
-            ))
-        }
-        "analytic" => {
-            if seed.is_some() {
-                return Err(no_seed("the analytic schedule"));
+            _ => {
+                if seed.is_some() {
+                    return Err(no_seed("the analytic schedule"));
+                }
+                // the CLI's `analyze`: a miss is flagged in the analysis
+                let a = catflip::verify::analyze::analyze(&cfg).map_err(err)?;
+                let sched = catflip::verify::analyze::analytic_schedule(&cfg, &a.plan);
+                let status = Status::ClosedForm;
+                let reason = judged(
+                    &cfg,
+                    status,
+                    (a.peak_torque_nm, a.closed.bend_deg),
+                    &sched,
+                    (a.flip_error_rad, a.tilt_deg),
+                );
+                let json = serde_json::to_value(&a).expect("serialises");
+                catflip::output::ensure_finite(&json, &[]).map_err(err)?;
+                (
+                    Box::new(a.plan),
+                    sched,
+                    json,
+                    status,
+                    reason,
+                    a.peak_torque_nm,
+                    a.closed.phase_durations_s,
+                )
             }
-            // mirrors the CLI's `analyze`: a miss is flagged in the analysis
-            let a = catflip::verify::analyze::analyze(cfg).map_err(err)?;
-            let sched = catflip::verify::analyze::analytic_schedule(cfg, &a.plan);
-            let usage = cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)));
-            let why = catflip::run::schedule_flags(
-                cfg,
-                (a.flip_error_rad, a.tilt_deg),
-                a.peak_torque_nm,
-                a.closed.bend_deg,
-                Some(usage.max_speed_rad_s),
-                usage.min_margin,
-            );
-            let reason = (!why.is_empty()).then(|| why.join("; "));
-            let json = with_verdict(serde_json::to_value(&a).expect("serialises"), &reason);
-            Ok((
-                Box::new(a.plan),
-                json,
-                "closed-form".into(),
-                reason,
-                a.peak_torque_nm,
-                a.closed.phase_durations_s,
-            ))
-        }
-        other => Err(ConfigError::new_err(format!(
-            "unknown method `{other}`; use \"free\", \"phased\" or \"analytic\""
-        ))),
-    }
+        };
+    Ok(Design {
+        method,
+        source,
+        cfg,
+        plan,
+        schedule,
+        json: with_verdict(json, &reason),
+        status: status.name().into(),
+        reason,
+        peak,
+        durations,
+    })
 }
 
 /// Designs a torque schedule, as the CLI's `optimize --mode METHOD [--seed SEED]`
@@ -449,23 +549,7 @@ fn design(
         }
     };
     let seed = seed.map(String::from);
-    py.detach(move || {
-        let (plan, json, status, reason, peak, durations) =
-            run_design(&cfg, method, seed.as_deref())?;
-        let schedule = Schedule::sample(&cfg.cat(), plan.as_ref(), cfg.simulate.samples_per_phase);
-        Ok(Design {
-            method,
-            source,
-            cfg,
-            plan,
-            schedule,
-            json,
-            status,
-            reason,
-            peak,
-            durations,
-        })
-    })
+    py.detach(move || run_design(cfg, source, method, seed.as_deref()))
 }
 
 #[pymethods]
@@ -480,6 +564,7 @@ impl Design {
     fn status(&self) -> &str {
         &self.status
     }
+    /// `flagged` when the design misses a target (solver status, flip or tilt, a limit), else `ok`.
     #[getter]
     fn verdict(&self) -> &'static str {
         if self.reason.is_some() {
@@ -488,6 +573,7 @@ impl Design {
             "ok"
         }
     }
+    /// Why it is flagged, in the CLI's words; None when ok.
     #[getter]
     fn reason(&self) -> Option<String> {
         self.reason.clone()
@@ -685,11 +771,18 @@ fn simulate(
             }
         };
         let report = report.map_err(err)?;
-        let reason = catflip::verify::simulate::misses_flip(
+        // as the CLI's `simulate`
+        catflip::output::ensure_finite(&serde_json::to_value(&report).expect("serialises"), &[])
+            .map_err(err)?;
+        let why: Vec<String> = catflip::verdict::flip_misses(
             report.flip_error_rad,
             report.tilt_deg,
             cfg.simulate.flip_tolerance,
-        );
+        )
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+        let reason = (!why.is_empty()).then(|| why.join("; "));
         Ok(Simulation {
             report,
             source,
@@ -730,6 +823,7 @@ impl Simulation {
     fn peak_torque_nm(&self) -> f64 {
         self.report.peak_torque_nm
     }
+    /// `flagged` when the flip or tilt misses `simulate.flip_tolerance`, else `ok`.
     #[getter]
     fn verdict(&self) -> &'static str {
         if self.reason.is_some() {
@@ -738,10 +832,12 @@ impl Simulation {
             "ok"
         }
     }
+    /// Why it is flagged; None when ok.
     #[getter]
     fn reason(&self) -> Option<String> {
         self.reason.clone()
     }
+    /// Step times, s: float64, shape (M,).
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.report.trace.iter().map(|p| p.t).collect())
@@ -756,6 +852,7 @@ impl Simulation {
     fn tilt<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.report.trace.iter().map(|p| p.tilt).collect())
     }
+    /// Joint angles, rad: float64, shape (M, 2).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -763,6 +860,7 @@ impl Simulation {
             &self.report.trace.iter().map(|p| p.q).collect::<Vec<_>>(),
         )
     }
+    /// Applied joint torques, N m: float64, shape (M, 2).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -860,12 +958,14 @@ impl LeastHeight {
     /// That design's solver status.
     #[getter]
     fn status(&self) -> String {
-        self.answer.status.clone()
+        self.answer.status.name().into()
     }
+    /// Times of the least-height schedule, s: float64, shape (N,).
     #[getter]
     fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
         vector(py, self.answer.schedule.rows.iter().map(|r| r.t).collect())
     }
+    /// Its joint angles, rad: float64, shape (N, 2).
     #[getter]
     fn q<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -879,6 +979,7 @@ impl LeastHeight {
                 .collect::<Vec<_>>(),
         )
     }
+    /// Its joint torques, N m: float64, shape (N, 2).
     #[getter]
     fn tau<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(
@@ -1011,7 +1112,7 @@ fn sweep_columns<'py>(
         "free_status",
         points
             .iter()
-            .map(|p| p.free_status.clone())
+            .map(|p| p.free_status.map(|s| s.name()))
             .collect::<Vec<_>>(),
     )?;
     d.set_item(
@@ -1193,7 +1294,11 @@ impl Controls {
     /// Peak norm: `euclidean` or `per-motor`.
     #[getter]
     fn norm(&self) -> String {
-        catflip::run::json_name(&self.cfg.norm())
+        match self.cfg.norm() {
+            catflip::model::TorqueNorm::Euclidean => "euclidean",
+            catflip::model::TorqueNorm::PerMotor => "per-motor",
+        }
+        .into()
     }
     /// Step start times, s: float64, shape (n + 1,).
     #[getter]
@@ -1262,6 +1367,7 @@ fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("DesignError", py.get_type::<DesignError>())?;
     m.add("ImpossibleError", py.get_type::<ImpossibleError>())?;
+    m.add("UnitSlipWarning", py.get_type::<UnitSlipWarning>())?;
     m.add_class::<Config>()?;
     m.add_class::<Design>()?;
     m.add_class::<Simulation>()?;

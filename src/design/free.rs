@@ -35,8 +35,8 @@ use crate::design::conic::{Cone, ConicData, ConicSettings};
 use crate::design::objective::Objective;
 use crate::design::plan::ShapePlan;
 use crate::design::scp::{
-    Certificate, Cost, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus, Triplets,
-    Values, WarmStart, solve_warm,
+    Certificate, Cost, Executor, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus,
+    Triplets, Values, WarmStart,
 };
 use crate::error::Result;
 use crate::model::dynamics::{christoffel, linearize_torque, torque_from};
@@ -997,49 +997,16 @@ impl Seed {
     }
 }
 
-/// What a free-form design reports as it runs (an argmin-style observer):
-/// each SCP iteration and, with mesh continuation, the start of each mesh.
-/// Any `FnMut(&ScpIteration)` is an observer that ignores the meshes.
-pub trait Observer {
-    fn iteration(&mut self, it: &ScpIteration);
-    /// The SCP begins on a mesh of `nodes` per phase (mesh continuation
-    /// only: each coarse mesh, then the finest; again if the finest starts
-    /// over from the seed, numbered on from the coarse meshes: the failed
-    /// attempt is not on the record).
-    fn mesh(&mut self, _nodes: usize) {}
-}
-
-impl<F: FnMut(&ScpIteration)> Observer for F {
-    fn iteration(&mut self, it: &ScpIteration) {
-        self(it)
-    }
-}
-
-/// Numbers the iterations on across meshes and re-solves, each shown once.
-struct Numbered<'a> {
-    inner: &'a mut dyn Observer,
-    shown: usize,
-}
-
-impl Observer for Numbered<'_> {
-    fn iteration(&mut self, it: &ScpIteration) {
-        self.inner.iteration(&ScpIteration {
-            iteration: self.shown,
-            ..*it
-        });
-        self.shown += 1;
-    }
-    fn mesh(&mut self, nodes: usize) {
-        self.inner.mesh(nodes)
-    }
-}
+/// What a free-form design reports as it runs: the SCP's observer (each
+/// iteration and, with mesh continuation, the start of each mesh).
+pub use crate::design::scp::Observer;
 
 /// Runs the SCP from a seed plan at `nodes` per phase; a peak-torque design
 /// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`).
 /// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
-/// order (`mesh_levels`), and the observer sees them numbered on. A fine
-/// design the coarse one cannot start is solved from the seed.
-/// The observer is also told where each mesh begins.
+/// order (`mesh_levels`), numbered on by the SCP's [`Executor`] as the
+/// observer sees them. A fine design the coarse one cannot start is solved
+/// from the seed. The observer is also told where each mesh begins.
 fn from_plan(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
@@ -1048,34 +1015,33 @@ fn from_plan(
     observe: &mut dyn Observer,
 ) -> Result<FreeResult> {
     let clock = std::time::Instant::now();
-    let mut show = Numbered {
-        inner: observe,
-        shown: 0,
-    };
     let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
     let z0 = if cfg.free.mesh_continuation && !cfg.uses_envelope() {
-        coarse_start(cfg, seed_plan, nodes, &mut show, &mut levels)
+        coarse_start(cfg, seed_plan, nodes, observe, &mut levels)
     } else {
         seed_start()
     };
     if !levels.is_empty() {
-        show.mesh(nodes);
+        observe.mesh(nodes);
     }
     let mut before = clock.elapsed().as_secs_f64();
     // whether the fine mesh starts from a coarse design (not the seed)
     let from_coarse = levels.last().is_some_and(|l: &Coarse| l.0.converged);
-    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, |it| show.iteration(it)) {
+    // the fine mesh's iterations are numbered on from the coarse meshes'
+    let first = recorded(&levels);
+    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, first, |it| {
+        observe.iteration(it)
+    }) {
         // a fine design the coarse one could not start: from the seed (the
         // coarse meshes stay on the record); not an impossible flip, which
         // the seed would only find again
         Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
             before = clock.elapsed().as_secs_f64();
             // the failed attempt is not on the record: its numbers are reused
-            show.shown = levels.iter().map(|l| l.1.len()).sum();
-            show.mesh(nodes);
-            optimize_start(cfg, &seed_start(), None, seed, nodes, |it| {
-                show.iteration(it)
+            observe.mesh(nodes);
+            optimize_start(cfg, &seed_start(), None, seed, nodes, first, |it| {
+                observe.iteration(it)
             })?
         }
         r => r?,
@@ -1087,9 +1053,6 @@ fn from_plan(
         r.mesh_levels = meshes;
         let mut iterations: Vec<ScpIteration> = levels.into_iter().flat_map(|l| l.1).collect();
         iterations.append(&mut r.iterations);
-        for (i, it) in iterations.iter_mut().enumerate() {
-            it.iteration = i;
-        }
         r.iterations = iterations;
         r.scp_iterations = r.iterations.len();
     }
@@ -1190,6 +1153,12 @@ pub fn iterations_text(levels: &[MeshLevel]) -> String {
 /// A coarse mesh's summary and its iterations.
 type Coarse = (MeshLevel, Vec<ScpIteration>);
 
+/// The iterations recorded on the coarse meshes so far: the next mesh's
+/// are numbered on from there.
+fn recorded(levels: &[Coarse]) -> usize {
+    levels.iter().map(|l| l.1.len()).sum()
+}
+
 /// Mesh continuation: the start at `nodes` per phase, the design on the
 /// mesh below ([`coarser`], itself started the same way) solved to
 /// [`COARSE_TOLERANCE`] and sampled on the finer mesh; for the peak-torque objective without a torque-speed line
@@ -1223,7 +1192,8 @@ fn coarse_start(
     let z0 = coarse_start(cfg, seed_plan, coarse, observe, levels);
     let mut its = Vec::new();
     observe.mesh(coarse);
-    let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, |it| {
+    let first = recorded(levels);
+    let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, first, |it| {
         observe.iteration(it);
         its.push(*it);
     });
@@ -1283,6 +1253,7 @@ fn design(
     warm: Option<&WarmStart>,
     nodes: usize,
     mesh: Mesh,
+    first: usize,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Solved> {
     check_resolvable(cfg, nodes)?;
@@ -1331,9 +1302,12 @@ fn design(
     };
     let unit = problem.objective_unit();
     let warm = warm.filter(|w| problem.multipliers_fit(&w.multipliers));
-    let mut res = solve_warm(&problem, z0, warm, &settings, |it| {
-        observe(&it.in_units(unit))
-    })?;
+    let mut res = Executor::new(&settings)
+        .warm(warm)
+        .numbered_from(first)
+        .run(&problem, z0, &mut |it: &ScpIteration| {
+            observe(&it.in_units(unit))
+        })?;
     for it in res.iterations.iter_mut() {
         *it = it.in_units(unit);
     }
@@ -1367,6 +1341,7 @@ fn inside_envelope(
     cfg: &Config,
     mut solved: Solved,
     nodes: usize,
+    first: usize,
     observe: &mut dyn FnMut(&ScpIteration),
 ) -> Result<Solved> {
     let motor = cfg.motor();
@@ -1409,17 +1384,10 @@ fn inside_envelope(
                 Some(&solved.res.warm),
                 nodes,
                 Mesh::Final,
-                |it: &ScpIteration| {
-                    observe(&ScpIteration {
-                        iteration: it.iteration + n0,
-                        ..*it
-                    })
-                },
+                first + n0,
+                |it: &ScpIteration| observe(it),
             )?;
-            iterations.extend(again.res.iterations.iter().map(|it| ScpIteration {
-                iteration: it.iteration + n0,
-                ..*it
-            }));
+            iterations.extend_from_slice(&again.res.iterations);
             solved = again;
             solved.res.iterations = iterations;
         }
@@ -1436,14 +1404,15 @@ fn optimize_start(
     warm: Option<&WarmStart>,
     seed: &str,
     nodes: usize,
+    first: usize,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let start = std::time::Instant::now();
-    let solved = design(cfg, z0, warm, nodes, Mesh::Final, &mut observe)?;
+    let solved = design(cfg, z0, warm, nodes, Mesh::Final, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(cfg, solved.node_peak));
     }
-    let solved = inside_envelope(cfg, solved, nodes, &mut observe)?;
+    let solved = inside_envelope(cfg, solved, nodes, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(cfg, solved.node_peak));
     }
@@ -1573,6 +1542,7 @@ fn continue_from(
             Some(&prev.warm),
             "continuation",
             nodes,
+            0,
             &mut observe,
         ) {
             return Ok(r);
@@ -1591,7 +1561,15 @@ fn continue_from(
     for p in 0..3 {
         z0[tr.duration(p)] *= cfg.available_time();
     }
-    optimize_start(cfg, &z0, Some(&prev.warm), "continuation", nodes, observe)
+    optimize_start(
+        cfg,
+        &z0,
+        Some(&prev.warm),
+        "continuation",
+        nodes,
+        0,
+        observe,
+    )
 }
 
 /// Turns of the bend direction the mesh resolves: sixteen nodes per turn.
@@ -1673,7 +1651,7 @@ pub struct MeshCheck {
 pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = Transcription::new(3, nodes).sample(&r.plan);
-    let fine = design(cfg, &z0, None, nodes, Mesh::Final, |_| {})?;
+    let fine = design(cfg, &z0, None, nodes, Mesh::Final, 0, |_| {})?;
     let (peak, value) = dense_objective(cfg, &fine.plan);
     Ok(MeshCheck {
         nodes,

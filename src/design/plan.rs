@@ -176,10 +176,7 @@ impl Schedule {
             .next()
             .ok_or_else(|| bad(1, "empty file; expected a header line".into()))?;
         if header.trim_start().starts_with(['{', '[']) {
-            return Err(bad(
-                1,
-                "this is JSON; a schedule is the CSV catflip writes beside it (e.g. `free.csv` for `free.schedule.json`)".into(),
-            ));
+            return Self::from_json(text, origin);
         }
         let cols: Vec<&str> = header.split(',').map(str::trim).collect();
         let want = [
@@ -280,6 +277,72 @@ impl Schedule {
             }
         }
         Ok(sched)
+    }
+
+    /// Parses a schedule JSON written by [`Schedule::to_json`] (the same rows
+    /// as the CSV, `qdd_rad_s2` optional), checked as the CSV is. JSON is one
+    /// line: an error names the row.
+    pub fn from_json(text: &str, origin: &str) -> Result<Schedule> {
+        #[derive(serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct JsonSchedule {
+            rows: Vec<JsonRow>,
+        }
+        #[derive(serde::Deserialize)]
+        struct JsonRow {
+            t_s: f64,
+            phase: String,
+            q_rad: [f64; 2],
+            qd_rad_s: [f64; 2],
+            qdd_rad_s2: Option<[f64; 2]>,
+            tau_nm: [f64; 2],
+        }
+        const HINT: &str = "(read as a schedule JSON; the CSV catflip writes beside it, e.g. `free.csv` for `free.schedule.json`, holds the same rows)";
+        let js: JsonSchedule = serde_json::from_str(text).map_err(|e| Error::Schedule {
+            file: origin.to_string(),
+            line: e.line(),
+            message: format!("{e} {HINT}"),
+        })?;
+        // written as the CSV and read by its one checker
+        let qdd = js.rows.iter().all(|r| r.qdd_rad_s2.is_some());
+        let mut csv = String::from(if qdd {
+            CSV_HEADER
+        } else {
+            "t_s,phase,q1_rad,q2_rad,qd1_rad_s,qd2_rad_s,tau1_nm,tau2_nm"
+        });
+        csv.push('\n');
+        for r in &js.rows {
+            let mut cells = vec![
+                r.t_s.to_string(),
+                r.phase.replace([',', '\n'], " "),
+                r.q_rad[0].to_string(),
+                r.q_rad[1].to_string(),
+                r.qd_rad_s[0].to_string(),
+                r.qd_rad_s[1].to_string(),
+            ];
+            if let (true, Some(a)) = (qdd, r.qdd_rad_s2) {
+                cells.extend([a[0].to_string(), a[1].to_string()]);
+            }
+            cells.extend([r.tau_nm[0].to_string(), r.tau_nm[1].to_string()]);
+            csv.push_str(&cells.join(","));
+            csv.push('\n');
+        }
+        Self::from_csv(&csv, origin).map_err(|e| match e {
+            Error::Schedule {
+                file,
+                line,
+                message,
+            } => Error::Schedule {
+                file,
+                line: 1,
+                message: if line > 1 {
+                    format!("row {} of `rows`: {message} {HINT}", line - 2)
+                } else {
+                    format!("{message} {HINT}")
+                },
+            },
+            e => e,
+        })
     }
 
     /// Rows of one phase (phases are stored in order).

@@ -1926,8 +1926,10 @@ impl<'a> Executor<'a> {
     }
 
     /// Solves `p` from `z0`, reporting each recorded iteration to
-    /// `observer`; every iteration counts towards the limit (failed
-    /// subproblems, unrecorded, keep their numbers).
+    /// `observer`. Every iteration counts towards the limit; the records are
+    /// numbered on from `first` (a failed subproblem, unrecorded, takes no
+    /// number), so that a design's records over several solves are
+    /// numbered as they were shown.
     pub fn run(
         &self,
         p: &dyn ScpProblem,
@@ -1940,8 +1942,8 @@ impl<'a> Executor<'a> {
         let mut state = scp.init(z0, self.warm);
         let mut iterations = Vec::new();
         let mut termination = Termination::IterationLimit;
-        for k in 0..self.settings.max_iterations {
-            let rec = match scp.next_iter(&mut state, self.first + k)? {
+        for _ in 0..self.settings.max_iterations {
+            let rec = match scp.next_iter(&mut state, self.first + iterations.len())? {
                 Step::Failed => continue,
                 Step::Watchdog(rec) => {
                     observer.iteration(&rec);

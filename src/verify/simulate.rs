@@ -558,6 +558,16 @@ pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule>
         });
     }
     let s = Schedule::from_csv(text, origin)?;
+    if s.rows.len() > MAX_SCHEDULE_ROWS {
+        return Err(Error::Schedule {
+            file: origin.into(),
+            line: 1,
+            message: format!(
+                "{} rows, more than the {MAX_SCHEDULE_ROWS} a schedule may have; resample it more coarsely",
+                s.rows.len()
+            ),
+        });
+    }
     let b = s.phase_bounds();
     let (start, end) = (b[0], b[3]);
     let want = cfg.available_time();

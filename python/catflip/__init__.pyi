@@ -1,0 +1,355 @@
+"""Type stubs of catflip (the Python bindings of the catflip Rust library).
+
+Shapes: N schedule rows (3 phases of ``simulate.samples_per_phase + 1``
+samples; a phase junction appears twice), M simulation steps, n simulator
+steps. Every array is a fresh float64 (``phase``: int64) numpy array.
+"""
+
+import os
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
+
+import numpy as np
+import numpy.typing as npt
+
+F64 = npt.NDArray[np.float64]
+Method = Literal["free", "phased", "analytic"]
+Objective = Literal["peak-torque", "time", "energy"]
+Seed = Literal["phased", "analytic"]
+SimulatorName = Literal["mujoco", "pybullet"]
+Value = Union[bool, int, float, str, Sequence[Any]]
+
+SWEEP_METHODS: Tuple[str, str, str]
+
+class CatflipError(Exception):
+    """Base of catflip's errors."""
+
+class ConfigError(CatflipError):
+    """Bad input: config, key, value or file (the CLI's exit status 2). The message is the CLI's."""
+
+class DesignError(CatflipError):
+    """A computation failed: solver, simulation (the CLI's exit status 1). The message is the CLI's."""
+
+class ImpossibleError(DesignError):
+    """The motors cannot flip the cat from ``fall.height``; the message gives the least drop
+    height (``catflip optimize`` stops with it, exit 1; ``catflip run`` reports it, exit 4)."""
+
+class UnitSlipWarning(UserWarning):
+    """A config value that is valid but likely a unit slip (the CLI's ``warning:`` lines),
+    warned when a config is read or set."""
+
+class Config:
+    """A checked catflip configuration: the CLI's TOML keys, defaults and checks.
+
+    Safe to share between threads: ``set`` takes a lock, and every computation
+    works on a copy taken when it starts."""
+
+    @staticmethod
+    def from_toml(path: Union[str, os.PathLike[str]], overrides: Optional[Sequence[str]] = None) -> Config:
+        """Reads and checks a TOML config file with the CLI's ``--set KEY=VALUE`` ``overrides``
+        (as ``catflip CMD FILE --set ...``); raises ConfigError."""
+    @staticmethod
+    def from_text(text: str, origin: str = "<string>") -> Config:
+        """Checks a config given as TOML text; ``origin`` names it in messages."""
+    @staticmethod
+    def from_dict(d: Dict[str, Any]) -> Config:
+        """Checks a config given as a dict of the TOML's tables
+        (``{"name": ..., "cat": {...}, "fall": {...}}``); None values are refused."""
+    def set(self, key: str, value: Value) -> None:
+        """Sets one key, e.g. ``set("fall.height", 6)``, with the CLI's ``--set`` checks and
+        messages; on a ConfigError the config is left as it was."""
+    def copy(self) -> Config:
+        """An independent copy (later ``set``s on either leave the other alone)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """Every key with its value, defaults included, as nested dicts."""
+    def to_toml(self) -> str:
+        """Every key with its value, defaults included, as TOML text."""
+    @property
+    def name(self) -> str:
+        """The config's ``name`` (the CLI's output folder ``output/<name>/``)."""
+    @property
+    def slips(self) -> List[str]:
+        """The config's likely unit slips (the CLI's warnings), in words."""
+    @property
+    def overrides(self) -> List[str]:
+        """The ``KEY=VALUE`` overrides applied so far (``from_toml``'s, then each ``set``), in order."""
+    @property
+    def fall_time(self) -> float:
+        """``sqrt(2 h / g)``, s."""
+    @property
+    def manoeuvre_time(self) -> float:
+        """Time for the manoeuvre: fall time minus ``fall.margin``, s."""
+
+class Design:
+    """A designed schedule: what ``catflip optimize --mode free|phased`` (or ``analyze``) writes.
+
+    Immutable; the arrays are fresh copies on each access."""
+
+    @property
+    def method(self) -> Method:
+        """``free``, ``phased`` or ``analytic``."""
+    @property
+    def status(self) -> str:
+        """Solver status: ``converged``, ``iteration-limit``, ``stalled`` (free), ``solved``
+        (phased), ``closed-form`` (analytic)."""
+    @property
+    def verdict(self) -> Literal["ok", "flagged"]:
+        """``flagged`` when the design misses a target (solver status, flip or tilt, a limit)."""
+    @property
+    def reason(self) -> Optional[str]:
+        """Why it is flagged, in the CLI's words; None when ok."""
+    @property
+    def peak(self) -> float:
+        """Peak joint torque of the schedule (inverse dynamics, sampled densely), N m."""
+    @property
+    def energy(self) -> float:
+        """``integral |tau|^2 dt`` over the rows, N^2 m^2 s."""
+    @property
+    def durations(self) -> Tuple[float, float, float]:
+        """Phase durations (fold, twist, unfold), s."""
+    @property
+    def duration(self) -> float:
+        """Manoeuvre time, s."""
+    @property
+    def certificate(self) -> Optional[Dict[str, Any]]:
+        """The free-form optimiser's stopping certificate (``step``, ``constraint_violation``,
+        ``criticality``, ``radius``, ``weight``, ``rule``); None for the other methods."""
+    @property
+    def flip_deg(self) -> float:
+        """Flip of the design's own simulation, deg (dynamic for free and phased, kinematic for analytic)."""
+    @property
+    def config(self) -> Config:
+        """The config the design was made with (with ``objective`` applied)."""
+    @property
+    def t(self) -> F64:
+        """Sample times, s: shape (N,)."""
+    @property
+    def phase(self) -> npt.NDArray[np.int64]:
+        """Phase of each row, 0 fold, 1 twist, 2 unfold: shape (N,)."""
+    @property
+    def q(self) -> F64:
+        """Joint angles q1, q2, rad: shape (N, 2)."""
+    @property
+    def qd(self) -> F64:
+        """Joint rates, rad/s: shape (N, 2)."""
+    @property
+    def qdd(self) -> F64:
+        """Joint accelerations, rad/s^2: shape (N, 2)."""
+    @property
+    def tau(self) -> F64:
+        """Joint torques tau1, tau2, N m: shape (N, 2)."""
+    def to_dict(self) -> Dict[str, Any]:
+        """The summary ``to_json()`` gives, as a dict."""
+    def to_json(self) -> str:
+        """The CLI's ``free.json`` / ``phased.json`` / ``analyze.json``, with ``verdict`` and ``reason``."""
+    def to_csv(self) -> str:
+        """The CLI's ``<method>.csv`` schedule."""
+    def schedule_json(self) -> str:
+        """The CLI's ``<method>.schedule.json``."""
+
+def design(config: Config, method: Method = "free", objective: Optional[Objective] = None,
+           seed: Optional[Seed] = None) -> Design:
+    """Designs a torque schedule, as the CLI's ``optimize --mode METHOD [--seed SEED]``
+    (``analyze`` for ``method="analytic"``), with the GIL released.
+
+    ``objective`` overrides ``design.objective``; ``seed`` (``"phased"`` default,
+    ``"analytic"``) applies to ``method="free"`` only. Raises ConfigError, ImpossibleError
+    (the motors cannot flip the cat from ``fall.height``) or DesignError, with the CLI's messages."""
+
+class Simulation:
+    """A forward simulation in the full free-floating model (feed-forward, PD if ``simulate.pd``,
+    the motor envelope), as ``catflip simulate``."""
+
+    @property
+    def flip_deg(self) -> float:
+        """Final rotation about the initial spine, unwrapped, deg."""
+    @property
+    def flip_error_rad(self) -> float:
+        """``pi - |flip|``, rad."""
+    @property
+    def tilt_deg(self) -> float:
+        """Angle between the final and the initial spine, deg."""
+    @property
+    def final_shape_error_rad(self) -> float:
+        """``|q(T)|``: how far from straight the cat ends, rad."""
+    @property
+    def momentum_drift_nms(self) -> float:
+        """Largest angular momentum recomputed from the bodies' velocities, N m s."""
+    @property
+    def peak_torque_nm(self) -> float:
+        """Largest joint torque applied, N m (the config's norm)."""
+    @property
+    def verdict(self) -> Literal["ok", "flagged"]:
+        """``flagged`` when the flip or tilt misses ``simulate.flip_tolerance``."""
+    @property
+    def reason(self) -> Optional[str]:
+        """Why it is flagged; None when ok."""
+    @property
+    def t(self) -> F64:
+        """Step times, s: shape (M,)."""
+    @property
+    def flip(self) -> F64:
+        """Flip at each step, rad: shape (M,)."""
+    @property
+    def tilt(self) -> F64:
+        """Tilt at each step, rad: shape (M,)."""
+    @property
+    def q(self) -> F64:
+        """Joint angles, rad: shape (M, 2)."""
+    @property
+    def tau(self) -> F64:
+        """Applied joint torques, N m: shape (M, 2)."""
+    @property
+    def attitude(self) -> F64:
+        """Rear half's attitude quaternion (w, x, y, z): shape (M, 4)."""
+    def to_json(self) -> str:
+        """The CLI's ``simulate --json``."""
+    def to_dict(self) -> Dict[str, Any]:
+        """``to_json()`` as a dict."""
+    def to_csv(self) -> str:
+        """The CLI's ``simulation.csv``."""
+
+def simulate(config: Config, design: Union[Design, str, os.PathLike[str], None] = None) -> Simulation:
+    """Simulates ``design`` (a Design, a schedule CSV path, or None for the analytic schedule)
+    on ``config``'s cat, as ``catflip simulate [--schedule FILE]``, with the GIL released.
+    ``config`` may differ from the design's (model error). Raises ConfigError, DesignError."""
+
+class LeastHeight:
+    """The robot builder's answer: can the motors flip the cat from ``fall.height``, and the
+    least drop height found (``run``'s least-height stage)."""
+
+    @property
+    def possible(self) -> bool:
+        """Whether the least height found is within ``fall.height``."""
+    @property
+    def height_m(self) -> float:
+        """The configured drop height, m."""
+    @property
+    def least_height_m(self) -> float:
+        """The least drop height found, m (an upper bound on the true one)."""
+    @property
+    def phased_least_height_m(self) -> float:
+        """The phased time design's least height, m."""
+    @property
+    def least_time_s(self) -> float:
+        """The shortest manoeuvre found inside the motor envelope, s."""
+    @property
+    def method(self) -> Literal["phased", "free"]:
+        """Which design settles the answer."""
+    @property
+    def status(self) -> str:
+        """That design's solver status."""
+    @property
+    def t(self) -> F64:
+        """Times of the least-height schedule, s: shape (N,)."""
+    @property
+    def q(self) -> F64:
+        """Its joint angles, rad: shape (N, 2)."""
+    @property
+    def tau(self) -> F64:
+        """Its joint torques, N m: shape (N, 2)."""
+    def sentence(self) -> str:
+        """The answer in one sentence, as the CLI's table prints it."""
+    def to_json(self) -> str:
+        """The ``answer`` object of ``summary.json``."""
+    def to_csv(self) -> str:
+        """The schedule at the least height, as ``least-height.csv``."""
+
+def least_height(config: Config) -> Optional[LeastHeight]:
+    """The least drop height at which the config's motors flip the cat (the phased and
+    free-form ``time`` designs inside the motor envelope), or None when the config sets no
+    motor limit. GIL released."""
+
+def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
+          methods: Sequence[str] = ..., threads: Optional[int] = None,
+          frame: Optional[bool] = None) -> Any:
+    """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``.
+
+    Returns the CSV's columns (float64 arrays of shape ``(len(values),)``, NaN where a method
+    gave no number; ``free_status`` and ``error`` lists of str or None): a
+    ``pandas.DataFrame`` when pandas is installed and ``frame`` is not False, else a dict that
+    also holds ``"csv"``, the CLI's ``sweep-<key>.csv`` text."""
+
+class Run:
+    """A whole ``catflip run``, kept in memory: the summary and every file it would write."""
+
+    @property
+    def summary(self) -> Dict[str, Any]:
+        """``summary.json`` as a dict."""
+    @property
+    def outcome(self) -> Literal["ok", "partial", "impossible"]:
+        """``ok``, ``partial`` (some method flagged or failed: the CLI's exit 3) or
+        ``impossible`` (exit 4)."""
+    @property
+    def partial(self) -> bool:
+        """Whether some method is flagged or failed."""
+    @property
+    def impossible(self) -> bool:
+        """Whether the motors cannot flip the cat from ``fall.height``."""
+    @property
+    def names(self) -> List[str]:
+        """Names of the files ``catflip run`` writes."""
+    def file(self, name: str) -> str:
+        """One of those files, as text; KeyError for another name."""
+
+def run(config: Config) -> Run:
+    """The CLI's main job, ``catflip run``, in memory (nothing written), with the GIL released.
+    Raises DesignError when every method fails."""
+
+def export_mjcf(config: Config) -> str:
+    """The cat as MuJoCo MJCF text (``catflip export mjcf``)."""
+
+def export_urdf(config: Config) -> str:
+    """The cat as URDF text (``catflip export urdf``)."""
+
+class Controls:
+    """A design's controls at a simulator's time step: what ``<method>.mujoco.csv`` /
+    ``<method>.pybullet.csv`` hold (n steps, n + 1 rows: the last is the final planned state)."""
+
+    @property
+    def simulator(self) -> SimulatorName:
+        """``mujoco`` or ``pybullet``."""
+    @property
+    def dt(self) -> float:
+        """Time step, s."""
+    @property
+    def steps(self) -> int:
+        """Number of steps n."""
+    @property
+    def slope(self) -> float:
+        """``k`` of MuJoCo's DC-motor actuators (the torque columns are then the command
+        ``tau + k qd``); 0 otherwise."""
+    @property
+    def columns(self) -> List[str]:
+        """The CSV's column names (``t_s``, then position, velocity and torque columns)."""
+    @property
+    def kp(self) -> float:
+        """catflip's PD stiffness, N m/rad."""
+    @property
+    def kd(self) -> float:
+        """catflip's PD damping, N m s/rad."""
+    @property
+    def max_torque(self) -> Optional[float]:
+        """``limits.max_torque``, N m, or None."""
+    @property
+    def norm(self) -> Literal["euclidean", "per-motor"]:
+        """Peak norm."""
+    @property
+    def t(self) -> F64:
+        """Step start times, s: shape (n + 1,)."""
+    @property
+    def pos(self) -> F64:
+        """Planned joint position: shape (n + 1, 4) for the no-twist ball (quaternion, MuJoCo
+        w x y z, pyBullet x y z w) or (n + 1, 2) for the universal joint."""
+    @property
+    def vel(self) -> F64:
+        """Planned joint velocity: shape (n + 1, 3) (ball) or (n + 1, 2)."""
+    @property
+    def torque(self) -> F64:
+        """Torque (or DC command) held over each step, N m: shape (n + 1, 3) or (n + 1, 2);
+        0 on the last row."""
+    def to_csv(self, method: Optional[str] = None) -> str:
+        """The CLI's ``<method>.<simulator>.csv`` (``method`` defaults to the design's)."""
+
+def controls(design: Design, simulator: SimulatorName = "mujoco") -> Controls:
+    """A design's controls for ``simulator``, in its joint coordinates and actuators, as
+    ``catflip run`` writes them."""

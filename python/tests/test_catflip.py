@@ -1,0 +1,368 @@
+"""The Python package against the real catflip binary (the CLI's JSON, CSV
+and messages), its documented shapes and exceptions, and the quickstart.
+
+The binary is $CATFLIP_BIN, else target/release/catflip (CARGO_TARGET_DIR
+honoured) at the repository root; build it with `cargo build --release`.
+"""
+
+import json
+import math
+import os
+import pathlib
+import subprocess
+import sys
+import threading
+import time
+
+import numpy as np
+import pytest
+
+import catflip
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+CONFIGS = sorted((ROOT / "configs").glob("*.toml"))
+TARGET = pathlib.Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
+BIN = pathlib.Path(os.environ.get("CATFLIP_BIN", TARGET / "release" / "catflip"))
+# wall-clock numbers: the only fields that differ between two identical solves
+TIMING = {"solve_time_s", "solve_ms"}
+
+
+def cli(*args, out):
+    """Runs the binary; returns (exit status, stdout, stderr)."""
+    if not BIN.exists():
+        pytest.fail(f"{BIN} is missing: run `cargo build --release` at the repository root")
+    p = subprocess.run([str(BIN), *map(str, args), "--out", str(out)], capture_output=True, text=True,
+                       cwd=ROOT, timeout=600)
+    return p.returncode, p.stdout, p.stderr
+
+
+def cli_error(stderr):
+    """The CLI's message: its stderr from the `error: ` that starts a line, without the prefix
+    (a TOML error spans several lines)."""
+    at = 0 if stderr.startswith("error: ") else stderr.find("\nerror: ") + 1
+    assert at > 0 or stderr.startswith("error: "), stderr
+    return stderr[at + len("error: "):].rstrip("\n")
+
+
+def message(e):
+    return str(e.value).rstrip("\n")
+
+
+def assert_close(a, b, path="", tol=1e-12):
+    """Same structure, same strings, numbers within tol (relative to their size)."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and set(a) == set(b), (path, sorted(set(a) ^ set(b)))
+        for k in a:
+            if k not in TIMING:
+                assert_close(a[k], b[k], f"{path}.{k}", tol)
+    elif isinstance(a, list):
+        assert isinstance(b, list) and len(a) == len(b), (path, len(a), len(b))
+        for i, (x, y) in enumerate(zip(a, b)):
+            assert_close(x, y, f"{path}[{i}]", tol)
+    elif isinstance(a, float) or isinstance(b, float):
+        assert isinstance(a, (int, float)) and isinstance(b, (int, float)), (path, a, b)
+        assert abs(a - b) <= tol * max(1.0, abs(a), abs(b)), (path, a, b)
+    else:
+        assert a == b, (path, a, b)
+
+
+# each design through Python and through the CLI: the command and its files' folder and stem
+METHODS = {
+    ("free", None): (["optimize", "--mode", "free"], "optimize-free", "free"),
+    ("free", "analytic"): (["optimize", "--mode", "free", "--seed", "analytic"], "optimize-free", "free"),
+    ("phased", None): (["optimize", "--mode", "phased"], "optimize-phased", "phased"),
+    ("analytic", None): (["analyze"], "analyze", "analytic"),
+}
+
+
+@pytest.mark.parametrize("config", CONFIGS, ids=lambda p: p.stem)
+@pytest.mark.parametrize("method,seed", list(METHODS), ids=lambda x: str(x))
+def test_every_bundled_design_equals_the_cli(config, method, seed, tmp_path):
+    command, folder, stem = METHODS[(method, seed)]
+    status, stdout, stderr = cli(command[0], config, *command[1:], "--json", out=tmp_path)
+    cfg = catflip.Config.from_toml(config)
+    if status in (0, 3):
+        d = catflip.design(cfg, method, seed=seed)
+        assert_close(json.loads(stdout), d.to_dict())
+        # `analyze` exits 0 on a flagged schedule: the analysis is what was asked
+        assert d.verdict == json.loads(stdout)["verdict"]
+        assert method == "analytic" or (d.verdict == "ok") == (status == 0)
+        files = tmp_path / cfg.name / folder
+        # the same computation prints the same digits
+        assert d.to_csv() == (files / f"{stem}.csv").read_text()
+        assert d.schedule_json() == (files / f"{stem}.schedule.json").read_text()
+        written = json.loads((files / ("analyze.json" if method == "analytic" else f"{stem}.json")).read_text())
+        assert_close(written, json.loads(d.to_json()))
+        assert d.peak == pytest.approx(written["peak_torque_nm"], rel=1e-12)
+        assert list(d.durations) == pytest.approx(written["phase_durations_s"], rel=1e-12)
+    else:
+        # the CLI's exit reason, as the documented exception, with its message
+        expected = {1: catflip.DesignError, 2: catflip.ConfigError}[status]
+        with pytest.raises(expected) as e:
+            catflip.design(cfg, method, seed=seed)
+        assert message(e) == cli_error(stderr)
+
+
+@pytest.mark.parametrize("key,value,cli_value", [
+    ("fall.height", -1, "-1"),
+    ("cat.masss", 1, "1"),
+    ("cat.joint", "hinge", "hinge"),
+    ("cat.mass", "abc", "abc"),
+    ("phased.nodes", 10.5, "10.5"),
+    ("analytic.split", [0.5, 0.6, 0.2], "[0.5, 0.6, 0.2]"),
+    ("fall.margin", 5, "5"),
+])
+def test_bad_keys_raise_config_error_with_the_cli_message(key, value, cli_value, tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, _, stderr = cli("analyze", seed, "--set", f"{key}={cli_value}", out=tmp_path)
+    assert status == 2
+    cfg = catflip.Config.from_toml(seed)
+    before = cfg.to_dict()
+    with pytest.raises(catflip.ConfigError) as e:
+        cfg.set(key, value)
+    assert message(e) == cli_error(stderr)
+    assert cfg.to_dict() == before and cfg.overrides == []
+    assert isinstance(e.value, catflip.CatflipError)
+
+
+def test_bad_files_raise_config_error_with_the_cli_message(tmp_path):
+    broken = tmp_path / "broken.toml"
+    broken.write_text('name = "x"\n[cat]\nmass = 1\n')
+    for path in (tmp_path / "missing.toml", broken):
+        status, _, stderr = cli("analyze", path, out=tmp_path)
+        assert status == 2
+        with pytest.raises(catflip.ConfigError) as e:
+            catflip.Config.from_toml(path)
+        assert message(e) == cli_error(stderr)
+
+
+def test_the_exception_hierarchy():
+    assert issubclass(catflip.ConfigError, catflip.CatflipError)
+    assert issubclass(catflip.DesignError, catflip.CatflipError)
+    assert issubclass(catflip.ImpossibleError, catflip.DesignError)
+    assert issubclass(catflip.CatflipError, Exception)
+
+
+def test_impossible_from_this_height(tmp_path):
+    robot = ROOT / "configs" / "robot-universal.toml"
+    status, _, stderr = cli("optimize", robot, "--mode", "phased", out=tmp_path)
+    assert status == 1
+    with pytest.raises(catflip.ImpossibleError) as e:
+        catflip.design(catflip.Config.from_toml(robot), "phased")
+    assert message(e) == cli_error(stderr)
+    assert "at least 5.663 m" in str(e.value)
+
+
+def test_set_and_objective_apply_like_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, stdout, _ = cli("optimize", seed, "--mode", "phased", "--set", "fall.height=6",
+                            "--set", "design.objective=energy", "--json", out=tmp_path)
+    assert status == 0
+    cfg = catflip.Config.from_toml(seed)
+    cfg.set("fall.height", 6)
+    assert cfg.overrides == ["fall.height=6"]
+    assert cfg.fall_time == pytest.approx(math.sqrt(2 * 6 / 9.8), rel=1e-15)
+    d = catflip.design(cfg, "phased", objective="energy")
+    assert_close(json.loads(stdout), d.to_dict())
+    # the design's objective did not change the config
+    assert cfg.to_dict()["design"]["objective"] == "peak-torque"
+    assert d.config.to_dict()["design"]["objective"] == "energy"
+    with pytest.raises(catflip.ConfigError, match="seed applies to"):
+        catflip.design(cfg, "phased", seed="analytic")
+    with pytest.raises(catflip.ConfigError, match="unknown method"):
+        catflip.design(cfg, "fast")
+
+
+def test_from_dict_and_from_text_read_as_the_file():
+    tomllib = pytest.importorskip("tomllib")
+    seed = ROOT / "configs" / "seed.toml"
+    a = catflip.Config.from_toml(seed)
+    b = catflip.Config.from_dict(tomllib.loads(seed.read_text()))
+    c = catflip.Config.from_text(seed.read_text())
+    assert a.to_dict() == b.to_dict() == c.to_dict()
+    assert catflip.Config.from_text(a.to_toml()).to_dict() == a.to_dict()
+    with pytest.raises(catflip.ConfigError, match="masss"):
+        catflip.Config.from_dict({**tomllib.loads(seed.read_text()), "cat": {"masss": 1}})
+
+
+def test_arrays_have_the_documented_shapes_and_dtypes():
+    cfg = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    cfg.set("simulate.samples_per_phase", 10)
+    d = catflip.design(cfg, "phased")
+    n = 3 * (10 + 1)
+    assert d.t.shape == (n,) and d.t.dtype == np.float64
+    for a in (d.q, d.qd, d.qdd, d.tau):
+        assert a.shape == (n, 2) and a.dtype == np.float64
+    assert d.phase.shape == (n,) and d.phase.dtype == np.int64
+    assert list(np.unique(d.phase)) == [0, 1, 2]
+    assert d.t[0] == 0.0 and d.t[-1] == pytest.approx(cfg.manoeuvre_time, rel=1e-12)
+    assert sum(d.durations) == pytest.approx(d.duration, rel=1e-12)
+    # the peak is the dense one: at least the rows' Euclidean peak (the seed's norm)
+    assert d.peak >= np.hypot(d.tau[:, 0], d.tau[:, 1]).max() * (1 - 1e-12)
+    s = catflip.simulate(cfg, d)
+    m = len(s.t)
+    assert m > 10 and s.t.dtype == np.float64
+    assert s.flip.shape == s.tilt.shape == (m,)
+    assert s.q.shape == s.tau.shape == (m, 2) and s.attitude.shape == (m, 4)
+    assert np.allclose(np.linalg.norm(s.attitude, axis=1), 1.0, atol=1e-9)
+    for sim, width in (("mujoco", (4, 3)), ("pybullet", (4, 3))):
+        c = catflip.controls(d, sim)
+        rows = c.steps + 1
+        assert c.t.shape == (rows,)
+        assert c.pos.shape == (rows, width[0]) and c.vel.shape == (rows, width[1])
+        assert c.torque.shape == (rows, width[1]) and c.pos.dtype == np.float64
+        assert len(c.columns) == 1 + width[0] + 2 * width[1]
+        assert c.dt * c.steps == pytest.approx(d.duration, rel=1e-12)
+    robot = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml")
+    c = catflip.controls(catflip.design(robot, "analytic"), "mujoco")
+    assert c.pos.shape == c.vel.shape == c.torque.shape == (c.steps + 1, 2) and c.slope > 0
+
+
+def test_simulating_a_design_reproduces_its_own_flip(tmp_path):
+    cfg = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    d = catflip.design(cfg, "free")
+    s = catflip.simulate(cfg, d)
+    assert s.flip_deg == pytest.approx(d.flip_deg, rel=1e-12)
+    assert s.verdict == "ok"
+    # a schedule file and no schedule, as `catflip simulate [--schedule FILE]`
+    path = tmp_path / "free.csv"
+    path.write_text(d.to_csv())
+    for arg, extra in ((path, ["--schedule", path]), (None, [])):
+        status, stdout, _ = cli("simulate", ROOT / "configs" / "seed.toml", *extra, "--json", out=tmp_path)
+        assert status == 0
+        s = catflip.simulate(cfg, arg)
+        assert_close(json.loads(stdout), s.to_dict())
+        assert s.to_csv() == (tmp_path / "seed" / "simulate" / "simulation.csv").read_text()
+
+
+def test_run_and_controls_and_models_match_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, stdout, _ = cli("run", seed, "--json", out=tmp_path)
+    assert status == 0
+    cfg = catflip.Config.from_toml(seed)
+    r = catflip.run(cfg)
+    assert r.outcome == "ok" and not r.partial and not r.impossible
+    assert_close(json.loads(stdout), r.summary)
+    files = tmp_path / "seed" / "run"
+    for name in ("free.csv", "phased.mujoco.csv", "seed.mjcf.xml", "seed.urdf"):
+        assert r.file(name) == (files / name).read_text(), name
+    assert catflip.export_mjcf(cfg) == (files / "seed.mjcf.xml").read_text()
+    assert catflip.export_urdf(cfg) == (files / "seed.urdf").read_text()
+    # the analytic and phased designs are run's own: their controls are its files
+    for method in ("analytic", "phased"):
+        d = catflip.design(cfg, method)
+        for sim in ("mujoco", "pybullet"):
+            assert catflip.controls(d, sim).to_csv() == (files / f"{method}.{sim}.csv").read_text()
+    with pytest.raises(KeyError):
+        r.file("nothing.csv")
+
+
+def test_least_height_is_runs_answer():
+    robot = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml")
+    h = catflip.least_height(robot)
+    answer = catflip.run(robot).summary["answer"]
+    assert not h.possible and not answer["possible"]
+    assert h.least_height_m == pytest.approx(answer["least_height_m"], rel=1e-12)
+    assert h.least_time_s == pytest.approx(answer["least_time_s"], rel=1e-12)
+    # F7's relation between the least time and height, with the robot's margin
+    g, margin = robot.to_dict()["fall"]["gravity"], robot.to_dict()["fall"]["margin"]
+    assert h.least_height_m == pytest.approx(g * (h.least_time_s + margin) ** 2 / 2, rel=1e-9)
+    assert h.t.shape == (h.q.shape[0],) and h.tau.shape[1] == 2
+    assert catflip.least_height(catflip.Config.from_toml(ROOT / "configs" / "seed.toml")) is None
+
+
+def test_sweep_equals_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, stdout, _ = cli("sweep", seed, "--set-range", "fall.height=1:3:3", "--methods", "analytic,phased",
+                            "--json", out=tmp_path)
+    assert status == 0
+    points = json.loads(stdout)
+    cols = catflip.sweep(catflip.Config.from_toml(seed), "fall.height", np.linspace(1, 3, 3),
+                         methods=("analytic", "phased"), frame=False)
+    assert cols["csv"] == (tmp_path / "seed" / "sweep-fall_height" / "sweep-fall_height.csv").read_text()
+    for k in ("value", "analytic_peak_nm", "phased_peak_nm", "phased_bend_deg"):
+        assert cols[k].shape == (3,) and cols[k].dtype == np.float64
+        assert np.allclose(cols[k], [p[k] for p in points], rtol=1e-12, atol=0)
+    assert np.isnan(cols["free_peak_nm"]).all() and cols["error"] == [None] * 3
+    # F3: the phased peak scales as 1 / T^2, T = sqrt(2 h / g)
+    peaks = cols["phased_peak_nm"]
+    assert peaks[0] / peaks[2] == pytest.approx(3.0, rel=1e-9)
+    with pytest.raises(catflip.ConfigError, match="every point is invalid"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, -2], frame=False)
+    try:
+        import pandas  # noqa: F401
+    except ImportError:
+        assert isinstance(catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [2],
+                                        methods=("analytic",)), dict)
+    else:
+        df = catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [2], methods=("analytic",))
+        assert list(df["value"]) == [2.0]
+
+
+def test_solves_release_the_gil_and_objects_are_shared_by_threads():
+    cfg = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    cfg.set("free.mesh_continuation", False)
+    reference = catflip.design(cfg, "free").to_dict()
+    results, ticks = [], 0
+    workers = [threading.Thread(target=lambda: results.append(catflip.design(cfg, "free"))) for _ in range(2)]
+    start = time.perf_counter()
+    for w in workers:
+        w.start()
+    while any(w.is_alive() for w in workers):
+        time.sleep(0.005)
+        ticks += 1
+    elapsed = time.perf_counter() - start
+    # with the GIL held by a solve this thread would not wake until it ended
+    assert ticks >= 0.2 * elapsed / 0.005, (ticks, elapsed)
+    assert len(results) == 2
+    for r in results:
+        assert_close(reference, r.to_dict())
+    # setting keys from many threads at once: every set applied once
+    shared = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    setters = [threading.Thread(target=shared.set, args=("fall.height", 5 + i)) for i in range(8)]
+    for s in setters:
+        s.start()
+    for s in setters:
+        s.join()
+    assert len(shared.overrides) == 8
+
+
+def test_the_quickstart_runs(tmp_path):
+    script = ROOT / "examples" / "python" / "quickstart.py"
+    assert len(script.read_text().splitlines()) < 40
+    env = {**os.environ, "MPLBACKEND": "Agg"}
+    p = subprocess.run([sys.executable, str(script)], capture_output=True, text=True, cwd=tmp_path,
+                       env=env, timeout=600)
+    assert p.returncode == 0, p.stderr
+    assert (tmp_path / "quickstart.png").stat().st_size > 10_000
+    assert "MuJoCo flip" in p.stdout
+
+
+def test_unit_slips_warn_as_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, _, stderr = cli("analyze", seed, "--set", "cat.mass=500", out=tmp_path)
+    assert status == 0
+    cli_warnings = [l[len("warning: "):] for l in stderr.splitlines() if "typed as" in l]
+    assert cli_warnings
+    cfg = catflip.Config.from_toml(seed)
+    with pytest.warns(catflip.UnitSlipWarning) as caught:
+        cfg.set("cat.mass", 500)
+    assert [str(w.message) for w in caught] == cli_warnings == cfg.slips
+
+
+def test_everything_public_has_a_docstring_and_a_stub():
+    import ast
+
+    stub = ast.parse((pathlib.Path(catflip.__file__).parent / "__init__.pyi").read_text())
+    stubbed = {n.name: n for n in stub.body if isinstance(n, (ast.ClassDef, ast.FunctionDef))}
+    for name in catflip.__all__:
+        obj = getattr(catflip, name)
+        assert (obj.__doc__ or "").strip(), name
+        assert name in stubbed, f"{name} has no stub"
+        if isinstance(obj, type) and not issubclass(obj, BaseException):
+            members = {n.name for n in stubbed[name].body if isinstance(n, ast.FunctionDef)}
+            for attr in dir(obj):
+                if attr.startswith("_"):
+                    continue
+                assert (getattr(obj, attr).__doc__ or "").strip(), f"{name}.{attr} has no docstring"
+                assert attr in members, f"{name}.{attr} has no stub"

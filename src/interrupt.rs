@@ -1,0 +1,150 @@
+//! Long studies (sweeps, Monte Carlo trials) that stop on SIGINT or SIGTERM
+//! within a fraction of a second and keep what they finished.
+//!
+//! A study runs its work on a thread of its own ([`supervise`]) and records
+//! each finished item in a store it shares with the caller. The caller's
+//! thread waits for the work or for a signal: on a signal it returns at
+//! once with [`Outcome::Interrupted`], and the caller publishes the finished
+//! items as a partial set and ends the process (exit 130), leaving the items
+//! in progress unfinished. A second signal while that happens ends the
+//! process at once. Work in progress need not poll anything, so the
+//! optimisers stay free of cancellation checks.
+//!
+//! The signals are caught with `signal-hook`, whose handler only sets an
+//! atomic flag (async-signal-safe), and whose registrations undo cleanly.
+
+use crate::error::{Error, Result};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+/// Exit status of an interrupted command: 128 + SIGINT, what a shell
+/// reports for a program that Ctrl-C ended.
+pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// How often the waiting thread looks at the flag and the work.
+const POLL: Duration = Duration::from_millis(20);
+
+/// SIGINT and SIGTERM caught for as long as this lives.
+#[derive(Debug)]
+pub struct Interrupt {
+    flag: Arc<AtomicBool>,
+    ids: Vec<signal_hook::SigId>,
+}
+
+impl Interrupt {
+    /// Catches SIGINT and SIGTERM: the first sets the flag; a second, once
+    /// the flag is set, ends the process at once with [`EXIT_INTERRUPTED`].
+    pub fn catch() -> Result<Interrupt> {
+        use signal_hook::consts::{SIGINT, SIGTERM};
+        let flag = Arc::new(AtomicBool::new(false));
+        let mut ids = Vec::new();
+        for sig in [SIGINT, SIGTERM] {
+            let err = |e: std::io::Error| {
+                Error::Usage(format!("cannot catch signal {sig} to stop safely: {e}"))
+            };
+            // the shutdown first: it sees the flag as it was before this signal
+            ids.push(
+                signal_hook::flag::register_conditional_shutdown(
+                    sig,
+                    EXIT_INTERRUPTED as i32,
+                    Arc::clone(&flag),
+                )
+                .map_err(err)?,
+            );
+            ids.push(signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(err)?);
+        }
+        Ok(Interrupt { flag, ids })
+    }
+
+    /// An interrupt that no signal sets (library callers, tests).
+    pub fn never() -> Interrupt {
+        Interrupt {
+            flag: Arc::new(AtomicBool::new(false)),
+            ids: Vec::new(),
+        }
+    }
+
+    /// Whether a signal arrived.
+    pub fn requested(&self) -> bool {
+        self.flag.load(Ordering::SeqCst)
+    }
+
+    /// Sets the flag as a signal would (tests, a study's own stop).
+    pub fn request(&self) {
+        self.flag.store(true, Ordering::SeqCst)
+    }
+}
+
+impl Drop for Interrupt {
+    fn drop(&mut self) {
+        for id in self.ids.drain(..) {
+            signal_hook::low_level::unregister(id);
+        }
+    }
+}
+
+/// How supervised work ended.
+#[derive(Debug)]
+pub enum Outcome<T> {
+    /// The work returned.
+    Finished(T),
+    /// A signal came first; the work's thread is still running.
+    Interrupted,
+}
+
+impl<T> Outcome<T> {
+    pub fn is_interrupted(&self) -> bool {
+        matches!(self, Outcome::Interrupted)
+    }
+}
+
+/// Runs `work` on its own thread and waits for it or for `interrupt`,
+/// whichever comes first (within [`POLL`]). A panic in the work is resumed
+/// on the caller's thread. When interrupted, the caller is expected to
+/// publish what the work's shared store holds and end the process.
+pub fn supervise<T: Send + 'static>(
+    interrupt: &Interrupt,
+    work: impl FnOnce() -> T + Send + 'static,
+) -> Outcome<T> {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let handle = std::thread::spawn(move || {
+        let _ = tx.send(work());
+    });
+    loop {
+        match rx.recv_timeout(POLL) {
+            Ok(v) => {
+                let _ = handle.join();
+                return Outcome::Finished(v);
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Disconnected) => {
+                // the work panicked before sending
+                match handle.join() {
+                    Err(p) => std::panic::resume_unwind(p),
+                    Ok(()) => unreachable!("the work sends before it ends"),
+                }
+            }
+            Err(std::sync::mpsc::RecvTimeoutError::Timeout) => {
+                if interrupt.requested() {
+                    return Outcome::Interrupted;
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn finished_work_returns_its_value_and_a_request_returns_at_once() {
+        let i = Interrupt::never();
+        assert!(matches!(supervise(&i, || 7), Outcome::Finished(7)));
+        i.request();
+        let t = std::time::Instant::now();
+        let o = supervise(&i, || std::thread::sleep(Duration::from_secs(30)));
+        assert!(o.is_interrupted());
+        assert!(t.elapsed() < Duration::from_secs(1), "{:?}", t.elapsed());
+    }
+}

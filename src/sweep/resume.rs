@@ -1,0 +1,132 @@
+//! What an interrupted sweep leaves for `--resume`: beside its CSV, the
+//! set holds `sweep-<key>.state.json` with the sweep's identity (range,
+//! shard, methods, the resolved config) and every grid point's result so
+//! far, `null` for those not finished. A finished sweep writes the same file
+//! with `"status": "complete"`.
+
+use super::{Methods, Shard, SweepPoint, SweepSpec};
+use crate::config::Config;
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+
+/// Whether a published sweep has every point.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SweepStatus {
+    /// Interrupted: some points are missing; `--resume` computes them.
+    Partial,
+    Complete,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SweepState {
+    pub status: SweepStatus,
+    /// `KEY=FROM:TO:COUNT`.
+    pub range: String,
+    /// `K/N`.
+    pub shard: String,
+    pub methods: Vec<String>,
+    /// The config the points were computed from, as resolved (file and `--set`).
+    pub config: serde_json::Value,
+    /// One slot a point of the shard, in grid order.
+    pub points: Vec<Option<SweepPoint>>,
+}
+
+impl Methods {
+    /// `analytic`, `phased`, `free`: those computed.
+    pub fn names(&self) -> Vec<String> {
+        [
+            ("analytic", self.analytic),
+            ("phased", self.phased),
+            ("free", self.free),
+        ]
+        .iter()
+        .filter(|(_, on)| *on)
+        .map(|(n, _)| n.to_string())
+        .collect()
+    }
+}
+
+impl SweepState {
+    /// A sweep's identity with no point finished.
+    pub fn new(spec: &SweepSpec, shard: Shard, methods: Methods, cfg: &Config) -> SweepState {
+        SweepState {
+            status: SweepStatus::Partial,
+            range: spec.arg(),
+            shard: format!("{}/{}", shard.index, shard.count),
+            methods: methods.names(),
+            config: serde_json::to_value(cfg).expect("a config serialises"),
+            points: vec![None; shard.points(spec.count).len()],
+        }
+    }
+
+    /// `sweep-<file_key>.state.json`.
+    pub fn file_name(file_key: &str) -> String {
+        format!("sweep-{file_key}.state.json")
+    }
+
+    /// The points finished, in grid order.
+    pub fn finished(&self) -> Vec<SweepPoint> {
+        self.points.iter().flatten().cloned().collect()
+    }
+
+    /// This state with `points` and the status they imply.
+    pub fn with_points(&self, points: Vec<Option<SweepPoint>>) -> SweepState {
+        let status = if points.iter().all(|p| p.is_some()) {
+            SweepStatus::Complete
+        } else {
+            SweepStatus::Partial
+        };
+        SweepState {
+            status,
+            points,
+            ..self.clone()
+        }
+    }
+
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a sweep state serialises")
+    }
+
+    /// The published state in `set_dir` to resume from, checked to be the
+    /// same sweep as `self` (same grid, shard, methods and config).
+    pub fn resume_from(&self, set_dir: &Path, file_key: &str) -> Result<SweepState> {
+        let path = set_dir.join(Self::file_name(file_key));
+        let usage = |m: String| Error::Usage(format!("--resume: {m}"));
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            usage(format!(
+                "no sweep to resume at {} ({e}); run the sweep without --resume",
+                path.display()
+            ))
+        })?;
+        let old: SweepState = serde_json::from_str(&text).map_err(|e| {
+            usage(format!(
+                "{} is not a sweep state catflip wrote ({e}); run the sweep without --resume",
+                path.display()
+            ))
+        })?;
+        let differs = [
+            ("the range", old.range != self.range),
+            ("the shard", old.shard != self.shard),
+            ("the methods", old.methods != self.methods),
+            ("the config (file or --set)", old.config != self.config),
+            (
+                "the number of points",
+                old.points.len() != self.points.len(),
+            ),
+        ];
+        let what: Vec<&str> = differs.iter().filter(|d| d.1).map(|d| d.0).collect();
+        if !what.is_empty() {
+            return Err(usage(format!(
+                "the sweep at {} was made with other settings ({} differ: it has --set-range {} --shard {} --methods {}); give the same ones, or run without --resume to start afresh",
+                path.display(),
+                what.join(", "),
+                old.range,
+                old.shard,
+                old.methods.join(",")
+            )));
+        }
+        Ok(old)
+    }
+}
