@@ -90,6 +90,30 @@ const PIECES: &[&str] = &[
     "1:2:3",
     "0:0:0",
     "::",
+    // issue 31: the keys and sections whose ranges bound the work
+    "[cat.front]",
+    "[limits]",
+    "[simulate]",
+    "[phased]",
+    "[free]",
+    "[design]",
+    "gravity",
+    "radius",
+    "length",
+    "no_load_speed",
+    "max_speed",
+    "max_bend_deg",
+    "theta_deg",
+    "pd_bandwidth_hz",
+    "max_iterations",
+    "bend_tol_deg",
+    "samples_per_phase",
+    "1e9",
+    "4414",
+    "179.99999",
+    "0.785",
+    "1e-9",
+    "30",
 ];
 
 /// Random edits of `base`: insert, delete, replace or duplicate pieces.
@@ -160,6 +184,21 @@ fn config_file_and_set_parsers_never_panic() {
         "simulate.samples_per_phase",
         "phased.nodes",
         "free.nodes",
+        "fall.gravity",
+        "cat.radius",
+        "cat.length",
+        "cat.front.mass",
+        "cat.front.length",
+        "cat.front.radius",
+        "limits.no_load_speed",
+        "limits.max_speed",
+        "limits.max_bend_deg",
+        "simulate.rtol",
+        "simulate.pd_bandwidth_hz",
+        "simulate.pd_damping",
+        "phased.bend_tol_deg",
+        "free.max_iterations",
+        "design.objective",
         "name",
         "cat",
         "x.y.z",
@@ -183,7 +222,24 @@ fn config_file_and_set_parsers_never_panic() {
             .collect();
         let input = format!("{text}\n--set {overrides:?}");
         no_panic("Config::from_toml", &input, || {
-            Config::from_toml(&text, "fuzz.toml", &overrides)
+            let cfg = Config::from_toml(&text, "fuzz.toml", &overrides)?;
+            // what is accepted implies bounded work and finite numbers
+            let t = cfg.fall_time();
+            assert!(
+                (catflip::config::ranges::MIN_FALL_TIME_S
+                    ..=catflip::config::ranges::MAX_FALL_TIME_S)
+                    .contains(&t),
+                "{input:?}: fall time {t}"
+            );
+            let cf = catflip::design::analytic::closed_forms(&cfg);
+            assert!(
+                cf.twist_rad.is_finite() && cf.seed_torque_estimate_nm.is_finite(),
+                "{input:?}: {cf:?}"
+            );
+            for s in cfg.slips() {
+                assert!(!s.message.is_empty());
+            }
+            Ok(())
         });
     }
 }
@@ -222,6 +278,8 @@ fn schedule_reader_never_panics() {
     let plan = catflip::design::analytic::analytic_plan(&cfg);
     let base = Schedule::sample(&cfg.cat(), &plan, 4).to_csv();
     assert!(catflip::verify::simulate::read_schedule(&cfg, &base, "base").is_ok());
+    let base_json = Schedule::sample(&cfg.cat(), &plan, 4).to_json();
+    assert!(catflip::verify::simulate::read_schedule(&cfg, &base_json, "base").is_ok());
     for i in 0..10_000 {
         let text = if i % 7 == 0 {
             random_text(&mut rng)
@@ -230,6 +288,15 @@ fn schedule_reader_never_panics() {
         };
         no_panic("Schedule::from_csv", &text, || {
             Schedule::from_csv(&text, "fuzz.csv")
+        });
+        // the JSON form of the same rows (issue 31), mutated alike
+        let json = if i % 7 == 0 {
+            random_text(&mut rng)
+        } else {
+            mutate(&mut rng, &base_json)
+        };
+        no_panic("Schedule::from_json", &json, || {
+            Schedule::from_json(&json, "fuzz.schedule.json")
         });
         no_panic("read_schedule", &text, || {
             let s = catflip::verify::simulate::read_schedule(&cfg, &text, "fuzz.csv")?;

@@ -654,3 +654,104 @@ fn the_small_inconsistencies_are_fixed() {
         "{ignore}"
     );
 }
+
+/// Virtual memory allowed to each command of the cap test, KB (1 GB). The
+/// largest accepted run measured 133 MB resident; the rest of the margin is
+/// thread stacks and allocator arenas, which count against `ulimit -v`.
+const MEMORY_CAP_KB: u64 = 1 << 20;
+
+/// Runs the binary under `ulimit -v MEMORY_CAP_KB`.
+fn run_capped(args: &[&str], dir: &Path) -> Output {
+    Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {MEMORY_CAP_KB} && exec \"$0\" \"$@\""))
+        .arg(env!("CARGO_BIN_EXE_catflip"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("sh runs")
+}
+
+fn size(dir: &Path) -> u64 {
+    tree(dir)
+        .iter()
+        .filter(|p| p.is_file())
+        .map(|p| p.metadata().unwrap().len())
+        .sum()
+}
+
+/// The largest inputs the ranges accept (the longest fall, the most rows, the
+/// stiffest PD) finish under the memory cap, write at most the stated
+/// amounts and report only finite numbers.
+#[test]
+fn the_largest_accepted_inputs_hold_the_memory_and_output_caps() {
+    let dir = tempfile::tempdir().unwrap();
+    let robot = config("robot-universal.toml");
+    // 30 s at 9.81 m/s^2: 4414.5 m
+    let longest = "fall.height=4414";
+    let o = run_capped(
+        &[
+            "simulate",
+            &robot,
+            "--set",
+            longest,
+            "--set",
+            "simulate.samples_per_phase=30000",
+            "--set",
+            "simulate.pd_bandwidth_hz=100",
+            "--json",
+            "--out",
+            "s",
+        ],
+        dir.path(),
+    );
+    let err = stderr(&o);
+    assert!(matches!(o.status.code(), Some(0 | 3)), "{err}");
+    assert!(
+        !err.contains("memory allocation") && !err.contains("panicked"),
+        "{err}"
+    );
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(catflip::output::null_numbers(&v).is_empty(), "{v}");
+    let o = run_capped(
+        &[
+            "analyze",
+            &robot,
+            "--set",
+            longest,
+            "--set",
+            "simulate.samples_per_phase=30000",
+            "--json",
+            "--out",
+            "a",
+        ],
+        dir.path(),
+    );
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(catflip::output::null_numbers(&v).is_empty(), "{v}");
+    assert!(
+        size(&dir.path().join("s")) < 50_000_000,
+        "{}",
+        size(&dir.path().join("s"))
+    );
+    assert!(
+        size(&dir.path().join("a")) < 50_000_000,
+        "{}",
+        size(&dir.path().join("a"))
+    );
+    // the issue's run, at the longest fall it accepts (the 1e9 m one is refused)
+    let o = run_capped(&["run", &robot, "--set", longest, "--out", "r"], dir.path());
+    let err = stderr(&o);
+    assert!(
+        matches!(o.status.code(), Some(0 | 3 | 4)),
+        "{:?}: {err}",
+        o.status
+    );
+    assert!(
+        !err.contains("memory allocation") && !err.contains("panicked"),
+        "{err}"
+    );
+    let written = size(&dir.path().join("r"));
+    assert!(written < 100_000_000, "a run wrote {written} bytes");
+}

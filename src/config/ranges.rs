@@ -1,6 +1,6 @@
 //! What catflip accepts beyond "a positive number": the caps on the work a
 //! config implies, the geometry a cat can have, and the plausibility rules
-//! that catch unit slips (docs/inputs.md lists them for users).
+//! that catch unit slips (docs/configuration.md lists them for users).
 //!
 //! Three kinds of rule, checked in this order by [`Config::validate`]:
 //! - **ranges** ([`RANGES`]): each key's documented interval; values outside
