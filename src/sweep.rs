@@ -471,7 +471,7 @@ pub fn sweep_shard_into(
             ),
         });
     }
-    let configs = checked_configs(&spec.key, &spec.arg(), &all, &load)?;
+    let configs = checked_configs(&spec.key, &spec.arg(), &all, load)?;
     compute_into(
         &spec.key,
         values,
