@@ -33,6 +33,10 @@ pub struct Config {
     pub phased: PhasedConfig,
     #[serde(default)]
     pub free: FreeConfig,
+    /// `[body]`: general rigid halves, given or read from a URDF / MJCF
+    /// (default: none, the cylinders of `[cat]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub body: Option<crate::import::BodyConfig>,
     #[serde(default)]
     pub start: StartConfig,
     #[serde(default)]
@@ -280,13 +284,24 @@ impl Config {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-        Self::from_toml(&text, &path.display().to_string(), overrides)
+        let base = path.parent().unwrap_or(Path::new("."));
+        Self::from_toml_at(&text, &path.display().to_string(), overrides, base)
     }
 
     /// Parses the user's text, applies `--set` overrides and validates. An
     /// error in the file points at the file's own line; an error in an
     /// override names that `--set` argument.
     pub fn from_toml(text: &str, origin: &str, overrides: &[String]) -> Result<Config> {
+        Self::from_toml_at(text, origin, overrides, Path::new("."))
+    }
+
+    /// [`Config::from_toml`] with `[body]`'s files relative to the folder `base`.
+    pub fn from_toml_at(
+        text: &str,
+        origin: &str,
+        overrides: &[String],
+        base: &Path,
+    ) -> Result<Config> {
         let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
             message: plain_types(&e.to_string()),
@@ -294,8 +309,10 @@ impl Config {
         let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
         // the file alone, parsed from its own text: unknown keys and wrong
         // types carry the file's line; a missing key may come from an override
+        // ([body] fills in [cat])
         if let Err(e) = toml::from_str::<Config>(text)
-            && (overrides.is_empty() || !e.message().starts_with("missing field"))
+            && ((overrides.is_empty() && !table.contains_key("body"))
+                || !e.message().starts_with("missing field"))
         {
             return Err(file_err(e));
         }
@@ -312,13 +329,18 @@ impl Config {
             }
             apply_override(&mut table, arg)?;
         }
+        let halves = crate::import::resolve(&mut table, base, origin)?;
         // together: what is left is a key that neither gives
-        let cfg: Config = table
-            .try_into()
-            .map_err(|e: toml::de::Error| Error::ConfigParse {
-                origin: format!("{origin} (with --set overrides)"),
-                message: plain_types(e.message().trim()),
-            })?;
+        let mut cfg: Config =
+            table
+                .try_into()
+                .map_err(|e: toml::de::Error| Error::ConfigParse {
+                    origin: format!("{origin} (with --set overrides)"),
+                    message: plain_types(e.message().trim()),
+                })?;
+        if let Some(b) = cfg.body.as_mut() {
+            b.halves = halves;
+        }
         cfg.validate()?;
         Ok(cfg)
     }
@@ -585,6 +607,7 @@ impl Config {
             rear,
             front,
             joint: c.joint,
+            general: self.body.as_ref().and_then(|b| b.halves),
         }
     }
 

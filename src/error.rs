@@ -27,6 +27,14 @@ pub enum Error {
         line: usize,
         message: String,
     },
+    /// A robot description (`body.urdf`, `body.mjcf`) catflip cannot read or model.
+    #[error("{file}, line {line}, {element}: {message}")]
+    Import {
+        file: String,
+        line: usize,
+        element: String,
+        message: String,
+    },
     #[error("{what}: the solver stopped with status {status}. {hint}")]
     Solver {
         what: String,
@@ -71,6 +79,7 @@ impl Error {
                 | Error::Range { .. }
                 | Error::Usage(_)
                 | Error::Schedule { .. }
+                | Error::Import { .. }
                 | Error::OutputDir { .. }
         )
     }

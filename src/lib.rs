@@ -12,6 +12,7 @@ pub mod config;
 pub mod design;
 pub mod error;
 pub mod export;
+pub mod import;
 pub mod interrupt;
 pub mod model;
 pub mod output;

@@ -660,6 +660,7 @@ pub fn run(cfg: &Config, mut progress: impl FnMut(Progress)) -> Result<RunResult
         rear: cat.rear,
         front: cat.front,
         joint: summary.joint,
+        boxes: report::animation::boxes(&cat),
         norm: norm_name.clone(),
         max_torque_nm: cfg.limits.max_torque,
         tracks,

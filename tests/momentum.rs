@@ -77,16 +77,17 @@ fn bodies<T: Real>(cat: &Cat, q: [T; 2], qd: [T; 2], w: [T; 3]) -> (T, [T; 3]) {
     let half = T::from(0.5);
     let mut e = T::zero();
     let mut l = [T::zero(); 3];
+    let halves = cat.halves();
     for (share, h, rate, frame) in [
         (
             -cat.front.mass / m,
-            &cat.rear,
+            &halves.rear,
             w,
             catflip::model::small::eye3::<T>(),
         ),
         (
             cat.rear.mass / m,
-            &cat.front,
+            &halves.front,
             [w[0] + w_rel[0], w[1] + w_rel[1], w[2] + w_rel[2]],
             r,
         ),

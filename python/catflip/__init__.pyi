@@ -208,10 +208,13 @@ class Simulation:
     def to_csv(self) -> str:
         """The CLI's ``simulation.csv``."""
 
-def simulate(config: Config, design: Union[Design, str, os.PathLike[str], None] = None) -> Simulation:
+def simulate(config: Config, design: Union[Design, str, os.PathLike[str], None] = None,
+             start: Optional[Dict[str, Value]] = None) -> Simulation:
     """Simulates ``design`` (a Design, a schedule CSV path, or None for the analytic schedule)
     on ``config``'s cat, as ``catflip simulate [--schedule FILE]``, with the GIL released.
-    ``config`` may differ from the design's (model error). Raises ConfigError, DesignError."""
+    ``config`` may differ from the design's (model error); ``start`` sets its ``[start]`` keys
+    (``{"angular_velocity": [0, 0, 0.5], "rotation_deg": [0, 30, 0]}``) for this simulation,
+    with the CLI's checks. Raises ConfigError, DesignError."""
 
 class LeastHeight:
     """The robot builder's answer: can the motors flip the cat from ``fall.height``, and the

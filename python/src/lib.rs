@@ -423,7 +423,11 @@ fn run_design(
                         )));
                     }
                 };
-                let r = catflip::design::free::optimize(&cfg, seed, |_| {}).map_err(err)?;
+                let r = catflip::design::free::FreeDesign::new(&cfg)
+                    .seed(seed)
+                    .check_mesh()
+                    .solve()
+                    .map_err(err)?;
                 let sched = sample(&r.plan);
                 let status = Status::from(r.status);
                 let reason = judged(
@@ -718,15 +722,29 @@ enum Subject {
 
 /// Simulates `design` (a Design, a schedule CSV path, or None for the analytic
 /// schedule) on `config`'s cat, as `catflip simulate [--schedule FILE]`, with the GIL released.
-/// `config` may differ from the design's (model error). Raises ConfigError, DesignError.
+/// `config` may differ from the design's (model error); `start` sets its `[start]` keys
+/// (`{"angular_velocity": [0, 0, 0.5], "rotation_deg": [0, 30, 0]}`) for this simulation,
+/// with the CLI's checks. Raises ConfigError, DesignError.
 #[pyfunction]
-#[pyo3(signature = (config, design = None))]
+#[pyo3(signature = (config, design = None, start = None))]
 fn simulate(
     py: Python<'_>,
     config: &Config,
     design: Option<&Bound<'_, PyAny>>,
+    start: Option<&Bound<'_, PyDict>>,
 ) -> PyResult<Simulation> {
-    let (_, cfg) = config.snapshot();
+    let (mut source, mut cfg) = config.snapshot();
+    if let Some(start) = start {
+        // each `[start]` key as `--set start.KEY=VALUE`, the CLI's checks
+        for (k, v) in start.iter() {
+            source.overrides.push(format!(
+                "start.{}={}",
+                k.extract::<String>()?,
+                toml_text(&v)?
+            ));
+        }
+        cfg = source.load(None).map_err(err)?;
+    }
     let subject = match design {
         None => Subject::Analytic,
         Some(d) => match d.cast::<Design>() {

@@ -366,3 +366,21 @@ def test_everything_public_has_a_docstring_and_a_stub():
                     continue
                 assert (getattr(obj, attr).__doc__ or "").strip(), f"{name}.{attr} has no docstring"
                 assert attr in members, f"{name}.{attr} has no stub"
+
+
+def test_simulate_from_another_start_equals_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    cfg = catflip.Config.from_toml(seed)
+    d = catflip.design(cfg, "phased")
+    path = tmp_path / "phased.csv"
+    path.write_text(d.to_csv())
+    status, stdout, _ = cli("simulate", seed, "--schedule", path, "--set", "start.angular_velocity=[0,0,0.5]",
+                            "--json", out=tmp_path)
+    assert status in (0, 3)
+    s = catflip.simulate(cfg, path, start={"angular_velocity": [0, 0, 0.5]})
+    assert_close(json.loads(stdout), s.to_dict())
+    # the spin changes the landing; the config itself is left at rest
+    assert abs(s.flip_deg - catflip.simulate(cfg, path).flip_deg) > 1.0
+    assert cfg.overrides == []
+    with pytest.raises(catflip.ConfigError, match="start"):
+        catflip.simulate(cfg, d, start={"angular_velocity": [0, 0, 500]})

@@ -87,6 +87,7 @@ const SEED_TWIST_TOL: f64 = 1e-8;
 /// holds for unequal halves too, each being a cylinder about its own axis)
 /// and the torque is invariant under time reversal, so the unfold reuses the
 /// fold's timing reversed (the discrete SOCP has the same symmetry, tested).
+/// General halves (`[body]`) break it: their unfold is solved on its own path.
 pub fn design_at(cat: &Cat, problem: &mut TimingProblem, bend: f64) -> Result<BendDesign> {
     design_to(cat, problem, bend, TWIST_TOL)
 }
@@ -106,8 +107,9 @@ fn design_to(
         twist = twist_to(cat, bend, twist_tol)?;
         let [_, twist_path, unfold_path] = Path::phased(bend, twist);
         Ok(match cat.joint {
-            Joint::NoTwist => vec![twist_path],
-            Joint::Universal => vec![twist_path, unfold_path],
+            Joint::NoTwist if cat.is_axisymmetric() => vec![twist_path],
+            // general halves break the symmetry: the unfold is a program of its own
+            _ => vec![twist_path, unfold_path],
         })
     })?;
     let mut solved = solved.into_iter();

@@ -24,6 +24,50 @@ pub(crate) fn speed_limit(cfg: &Config) -> Option<f64> {
     cfg.limits.max_speed.or(cfg.limits.no_load_speed)
 }
 
+/// One half as the model files write it: the rigid body, and its cylinder
+/// when the config gives cylinders (drawn as such; else the inertia box).
+pub struct Shape {
+    pub rigid: crate::model::Rigid,
+    pub cylinder: Option<Half>,
+}
+
+impl Shape {
+    /// The inertia-equivalent box: edges (m) and the roll-pitch-yaw of its
+    /// principal axes in the half's frame.
+    pub fn inertia_box(&self) -> ([f64; 3], [f64; 3]) {
+        let (_, axes) = self.rigid.principal();
+        let mut r = axes;
+        if r.determinant() < 0.0 {
+            r.column_mut(2).neg_mut();
+        }
+        let rot = nalgebra::Rotation3::from_matrix_unchecked(r);
+        let (roll, pitch, yaw) = rot.euler_angles();
+        (self.rigid.box_edges(), [roll, pitch, yaw])
+    }
+}
+
+/// Both halves as [`Shape`]s.
+pub fn shapes(cfg: &Config) -> [Shape; 2] {
+    let cat = cfg.cat();
+    let h = cat.halves();
+    let cyl = |c: Half| cat.general.is_none().then_some(c);
+    [
+        Shape {
+            rigid: h.rear,
+            cylinder: cyl(cat.rear),
+        },
+        Shape {
+            rigid: h.front,
+            cylinder: cyl(cat.front),
+        },
+    ]
+}
+
+/// A vector as a model file writes it: `x y z`.
+pub(crate) fn v3(v: [f64; 3]) -> String {
+    format!("{} {} {}", f(v[0]), f(v[1]), f(v[2]))
+}
+
 /// Numbers in model files: the shortest text that reads back to the same f64.
 pub(crate) fn f(x: f64) -> String {
     format!("{x}")

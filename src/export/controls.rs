@@ -401,7 +401,7 @@ mod tests {
         let wbd = add3(wd, add3(cross(w, re(&wr)), d1(&wr)));
         let r = rel.map(|row| row.map(|v| v.re));
         let ib = mat_mul(
-            &mat_mul(&r, &Cat::body_inertia::<f64>(&cat.front)),
+            &mat_mul(&r, &Cat::body_inertia::<f64>(&cat.halves().front)),
             &transpose(&r),
         );
         // I wd + w x I w = torque + (joint - B) x F, joint - B = -s

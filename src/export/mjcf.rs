@@ -1,20 +1,61 @@
 //! The cat as an MJCF model for MuJoCo.
 
-use super::common::{Half, dc_motor, f, halves, torque_limit};
+use super::common::{Shape, dc_motor, f, shapes, torque_limit, v3};
 use super::controls::{Simulator, time_step};
 use crate::config::Config;
 use crate::model::Joint;
 
-/// `<inertial>` and `<geom>` of one half whose centre of mass is at `z` on its own axis.
-fn body_parts(h: &Half, z: f64) -> String {
+/// `<inertial>` and `<geom>` of one half whose body frame has its origin at
+/// `origin` (a point of the half's frame).
+fn body_parts(shape: &Shape, origin: [f64; 3]) -> String {
+    let r = &shape.rigid;
+    let i = &r.inertia;
+    let com = std::array::from_fn(|k| r.com[k] - origin[k]);
+    let diagonal = [i[0][1], i[0][2], i[1][2]] == [0.0; 3];
+    let inertia = if diagonal {
+        format!(
+            "diaginertia=\"{} {} {}\"",
+            f(i[0][0]),
+            f(i[1][1]),
+            f(i[2][2])
+        )
+    } else {
+        format!(
+            "fullinertia=\"{} {} {} {} {} {}\"",
+            f(i[0][0]),
+            f(i[1][1]),
+            f(i[2][2]),
+            f(i[0][1]),
+            f(i[0][2]),
+            f(i[1][2])
+        )
+    };
+    let geom = match shape.cylinder {
+        Some(h) => format!(
+            "type=\"cylinder\" size=\"{r} {hl}\" pos=\"{c}\"",
+            r = f(h.radius),
+            hl = f(h.length / 2.0),
+            c = v3(com)
+        ),
+        None => {
+            let (edges, rpy) = shape.inertia_box();
+            let rot = nalgebra::Rotation3::from_euler_angles(rpy[0], rpy[1], rpy[2]);
+            let q = nalgebra::UnitQuaternion::from_rotation_matrix(&rot);
+            format!(
+                "type=\"box\" size=\"{h}\" pos=\"{c}\" quat=\"{w} {x} {y} {z}\"",
+                h = v3(edges.map(|e| (e / 2.0).max(1e-6))),
+                c = v3(com),
+                w = f(q.w),
+                x = f(q.i),
+                y = f(q.j),
+                z = f(q.k)
+            )
+        }
+    };
     format!(
-        "      <inertial pos=\"0 0 {z}\" mass=\"{m}\" diaginertia=\"{it} {it} {ia}\"/>\n      <geom type=\"cylinder\" size=\"{r} {hl}\" pos=\"0 0 {z}\" mass=\"0\"/>\n",
-        z = f(z),
-        m = f(h.mass),
-        it = f(h.i_t()),
-        ia = f(h.i_a()),
-        r = f(h.radius),
-        hl = f(h.length / 2.0),
+        "      <inertial pos=\"{c}\" mass=\"{m}\" {inertia}/>\n      <geom {geom} mass=\"0\"/>\n",
+        c = v3(com),
+        m = f(r.mass),
     )
 }
 
@@ -58,7 +99,7 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
 /// `forcerange` of every motor (unless a torque-speed line makes it speed
 /// dependent, which MJCF motors cannot say; the header comment then states it).
 pub fn mjcf(cfg: &Config) -> String {
-    let [rear, front] = halves(cfg);
+    let [rear, front] = shapes(cfg);
     let (dt, _) = time_step(cfg.available_time(), Simulator::Mujoco.target_step());
     // A box on the torque is exact only without a torque-speed line; with one
     // (|tau + k w| <= T) the replay clips to the envelope itself.
@@ -74,7 +115,8 @@ pub fn mjcf(cfg: &Config) -> String {
         .unwrap_or_default();
     let (joints, actuators) = match cfg.cat.joint {
         Joint::Universal => (
-            "      <!-- universal joint: motor1 about the rear's x, then motor2 about the rotated y -->\n      <joint name=\"motor1\" type=\"hinge\" axis=\"1 0 0\"/>\n      <joint name=\"motor2\" type=\"hinge\" axis=\"0 1 0\"/>\n".to_string(),
+            format!("      <!-- universal joint: motor1 about the rear's axis, then motor2 about the front's, turned by motor1 -->\n      <joint name=\"motor1\" type=\"hinge\" axis=\"{}\"/>\n      <joint name=\"motor2\" type=\"hinge\" axis=\"{}\"/>\n",
+            v3(rear.rigid.axis), v3(front.rigid.axis)),
             match dc_motor(cfg) {
                 Some(dc) => format!(
                     "    <!-- DC motors: force = ctrl - k qd (back-EMF), ctrl limited to the stall torque -->\n    <general name=\"tau1\" joint=\"motor1\"{dc}/>\n    <general name=\"tau2\" joint=\"motor2\"{dc}/>\n"
@@ -120,7 +162,7 @@ pub fn mjcf(cfg: &Config) -> String {
          pose, belly (its x) up; the keyframe "start" adds the release velocities -->
     <body name="rear" pos="0 0 {height}" quat="{quat}">
       <freejoint name="fall"/>
-{rear_parts}      <body name="front" pos="0 0 {joint_z}">
+{rear_parts}      <body name="front" pos="{joint_at}">
 {joints}{front_parts}      </body>
     </body>
   </worldbody>
@@ -139,9 +181,9 @@ pub fn mjcf(cfg: &Config) -> String {
         joint = cfg.cat.joint.name(),
         g = f(cfg.fall.gravity),
         height = f(cfg.fall.height),
-        joint_z = f(rear.length / 2.0),
+        joint_at = v3(rear.rigid.joint),
         motor_note = motor_note(cfg),
-        rear_parts = body_parts(&rear, 0.0),
-        front_parts = body_parts(&front, front.length / 2.0),
+        rear_parts = body_parts(&rear, [0.0; 3]),
+        front_parts = body_parts(&front, front.rigid.joint),
     )
 }

@@ -16,7 +16,7 @@ pub mod mjcf;
 pub mod start;
 pub mod urdf;
 
-pub use common::halves;
+pub use common::{Shape, halves, shapes};
 
 pub use mjcf::mjcf;
 pub use urdf::urdf;

@@ -36,9 +36,13 @@ pub fn base_start(cfg: &Config) -> BaseStart {
     let s = cfg.start.start();
     let r = world_map() * s.rotation();
     let w = Vector3::from(s.body_rate);
-    // A's centre of mass from the common one: -(m_B / m) d, d along A's z
-    let d = 0.5 * (cat.rear.length + cat.front.length);
-    let r_a = Vector3::new(0.0, 0.0, -cat.front.mass / cat.mass() * d);
+    // A's centre of mass from the common one: -(m_B / m) d, with d from A's
+    // to B's centre of mass in the straight cat; the free joint moves A's
+    // frame origin, c_A from that centre (general halves, docs/model.md 3a)
+    let h = cat.halves();
+    let v3 = |a: [f64; 3]| Vector3::from(a);
+    let d = v3(h.rear.com_to_joint()) - v3(h.front.com_to_joint());
+    let r_a = d * (-h.front.mass / cat.mass()) - v3(h.rear.com);
     let v = r * w.cross(&r_a);
     let ww = r * w;
     BaseStart {

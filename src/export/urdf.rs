@@ -1,9 +1,8 @@
 //! The cat as a URDF for pyBullet (the seed's simulator); the universal one
 //! also loads in MuJoCo.
 
-use super::common::{f, halves, speed_limit, torque_limit};
+use super::common::{Shape, f, shapes, speed_limit, torque_limit, v3};
 use crate::config::Config;
-use crate::model::Half;
 use crate::model::Joint;
 
 /// Mass and inertia of the universal joint's `cross` link (massless in the
@@ -20,26 +19,44 @@ const NO_SPEED_LIMIT: f64 = 1e3;
 /// Effort written when the config has no torque limit, N m.
 const NO_TORQUE_LIMIT: f64 = 1e3;
 
-fn inertial(m: f64, it: f64, ia: f64, z: f64) -> String {
+fn inertial(m: f64, com: [f64; 3], i: &[[f64; 3]; 3]) -> String {
     format!(
-        "    <inertial>\n      <origin xyz=\"0 0 {z}\" rpy=\"0 0 0\"/>\n      <mass value=\"{m}\"/>\n      <inertia ixx=\"{it}\" ixy=\"0\" ixz=\"0\" iyy=\"{it}\" iyz=\"0\" izz=\"{ia}\"/>\n    </inertial>\n",
-        z = f(z),
+        "    <inertial>\n      <origin xyz=\"{c}\" rpy=\"0 0 0\"/>\n      <mass value=\"{m}\"/>\n      <inertia ixx=\"{}\" ixy=\"{}\" ixz=\"{}\" iyy=\"{}\" iyz=\"{}\" izz=\"{}\"/>\n    </inertial>\n",
+        f(i[0][0]),
+        f(i[0][1]),
+        f(i[0][2]),
+        f(i[1][1]),
+        f(i[1][2]),
+        f(i[2][2]),
+        c = v3(com),
         m = f(m),
-        it = f(it),
-        ia = f(ia)
     )
 }
 
-fn link(name: &str, h: &Half, z: f64) -> String {
-    let geometry = format!(
-        "<origin xyz=\"0 0 {z}\"/><geometry><cylinder radius=\"{r}\" length=\"{l}\"/></geometry>",
-        z = f(z),
-        r = f(h.radius),
-        l = f(h.length)
-    );
+/// One half's link, its frame's origin at `origin` (a point of the half's frame).
+fn link(name: &str, shape: &Shape, origin: [f64; 3]) -> String {
+    let r = &shape.rigid;
+    let com = std::array::from_fn(|k| r.com[k] - origin[k]);
+    let geometry = match shape.cylinder {
+        Some(h) => format!(
+            "<origin xyz=\"{c}\"/><geometry><cylinder radius=\"{r}\" length=\"{l}\"/></geometry>",
+            c = v3(com),
+            r = f(h.radius),
+            l = f(h.length)
+        ),
+        None => {
+            let (edges, rpy) = shape.inertia_box();
+            format!(
+                "<origin xyz=\"{c}\" rpy=\"{rpy}\"/><geometry><box size=\"{e}\"/></geometry>",
+                c = v3(com),
+                rpy = v3(rpy),
+                e = v3(edges)
+            )
+        }
+    };
     format!(
         "  <link name=\"{name}\">\n{}    <visual>{geometry}</visual>\n    <collision>{geometry}</collision>\n  </link>\n",
-        inertial(h.mass, h.i_t(), h.i_a(), z)
+        inertial(r.mass, com, &r.inertia)
     )
 }
 
@@ -47,13 +64,14 @@ fn revolute(
     name: &str,
     parent: &str,
     child: &str,
-    z: f64,
-    axis: &str,
+    at: [f64; 3],
+    axis: [f64; 3],
     (effort, speed): (f64, f64),
 ) -> String {
     format!(
-        "  <joint name=\"{name}\" type=\"revolute\">\n    <parent link=\"{parent}\"/>\n    <child link=\"{child}\"/>\n    <origin xyz=\"0 0 {z}\"/>\n    <axis xyz=\"{axis}\"/>\n    <limit lower=\"{lo}\" upper=\"{hi}\" effort=\"{effort}\" velocity=\"{v}\"/>\n  </joint>\n",
-        z = f(z),
+        "  <joint name=\"{name}\" type=\"revolute\">\n    <parent link=\"{parent}\"/>\n    <child link=\"{child}\"/>\n    <origin xyz=\"{at}\"/>\n    <axis xyz=\"{axis}\"/>\n    <limit lower=\"{lo}\" upper=\"{hi}\" effort=\"{effort}\" velocity=\"{v}\"/>\n  </joint>\n",
+        at = v3(at),
+        axis = v3(axis),
         lo = f(-std::f64::consts::PI),
         hi = f(std::f64::consts::PI),
         effort = f(effort),
@@ -63,7 +81,8 @@ fn revolute(
 
 /// URDF text of the cat of `cfg`.
 pub fn urdf(cfg: &Config) -> String {
-    let [rear, front] = halves(cfg);
+    let [rear, front] = shapes(cfg);
+    let joint = rear.rigid.joint;
     // URDF's effort is one bound on |tau|: the stall torque, or with a
     // torque-speed line the most the envelope allows (braking at the speed limit).
     let speed = speed_limit(cfg).unwrap_or(NO_SPEED_LIMIT);
@@ -80,32 +99,43 @@ pub fn urdf(cfg: &Config) -> String {
             .unwrap_or_else(|| "none: 1000 N m written".into()),
         note = super::mjcf::motor_note(cfg),
     );
-    s.push_str(&link("rear", &rear, 0.0));
+    s.push_str(&link("rear", &rear, [0.0; 3]));
     match cfg.cat.joint {
         Joint::Universal => {
-            let (m, i) = (CROSS_FRACTION * rear.mass, CROSS_FRACTION * rear.i_a());
+            let (m, i) = (
+                CROSS_FRACTION * rear.rigid.mass,
+                CROSS_FRACTION * rear.rigid.inertia[2][2],
+            );
             s.push_str(&format!(
                 "  <!-- the universal joint's cross: massless in the model; a negligible mass and inertia ({CROSS_FRACTION:e}\n       of a half's mass and axial inertia) because simulators need every moving link massive -->\n  <link name=\"cross\">\n{}  </link>\n",
-                inertial(m, i, i, 0.0)
+                inertial(m, [0.0; 3], &[[i, 0.0, 0.0], [0.0, i, 0.0], [0.0, 0.0, i]])
             ));
             s.push_str(&revolute(
                 "motor1",
                 "rear",
                 "cross",
-                rear.length / 2.0,
-                "1 0 0",
+                joint,
+                rear.rigid.axis,
                 limits,
             ));
-            s.push_str(&revolute("motor2", "cross", "front", 0.0, "0 1 0", limits));
+            s.push_str(&revolute(
+                "motor2",
+                "cross",
+                "front",
+                [0.0; 3],
+                front.rigid.axis,
+                limits,
+            ));
         }
         Joint::NoTwist => {
             s.push_str(&format!(
-                "  <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)). type=\"spherical\" is a\n       pyBullet extension (3 DoF, torque in the front link's frame, see *.pybullet.csv) -->\n  <joint name=\"spine\" type=\"spherical\">\n    <parent link=\"rear\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"0 0 {}\"/>\n    <axis xyz=\"0 0 1\"/>\n  </joint>\n",
-                f(rear.length / 2.0)
+                "  <!-- Kane & Scher no-twist joint: relative rotation exp(hat(q1, q2, 0)). type=\"spherical\" is a\n       pyBullet extension (3 DoF, torque in the front link's frame, see *.pybullet.csv) -->\n  <joint name=\"spine\" type=\"spherical\">\n    <parent link=\"rear\"/>\n    <child link=\"front\"/>\n    <origin xyz=\"{}\"/>\n    <axis xyz=\"0 0 1\"/>\n  </joint>\n",
+                v3(joint)
             ));
         }
     }
-    s.push_str(&link("front", &front, front.length / 2.0));
+    // the front link's frame: parallel to the rear's, its origin at the joint
+    s.push_str(&link("front", &front, front.rigid.joint));
     // MuJoCo reads this (pyBullet ignores it): keep the root link as a body of its own.
     s.push_str("  <mujoco><compiler fusestatic=\"false\" discardvisual=\"true\"/></mujoco>\n");
     s.push_str("</robot>\n");

@@ -154,9 +154,10 @@ pub fn angular_momentum(
     let d_world = mat_vec(&ra, d);
     let m = cat.mass();
     let mut l = [0.0; 3];
+    let h = cat.halves();
     for (rot, half, share) in [
-        (ra, &cat.rear, -cat.front.mass / m),
-        (rb, &cat.front, cat.rear.mass / m),
+        (ra, &h.rear, -h.front.mass / m),
+        (rb, &h.front, h.rear.mass / m),
     ] {
         let ic = Cat::body_inertia::<f64>(half);
         let r = scale3(D::from(share), d_world);

@@ -21,10 +21,12 @@ pub mod body;
 pub mod dynamics;
 pub mod momentum;
 pub mod motor;
+pub mod rigid;
 pub mod small;
 pub mod so3;
 
 pub use body::{Half, InertiaFormula};
+pub use rigid::{Halves, Rigid};
 
 use crate::model::small::*;
 use nalgebra::{Const, U1};
@@ -86,9 +88,13 @@ impl TorqueNorm {
 /// reference) and front half B.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Cat {
+    /// The rear half's cylinder; with `general` halves, the equivalent
+    /// cylinder ([`Rigid::equivalent_cylinder`]) for scales and drawings.
     pub rear: Half,
     pub front: Half,
     pub joint: Joint,
+    /// General rigid halves (`[body]`); `None`: the cylinders `rear` and `front`.
+    pub general: Option<Halves>,
 }
 
 impl Cat {
@@ -98,43 +104,94 @@ impl Cat {
             rear: half,
             front: half,
             joint,
+            general: None,
         }
     }
 
-    /// Whether both halves are the same cylinder (the seed's closed forms are exact only then).
+    /// General rigid halves: `rear` and `front` become their equivalent cylinders.
+    pub fn rigid(halves: Halves, joint: Joint) -> Cat {
+        Cat {
+            rear: halves.rear.equivalent_cylinder(),
+            front: halves.front.equivalent_cylinder(),
+            joint,
+            general: Some(halves),
+        }
+    }
+
+    /// The halves as rigid bodies: the general ones, or the cylinders' exactly.
+    pub fn halves(&self) -> Halves {
+        self.general
+            .unwrap_or_else(|| Halves::of_cylinders(&self.rear, &self.front))
+    }
+
+    /// The same cat with the halves' roles exchanged (docs/model.md, relabelling).
+    pub fn swapped(&self) -> Cat {
+        let h = self.halves().swapped();
+        Cat {
+            rear: self.front,
+            front: self.rear,
+            joint: self.joint,
+            general: Some(h),
+        }
+    }
+
+    /// Whether the halves are mirror images, axisymmetric about the spine
+    /// (the seed's identical cylinders): the seed's closed forms are exact only then.
     pub fn is_symmetric(&self) -> bool {
-        self.rear == self.front
+        match self.general {
+            None => self.rear == self.front,
+            Some(h) => h.is_mirror_pair(),
+        }
     }
 
-    /// Transverse inertia of a half, `I_t`; with unequal halves, the mean of the two
-    /// (used only by the seed's closed forms, which assume identical halves).
+    /// Whether both halves are axisymmetric about the spine, so that the
+    /// model is (`M(R q) = R M(q) R'` for the no-twist joint; docs/model.md).
+    pub fn is_axisymmetric(&self) -> bool {
+        self.general.is_none_or(|h| h.is_axisymmetric())
+    }
+
+    /// Transverse inertia of a half, `I_t` (for a general half the mean of
+    /// `I_xx` and `I_yy`); with unequal halves, the mean of the two
+    /// (used only by the seed's closed forms and as a scale).
     pub fn i_t(&self) -> f64 {
-        0.5 * (self.rear.i_t() + self.front.i_t())
+        let h = self.halves();
+        let t = |r: &Rigid| 0.5 * (r.inertia[0][0] + r.inertia[1][1]);
+        0.5 * (t(&h.rear) + t(&h.front))
     }
 
-    /// Axial inertia of a half, `I_a`; with unequal halves, the mean of the two.
+    /// Axial inertia of a half, `I_a` (`I_zz`); with unequal halves, the mean of the two.
     pub fn i_a(&self) -> f64 {
-        0.5 * (self.rear.i_a() + self.front.i_a())
+        let h = self.halves();
+        0.5 * (h.rear.inertia[2][2] + h.front.inertia[2][2])
     }
 
     /// Total mass, kg.
     pub fn mass(&self) -> f64 {
-        self.rear.mass + self.front.mass
+        let h = self.halves();
+        h.rear.mass + h.front.mass
     }
 
     /// Reduced mass of the pair, `m_A m_B / (m_A + m_B)`.
     pub fn reduced_mass(&self) -> f64 {
-        self.rear.mass * self.front.mass / self.mass()
+        let h = self.halves();
+        h.rear.mass * h.front.mass / self.mass()
     }
 
     /// `M(0)`, the straight cat's mass matrix (a multiple of the identity by
     /// axisymmetry), in closed form: with `a = l_A/2`, `b = l_B/2`, `D = a + b`
     /// and `mu` the reduced mass,
     /// `M(0) = I_tB + mu b^2 - (I_tB + mu D b)^2 / (I_tA + I_tB + mu D^2)`,
-    /// which is `I_t / 2` for identical halves.
+    /// which is `I_t / 2` for identical halves. General halves break the
+    /// axisymmetry and `M(0)` has two eigenvalues: their mean (a scale for
+    /// units and gains).
     pub fn straight_inertia(&self) -> f64 {
-        let (ita, itb) = (self.rear.i_t(), self.front.i_t());
-        let (a, b) = (self.rear.half_length(), self.front.half_length());
+        let h = self.halves();
+        if !h.is_axisymmetric() {
+            let (m, _) = self.locked_terms::<f64>([0.0, 0.0]);
+            return 0.5 * (m[0][0] + m[1][1]);
+        }
+        let (ita, itb) = (h.rear.inertia[0][0], h.front.inertia[0][0]);
+        let (a, b) = (h.rear.com_to_joint()[2], -h.front.com_to_joint()[2]);
         let (d, mu) = (a + b, self.reduced_mass());
         itb + mu * b * b - (itb + mu * d * b).powi(2) / (ita + itb + mu * d * d)
     }
@@ -143,7 +200,13 @@ impl Cat {
     pub fn rel_rotation<T: Real>(&self, q: [T; 2]) -> M3<T> {
         match self.joint {
             Joint::NoTwist => exp_so3([q[0], q[1], T::zero()]),
-            Joint::Universal => mat_mul(&rot_x(q[0]), &rot_y(q[1])),
+            Joint::Universal => {
+                let h = self.halves();
+                mat_mul(
+                    &rot_about(h.rear.axis, q[0]),
+                    &rot_about(h.front.axis, q[1]),
+                )
+            }
         }
     }
 
@@ -155,27 +218,27 @@ impl Cat {
                 [jl[0], jl[1]]
             }
             Joint::Universal => {
-                let z = T::zero();
-                [[T::one(), z, z], [z, q[0].cos(), q[0].sin()]]
+                // motor 1's axis is fixed in A; motor 2's turns with motor 1
+                let h = self.halves();
+                let (a1, a2) = (h.rear.axis.map(c::<T>), h.front.axis.map(c::<T>));
+                [a1, mat_vec(&rot_about(h.rear.axis, q[0]), a2)]
             }
         }
     }
 
-    /// Joint-to-B vector `s` and A-to-B vector `d`, both in A's frame.
+    /// Joint-to-B vector `s` and A-to-B vector `d` (centres of mass), both in A's frame.
     pub fn offsets<T: Real>(&self, rel: &M3<T>) -> (V3<T>, V3<T>) {
-        let b = c::<T>(self.front.half_length());
-        let s = [rel[0][2] * b, rel[1][2] * b, rel[2][2] * b];
-        let d = [s[0], s[1], s[2] + c::<T>(self.rear.half_length())];
+        let h = self.halves();
+        let b = h.front.com_to_joint().map(|x| c::<T>(-x));
+        let s = mat_vec(rel, b);
+        let a = h.rear.com_to_joint();
+        let d = std::array::from_fn(|i| s[i] + c::<T>(a[i]));
         (s, d)
     }
 
-    /// Principal inertia of a half in its own frame.
-    pub fn body_inertia<T: Real>(half: &Half) -> M3<T> {
-        let mut m = zero3();
-        m[0][0] = c(half.i_t());
-        m[1][1] = c(half.i_t());
-        m[2][2] = c(half.i_a());
-        m
+    /// Inertia tensor of a half about its centre of mass, in its own frame.
+    pub fn body_inertia<T: Real>(half: &Rigid) -> M3<T> {
+        half.inertia.map(|row| row.map(c::<T>))
     }
 
     /// Reduced mass matrix `M(q)` and connection `A(q) = J^-1 K` (body rate `w_A = -A q_dot`).
@@ -203,9 +266,10 @@ impl Cat {
     fn locked_parts_of<T: Real>(&self, rel: &M3<T>) -> (M3<T>, M3<T>, M3<T>) {
         let (s, d) = self.offsets(rel);
         let mu = c::<T>(self.reduced_mass());
-        let ic = Self::body_inertia::<T>(&self.rear);
+        let h = self.halves();
+        let ic = Self::body_inertia::<T>(&h.rear);
         let ib = mat_mul(
-            &mat_mul(rel, &Self::body_inertia::<T>(&self.front)),
+            &mat_mul(rel, &Self::body_inertia::<T>(&h.front)),
             &transpose(rel),
         );
         let gram = |a: V3<T>, b: V3<T>| {
@@ -273,6 +337,22 @@ fn left_jacobian_columns<T: Real>(v: V3<T>) -> [V3<T>; 3] {
         &mat_scale(c, &mat_mul(&h, &h)),
     );
     [0, 1, 2].map(|k| [jl[0][k], jl[1][k], jl[2][k]])
+}
+
+/// Rotation by `a` about the unit axis `n`: the coordinate axes by their
+/// own formulas (exactly the cylinders' numbers), any other by Rodrigues.
+fn rot_about<T: Real>(n: [f64; 3], a: T) -> M3<T> {
+    match n {
+        [1.0, 0.0, 0.0] => rot_x(a),
+        [0.0, 1.0, 0.0] => rot_y(a),
+        _ => {
+            let k = hat(n.map(c::<T>));
+            mat_add(
+                &mat_add(&eye3(), &mat_scale(a.sin(), &k)),
+                &mat_scale(T::one() - a.cos(), &mat_mul(&k, &k)),
+            )
+        }
+    }
 }
 
 fn rot_x<T: Real>(a: T) -> M3<T> {
@@ -466,6 +546,7 @@ mod tests {
                     rear: c.front,
                     front: c.rear,
                     joint,
+                    general: None,
                 }
             }] {
                 let t = ShapeTerms::second(&cat, [0.0, 0.0]);

@@ -47,9 +47,42 @@ pub struct Scene {
     pub rear: Half,
     pub front: Half,
     pub joint: &'static str,
+    /// General halves (`[body]`), drawn as their inertia-equivalent boxes
+    /// ([`boxes`]); none: the cylinders `rear` and `front`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub boxes: Option<[BoxView; 2]>,
     pub norm: String,
     pub max_torque_nm: Option<f64>,
     pub tracks: Vec<Track>,
+}
+
+/// A general half as the player draws it: the uniform box of its mass and
+/// principal moments, centred on its centre of mass.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct BoxView {
+    /// From the centre of mass to the joint, in the half's frame, m.
+    pub to_joint: [f64; 3],
+    /// Edges along the box's own axes, m.
+    pub edges: [f64; 3],
+    /// The box's axes in the half's frame, `[w, x, y, z]`.
+    pub quat: [f64; 4],
+}
+
+/// Both halves' boxes, for general halves only.
+pub fn boxes(cat: &Cat) -> Option<[BoxView; 2]> {
+    let h = cat.general?;
+    let view = |r: &crate::model::Rigid| {
+        let (_, mut axes) = r.principal();
+        if axes.determinant() < 0.0 {
+            axes.column_mut(2).neg_mut();
+        }
+        BoxView {
+            to_joint: r.com_to_joint(),
+            edges: r.box_edges(),
+            quat: quat(&Rotation3::from_matrix_unchecked(axes)),
+        }
+    };
+    Some([view(&h.rear), view(&h.front)])
 }
 
 /// Quaternion components to 1e-7 (far below a pixel), which halves the page.

@@ -64,10 +64,38 @@
     return { faces, legs };
   }
 
+  // --- a general half: its inertia-equivalent box about its centre of mass ---
+  function qmul(p, q) {
+    const [a, b, c, d] = p, [e, f, g, h] = q;
+    return [a * e - b * f - c * g - d * h, a * f + b * e + c * h - d * g,
+      a * g - b * h + c * e + d * f, a * h + b * g - c * f + d * e];
+  }
+  function box(q, centre, body) {
+    const bx = scene.boxes[body === 'A' ? 0 : 1], e = bx.edges.map(v => v / 2), qb = qmul(q, bx.quat);
+    const at = (x, y, z) => add(centre, rot(qb, [x * e[0], y * e[1], z * e[2]]));
+    const faces = [];
+    for (let k = 0; k < 3; k++) for (const sgn of [-1, 1]) {
+      const u = (k + 1) % 3, v = (k + 2) % 3, corner = (a, b) => { const p = [0, 0, 0]; p[k] = sgn; p[u] = a; p[v] = b; return at(...p); };
+      const n = [0, 0, 0]; n[k] = sgn;
+      const nw = rot(qb, n), belly = rot(q, [1, 0, 0]);
+      const back = nw[0] * belly[0] + nw[1] * belly[1] + nw[2] * belly[2];
+      faces.push({ pts: [corner(-1, -1), corner(1, -1), corner(1, 1), corner(-1, 1)], n: nw, body,
+        dark: back < -0.6 });
+    }
+    // two belly stubs on the half's +x, from the box's surface
+    const reach = [0, 1, 2].reduce((acc, k) => { const ax = [0, 0, 0]; ax[k] = 1; return acc + Math.abs(rot(bx.quat, ax)[0]) * e[k]; }, 0);
+    const legs = [-0.3, 0.3].map(z => [add(centre, rot(q, [reach, 0, z * L])), add(centre, rot(q, [reach + 0.45 * L, 0, z * L]))]);
+    return { faces, legs };
+  }
+
   // Both halves, placed so that the common centre of mass stays at the origin:
   // d runs from A's centre through the joint to B's centre.
   function pose(s) {
     const { A, B } = halves, m = A.mass + B.mass;
+    if (scene.boxes) {
+      const d = add(rot(s.a, scene.boxes[0].to_joint), rot(s.b, scale(scene.boxes[1].to_joint, -1)));
+      return [box(s.a, scale(d, -B.mass / m), 'A'), box(s.b, scale(d, A.mass / m), 'B')];
+    }
     const d = add(rot(s.a, [0, 0, A.length / 2]), rot(s.b, [0, 0, B.length / 2]));
     return [cylinder(s.a, scale(d, -B.mass / m), 'A'), cylinder(s.b, scale(d, A.mass / m), 'B')];
   }

@@ -1,0 +1,334 @@
+//! `[body] urdf = ...` / `mjcf = ...`: catflip's own exports read back give
+//! the same model to round-off; what catflip cannot model is refused with
+//! the element and its line, exit status 2, nothing written.
+
+mod util;
+
+use catflip::Config;
+use catflip::export::{mjcf, urdf};
+use catflip::model::{Cat, ShapeTerms};
+use std::path::Path;
+use util::{config, run, seed, temp_dir};
+
+/// A body with products of inertia, off-axis centres of mass, an
+/// off-centre joint and (universal) tilted motor axes, as `[body]` keys.
+pub const LOPSIDED: &str = r#"
+[body.rear]
+mass = 1.3
+com = [0.03, -0.02, 0.01]
+inertia = [[0.09, 0.004, -0.003], [0.004, 0.08, 0.006], [-0.003, 0.006, 0.03]]
+joint = [0.01, 0.02, 0.5]
+axis = [0.6, 0.8, 0.0]
+
+[body.front]
+mass = 0.7
+com = [-0.02, 0.0, 0.04]
+inertia = [0.05, 0.06, 0.02, -0.002, 0.0, 0.001]
+joint = [0.0, 0.01, -0.45]
+axis = [-0.8, 0.6, 0.0]
+"#;
+
+pub fn lopsided(joint: &str, extra: &str) -> Config {
+    let text = format!(
+        "name = \"lopsided\"\n[cat]\njoint = \"{joint}\"\n[fall]\nheight = 10.0\n{extra}\n{LOPSIDED}"
+    );
+    Config::from_toml(&text, "lopsided", &[]).unwrap()
+}
+
+/// The config reading the robot from `file` (written into `dir`).
+fn imported(dir: &Path, key: &str, file: &str, text: &str) -> catflip::Result<Config> {
+    std::fs::write(dir.join(file), text).unwrap();
+    let cfg = format!("name = \"imported\"\n[fall]\nheight = 10.0\n[body]\n{key} = \"{file}\"\n");
+    std::fs::write(dir.join("robot.toml"), cfg).unwrap();
+    Config::load(&dir.join("robot.toml"), &[])
+}
+
+/// Largest relative difference between the two models: masses, the
+/// centre-of-mass-to-joint vectors, inertias, axes, and `M`, `A` at shapes.
+fn model_difference(a: &Cat, b: &Cat) -> f64 {
+    assert_eq!(a.joint, b.joint);
+    let (ha, hb) = (a.halves(), b.halves());
+    let mut worst: f64 = 0.0;
+    let mut cmp = |x: f64, y: f64, scale: f64| {
+        worst = worst.max((x - y).abs() / scale);
+    };
+    for (p, q) in [(ha.rear, hb.rear), (ha.front, hb.front)] {
+        cmp(p.mass, q.mass, p.mass);
+        let (cp, cq) = (p.com_to_joint(), q.com_to_joint());
+        let len = cp.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let big = p
+            .inertia
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, x| m.max(x.abs()));
+        for i in 0..3 {
+            cmp(cp[i], cq[i], len);
+            if a.joint == catflip::model::Joint::Universal {
+                cmp(p.axis[i], q.axis[i], 1.0);
+            }
+            for j in 0..3 {
+                cmp(p.inertia[i][j], q.inertia[i][j], big);
+            }
+        }
+    }
+    for q in [[0.0, 0.0], [0.7, -0.4], [2.1, 1.3]] {
+        let (ta, tb) = (ShapeTerms::first(a, q), ShapeTerms::first(b, q));
+        let big = ta.m.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+        for i in 0..2 {
+            for j in 0..2 {
+                cmp(ta.m[i][j], tb.m[i][j], big);
+            }
+            for r in 0..3 {
+                cmp(ta.a[i][r], tb.a[i][r], 1.0);
+            }
+        }
+    }
+    worst
+}
+
+#[test]
+fn export_then_import_gives_the_same_model() {
+    let dir = temp_dir();
+    let mut worst: f64 = 0.0;
+    for (what, cfg) in [
+        ("seed", seed(&[])),
+        ("robot", config("robot-universal", &[])),
+        (
+            "unequal universal",
+            seed(&[
+                "cat.joint=universal",
+                "cat.front.mass=0.4",
+                "cat.front.length=1.4",
+                "cat.front.radius=0.05",
+                "limits.max_torque=3.0",
+            ]),
+        ),
+        (
+            "lopsided no-twist",
+            lopsided("no-twist", "[limits]\nmax_torque = 2.0"),
+        ),
+        ("lopsided universal", lopsided("universal", "")),
+    ] {
+        for (key, text) in [("urdf", urdf(&cfg)), ("mjcf", mjcf(&cfg))] {
+            let back = imported(dir.path(), key, &format!("robot.{key}"), &text)
+                .unwrap_or_else(|e| panic!("{what} {key}: {e}"));
+            let d = model_difference(&cfg.cat(), &back.cat());
+            assert!(d < 1e-12, "{what} {key}: the model differs by {d:e}");
+            worst = worst.max(d);
+            // the motor limit comes back as [limits] (no torque-speed line here
+            // but the robot's, whose URDF effort is the braking bound; the
+            // URDF's spherical joint carries no <limit>)
+            let spherical = key == "urdf" && cfg.cat.joint == catflip::model::Joint::NoTwist;
+            if let Some(t) = cfg.limits.max_torque
+                && cfg.limits.no_load_speed.is_none()
+                && !spherical
+            {
+                assert_eq!(back.limits.max_torque, Some(t), "{what} {key}");
+            }
+        }
+    }
+    eprintln!("export -> import: largest relative model difference {worst:e}");
+    // the check can fail: another body is told apart
+    let other = seed(&["cat.front.mass=1.01"]);
+    assert!(model_difference(&seed(&[]).cat(), &other.cat()) > 1e-4);
+}
+
+#[test]
+fn a_config_key_replaces_the_files_value_and_the_config_limits_win() {
+    let dir = temp_dir();
+    let cfg = config("robot-universal", &[]);
+    std::fs::write(dir.path().join("r.urdf"), urdf(&cfg)).unwrap();
+    let text = "name = \"r\"\n[fall]\nheight = 3.0\n[limits]\nmax_torque = 0.5\n[body]\nurdf = \"r.urdf\"\n[body.front]\nmass = 0.5\n";
+    std::fs::write(dir.path().join("r.toml"), text).unwrap();
+    let back = Config::load(&dir.path().join("r.toml"), &[]).unwrap();
+    let h = back.cat().halves();
+    assert_eq!(h.front.mass, 0.5);
+    assert_eq!(h.rear.mass, cfg.cat().halves().rear.mass);
+    assert_eq!(back.limits.max_torque, Some(0.5));
+    assert_eq!(back.cat.joint, catflip::model::Joint::Universal);
+}
+
+/// A URDF of links and joints (a `<link>`'s inertial is `mass` kg, unit-ish inertia).
+fn urdf_of(links: &[(&str, f64)], joints: &str) -> String {
+    let mut s = String::from("<?xml version=\"1.0\"?>\n<robot name=\"t\">\n");
+    for (name, m) in links {
+        if *m > 0.0 {
+            s.push_str(&format!(
+                "  <link name=\"{name}\">\n    <inertial><mass value=\"{m}\"/><inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.002\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>\n  </link>\n"
+            ));
+        } else {
+            s.push_str(&format!("  <link name=\"{name}\"/>\n"));
+        }
+    }
+    s.push_str(joints);
+    s.push_str("</robot>\n");
+    s
+}
+
+fn joint(name: &str, kind: &str, parent: &str, child: &str, xyz: &str, axis: &str) -> String {
+    format!(
+        "  <joint name=\"{name}\" type=\"{kind}\">\n    <parent link=\"{parent}\"/>\n    <child link=\"{child}\"/>\n    <origin xyz=\"{xyz}\"/>\n    <axis xyz=\"{axis}\"/>\n  </joint>\n"
+    )
+}
+
+/// Line (1-based) of the first line of `text` containing `needle`.
+fn line_of(text: &str, needle: &str) -> usize {
+    text.lines().position(|l| l.contains(needle)).unwrap() + 1
+}
+
+#[test]
+fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
+    let two = |j: &str| {
+        urdf_of(
+            &[("rear", 1.0), ("cross", 0.0), ("front", 1.0), ("tail", 0.2)],
+            j,
+        )
+    };
+    let m1 = joint("m1", "revolute", "rear", "cross", "0 0 0.1", "1 0 0");
+    let cases: Vec<(&str, String, &str, &str)> = vec![
+        (
+            "prismatic",
+            urdf_of(
+                &[("rear", 1.0), ("front", 1.0)],
+                &joint("slider", "prismatic", "rear", "front", "0 0 0.1", "0 0 1"),
+            ),
+            "<joint name=\"slider\">",
+            "prismatic",
+        ),
+        (
+            "third link",
+            two(&format!(
+                "{m1}{}{}",
+                joint("m2", "revolute", "cross", "front", "0 0 0", "0 1 0"),
+                joint("wag", "revolute", "front", "tail", "0 0 0.1", "1 0 0")
+            )),
+            "<link name=\"tail\">",
+            "third moving link",
+        ),
+        (
+            "axes apart",
+            two(&format!(
+                "{m1}{}{}",
+                joint("m2", "revolute", "cross", "front", "0 0 0.05", "0 1 0"),
+                joint("fixtail", "fixed", "front", "tail", "0 0 0.1", "1 0 0")
+            )),
+            "<joint name=\"m2\">",
+            "do not meet",
+        ),
+        (
+            "massless half",
+            urdf_of(
+                &[("rear", 1.0), ("front", 0.0)],
+                &joint("ball", "spherical", "rear", "front", "0 0 0.1", "0 0 1"),
+            ),
+            "<link name=\"front\">",
+            "without mass",
+        ),
+        (
+            "malformed",
+            "<robot name=\"t\">\n  <link name=\"rear\">\n</robot>\n".to_string(),
+            "the document",
+            "not well-formed",
+        ),
+    ];
+    for (what, text, element, why) in cases {
+        let dir = temp_dir();
+        std::fs::write(dir.path().join("robot.urdf"), &text).unwrap();
+        std::fs::write(
+            dir.path().join("robot.toml"),
+            "name = \"bad\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
+        )
+        .unwrap();
+        let (code, out, err) = run(&["run", "robot.toml", "--out", "out"], dir.path());
+        assert_eq!(code, Some(2), "{what}: {out} {err}");
+        assert!(err.contains(element), "{what}: names {element}: {err}");
+        assert!(err.contains(why), "{what}: says why ({why}): {err}");
+        let line = if element == "the document" {
+            3
+        } else {
+            line_of(&text, &element[..element.len() - 1])
+        };
+        assert!(
+            err.contains(&format!("line {line},")),
+            "{what}: names line {line}: {err}"
+        );
+        assert!(!dir.path().join("out").exists(), "{what}: nothing written");
+    }
+}
+
+#[test]
+fn mjcf_files_catflip_cannot_model_are_refused() {
+    let cfg = config("robot-universal", &[]);
+    let good = mjcf(&cfg);
+    let dir = temp_dir();
+    for (what, text, why) in [
+        (
+            "slide",
+            good.replace(
+                "type=\"hinge\" axis=\"0 1 0\"",
+                "type=\"slide\" axis=\"0 1 0\"",
+            ),
+            "slide",
+        ),
+        (
+            "parallel",
+            good.replace("axis=\"0 1 0\"", "axis=\"1 0 0\""),
+            "parallel",
+        ),
+        (
+            "no inertial",
+            good.replacen("<inertial", "<!-- <inertial", 2).replacen(
+                "\"/>\n      <geom",
+                "\"/> -->\n      <geom",
+                2,
+            ),
+            "no <inertial>",
+        ),
+    ] {
+        let e = imported(dir.path(), "mjcf", "robot.xml", &text)
+            .expect_err(what)
+            .to_string();
+        assert!(e.contains(why) && e.contains("line "), "{what}: {e}");
+    }
+}
+
+#[test]
+fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
+    let cfg = config("box-robot", &[]);
+    let cat = cfg.cat();
+    let h = cat.halves();
+    assert_eq!(cat.joint, catflip::model::Joint::Universal);
+    // every part of each half, fixed to it in the URDF, is in its rigid body
+    assert!((h.rear.mass - (0.22 + 0.11 + 0.057 + 2.0 * 0.018)).abs() < 1e-12);
+    assert!((h.front.mass - (0.18 + 0.057 + 0.03 + 2.0 * 0.018)).abs() < 1e-12);
+    // the battery puts the rear's centre of mass off the axis, and products of inertia in
+    assert!(
+        h.rear.com[0].hypot(h.rear.com[1]) > 4e-3,
+        "{:?}",
+        h.rear.com
+    );
+    assert!(h.rear.inertia[0][1].abs() > 1e-7 && h.front.inertia[0][2].abs() > 1e-7);
+    assert!(!cat.is_axisymmetric());
+    // the servos' limits from the file, the torque-speed line from the config
+    assert_eq!(cfg.limits.max_torque, Some(1.4));
+    assert_eq!(cfg.limits.max_speed, Some(5.969));
+    assert_eq!(cfg.limits.no_load_speed, Some(5.969));
+    // the robot question: from its 2 m it cannot; the least height says from where
+    let a = catflip::design::least_height::answer(&cfg)
+        .unwrap()
+        .unwrap();
+    assert!(
+        !a.possible && a.least_height_m > cfg.fall.height,
+        "{}",
+        a.least_height_m
+    );
+    assert!(a.least_height_m.is_finite() && a.flip_error_rad.abs() < 1e-6);
+    let again = config(
+        "box-robot",
+        &[&format!("fall.height={}", 1.01 * a.least_height_m)],
+    );
+    let b = catflip::design::least_height::answer(&again)
+        .unwrap()
+        .unwrap();
+    assert!(b.possible, "from 1.01 x its least height it can");
+}
