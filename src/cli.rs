@@ -44,20 +44,20 @@ struct Cli {
 }
 
 #[derive(Args, Clone)]
-struct Common {
+pub(crate) struct Common {
     /// TOML configuration (see configs/).
-    config: PathBuf,
+    pub(crate) config: PathBuf,
     /// Override a config key, e.g. `--set cat.joint=universal` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
+    pub(crate) set: Vec<String>,
     /// Print JSON instead of the table: one object (`sweep`: an array of
     /// its points; `export` has no table and lists the files it wrote
     /// either way).
     #[arg(long)]
-    json: bool,
+    pub(crate) json: bool,
     /// Folder that receives `<name>/`.
     #[arg(long, default_value = "output")]
-    out: PathBuf,
+    pub(crate) out: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -109,6 +109,24 @@ enum Command {
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
+    /// Monte Carlo study of the closed loop: open loop with joint PD against TVLQR, perturbations from `[robustness]`.
+    Robustness {
+        #[command(flatten)]
+        common: Common,
+        /// Trials (at most 1000000).
+        #[arg(long, default_value_t = 1000)]
+        trials: usize,
+        /// Seed of the study: each trial's draws follow from it and the trial's index.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Trials flown at once (default: the machine's cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// K/N: fly only the K-th of N contiguous slices of the trials; the
+        /// shards' CSVs concatenate into the whole study's.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+    },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
         #[command(flatten)]
@@ -145,7 +163,7 @@ enum SeedArg {
 }
 
 /// Loads and checks the config; likely unit slips are warned about on stderr.
-fn load(c: &Common) -> Result<Config> {
+pub(crate) fn load(c: &Common) -> Result<Config> {
     let cfg = Config::load(&c.config, &c.set)?;
     for s in cfg.slips() {
         eprintln!("warning: {s}");
@@ -160,7 +178,7 @@ fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
 /// Starts the command's output set `<out>/<name>/<set>` before any work, so
 /// that an unwritable `--out` fails at once. With `--set` overrides the set
 /// is named after them too ([`catflip::output::set_name`]).
-fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
+pub(crate) fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
     Ok(Publisher::begin(
         &out_dir(c, cfg),
         &catflip::output::set_name(set, &c.set),
@@ -212,6 +230,13 @@ pub fn run() -> Result<Status> {
             schedule,
         } => cmd_export(&common, format, schedule.as_deref()),
         Command::Analyze(c) => cmd_analyze(&c),
+        Command::Robustness {
+            common,
+            trials,
+            seed,
+            threads,
+            shard,
+        } => crate::robustness::cmd_robustness(&common, trials, seed, threads, shard.as_deref()),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
             common,
@@ -1170,6 +1195,11 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
         out.add(
             format!("{stem}.{}.csv", sim.name()),
             controls.to_csv(&cfg, &stem),
+        );
+        // the closed loop's gains along the same schedule (issue 27)
+        out.add(
+            format!("{stem}.tvlqr.csv"),
+            catflip::control::export::gains_csv(&cfg, &s),
         );
     }
     for w in publisher.publish(out)? {

@@ -10,8 +10,10 @@ use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
+mod control;
 pub mod ranges;
 mod start;
+pub use control::{ControlConfig, MAX_TRIALS, RobustnessConfig};
 pub use start::{LandConfig, MAX_START_RATE, StartConfig};
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -41,6 +43,10 @@ pub struct Config {
     pub start: StartConfig,
     #[serde(default)]
     pub land: LandConfig,
+    #[serde(default)]
+    pub control: ControlConfig,
+    #[serde(default)]
+    pub robustness: RobustnessConfig,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -573,6 +579,8 @@ impl Config {
         )?;
         self.start.validate()?;
         self.land.validate()?;
+        self.control.validate()?;
+        self.robustness.validate()?;
         ranges::check_ranges(self)?;
         ranges::impossible(self)
     }
@@ -703,7 +711,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 30] = [
+pub const UNITS: [(&str, &str); 50] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -734,6 +742,26 @@ pub const UNITS: [(&str, &str); 30] = [
     ("free.tolerance", "relative"),
     ("free.attitude_tolerance", "rad"),
     ("land.max_tilt_deg", "deg"),
+    ("control.rate_hz", "Hz"),
+    ("control.delay_ms", "ms"),
+    ("control.sim_rate_hz", "Hz"),
+    ("control.landing_weight", "weight"),
+    ("control.final_shape_weight", "weight"),
+    ("control.attitude_weight", "weight"),
+    ("control.shape_weight", "weight"),
+    ("control.rate_weight", "weight"),
+    ("control.torque_weight", "weight"),
+    ("control.max_correction", "design peak torques"),
+    ("robustness.tilt_deg", "deg"),
+    ("robustness.mass_error", "relative"),
+    ("robustness.inertia_error", "relative"),
+    ("robustness.length_error", "relative"),
+    ("robustness.delay_ms", "ms"),
+    ("robustness.torque_noise", "design peak torques"),
+    ("robustness.attitude_noise_deg", "deg"),
+    ("robustness.rate_noise_rad_s", "rad/s"),
+    ("robustness.pd_gain_error", "relative"),
+    ("robustness.worst_kept", "trials"),
 ];
 
 /// A config key with its unit, e.g. `fall.height (m)`.

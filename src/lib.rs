@@ -9,6 +9,7 @@
 //! [`run`] and [`sweep`] drive the whole pipeline; [`config`] checks the input
 //! and [`output`] writes a command's files all together or not at all.
 pub mod config;
+pub mod control;
 pub mod design;
 pub mod error;
 pub mod export;

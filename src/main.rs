@@ -7,6 +7,7 @@
 //! (the least drop height and its schedule are written); 130 interrupted
 //! (a sweep publishes the points it finished as a partial set).
 mod cli;
+mod robustness;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {

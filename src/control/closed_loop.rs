@@ -1,0 +1,191 @@
+//! One closed-loop flight in catflip's fixed-step simulator: the robot
+//! (possibly not the model: other inertias, another start, a delay, noisy
+//! torques and sensors) under the design's feed-forward plus a feedback.
+
+use super::plant::{Y, attitude, error, gyro, momentum_from_rates, rk4};
+use super::reference::Reference;
+use super::rng::Rng;
+use super::tvlqr::Tvlqr;
+use crate::model::Cat;
+use crate::model::momentum::landing_error;
+use crate::model::motor::Motor;
+use nalgebra::{UnitQuaternion, Vector3};
+
+/// What closes the loop.
+#[derive(Debug, Clone, Copy)]
+pub enum Feedback<'a> {
+    /// Today's joint PD on the planned shape, every simulator step.
+    JointPd { kp: f64, kd: f64 },
+    /// Time-varying LQR on the full state, at its control rate, predicting over its delay.
+    Tvlqr(&'a Tvlqr),
+}
+
+/// How the flight differs from the design's.
+#[derive(Debug, Clone)]
+pub struct Flight {
+    /// The robot as built.
+    pub plant: Cat,
+    /// Its state at release.
+    pub release: Y,
+    /// Actuator delay, simulator steps.
+    pub delay_steps: usize,
+    /// Torque noise, standard deviation, N m, redrawn each `noise_steps`.
+    pub torque_noise: f64,
+    pub noise_steps: usize,
+    /// Attitude (rad per axis) and rate (rad/s) sensor noise, standard deviations.
+    pub attitude_noise: f64,
+    pub rate_noise: f64,
+    /// Stream of the noises.
+    pub rng: Rng,
+}
+
+impl Flight {
+    /// The design's own flight: the model, the nominal release, nothing added.
+    pub fn nominal(r: &Reference) -> Flight {
+        Flight {
+            plant: r.cat,
+            release: r.nominal[0],
+            delay_steps: 0,
+            torque_noise: 0.0,
+            noise_steps: 1,
+            attitude_noise: 0.0,
+            rate_noise: 0.0,
+            rng: Rng::new(0, 0, 0),
+        }
+    }
+}
+
+/// How a flight ended.
+#[derive(Debug, Clone, Copy)]
+pub struct Landing {
+    /// The belly's angle from straight down at touchdown, deg (NaN: diverged).
+    pub error_deg: f64,
+    /// Largest correction on top of the feed-forward, N m (in the motor norm).
+    pub max_correction_nm: f64,
+    /// The state at touchdown.
+    pub state: Y,
+}
+
+/// What the sensors report: attitude, gyro and joint encoders, the momentum
+/// estimated from them with the model's inertias.
+fn measure(r: &Reference, f: &mut Flight, y: &Y) -> Y {
+    let mut m = *y;
+    if f.attitude_noise > 0.0 {
+        let n = Vector3::new(f.rng.normal(), f.rng.normal(), f.rng.normal()) * f.attitude_noise;
+        let a = attitude(y) * UnitQuaternion::from_scaled_axis(n);
+        m[..4].copy_from_slice(&[a.w, a.i, a.j, a.k]);
+    }
+    let mut w = gyro(&f.plant, y);
+    if f.rate_noise > 0.0 {
+        for v in w.iter_mut().chain(m[6..8].iter_mut()) {
+            *v += f.rate_noise * f.rng.normal();
+        }
+    }
+    let l = momentum_from_rates(&r.cat, [m[4], m[5]], [m[6], m[7]], w);
+    m[8..11].copy_from_slice(&l);
+    m
+}
+
+/// Flies the design `r` under `fb` with the motor `motor` (saturation and
+/// back-EMF at the actual joint speed).
+pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing {
+    let n = r.steps;
+    // corrections by the step from which they act
+    let mut queue: Vec<Option<[f64; 2]>> = vec![None; n + f.delay_steps + 2];
+    let mut issued: Vec<[f64; 2]> = Vec::new();
+    let (mut acting, mut noise) = ([0.0; 2], [0.0; 2]);
+    let mut max_corr = 0.0f64;
+    let mut y = f.release;
+    let period = match fb {
+        Feedback::Tvlqr(tv) => tv.period_steps,
+        Feedback::JointPd { .. } => 1,
+    };
+    for j in 0..n {
+        if j % period == 0 {
+            let u = match fb {
+                Feedback::JointPd { kp, kd } => {
+                    let m = measure(r, &mut f, &y);
+                    let (q, qd) = r.shape[j];
+                    Some([0, 1].map(|i| kp * (q[i] - m[4 + i]) + kd * (qd[i] - m[6 + i])))
+                }
+                Feedback::Tvlqr(tv) => {
+                    let k = j / period;
+                    (k < tv.starts.len()).then(|| {
+                        let m = measure(r, &mut f, &y);
+                        let u = tvlqr_command(r, tv, motor, &issued, k, &m);
+                        issued.push(u);
+                        u
+                    })
+                }
+            };
+            if let Some(u) = u {
+                queue[j + f.delay_steps] = Some(u);
+            }
+        }
+        if j % f.noise_steps == 0 && f.torque_noise > 0.0 {
+            noise = [
+                f.torque_noise * f.rng.normal(),
+                f.torque_noise * f.rng.normal(),
+            ];
+        }
+        if let Some(u) = queue[j] {
+            acting = u;
+            max_corr = max_corr.max(motor.norm.of(u));
+        }
+        let plant = f.plant;
+        y = rk4(&plant, &y, r.h, |s, ys| {
+            let ff = r.ff_at(j, s);
+            motor.clip([0, 1].map(|i| ff[i] + acting[i] + noise[i]), [ys[6], ys[7]])
+        });
+        if !y.iter().all(|v| v.is_finite()) {
+            return Landing {
+                error_deg: f64::NAN,
+                max_correction_nm: max_corr,
+                state: y,
+            };
+        }
+    }
+    let rm = *attitude(&y).to_rotation_matrix().matrix();
+    Landing {
+        error_deg: landing_error(&rm).to_degrees(),
+        max_correction_nm: max_corr,
+        state: y,
+    }
+}
+
+/// The TVLQR's correction `k` from the measurement `m` taken `delay` steps
+/// before it acts: the model predicts the state over the delay under the
+/// corrections already sent, the gain acts on the predicted error, and the
+/// sum with the feed-forward is held inside the motor envelope at the
+/// predicted joint speed.
+pub fn tvlqr_command(
+    r: &Reference,
+    tv: &Tvlqr,
+    motor: &Motor,
+    issued: &[[f64; 2]],
+    k: usize,
+    m: &Y,
+) -> [f64; 2] {
+    let s = tv.starts[k];
+    let mut yp = *m;
+    for i in s - tv.delay_steps..s {
+        let u = tv
+            .interval_at(i)
+            .and_then(|c| issued.get(c))
+            .copied()
+            .unwrap_or([0.0; 2]);
+        yp = rk4(&r.cat, &yp, r.h, |st, ys| {
+            let ff = r.ff_at(i, st);
+            motor.clip([ff[0] + u[0], ff[1] + u[1]], [ys[6], ys[7]])
+        });
+    }
+    let x = error(&yp, &r.nominal[s]);
+    let mut u = -(tv.gains[k] * x);
+    let size = motor.norm.of([u[0], u[1]]);
+    if size > tv.max_correction {
+        u *= tv.max_correction / size;
+    }
+    let ff = r.ff_at(s, 0);
+    let total = motor.clip([ff[0] + u[0], ff[1] + u[1]], [yp[6], yp[7]]);
+    [total[0] - ff[0], total[1] - ff[1]]
+}

@@ -1,0 +1,74 @@
+//! The TVLQR gains as a CSV beside a schedule's controls, in the
+//! simulators' world (gravity along `-z`, [`crate::export::start::world_map`]).
+
+use super::reference::Reference;
+use super::tvlqr::Tvlqr;
+use crate::config::Config;
+use crate::design::plan::ShapePlan;
+use crate::export::start::world_map;
+use crate::model::Joint;
+
+/// The design's gains, one row per control step.
+pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
+    let r = Reference::new(cfg, plan);
+    let tv = Tvlqr::new(&r, &cfg.control);
+    let shape = match cfg.cat.joint {
+        Joint::Universal => "q = the two hinge angles (qpos of the hinges), qd their rates",
+        Joint::NoTwist => {
+            "q = (v1, v2), the ball joint's rotation vector (v3 = 0), qd = dv/dt (not the ball's angular velocity)"
+        }
+    };
+    let mut s = format!(
+        "# catflip TVLQR gains for {name}: u = -K (x_measured - x_nominal), held from t_apply_s to the next row's,\n\
+         # added to the schedule's feed-forward torque (catflip's tau, hinge torques for universal),\n\
+         # measured delay_s = {delay:.6e} s before t_apply_s and predicted over the delay with the model.\n\
+         # x = [dtheta (3), dlambda (3), dq (2), dqd (2)]: dtheta = log(R_nom' R) of the rear half in its own frame\n\
+         # (the same in catflip's world and the simulator's: R_sim = W R), lambda = R' L the momentum about the\n\
+         # common centre of mass in the rear half's frame, N m s; {shape}.\n\
+         # Nominal attitude qnom_* = W R_nom, [w x y z], the simulator's world (gravity -z). K_i_j: row i (torque), column j (x).\n\
+         # control.rate_hz = {rate}, control.delay_ms = {dms}, simulator step {h:.9e} s.\n",
+        name = cfg.name,
+        delay = tv.delay_steps as f64 * r.h,
+        rate = cfg.control.rate_hz,
+        dms = cfg.control.delay_ms,
+        h = r.h,
+    );
+    let mut cols = vec![
+        "t_apply_s".to_string(),
+        "qnom_w".into(),
+        "qnom_x".into(),
+        "qnom_y".into(),
+        "qnom_z".into(),
+        "lnom_1".into(),
+        "lnom_2".into(),
+        "lnom_3".into(),
+        "qnom_1".into(),
+        "qnom_2".into(),
+        "qdnom_1".into(),
+        "qdnom_2".into(),
+    ];
+    for i in 0..2 {
+        for j in 0..10 {
+            cols.push(format!("K_{i}_{j}"));
+        }
+    }
+    s.push_str(&cols.join(","));
+    s.push('\n');
+    let w = world_map();
+    for (k, &a) in tv.starts.iter().enumerate() {
+        let y = r.nominal[a];
+        let q = w * super::plant::attitude(&y);
+        let mut v = vec![a as f64 * r.h, q.w, q.i, q.j, q.k];
+        v.extend_from_slice(&[y[8], y[9], y[10], y[4], y[5], y[6], y[7]]);
+        let g = &tv.gains[k];
+        for i in 0..2 {
+            for j in 0..10 {
+                v.push(g[(i, j)]);
+            }
+        }
+        let v: Vec<String> = v.iter().map(|x| format!("{x:.17e}")).collect();
+        s.push_str(&v.join(","));
+        s.push('\n');
+    }
+    s
+}

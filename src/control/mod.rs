@@ -1,0 +1,13 @@
+//! Closed loop along a design (issue 27): catflip's fixed-step plant with
+//! delay, noise and model error ([`plant`], [`closed_loop`]), the nominal a
+//! controller tracks ([`reference`]), the time-varying LQR ([`tvlqr`]) and
+//! the Monte Carlo study of `catflip robustness` ([`robustness`]).
+
+pub mod closed_loop;
+pub mod export;
+pub mod figure;
+pub mod plant;
+pub mod reference;
+pub mod rng;
+pub mod robustness;
+pub mod tvlqr;

@@ -1,0 +1,401 @@
+//! `catflip robustness`: a Monte Carlo study of the closed loop. Each trial
+//! draws a robot, a start and noises from `[robustness]` with its own random
+//! stream ([`super::rng`]), so that the study is deterministic for a seed,
+//! independent of threads, and its shards concatenate into the whole.
+
+use super::closed_loop::{Feedback, Flight, fly};
+use super::reference::{Reference, release};
+use super::rng::Rng;
+use super::tvlqr::{Tvlqr, steps_of};
+use crate::config::Config;
+use crate::design::plan::ShapePlan;
+use crate::model::momentum::Start;
+use crate::model::{Cat, Half};
+use crate::verify::simulate::Controller;
+use serde::Serialize;
+
+/// Landing tolerance of a study when `land.max_tilt_deg` is not set, deg.
+pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
+
+/// The controllers a study compares, in the order of the CSV's columns.
+pub const CONTROLLERS: [&str; 2] = ["open-loop", "tvlqr"];
+
+/// The design a study flies: the free-form one from the phased seed, as
+/// `run` makes it, or from the analytic seed where the phased family cannot fit.
+pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
+    use crate::design::free::{FreeDesign, Seed};
+    FreeDesign::new(cfg)
+        .solve()
+        .or_else(|_| FreeDesign::new(cfg).seed(Seed::Analytic).solve())
+}
+
+/// One trial's draws.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Draw {
+    pub trial: usize,
+    /// Release body rate, rad/s (rear half's axes).
+    pub spin_rad_s: [f64; 3],
+    /// Release tilt of the spine, deg, about a horizontal axis at `tilt_axis_deg` from world y.
+    pub tilt_deg: f64,
+    pub tilt_axis_deg: f64,
+    /// Relative errors `[rear, front]`.
+    pub mass_error: [f64; 2],
+    pub inertia_error: [f64; 2],
+    pub length_error: [f64; 2],
+    pub pd_gain_factor: f64,
+}
+
+impl Draw {
+    pub fn new(cfg: &Config, seed: u64, trial: usize) -> Draw {
+        let p = &cfg.robustness;
+        let mut g = Rng::new(seed, trial as u64, 0);
+        let d = g.direction();
+        let m = g.uniform();
+        let spin_rad_s = [0, 1, 2].map(|i| m * d[i] * p.spin_rad_s[i]);
+        let tilt_deg = p.tilt_deg * g.uniform();
+        let tilt_axis_deg = 360.0 * g.uniform();
+        let mut pair = |e: f64| [e * g.signed(), e * g.signed()];
+        let mass_error = pair(p.mass_error);
+        let inertia_error = pair(p.inertia_error);
+        let length_error = pair(p.length_error);
+        let pd_gain_factor = 1.0 + p.pd_gain_error * g.signed();
+        Draw {
+            trial,
+            spin_rad_s,
+            tilt_deg,
+            tilt_axis_deg,
+            mass_error,
+            inertia_error,
+            length_error,
+            pd_gain_factor,
+        }
+    }
+
+    /// The robot as built: each half's mass, inertia (radii of gyration, the
+    /// radius and length scaled by `sqrt(1 + e)`) and length off by the draws.
+    pub fn plant(&self, cat: &Cat) -> Cat {
+        let half = |h: Half, i: usize| {
+            let g = (1.0 + self.inertia_error[i]).sqrt();
+            Half {
+                mass: h.mass * (1.0 + self.mass_error[i]),
+                radius: h.radius * g,
+                length: h.length * g * (1.0 + self.length_error[i]),
+                ..h
+            }
+        };
+        Cat {
+            rear: half(cat.rear, 0),
+            front: half(cat.front, 1),
+            ..*cat
+        }
+    }
+
+    pub fn start(&self, cfg: &Config) -> Start {
+        let a = self.tilt_axis_deg.to_radians();
+        let t = self.tilt_deg.to_radians();
+        let tilt = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(
+            0.0,
+            t * a.cos(),
+            t * a.sin(),
+        ));
+        let base = cfg.start.start().rotation();
+        let r = tilt * base;
+        let mut s = Start {
+            attitude: [r.w, r.i, r.j, r.k],
+            body_rate: cfg.start.start().body_rate,
+        };
+        for i in 0..3 {
+            s.body_rate[i] += self.spin_rad_s[i];
+        }
+        s
+    }
+}
+
+/// A trial's outcome: the landing error under each of [`CONTROLLERS`].
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct TrialResult {
+    pub draw: Draw,
+    pub landing_error_deg: [f64; 2],
+}
+
+/// The design and the gains a study flies.
+pub struct Study<'a> {
+    pub cfg: &'a Config,
+    pub seed: u64,
+    pub reference: Reference,
+    pub tvlqr: Tvlqr,
+    pub pd: Controller,
+}
+
+impl<'a> Study<'a> {
+    pub fn new(cfg: &'a Config, plan: &dyn ShapePlan, seed: u64) -> Study<'a> {
+        let reference = Reference::new(cfg, plan);
+        let tvlqr = Tvlqr::new(&reference, &cfg.control);
+        Study {
+            cfg,
+            seed,
+            reference,
+            tvlqr,
+            pd: Controller::from_config(cfg),
+        }
+    }
+
+    /// Landing tolerance, deg.
+    pub fn max_tilt_deg(&self) -> f64 {
+        self.cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG)
+    }
+
+    pub fn trial(&self, trial: usize) -> TrialResult {
+        let (cfg, r) = (self.cfg, &self.reference);
+        let p = &cfg.robustness;
+        let draw = Draw::new(cfg, self.seed, trial);
+        let plant = draw.plant(&r.cat);
+        let flight = Flight {
+            plant,
+            release: release(&plant, &draw.start(cfg)),
+            delay_steps: steps_of(p.delay_ms * 1e-3, r.h),
+            torque_noise: p.torque_noise * r.peak_torque,
+            noise_steps: self.tvlqr.period_steps,
+            attitude_noise: p.attitude_noise_deg.to_radians(),
+            rate_noise: p.rate_noise_rad_s,
+            rng: Rng::new(self.seed, trial as u64, 1),
+        };
+        let motor = cfg.motor();
+        let f = draw.pd_gain_factor;
+        let open = fly(
+            r,
+            Feedback::JointPd {
+                kp: self.pd.kp * f,
+                kd: self.pd.kd * f,
+            },
+            &motor,
+            flight.clone(),
+        );
+        let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight);
+        TrialResult {
+            draw,
+            landing_error_deg: [open.error_deg, closed.error_deg],
+        }
+    }
+
+    /// Trials `range` on `threads` threads, in trial order; `progress(done, total)`.
+    pub fn run(
+        &self,
+        range: std::ops::Range<usize>,
+        threads: usize,
+        progress: impl Fn(usize, usize) + Sync,
+    ) -> Vec<TrialResult> {
+        use std::sync::Mutex;
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        let total = range.len();
+        let next = AtomicUsize::new(0);
+        let done = AtomicUsize::new(0);
+        let out: Mutex<Vec<TrialResult>> = Mutex::new(Vec::with_capacity(total));
+        std::thread::scope(|s| {
+            for _ in 0..threads.max(1).min(total.max(1)) {
+                s.spawn(|| {
+                    loop {
+                        let i = next.fetch_add(1, Ordering::Relaxed);
+                        if i >= total {
+                            break;
+                        }
+                        let r = self.trial(range.start + i);
+                        out.lock().unwrap().push(r);
+                        progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
+                    }
+                });
+            }
+        });
+        let mut v = out.into_inner().unwrap();
+        v.sort_by_key(|r| r.draw.trial);
+        v
+    }
+}
+
+/// Wilson score interval at 95 % for `k` successes in `n` trials.
+pub fn wilson(k: usize, n: usize) -> [f64; 2] {
+    if n == 0 {
+        return [0.0, 1.0];
+    }
+    let z = 1.959_963_984_540_054;
+    let (n, p) = (n as f64, k as f64 / n as f64);
+    let d = 1.0 + z * z / n;
+    let c = (p + z * z / (2.0 * n)) / d;
+    let h = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / d;
+    [(c - h).max(0.0), (c + h).min(1.0)]
+}
+
+/// A trial kept for replay: `catflip robustness --seed S` draws trial `trial` again.
+#[derive(Debug, Clone, Serialize)]
+pub struct Worst {
+    pub trial: usize,
+    pub seed: u64,
+    pub landing_error_deg: f64,
+}
+
+/// One controller's line of the study.
+#[derive(Debug, Clone, Serialize)]
+pub struct ControllerSummary {
+    pub name: &'static str,
+    pub successes: usize,
+    pub success_rate: f64,
+    pub ci95: [f64; 2],
+    /// Landing error percentiles, deg (a diverged flight counts as 180).
+    pub landing_error_deg: Percentiles,
+    pub worst: Vec<Worst>,
+}
+
+#[derive(Debug, Clone, Serialize)]
+pub struct Percentiles {
+    pub p50: f64,
+    pub p90: f64,
+    pub p99: f64,
+    pub max: f64,
+}
+
+fn percentile(sorted: &[f64], p: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let i = ((p * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1;
+    sorted[i]
+}
+
+/// The study's JSON.
+#[derive(Debug, Clone, Serialize)]
+pub struct Summary {
+    pub trials: usize,
+    pub seed: u64,
+    pub max_tilt_deg: f64,
+    pub controllers: Vec<ControllerSummary>,
+}
+
+/// A diverged flight (NaN) lands anywhere: 180 deg in the statistics.
+fn error_or_worst(e: f64) -> f64 {
+    if e.is_nan() { 180.0 } else { e }
+}
+
+pub fn summarise(results: &[TrialResult], seed: u64, max_tilt_deg: f64, keep: usize) -> Summary {
+    let controllers = CONTROLLERS
+        .iter()
+        .enumerate()
+        .map(|(c, &name)| {
+            let errs: Vec<f64> = results
+                .iter()
+                .map(|r| error_or_worst(r.landing_error_deg[c]))
+                .collect();
+            let k = errs.iter().filter(|&&e| e <= max_tilt_deg).count();
+            let mut sorted = errs.clone();
+            sorted.sort_by(f64::total_cmp);
+            let mut idx: Vec<usize> = (0..results.len()).collect();
+            idx.sort_by(|&a, &b| errs[b].total_cmp(&errs[a]));
+            ControllerSummary {
+                name,
+                successes: k,
+                success_rate: if results.is_empty() {
+                    f64::NAN
+                } else {
+                    k as f64 / results.len() as f64
+                },
+                ci95: wilson(k, results.len()),
+                landing_error_deg: Percentiles {
+                    p50: percentile(&sorted, 0.5),
+                    p90: percentile(&sorted, 0.9),
+                    p99: percentile(&sorted, 0.99),
+                    max: sorted.last().copied().unwrap_or(f64::NAN),
+                },
+                worst: idx
+                    .iter()
+                    .take(keep)
+                    .map(|&i| Worst {
+                        trial: results[i].draw.trial,
+                        seed,
+                        landing_error_deg: errs[i],
+                    })
+                    .collect(),
+            }
+        })
+        .collect();
+    Summary {
+        trials: results.len(),
+        seed,
+        max_tilt_deg,
+        controllers,
+    }
+}
+
+/// The CSV header: the draws, then each controller's landing error.
+pub const CSV_HEADER: &str = "trial,spin_x_rad_s,spin_y_rad_s,spin_z_rad_s,tilt_deg,tilt_axis_deg,mass_error_rear,mass_error_front,inertia_error_rear,inertia_error_front,length_error_rear,length_error_front,pd_gain_factor,open_loop_landing_error_deg,tvlqr_landing_error_deg";
+
+/// Rows of `results`; with the header only for the first shard, so that
+/// the shards' files concatenate into the whole study's.
+pub fn to_csv(results: &[TrialResult], header: bool) -> String {
+    let mut s = String::new();
+    if header {
+        s.push_str(CSV_HEADER);
+        s.push('\n');
+    }
+    for r in results {
+        let d = &r.draw;
+        let v: Vec<String> = [
+            d.spin_rad_s[0],
+            d.spin_rad_s[1],
+            d.spin_rad_s[2],
+            d.tilt_deg,
+            d.tilt_axis_deg,
+            d.mass_error[0],
+            d.mass_error[1],
+            d.inertia_error[0],
+            d.inertia_error[1],
+            d.length_error[0],
+            d.length_error[1],
+            d.pd_gain_factor,
+            r.landing_error_deg[0],
+            r.landing_error_deg[1],
+        ]
+        .iter()
+        .map(|x| format!("{x:e}"))
+        .collect();
+        s.push_str(&format!("{},{}\n", d.trial, v.join(",")));
+    }
+    s
+}
+
+/// Contiguous trials of shard `k` of `n` (1-based).
+pub fn shard_range(trials: usize, k: usize, n: usize) -> std::ops::Range<usize> {
+    trials * (k - 1) / n..trials * k / n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Wilson's interval against its closed form at the ends and a textbook value.
+    #[test]
+    fn wilson_interval() {
+        // n = 10, k = 10: [n / (n + z^2), 1]
+        let z2 = 1.959_963_984_540_054f64.powi(2);
+        let [lo, hi] = wilson(10, 10);
+        assert!((lo - 10.0 / (10.0 + z2)).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
+        let [lo, hi] = wilson(0, 10);
+        assert!(lo.abs() < 1e-12 && (hi - z2 / (10.0 + z2)).abs() < 1e-12);
+        // 50 of 100: 0.4038 to 0.5962 (Wilson 1927; Newcombe 1998, table I)
+        let [lo, hi] = wilson(50, 100);
+        assert!((lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4);
+    }
+
+    #[test]
+    fn shards_tile_the_trials() {
+        for n in [0, 1, 7, 1000] {
+            for count in 1..6 {
+                let mut next = 0;
+                for k in 1..=count {
+                    let r = shard_range(n, k, count);
+                    assert_eq!(r.start, next);
+                    next = r.end;
+                }
+                assert_eq!(next, n);
+            }
+        }
+    }
+}

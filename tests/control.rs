@@ -1,0 +1,244 @@
+//! The closed loop of issue 27: TVLQR along a design.
+
+use catflip::Config;
+use catflip::control::closed_loop::{Feedback, Flight, fly};
+use catflip::control::plant::{X, error};
+use catflip::control::reference::{Reference, release};
+use catflip::control::tvlqr::{Tvlqr, linearise, period_map};
+use catflip::model::momentum::Start;
+use nalgebra::SMatrix;
+use std::sync::OnceLock;
+
+fn seed_cfg() -> Config {
+    Config::load(std::path::Path::new("configs/seed.toml"), &[]).unwrap()
+}
+
+/// The seed's free-form design and its gains, made once for all tests.
+fn design() -> &'static (Config, Reference, Tvlqr) {
+    static D: OnceLock<(Config, Reference, Tvlqr)> = OnceLock::new();
+    D.get_or_init(|| {
+        let cfg = seed_cfg();
+        let plan = catflip::control::robustness::design(&cfg).unwrap().plan;
+        let r = Reference::new(&cfg, &plan);
+        let tv = Tvlqr::new(&r, &cfg.control);
+        (cfg, r, tv)
+    })
+}
+
+/// The belly's tilt rows at touchdown (world y and z of the belly's move).
+fn tilt(r: &Reference, x: &X) -> [f64; 2] {
+    let rm = *catflip::control::plant::attitude(&r.nominal[r.steps])
+        .to_rotation_matrix()
+        .matrix();
+    let d = -rm * catflip::model::so3::hat(&nalgebra::Vector3::x()) * x.fixed_rows::<3>(0);
+    [d.y, d.z]
+}
+
+#[test]
+fn tvlqr_on_the_nominal_model_reproduces_the_design() {
+    let (cfg, r, tv) = design();
+    let motor = cfg.motor();
+    let open = fly(
+        r,
+        Feedback::JointPd { kp: 0.0, kd: 0.0 },
+        &motor,
+        Flight::nominal(r),
+    );
+    let closed = fly(r, Feedback::Tvlqr(tv), &motor, Flight::nominal(r));
+    assert!(
+        closed.max_correction_nm < 1e-9 * r.peak_torque,
+        "correction {} N m on the nominal",
+        closed.max_correction_nm
+    );
+    assert!((closed.error_deg - open.error_deg).abs() < 1e-9);
+    // and the design lands: the nominal is belly-down
+    assert!(
+        open.error_deg < 0.05,
+        "nominal lands {} deg off",
+        open.error_deg
+    );
+}
+
+#[test]
+fn the_period_map_linearisation_is_its_derivative() {
+    let (_, r, tv) = design();
+    let k = tv.starts.len() / 2;
+    let (a, b) = (tv.starts[k], tv.starts[k + 1]);
+    let (am, bm) = linearise(r, a, b, &tv.scale, tv.torque_scale);
+    let dir = X::from_fn(|i, _| tv.scale[i] * (0.3 + 0.1 * i as f64));
+    let u = [0.2 * tv.torque_scale, -0.1 * tv.torque_scale];
+    let rem = |e: f64| {
+        let x = dir * e;
+        let got = period_map(r, a, b, &x, [u[0] * e, u[1] * e]);
+        let lin = am * x + bm * nalgebra::Vector2::new(u[0] * e, u[1] * e);
+        (got - lin).norm()
+    };
+    // the remainder is second order: halving the step quarters it
+    let (r1, r2) = (rem(1e-3), rem(5e-4));
+    assert!(
+        r1 > 0.0 && (r1 / r2 - 4.0).abs() < 0.4,
+        "remainders {r1:e} {r2:e}"
+    );
+}
+
+/// The cost-to-go is a Lyapunov function of the closed-loop linearisation:
+/// `P_k - Acl' P_{k+1} Acl = Q_k + K' R K >= 0`, every period; with the
+/// gain's sign flipped or the gain transposed onto the wrong state it is not.
+#[test]
+fn the_closed_loop_linearisation_is_stable_along_the_design() {
+    let (_, r, tv) = design();
+    let min_eig = |m: &SMatrix<f64, 10, 10>| {
+        m.symmetric_eigen()
+            .eigenvalues
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+    };
+    let (mut worst_ok, mut worst_flipped) = (f64::INFINITY, f64::INFINITY);
+    for k in 0..tv.starts.len() {
+        let (p, pn) = (&tv.cost_to_go[k], &tv.cost_to_go[k + 1]);
+        let decrease = |acl: &SMatrix<f64, 10, 10>| {
+            let d = p - acl.transpose() * pn * acl;
+            min_eig(&(0.5 * (d + d.transpose()))) / p.norm().max(1e-300)
+        };
+        worst_ok = worst_ok.min(decrease(&tv.closed_loop(k)));
+        let flipped = tv.a[k] + tv.b[k] * tv.gains[k];
+        worst_flipped = worst_flipped.min(decrease(&flipped));
+    }
+    assert!(worst_ok > -1e-9, "cost-to-go grows: {worst_ok:e}");
+    assert!(
+        worst_flipped < -1e-6,
+        "a flipped gain passed: {worst_flipped:e}"
+    );
+    // the landing's sensitivity to a start error: far smaller closed loop
+    let n = tv.starts.len();
+    let (mut phi_cl, mut phi_ol) = (SMatrix::<f64, 10, 10>::identity(), SMatrix::identity());
+    for k in 0..n {
+        phi_cl = tv.closed_loop(k) * phi_cl;
+        phi_ol = tv.a[k] * phi_ol;
+    }
+    let landing = |phi: &SMatrix<f64, 10, 10>| {
+        (0..10)
+            .map(|i| {
+                let x = phi.column(i).into_owned() * tv.scale[i];
+                let t = tilt(r, &x);
+                t[0].hypot(t[1])
+            })
+            .fold(0.0, f64::max)
+    };
+    let (cl, ol) = (landing(&phi_cl), landing(&phi_ol));
+    eprintln!("largest landing tilt per scaled start error: closed {cl:.3e}, open {ol:.3e}");
+    assert!(cl < 0.1 * ol, "closed {cl} vs open {ol}");
+}
+
+/// A small start error (spin end over end, tilt of the spine; the heading,
+/// rotation about world x, is free) shrinks in the nonlinear closed loop by
+/// the factor the linearisation predicts: the landing tilt closed loop over
+/// open loop, simulated against `C Phi_cl x0 / C Phi_ol x0`.
+#[test]
+fn a_small_start_error_shrinks_as_the_linearisation_predicts() {
+    let (cfg, r, tv) = design();
+    let motor = cfg.motor();
+    for (rot, w) in [
+        ([0.0; 3], [0.0, 0.02, 0.0]),
+        ([0.0; 3], [0.0, 0.01, 0.0]),
+        ([0.0, 0.02, 0.0], [0.0; 3]),
+        ([0.0, 0.0, 0.02], [0.0; 3]),
+    ] {
+        let y0 = release(&r.cat, &Start::new(rot, w));
+        let mut f = Flight::nominal(r);
+        f.release = y0;
+        f.delay_steps = tv.delay_steps;
+        let closed = fly(r, Feedback::Tvlqr(tv), &motor, f.clone());
+        let open = fly(r, Feedback::JointPd { kp: 0.0, kd: 0.0 }, &motor, f);
+        let (xc, xo) = (
+            error(&closed.state, &r.nominal[r.steps]),
+            error(&open.state, &r.nominal[r.steps]),
+        );
+        // linear prediction: open loop over the delay, then the closed loop
+        let x0 = error(&y0, &r.nominal[0]);
+        let (a0, _) = linearise(r, 0, tv.starts[0], &tv.scale, tv.torque_scale);
+        let mut xl = a0 * x0;
+        let mut xlo = xl;
+        for k in 0..tv.starts.len() {
+            xl = tv.closed_loop(k) * xl;
+            xlo = tv.a[k] * xlo;
+        }
+        let norm = |t: [f64; 2]| t[0].hypot(t[1]);
+        let (sim, lin) = (
+            norm(tilt(r, &xc)) / norm(tilt(r, &xo)),
+            norm(tilt(r, &xl)) / norm(tilt(r, &xlo)),
+        );
+        eprintln!(
+            "start {rot:?} {w:?}: landing tilt open {:.4e} closed {:.4e} rad; shrink simulated {sim:.4}, predicted {lin:.4}",
+            norm(tilt(r, &xo)),
+            norm(tilt(r, &xc))
+        );
+        assert!(sim < 0.1, "no shrink: {sim}");
+        assert!(
+            (sim - lin).abs() < 0.05 * lin + 1e-3,
+            "simulated {sim} vs predicted {lin}"
+        );
+    }
+}
+
+/// The study is deterministic for a seed, the same on any number of
+/// threads, and its shards' CSVs concatenate into the whole study's.
+#[test]
+fn the_study_is_deterministic_and_its_shards_concatenate() {
+    use catflip::control::robustness::{Study, shard_range, to_csv};
+    let (cfg, r, _) = design();
+    let _ = r;
+    let plan = catflip::control::robustness::design(cfg).unwrap().plan;
+    let study = Study::new(cfg, &plan, 7);
+    let n = 6;
+    let whole = to_csv(&study.run(0..n, 2, |_, _| {}), true);
+    let again = to_csv(&study.run(0..n, 1, |_, _| {}), true);
+    assert_eq!(whole, again);
+    let shards: String = (1..=4)
+        .map(|k| {
+            let range = shard_range(n, k, 4);
+            let first = range.start == 0;
+            to_csv(&study.run(range, 1, |_, _| {}), first)
+        })
+        .collect();
+    assert_eq!(whole, shards);
+    // another seed draws other trials
+    let other = Study::new(cfg, &plan, 8);
+    assert_ne!(whole, to_csv(&other.run(0..n, 2, |_, _| {}), true));
+}
+
+/// Bad input is refused with the key, the value and the range; nothing is written.
+#[test]
+fn bad_input_is_refused_before_anything_is_written() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, key) in [
+        (vec!["--set", "control.delay_ms=-1"], "control.delay_ms"),
+        (
+            vec!["--set", "robustness.delay_ms=-5"],
+            "robustness.delay_ms",
+        ),
+        (vec!["--set", "control.rate_hz=5000"], "control.rate_hz"),
+        (
+            vec!["--set", "robustness.mass_error=1.0"],
+            "robustness.mass_error",
+        ),
+        (vec!["--trials", "1000001"], "--trials"),
+    ] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_catflip"))
+            .args(["robustness", "configs/seed.toml", "--out"])
+            .arg(dir.path())
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(key), "{args:?}: {err}");
+        assert!(err.contains("must be in"), "{args:?}: {err}");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).unwrap().count(),
+            0,
+            "{args:?} wrote files"
+        );
+    }
+}
