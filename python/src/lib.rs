@@ -93,13 +93,15 @@ struct Source {
     text: String,
     origin: String,
     overrides: Vec<String>,
+    /// The folder a file's relative paths (`body.urdf`) are read from, as the CLI's.
+    base: PathBuf,
 }
 
 impl Source {
     fn load(&self, extra: Option<&str>) -> catflip::Result<Cfg> {
         let mut ov = self.overrides.clone();
         ov.extend(extra.map(String::from));
-        Cfg::from_toml(&self.text, &self.origin, &ov)
+        Cfg::from_toml_at(&self.text, &self.origin, &ov, &self.base)
     }
 }
 
@@ -212,6 +214,10 @@ impl Config {
                 text,
                 origin: path.display().to_string(),
                 overrides: overrides.unwrap_or_default(),
+                base: path
+                    .parent()
+                    .unwrap_or(std::path::Path::new("."))
+                    .to_path_buf(),
             },
         )
     }
@@ -226,6 +232,7 @@ impl Config {
                 text,
                 origin: origin.into(),
                 overrides: Vec::new(),
+                base: PathBuf::from("."),
             },
         )
     }
@@ -248,6 +255,7 @@ impl Config {
                 text,
                 origin: "dict".into(),
                 overrides: Vec::new(),
+                base: PathBuf::from("."),
             },
         )
     }
