@@ -132,6 +132,10 @@ enum Command {
         /// shards' CSVs concatenate into the whole study's.
         #[arg(long, value_name = "K/N")]
         shard: Option<String>,
+        /// Continue an interrupted study (same trials, seed, shard and
+        /// config) from the partial set it published.
+        #[arg(long)]
+        resume: bool,
     },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
@@ -296,7 +300,15 @@ pub fn run() -> Result<Status> {
             seed,
             threads,
             shard,
-        } => crate::robustness::cmd_robustness(&common, trials, seed, threads, shard.as_deref()),
+            resume,
+        } => crate::robustness::cmd_robustness(
+            &common,
+            trials,
+            seed,
+            threads,
+            shard.as_deref(),
+            resume,
+        ),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
             common,

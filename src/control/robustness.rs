@@ -185,30 +185,46 @@ impl<'a> Study<'a> {
         threads: usize,
         progress: impl Fn(usize, usize) + Sync,
     ) -> Vec<TrialResult> {
-        use std::sync::Mutex;
+        let store = std::sync::Mutex::new(vec![None; range.len()]);
+        self.run_into(range, threads, &store, progress);
+        store.into_inner().unwrap().into_iter().flatten().collect()
+    }
+
+    /// Flies the trials of `range` whose slot in `store` (one a trial, in
+    /// trial order) is empty, filling each as it lands, so that a caller
+    /// interrupted mid-study still holds every finished trial and a resumed
+    /// study flies only the rest. `progress(done, total)` counts the kept ones.
+    pub fn run_into(
+        &self,
+        range: std::ops::Range<usize>,
+        threads: usize,
+        store: &std::sync::Mutex<Vec<Option<TrialResult>>>,
+        progress: impl Fn(usize, usize) + Sync,
+    ) {
         use std::sync::atomic::{AtomicUsize, Ordering};
         let total = range.len();
+        let lock = || store.lock().unwrap_or_else(|p| p.into_inner());
+        let todo: Vec<usize> = {
+            let s = lock();
+            assert_eq!(s.len(), total, "one slot a trial");
+            (0..total).filter(|&i| s[i].is_none()).collect()
+        };
         let next = AtomicUsize::new(0);
-        let done = AtomicUsize::new(0);
-        let out: Mutex<Vec<TrialResult>> = Mutex::new(Vec::with_capacity(total));
+        let done = AtomicUsize::new(total - todo.len());
         std::thread::scope(|s| {
-            for _ in 0..threads.max(1).min(total.max(1)) {
+            for _ in 0..threads.max(1).min(todo.len().max(1)) {
                 s.spawn(|| {
                     loop {
-                        let i = next.fetch_add(1, Ordering::Relaxed);
-                        if i >= total {
+                        let Some(&i) = todo.get(next.fetch_add(1, Ordering::Relaxed)) else {
                             break;
-                        }
+                        };
                         let r = self.trial(range.start + i);
-                        out.lock().unwrap().push(r);
+                        lock()[i] = Some(r);
                         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
                     }
                 });
             }
         });
-        let mut v = out.into_inner().unwrap();
-        v.sort_by_key(|r| r.draw.trial);
-        v
     }
 }
 
@@ -359,6 +375,43 @@ pub fn to_csv(results: &[TrialResult], header: bool) -> String {
         s.push_str(&format!("{},{}\n", d.trial, v.join(",")));
     }
     s
+}
+
+/// The trials of a CSV [`to_csv`] wrote (with or without its header): its
+/// numbers are printed shortest-round-trip, so they read back exactly.
+pub fn from_csv(text: &str) -> std::result::Result<Vec<TrialResult>, String> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        if line == CSV_HEADER || line.is_empty() {
+            continue;
+        }
+        let bad = |what: &str| format!("line {}: {what}: {line}", n + 1);
+        let mut cells = line.split(',');
+        let trial = cells
+            .next()
+            .and_then(|c| c.parse().ok())
+            .ok_or_else(|| bad("no trial index"))?;
+        let v: Vec<f64> = cells
+            .map(|c| c.parse().map_err(|_| bad("not a number")))
+            .collect::<std::result::Result<_, _>>()?;
+        if v.len() != 14 {
+            return Err(bad("not 15 columns"));
+        }
+        out.push(TrialResult {
+            draw: Draw {
+                trial,
+                spin_rad_s: [v[0], v[1], v[2]],
+                tilt_deg: v[3],
+                tilt_axis_deg: v[4],
+                mass_error: [v[5], v[6]],
+                inertia_error: [v[7], v[8]],
+                length_error: [v[9], v[10]],
+                pd_gain_factor: v[11],
+            },
+            landing_error_deg: [v[12], v[13]],
+        });
+    }
+    Ok(out)
 }
 
 /// Contiguous trials of shard `k` of `n` (1-based).
