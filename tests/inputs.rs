@@ -755,3 +755,109 @@ fn the_largest_accepted_inputs_hold_the_memory_and_output_caps() {
     let written = size(&dir.path().join("r"));
     assert!(written < 100_000_000, "a run wrote {written} bytes");
 }
+
+/// `catflip robustness` on the seed cat, `trials` trials on 2 threads, into `out`.
+fn robustness_args(out: &str, trials: usize) -> Vec<String> {
+    [
+        "robustness",
+        &config("seed.toml"),
+        "--trials",
+        &trials.to_string(),
+        "--threads",
+        "2",
+        "--out",
+        out,
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect()
+}
+
+#[test]
+fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_the_same_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let set = |out: &str| dir.path().join(out).join("seed/robustness");
+    fn strs(a: &[String]) -> Vec<&str> {
+        a.iter().map(|s| s.as_str()).collect()
+    }
+    let whole_args = robustness_args("whole", 40);
+    let o = run(&strs(&whole_args), dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let whole = read(set("whole").join("robustness.csv"));
+    let whole_json = read(set("whole").join("robustness.json"));
+    // SIGINT once the progress shows 10 of the 40 trials (a line every 2)
+    let args = robustness_args("part", 40);
+    let (code, took, err) = interrupt_after(dir.path(), &args, 10, "-INT");
+    eprintln!("robustness stopped {took:?} after SIGINT");
+    assert_eq!(code, Some(130), "{err}");
+    assert!(
+        took < std::time::Duration::from_secs(1),
+        "stopped after {took:?}"
+    );
+    assert!(
+        err.contains("interrupted") && err.contains("--resume"),
+        "{err}"
+    );
+    let csv = read(set("part").join("robustness.csv"));
+    let json: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("robustness.json"))).unwrap();
+    assert_eq!(json["status"], "partial");
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
+    assert_eq!(state["status"], "partial");
+    let done = csv.lines().count() - 1;
+    assert!((10..40).contains(&done), "{done}");
+    assert_eq!(json["trials"], done);
+    // the finished trials are the uninterrupted study's, in trial order
+    let index = |row: &str| row.split(',').next().unwrap().parse::<usize>().unwrap();
+    let rows: Vec<&str> = csv.lines().skip(1).collect();
+    assert!(rows.windows(2).all(|w| index(w[0]) < index(w[1])), "{csv}");
+    for row in csv.lines() {
+        assert!(whole.lines().any(|w| w == row), "{row}");
+    }
+    // no hidden staging folder or lock left behind
+    let leftovers: Vec<PathBuf> = tree(&dir.path().join("part"))
+        .into_iter()
+        .filter(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            name.starts_with('.') && name != ".catflip-set"
+        })
+        .collect();
+    assert!(leftovers.is_empty(), "{leftovers:?}");
+    // a resume of another study is refused, naming what differs, and keeps the partial set
+    let mut other_seed = args.clone();
+    other_seed.extend(["--seed".into(), "2".into()]);
+    for (mut other, what) in [
+        (other_seed, "the seed"),
+        (robustness_args("part", 41), "the trials"),
+    ] {
+        other.push("--resume".into());
+        let o = run(&strs(&other), dir.path());
+        assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+        assert!(
+            stderr(&o).contains("other settings") && stderr(&o).contains(what),
+            "{}",
+            stderr(&o)
+        );
+    }
+    assert_eq!(read(set("part").join("robustness.csv")), csv);
+    // --resume flies the rest only, and the result is the whole study's, byte for byte
+    let mut resume = args.clone();
+    resume.push("--resume".into());
+    let o = run(&strs(&resume), dir.path());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains(&format!("resuming: {done} of 40 trials kept")),
+        "{err}"
+    );
+    assert!(
+        !err.contains(" 1/40 trials"),
+        "flew the kept trials again: {err}"
+    );
+    assert_eq!(read(set("part").join("robustness.csv")), whole);
+    assert_eq!(read(set("part").join("robustness.json")), whole_json);
+    let state: serde_json::Value =
+        serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
+    assert_eq!(state["status"], "complete");
+}
