@@ -219,11 +219,10 @@ pub fn cmd_robustness(
         to_csv(&results, range.start == 0),
     );
     out.add(format!("robustness{suffix}.json"), json.clone());
-    if !results.is_empty() {
-        if let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
-        {
-            out.add(format!("robustness{suffix}.svg"), svg);
-        }
+    if !results.is_empty()
+        && let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
+    {
+        out.add(format!("robustness{suffix}.svg"), svg);
     }
     out.add(
         StudyState::file_name(&suffix),

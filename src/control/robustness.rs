@@ -214,10 +214,7 @@ impl<'a> Study<'a> {
         std::thread::scope(|s| {
             for _ in 0..threads.max(1).min(todo.len().max(1)) {
                 s.spawn(|| {
-                    loop {
-                        let Some(&i) = todo.get(next.fetch_add(1, Ordering::Relaxed)) else {
-                            break;
-                        };
+                    while let Some(&i) = todo.get(next.fetch_add(1, Ordering::Relaxed)) {
                         let r = self.trial(range.start + i);
                         lock()[i] = Some(r);
                         progress(done.fetch_add(1, Ordering::Relaxed) + 1, total);
