@@ -5,7 +5,7 @@
 //! written; 3 partial: results written, but some are flagged or failed;
 //! 4 impossible: the motors cannot flip the cat from the configured height
 //! (the least drop height and its schedule are written); 130 interrupted
-//! (a sweep publishes the points it finished as a partial set).
+//! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
 mod robustness;
 
