@@ -434,6 +434,36 @@ mod tests {
         assert!((lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4);
     }
 
+    /// What `--resume` relies on: a CSV's trials read back bit for bit,
+    /// awkward numbers and a diverged (NaN) flight included.
+    #[test]
+    fn csv_rows_read_back_exactly() {
+        let cfg = Config::load(std::path::Path::new("configs/seed.toml"), &[]).unwrap();
+        let results: Vec<TrialResult> = (3..9)
+            .map(|t| TrialResult {
+                draw: Draw::new(&cfg, 7, t),
+                landing_error_deg: [
+                    0.1 + 0.2 * t as f64,
+                    if t == 5 { f64::NAN } else { 1e-300 / 3.0 },
+                ],
+            })
+            .collect();
+        for header in [true, false] {
+            let csv = to_csv(&results, header);
+            let back = from_csv(&csv).unwrap();
+            assert_eq!(to_csv(&back, header), csv);
+            for (a, b) in results.iter().zip(&back) {
+                assert_eq!(a.draw.trial, b.draw.trial);
+                assert_eq!(a.draw.tilt_deg.to_bits(), b.draw.tilt_deg.to_bits());
+                for c in 0..2 {
+                    let (x, y) = (a.landing_error_deg[c], b.landing_error_deg[c]);
+                    assert!(x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
+                }
+            }
+        }
+        assert!(from_csv("3,1,2\n").unwrap_err().contains("15 columns"));
+    }
+
     #[test]
     fn shards_tile_the_trials() {
         for n in [0, 1, 7, 1000] {
