@@ -10,24 +10,13 @@ use catflip::Config;
 use catflip::model::dynamics::inverse_dynamics;
 use std::path::Path;
 
-const LOPSIDED: &str = r#"name = "lopsided"
-[cat]
-joint = "universal"
-[fall]
-height = 10.0
-[body.rear]
-mass = 1.3
-com = [0.03, -0.02, 0.01]
-inertia = [[0.09, 0.004, -0.003], [0.004, 0.08, 0.006], [-0.003, 0.006, 0.03]]
-joint = [0.01, 0.02, 0.5]
-axis = [0.6, 0.8, 0.0]
-[body.front]
-mass = 0.7
-com = [-0.02, 0.0, 0.04]
-inertia = [0.05, 0.06, 0.02, -0.002, 0.0, 0.001]
-joint = [0.0, 0.01, -0.45]
-axis = [-0.8, 0.6, 0.0]
-"#;
+/// The lopsided body's config: the `[body]` keys tests/import.rs uses.
+fn lopsided() -> String {
+    format!(
+        "name = \"lopsided\"\n[cat]\njoint = \"universal\"\n[fall]\nheight = 10.0\n{}",
+        include_str!("../tests/data/lopsided-body.toml")
+    )
+}
 
 fn main() -> anyhow::Result<()> {
     let out = std::env::args()
@@ -40,7 +29,7 @@ fn main() -> anyhow::Result<()> {
             "box-robot",
             Config::load(Path::new("configs/box-robot.toml"), &[])?,
         ),
-        ("lopsided", Config::from_toml(LOPSIDED, "lopsided", &[])?),
+        ("lopsided", Config::from_toml(&lopsided(), "lopsided", &[])?),
     ];
     for (name, cfg) in bodies {
         let cat = cfg.cat();

@@ -12,21 +12,7 @@ use util::{config, run, seed, temp_dir};
 
 /// A body with products of inertia, off-axis centres of mass, an
 /// off-centre joint and (universal) tilted motor axes, as `[body]` keys.
-pub const LOPSIDED: &str = r#"
-[body.rear]
-mass = 1.3
-com = [0.03, -0.02, 0.01]
-inertia = [[0.09, 0.004, -0.003], [0.004, 0.08, 0.006], [-0.003, 0.006, 0.03]]
-joint = [0.01, 0.02, 0.5]
-axis = [0.6, 0.8, 0.0]
-
-[body.front]
-mass = 0.7
-com = [-0.02, 0.0, 0.04]
-inertia = [0.05, 0.06, 0.02, -0.002, 0.0, 0.001]
-joint = [0.0, 0.01, -0.45]
-axis = [-0.8, 0.6, 0.0]
-"#;
+pub const LOPSIDED: &str = include_str!("data/lopsided-body.toml");
 
 pub fn lopsided(joint: &str, extra: &str) -> Config {
     let text = format!(
