@@ -296,8 +296,9 @@ def make_callback(robot, ctl, stage):
     va = robot.va
     nv = robot.nominal.nv
     rhs, sol = np.zeros((4, nv)), np.zeros((4, nv))
-    for i in range(3):
-        rhs[1 + i, va + i] = 1.0
+    if robot.ball:
+        for i in range(3):
+            rhs[1 + i, va + i] = 1.0
 
     def control(m, d):
         s = int(round(2.0 * (d.time - stage.t0) / stage.h))
@@ -383,9 +384,8 @@ def fly(robot, ctl, start_sim, body_rate, d=None, plant=None):
 class PackageController:
     """catflip.Controller: the study's design, its gains and feed-forward, exactly."""
 
-    def __init__(self, cfg, kind):
-        import catflip
-        self.c = catflip.Controller(cfg, kind=kind)
+    def __init__(self, c):
+        self.c = c
         for k in ("step", "steps", "period_steps", "control_steps", "feedforward", "peak_torque"):
             setattr(self, k, getattr(self.c, k))
         self.torque, self.sensed, self.clip, self.reset = self.c.torque, self.c.sensed, self.c.clip, self.c.reset
@@ -453,7 +453,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--catflip", default=str(pathlib.Path(os.environ.get("CARGO_TARGET_DIR", ROOT / "target"))
                                              / "release" / "catflip"))
-    ap.add_argument("--out", default=None, help="folder for catflip's study (default: a temporary one)")
+    ap.add_argument("--out", default=None, help="folder under which catflip's study is written, in a "
+                    "fresh subfolder (default: a temporary folder)")
     ap.add_argument("--nominal-tol-deg", type=float, default=1e-3)
     ap.add_argument("--route", choices=("auto", "package", "csv"), default="auto",
                     help="controllers from the catflip package (auto: where installed) or from the exported CSVs")
@@ -463,7 +464,10 @@ def main():
 
 
 def main_with(args):
-    out = pathlib.Path(args.out or tempfile.mkdtemp(prefix="catflip-closed-loop-"))
+    # a fresh folder for this study's files (under --out when given)
+    if args.out:
+        pathlib.Path(args.out).mkdir(parents=True, exist_ok=True)
+    out = pathlib.Path(tempfile.mkdtemp(prefix="study-", dir=args.out))
     summary, folder, cfg, t_catflip = run_catflip_study(args, out)
     rows = draws_of_csv(folder / "robustness.csv")
     # the study's draws are catflip's random streams, redrawn here bit for bit
@@ -482,7 +486,8 @@ def main_with(args):
         import catflip
         config = catflip.Config.from_toml(args.config, args.overrides)
         mjcf = catflip.export_mjcf(config)
-        ctls = {k: PackageController(config, k) for k in CONTROLLERS}
+        tvlqr = catflip.Controller(config, kind="tvlqr")
+        ctls = {k: PackageController(tvlqr.with_kind(k)) for k in CONTROLLERS}
     else:
         ctls, mjcf = csv_route(args, out, cfg)
     tv_period = ctls["tvlqr"].period_steps

@@ -456,6 +456,8 @@ class Controller:
         """The corrections sent since the last reset, by control step: shape (k, 2)."""
     def gains_csv(self) -> str:
         """The gains as ``<stem>.tvlqr.csv`` text. GIL released."""
+    def with_kind(self, kind: ControllerKind) -> Controller:
+        """The same design's controller of another ``kind``, its gains reused (no new design)."""
     def fly(self, trial: Optional[int] = None, seed: int = 0) -> Flight:
         """A flight of catflip's closed-loop simulator under this controller: the nominal
         (``trial=None``) or trial ``trial`` of ``catflip robustness --seed SEED`` (its draws,

@@ -1418,7 +1418,30 @@ struct Controller {
 /// The design a controller follows: a Python `Design`'s, or the study's own.
 enum ControllerPlan {
     Design(Py<Design>),
-    Study(Plan),
+    Study(std::sync::Arc<dyn ShapePlan + Send + Sync>),
+}
+
+impl ControllerPlan {
+    fn plan(&self) -> &dyn ShapePlan {
+        match self {
+            ControllerPlan::Design(d) => d.get().plan.as_ref(),
+            ControllerPlan::Study(p) => p.as_ref(),
+        }
+    }
+}
+
+/// A controller kind by its name; "replan" is refused, naming why.
+fn controller_kind(kind: &str) -> PyResult<Kind> {
+    match kind {
+        "tvlqr" => Ok(Kind::Tvlqr),
+        "open-loop" => Ok(Kind::OpenLoop),
+        "replan" => Err(pyo3::exceptions::PyNotImplementedError::new_err(
+            "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz, which needs designs from any start (a measured attitude, momentum and shape), not yet in the catflip library; use kind=\"tvlqr\" (or \"open-loop\")",
+        )),
+        other => Err(ConfigError::new_err(format!(
+            "unknown controller kind `{other}`; use \"tvlqr\" or \"open-loop\" (\"replan\" is not built yet)"
+        ))),
+    }
 }
 
 /// A flight of catflip's closed-loop simulator, with every command the controller sent.
@@ -1445,32 +1468,16 @@ impl Controller {
         design: Option<Py<Design>>,
         kind: &str,
     ) -> PyResult<Controller> {
-        let kind = match kind {
-            "tvlqr" => Kind::Tvlqr,
-            "open-loop" => Kind::OpenLoop,
-            "replan" => {
-                return Err(pyo3::exceptions::PyNotImplementedError::new_err(
-                    "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz, which needs designs from any start (a measured attitude, momentum and shape), not yet in the catflip library; use kind=\"tvlqr\" (or \"open-loop\")",
-                ));
-            }
-            other => {
-                return Err(ConfigError::new_err(format!(
-                    "unknown controller kind `{other}`; use \"tvlqr\" or \"open-loop\" (\"replan\" is not built yet)"
-                )));
-            }
-        };
+        let kind = controller_kind(kind)?;
         let (_, cfg) = config.snapshot();
         py.detach(move || {
             let plan = match design {
                 Some(d) => ControllerPlan::Design(d),
-                None => ControllerPlan::Study(Box::new(
+                None => ControllerPlan::Study(std::sync::Arc::new(
                     catflip::control::robustness::design(&cfg).map_err(err)?.plan,
                 )),
             };
-            let online = match &plan {
-                ControllerPlan::Design(d) => Online::new(&cfg, d.get().plan.as_ref(), kind),
-                ControllerPlan::Study(p) => Online::new(&cfg, p.as_ref(), kind),
-            };
+            let online = Online::new(&cfg, plan.plan(), kind);
             Ok(Controller {
                 online: Mutex::new(online),
                 cfg,
@@ -1647,13 +1654,26 @@ impl Controller {
     /// The gains as the `<stem>.tvlqr.csv` text (`catflip export mjcf CONFIG --schedule S.csv`
     /// writes it for the schedule read back from its CSV). GIL released.
     fn gains_csv(&self, py: Python<'_>) -> String {
-        py.detach(|| {
-            let plan: &dyn ShapePlan = match &self.plan {
-                ControllerPlan::Design(d) => d.get().plan.as_ref(),
-                ControllerPlan::Study(p) => p.as_ref(),
-            };
-            catflip::control::export::gains_csv(&self.cfg, plan)
-        })
+        py.detach(|| catflip::control::export::gains_csv(&self.cfg, self.plan.plan()))
+    }
+
+    /// The same design's controller of another `kind`, its gains reused (no new design). GIL released.
+    fn with_kind(&self, py: Python<'_>, kind: &str) -> PyResult<Controller> {
+        let kind = controller_kind(kind)?;
+        let plan = match &self.plan {
+            ControllerPlan::Design(d) => ControllerPlan::Design(d.clone_ref(py)),
+            ControllerPlan::Study(p) => ControllerPlan::Study(p.clone()),
+        };
+        let mut online = self.lock().clone();
+        Ok(py.detach(move || {
+            online.kind = kind;
+            online.reset();
+            Controller {
+                online: Mutex::new(online),
+                cfg: self.cfg.clone(),
+                plan,
+            }
+        }))
     }
 
     /// A flight of catflip's closed-loop simulator under this controller: the nominal

@@ -35,7 +35,9 @@ _CACHE = {}
 def controller(name, kind="tvlqr"):
     """The study's design's controller (built once per config and kind)."""
     if (name, kind) not in _CACHE:
-        _CACHE[(name, kind)] = catflip.Controller(config(name), kind=kind)
+        if (name, "tvlqr") not in _CACHE:
+            _CACHE[(name, "tvlqr")] = catflip.Controller(config(name))
+        _CACHE[(name, kind)] = _CACHE[(name, "tvlqr")].with_kind(kind)
     return _CACHE[(name, kind)]
 
 
@@ -136,6 +138,8 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
 def test_replan_is_refused_naming_why():
     with pytest.raises(NotImplementedError, match="replan.*not built yet.*any start"):
         catflip.Controller(config("seed"), kind="replan")
+    with pytest.raises(NotImplementedError, match="replan.*not built yet"):
+        controller("seed").with_kind("replan")
     with pytest.raises(catflip.ConfigError, match="unknown controller kind `lqr`"):
         catflip.Controller(config("seed"), kind="lqr")
 
