@@ -288,6 +288,10 @@ class Stage:
     extra = np.zeros(2)
 
 
+# the stage the control callback works for: the flight's, or a prediction's inside a command
+_STAGE = [None]
+
+
 def make_callback(robot, ctl, stage):
     """ctrl at every RK4 stage: catflip's plant torque clip(ff(stage) + correction + noise)
     at the stage's joint speed, through the MJCF's actuators; for the no-twist ball the
@@ -300,7 +304,10 @@ def make_callback(robot, ctl, stage):
         for i in range(3):
             rhs[1 + i, va + i] = 1.0
 
+    _STAGE[0] = stage
+
     def control(m, d):
+        stage = _STAGE[0]
         s = int(round(2.0 * (d.time - stage.t0) / stage.h))
         f = ff[2 * stage.j + min(max(s, 0), 2)]
         if robot.ball:
@@ -548,8 +555,217 @@ def main_with(args):
         sys.exit(1)
 
 
+def run_cli(cmd):
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    return p.returncode, p.stdout, p.stderr
+
+
 def csv_route(args, out, cfg):
-    raise SystemExit("the CSV route is not built yet: install the catflip package (pip install ./python)")
+    """The controllers from the files catflip exports: the study's design as a schedule
+    (`catflip optimize --mode free`, from the analytic seed where the phased one cannot fit,
+    as the study), then `catflip export mjcf --schedule free.csv`: the MJCF, the controls
+    `free.mujoco.csv` and the gains `free.tvlqr.csv`."""
+    sets = sum((["--set", s] for s in args.overrides), [])
+    code, _, err = run_cli([args.catflip, "optimize", args.config, "--mode", "free", "--out", str(out)] + sets)
+    if code != 0:
+        code, _, err = run_cli([args.catflip, "optimize", args.config, "--mode", "free", "--seed", "analytic",
+                                "--out", str(out)] + sets)
+    if code not in (0, 3):
+        raise SystemExit(f"catflip optimize --mode free: exit {code}\n{err}")
+    schedule = next(pathlib.Path(out).rglob("free.csv"))
+    code, _, err = run_cli([args.catflip, "export", "mjcf", args.config, "--schedule", str(schedule),
+                            "--out", str(out)] + sets)
+    if code != 0:
+        raise SystemExit(f"catflip export mjcf --schedule: exit {code}\n{err}")
+    folder = next(pathlib.Path(out).rglob("free.tvlqr.csv")).parent
+    mjcf = next(folder.glob("*.mjcf.xml")).read_text()
+    robot = Robot(mjcf)
+    tv = CsvController(robot, folder / "free.tvlqr.csv", folder / "free.mujoco.csv", "tvlqr")
+    return {"open-loop": tv.with_kind("open-loop"), "tvlqr": tv}, mjcf
+
+
+def read_gains(path):
+    """`<stem>.tvlqr.csv`: its `# key = value` lines and its rows."""
+    meta, cols, rows = {}, None, []
+    for line in pathlib.Path(path).read_text().splitlines():
+        if line.startswith("#"):
+            k, _, v = line[1:].partition(" = ")
+            if v and " " not in k.strip() and " " not in v.strip():
+                meta[k.strip()] = float(v)
+        elif cols is None:
+            cols = line.split(",")
+        elif line.strip():
+            rows.append([float(x) for x in line.split(",")])
+    data = np.array(rows)
+    col = lambda name: data[:, cols.index(name)]
+    nominal = np.stack([col(c) for c in ("qnom_w", "qnom_x", "qnom_y", "qnom_z", "lnom_1", "lnom_2", "lnom_3",
+                                         "qnom_1", "qnom_2", "qdnom_1", "qdnom_2")], axis=1)
+    gains = np.stack([np.stack([col(f"K_{i}_{j}") for j in range(10)], axis=1) for i in range(2)], axis=1)
+    return meta, col("t_apply_s"), nominal, gains
+
+
+def momentum(robot, m, d):
+    """lambda: the angular momentum about the common centre of mass in the rear half's frame."""
+    mujoco.mj_kinematics(m, d)
+    mujoco.mj_comPos(m, d)
+    mujoco.mj_comVel(m, d)
+    mujoco.mj_subtreeVel(m, d)
+    return rotate(quat_conj(normalised(d.qpos[3:7])), d.subtree_angmom[robot.rear])
+
+
+class CsvController:
+    """The study's controllers from catflip's exported files, without the package: the
+    TVLQR of `<stem>.tvlqr.csv` (predicting over its delay with MuJoCo's model of the
+    robot), the PD on the planned shape of `<stem>.mujoco.csv`, whose held torques are
+    the feed-forward."""
+
+    def __init__(self, robot, gains_csv, controls_csv, kind):
+        from replay_common import read_controls
+        self.robot, self.kind = robot, kind
+        meta, self.t_apply, self.nom, self.k = read_gains(gains_csv)
+        self.meta = meta
+        self.step, self.steps = meta["step_s"], int(meta["steps"])
+        self.delay_steps = int(meta["delay_steps"])
+        self.tv_period = int(meta["period_steps"])
+        self.period_steps = self.tv_period if kind == "tvlqr" else 1
+        self.control_steps = len(self.t_apply) if kind == "tvlqr" else self.steps
+        self.peak_torque, self.cap = meta["peak_torque_nm"], meta["max_correction_nm"]
+        self.c = c = read_controls(controls_csv)
+        pos, vel, ctrl = c["pick"]("qpos"), c["pick"]("qvel"), c["pick"]("ctrl")
+        # catflip's coordinates: hinge angles, or the ball's rotation vector (v1, v2) and its rate
+        if robot.ball:
+            v = np.array([quat_log(p) for p in pos])
+            jr = [right_jacobian(x) for x in v]
+            self.q_plan = v[:, :2]
+            self.qd_plan = np.array([np.linalg.solve(j, w) for j, w in zip(jr, vel)])[:, :2]
+            held = np.array([(j.T @ u)[:2] for j, u in zip(jr, ctrl)])
+        else:
+            self.q_plan, self.qd_plan = pos, vel
+            held = ctrl.copy()
+            if c["slope"] > 0:
+                # DC command tau + k qd, qd averaged over the step
+                held[:-1] -= c["slope"] * (pos[1:] - pos[:-1]) / c["dt"]
+        # the feed-forward at catflip's half steps: each held torque is the schedule's average
+        # over its step, so its value at the step's middle to second order; linear between
+        # the middles (a held torque switching inside an RK4 step would cost first order)
+        n_rows = int(c["steps"]) - c["margin_steps"]
+        mid = (np.arange(n_rows) + 0.5) * c["dt"]
+        t = 0.5 * self.step * np.arange(2 * self.steps + 1)
+        inside = t < n_rows * c["dt"] * (1 - 1e-12)
+        self.feedforward = np.zeros((len(t), 2))
+        for i in range(2):
+            self.feedforward[inside, i] = np.interp(t[inside], mid, held[:n_rows, i])
+        self.issued = []
+        self.pred_model = robot.model(None)
+        self.pred = mujoco.MjData(self.pred_model)
+
+    def with_kind(self, kind):
+        other = object.__new__(CsvController)
+        other.__dict__.update(self.__dict__)
+        other.kind = kind
+        other.period_steps = self.tv_period if kind == "tvlqr" else 1
+        other.control_steps = len(self.t_apply) if kind == "tvlqr" else self.steps
+        other.issued = []
+        other.pred = mujoco.MjData(self.pred_model)
+        return other
+
+    def nominal_landing(self):
+        return self.meta["nominal_landing_error_deg_" + self.kind.replace("-", "_")]
+
+    def reset(self):
+        self.issued = []
+
+    def clip(self, tau, qd):
+        from replay_common import limit_catflip_torque
+        return limit_catflip_torque(np.asarray(tau, float), np.asarray(qd, float), self.c)
+
+    def _load(self, state, omega=None):
+        """The predictor's MuJoCo state at `state` (attitude, lambda, q, qd); with `omega`,
+        the rear half's rate instead of lambda."""
+        r, m, d = self.robot, self.pred_model, self.pred
+        d.qpos[0:3] = [0.0, 0.0, 10.0]
+        d.qpos[3:7] = state[:4]
+        d.qvel[:] = 0.0
+        q, qd = np.asarray(state[7:9], float), np.asarray(state[9:11], float)
+        if r.ball:
+            v = np.array([q[0], q[1], 0.0])
+            d.qpos[r.qa:r.qa + 4] = quat_exp(v)
+            d.qvel[r.va:r.va + 3] = right_jacobian(v) @ np.array([qd[0], qd[1], 0.0])
+        else:
+            d.qpos[r.qa:r.qa + 2], d.qvel[r.va:r.va + 2] = q, qd
+        if omega is None:
+            # lambda = lambda_0 + A w: the rate that carries the state's momentum
+            l0 = momentum(r, m, d)
+            a = np.zeros((3, 3))
+            for i in range(3):
+                d.qvel[3:6] = np.eye(3)[i]
+                a[:, i] = momentum(r, m, d) - l0
+            omega = np.linalg.solve(a, np.asarray(state[4:7], float) - l0)
+        d.qvel[3:6] = omega
+
+    def sensed(self, att, q, qd, gyro):
+        s = np.concatenate([att, np.zeros(3), q, qd])
+        self._load(s, np.asarray(gyro, float))
+        s[4:7] = momentum(self.robot, self.pred_model, self.pred)
+        return s
+
+    def torque(self, t, state):
+        j = int(math.floor(t / self.step + 1e-9))
+        k = j // self.period_steps
+        if k >= self.control_steps:
+            return self.issued[-1] if self.issued else np.zeros(2)
+        self.issued = (self.issued + [np.zeros(2)] * k)[:k]
+        if self.kind == "open-loop":
+            u = self.c["kp"] * (self.q_plan_at(j)[0] - state[7:9]) + self.c["kd"] * (self.q_plan_at(j)[1] - state[9:11])
+        else:
+            u = self.tvlqr(k, state)
+        self.issued.append(u)
+        return u
+
+    def q_plan_at(self, j):
+        """The planned (q, qd) at step j (cubic Hermite between the controls' rows)."""
+        from replay_common import reference
+        t = j * self.step
+        dt = self.c["dt"]
+        last = len(self.q_plan) - 1
+        row = min(int(math.floor(t / dt + 1e-9)), last)
+        if row >= last:
+            return self.q_plan[last], self.qd_plan[last]
+        return reference(self.q_plan, self.qd_plan, row, t / dt - row, dt)
+
+    def tvlqr(self, k, state):
+        """The correction of control step k: predict over the delay with MuJoCo's model under
+        the corrections sent, u = -K x of the predicted error, capped, the sum with the
+        feed-forward inside the envelope at the predicted speed."""
+        r, h = self.robot, self.step
+        s = int(round(self.t_apply[k] / h))
+        j0 = s - self.delay_steps
+        self._load(state)
+        d = self.pred
+        d.time = j0 * h
+        outer = _STAGE[0]
+        stage = Stage()
+        stage.h = h
+        _STAGE[0] = stage
+        try:
+            for i in range(j0, s):
+                c = min((i - self.delay_steps) // self.tv_period, len(self.issued) - 1) if i >= self.delay_steps else -1
+                stage.j, stage.t0 = i, d.time
+                stage.extra = self.issued[c] if c >= 0 else np.zeros(2)
+                mujoco.mj_step(self.pred_model, d)
+        finally:
+            _STAGE[0] = outer
+        att = normalised(d.qpos[3:7])
+        lam = momentum(r, self.pred_model, d)
+        q, qd = shape_of(r, d)
+        n = self.nom[k]
+        x = np.concatenate([quat_log(quat_mul(quat_conj(n[:4]), att)), lam - n[4:7], q[:2] - n[7:9], qd[:2] - n[9:11]])
+        u = -self.k[k] @ x
+        size = np.abs(u).max() if self.c["norm"] == "per-motor" else float(np.hypot(u[0], u[1]))
+        if size > self.cap:
+            u = u * (self.cap / size)
+        ff = self.feedforward[2 * s]
+        return self.clip(ff + u, qd[:2]) - ff
 
 
 if __name__ == "__main__":
