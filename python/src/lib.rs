@@ -1385,7 +1385,6 @@ impl Controls {
     }
 }
 
-
 // --- closed loop ------------------------------------------------------------
 
 use catflip::control::online::{Kind, Online, SimState, from_sim, to_sim};
@@ -1401,8 +1400,9 @@ fn sim_state(state: Vec<f64>) -> PyResult<SimState> {
 }
 
 fn pair(v: Vec<f64>, what: &str) -> PyResult<[f64; 2]> {
-    v.try_into()
-        .map_err(|v: Vec<f64>| ConfigError::new_err(format!("{what} has {} values; give 2", v.len())))
+    v.try_into().map_err(|v: Vec<f64>| {
+        ConfigError::new_err(format!("{what} has {} values; give 2", v.len()))
+    })
 }
 
 /// One of the study's controllers along a design, for a simulation loop run
@@ -1474,7 +1474,9 @@ impl Controller {
             let plan = match design {
                 Some(d) => ControllerPlan::Design(d),
                 None => ControllerPlan::Study(std::sync::Arc::new(
-                    catflip::control::robustness::design(&cfg).map_err(err)?.plan,
+                    catflip::control::robustness::design(&cfg)
+                        .map_err(err)?
+                        .plan,
                 )),
             };
             let online = Online::new(&cfg, plan.plan(), kind);

@@ -121,7 +121,13 @@ impl Online {
     /// attitude `W R` (`[w, x, y, z]`), the joint angles and rates and the
     /// gyro on the rear half (rad/s, its own frame); `lambda = J(q) w + K(q) q_dot`
     /// with the model's inertias, as the closed loop's sensors estimate it.
-    pub fn sensed(&self, attitude: [f64; 4], q: [f64; 2], qd: [f64; 2], gyro: [f64; 3]) -> SimState {
+    pub fn sensed(
+        &self,
+        attitude: [f64; 4],
+        q: [f64; 2],
+        qd: [f64; 2],
+        gyro: [f64; 3],
+    ) -> SimState {
         let l = momentum_from_rates(&self.reference.cat, q, qd, gyro);
         [
             attitude[0],
@@ -181,16 +187,18 @@ mod tests {
     #[test]
     fn the_simulators_state_maps_back_exactly_enough() {
         let y: Y = {
-            let q = nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(
-                0.3, -1.1, 2.0,
-            ));
-            [
-                q.w, q.i, q.j, q.k, 0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7,
-            ]
+            let q =
+                nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(0.3, -1.1, 2.0));
+            [q.w, q.i, q.j, q.k, 0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7]
         };
         let back = from_sim(&to_sim(&y));
         for i in 0..11 {
-            assert!((back[i] - y[i]).abs() < 1e-15, "{i}: {} vs {}", back[i], y[i]);
+            assert!(
+                (back[i] - y[i]).abs() < 1e-15,
+                "{i}: {} vs {}",
+                back[i],
+                y[i]
+            );
         }
         // W sends catflip's up (x) to the simulators' z
         let s = to_sim(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);

@@ -184,12 +184,7 @@ impl<'a> Study<'a> {
         let (cfg, r) = (self.cfg, &self.reference);
         let (draw, flight) = trial_flight(cfg, r, &self.tvlqr, self.seed, trial);
         let motor = cfg.motor();
-        let open = fly(
-            r,
-            open_loop(&self.pd, &draw),
-            &motor,
-            flight.clone(),
-        );
+        let open = fly(r, open_loop(&self.pd, &draw), &motor, flight.clone());
         let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight);
         TrialResult {
             draw,
