@@ -1436,7 +1436,7 @@ fn controller_kind(kind: &str) -> PyResult<Kind> {
         "tvlqr" => Ok(Kind::Tvlqr),
         "open-loop" => Ok(Kind::OpenLoop),
         "replan" => Err(pyo3::exceptions::PyNotImplementedError::new_err(
-            "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz, which needs designs from any start (a measured attitude, momentum and shape), not yet in the catflip library; use kind=\"tvlqr\" (or \"open-loop\")",
+            "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz; the re-solve from any start is in the catflip library (free::replan) but not yet in the closed loop, and it misses the control period (docs/control.md); use kind=\"tvlqr\" (or \"open-loop\")",
         )),
         other => Err(ConfigError::new_err(format!(
             "unknown controller kind `{other}`; use \"tvlqr\" or \"open-loop\" (\"replan\" is not built yet)"

@@ -136,7 +136,7 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
 
 
 def test_replan_is_refused_naming_why():
-    with pytest.raises(NotImplementedError, match="replan.*not built yet.*any start"):
+    with pytest.raises(NotImplementedError, match="replan.*not built yet.*any start.*closed loop"):
         catflip.Controller(config("seed"), kind="replan")
     with pytest.raises(NotImplementedError, match="replan.*not built yet"):
         controller("seed").with_kind("replan")
