@@ -41,15 +41,14 @@ pub fn verdict_text(grade: Grade, reason: Option<&str>) -> String {
     }
 }
 
+/// What the seed's analytic schedule is when it breaks the motor limits.
+const REFERENCE: &str = "a reference beyond the motors, not counted";
+
 /// A method's verdict in words, the reference beyond the motors said to be one.
 fn method_verdict(m: &MethodSummary) -> String {
     let text = verdict_text(m.verdict, m.reason.as_deref());
     if m.beyond_the_motors {
-        text.replacen(
-            "FLAGGED:",
-            "FLAGGED (a reference beyond the motors, not counted):",
-            1,
-        )
+        format!("{text} ({REFERENCE})")
     } else {
         text
     }
@@ -96,10 +95,7 @@ pub fn free_design_text(
 pub fn warning(m: &MethodSummary) -> Option<String> {
     let why = m.reason.as_ref()?;
     Some(if m.beyond_the_motors {
-        format!(
-            "{} (a reference beyond the motors, not counted): {why}",
-            m.method
-        )
+        format!("{}: {why} ({REFERENCE})", m.method)
     } else {
         format!("{}: {why}", m.method)
     })
