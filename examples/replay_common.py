@@ -255,7 +255,7 @@ def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_metho
     the largest |flip - catflip's| allowed, deg; `ff_tol` (or None) bounds the
     feed-forward-only flip of optimised, unsaturated schedules."""
     print(f"{engine} replay of {summary['name']} ({summary['joint']} joint); flip in catflip's convention")
-    print(f"  {'method':<9} {'mode':<5} {'flip deg':>16} {'catflip deg':>16} {'diff deg':>10} {'tilt deg':>10} "
+    print(f"  {'method':<12} {'mode':<5} {'flip deg':>16} {'catflip deg':>16} {'diff deg':>10} {'tilt deg':>10} "
           f"{'landing deg':>12} {'catflip deg':>12} {'diff deg':>10} "
           f"{'shape err rad':>13} {'peak N m':>10} {'catflip N m':>11}")
     fails = []
@@ -264,7 +264,7 @@ def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_metho
         diff = r["flip_deg"] - m["flip_deg"]
         land = m.get("landing_error_deg", float("nan"))
         ldiff = r["landing_deg"] - land
-        print(f"  {name:<9} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
+        print(f"  {name:<12} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
               f"{r['tilt_deg']:10.2e} {r['landing_deg']:12.6f} {land:12.6f} {ldiff:10.2e} "
               f"{r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
         if land_tol is not None and name in land_methods and (land_modes is None or mode in land_modes) \

@@ -199,9 +199,10 @@ def main():
     summary = load_summary(out)
     name = summary["name"]
     model = mujoco.MjModel.from_xml_path(str(out / f"{name}.mjcf.xml"))
-    # every method that produced a schedule (a failed one has none)
+    # every method that produced a schedule (a failed one, or one the motors cannot do
+    # in this fall, has none; the least-height schedule is one)
     methods = args.methods.split(",") if args.methods else [
-        m["method"] for m in summary["methods"] if m.get("verdict") != "failed"]
+        m["method"] for m in summary["methods"] if m.get("schedule_csv")]
     results, fails, controls = [], [], []
     for method in methods:
         c = read_controls(out / f"{method}.mujoco.csv")

@@ -157,9 +157,10 @@ def main():
     out = run_folder(args.output, args.overrides)
     summary = load_summary(out)
     urdf = out / f"{summary['name']}.urdf"
-    # every method that produced a schedule (a failed one has none)
+    # every method that produced a schedule (a failed one, or one the motors cannot do
+    # in this fall, has none; the least-height schedule is one)
     methods = args.methods.split(",") if args.methods else [
-        m["method"] for m in summary["methods"] if m.get("verdict") != "failed"]
+        m["method"] for m in summary["methods"] if m.get("schedule_csv")]
     results = []
     for method in methods:
         c = read_controls(out / f"{method}.pybullet.csv")

@@ -387,6 +387,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         Design::Phased(r) => serde_json::to_value(r)?,
         Design::Free(r) => serde_json::to_value(r)?,
         Design::Analytic(a) => serde_json::to_value(a)?,
+        Design::LeastHeight(l) => serde_json::to_value(l)?,
     };
     // a number that is not finite is refused, not written as null
     catflip::output::ensure_finite(
@@ -413,7 +414,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     match &judged.design {
         Design::Phased(r) => say_lines(console::design::phased(&cfg, r, &written).lines()),
         Design::Free(r) => say_lines(console::design::free(&cfg, r, &written).lines()),
-        Design::Analytic(_) => {}
+        Design::Analytic(_) | Design::LeastHeight(_) => {}
     }
     Ok(Status::of(partial))
 }

@@ -2,7 +2,8 @@
 //!
 //! Exit status: 0 every result meets its targets; 1 the computation failed;
 //! 2 bad input (config, arguments, files, output folder), nothing computed or
-//! written; 3 partial: results written, but some are flagged or failed;
+//! written; 3 partial: results written, but some are flagged or failed (the
+//! seed's analytic schedule beyond the motor limits, a reference, excepted);
 //! 4 impossible: the motors cannot flip the cat from the configured height
 //! (the least drop height and its schedule are written); 130 interrupted
 //! (a sweep or a robustness study publishes what it finished as a partial set).

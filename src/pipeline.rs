@@ -13,7 +13,7 @@ use crate::error::{Error, Result};
 use crate::output::Output;
 use crate::report::MethodTrace;
 use crate::report::animation::Track;
-use crate::verdict::{DesignNumbers, Grade, Simulated, Status, Targets, Verdict, verdict};
+use crate::verdict::{DesignNumbers, Grade, Miss, Simulated, Status, Targets, Verdict, verdict};
 use crate::verify::analyze::Analysis;
 use crate::verify::simulate::{SimReport, dynamic_cfg};
 use serde::Serialize;
@@ -28,9 +28,13 @@ pub enum Method {
     Phased,
     /// Collocation and successive convexification.
     Free,
+    /// The robot answer's schedule: the shortest manoeuvre found inside the
+    /// motor envelope, flown from the least drop height it needs.
+    LeastHeight,
 }
 
 impl Method {
+    /// The design methods a sweep or `optimize` can ask for.
     pub const ALL: [Method; 3] = [Method::Analytic, Method::Phased, Method::Free];
 
     /// The name of its files (`phased.csv`) and table rows.
@@ -39,6 +43,57 @@ impl Method {
             Method::Analytic => "analytic",
             Method::Phased => "phased",
             Method::Free => "free",
+            Method::LeastHeight => "least-height",
+        }
+    }
+}
+
+/// The least-height answer's schedule as a method: the rows of
+/// `least-height.csv` (a plan itself), the status of the time design that
+/// made it, and the drop height it needs.
+#[derive(Debug, Clone, Serialize)]
+pub struct LeastHeightDesign {
+    #[serde(skip)]
+    pub schedule: Schedule,
+    pub status: Status,
+    /// The least drop height found, m.
+    pub height_m: f64,
+    /// Which time design it is (`phased` or `free`).
+    pub design: &'static str,
+    /// Peak joint torque over the rows, N m (the config's norm).
+    pub peak_torque_nm: f64,
+    /// Largest bend, deg, and twist of the bend direction, rad, over the rows.
+    pub bend_deg: f64,
+    pub twist_rad: f64,
+}
+
+impl LeastHeightDesign {
+    /// The answer's schedule, its numbers read off its rows.
+    pub fn of(cfg: &Config, a: &crate::design::least_height::HeightAnswer) -> LeastHeightDesign {
+        let norm = cfg.norm();
+        let rows = &a.schedule.rows;
+        let peak = rows.iter().map(|r| norm.of(r.tau)).fold(0.0, f64::max);
+        let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
+        for r in rows {
+            let b = r.q[0].hypot(r.q[1]);
+            bend = bend.max(b);
+            // the bend direction is defined away from straight (as the free-form design's)
+            if b > 1e-3 {
+                let phi = r.q[1].atan2(r.q[0]);
+                if let Some(l) = last_phi {
+                    twist += crate::model::so3::wrap(phi - l);
+                }
+                last_phi = Some(phi);
+            }
+        }
+        LeastHeightDesign {
+            schedule: a.schedule.clone(),
+            status: a.status,
+            height_m: a.least_height_m,
+            design: a.method,
+            peak_torque_nm: peak,
+            bend_deg: bend.to_degrees(),
+            twist_rad: twist,
         }
     }
 }
@@ -50,6 +105,7 @@ pub enum Design {
     Analytic(Analysis),
     Phased(PhasedResult),
     Free(FreeResult),
+    LeastHeight(LeastHeightDesign),
 }
 
 impl Design {
@@ -58,6 +114,7 @@ impl Design {
             Design::Analytic(_) => Method::Analytic,
             Design::Phased(_) => Method::Phased,
             Design::Free(_) => Method::Free,
+            Design::LeastHeight(_) => Method::LeastHeight,
         }
     }
 
@@ -66,6 +123,7 @@ impl Design {
             Design::Analytic(a) => &a.plan,
             Design::Phased(p) => &p.plan,
             Design::Free(f) => &f.plan,
+            Design::LeastHeight(l) => &l.schedule,
         }
     }
 
@@ -74,6 +132,7 @@ impl Design {
             Design::Analytic(_) => Status::ClosedForm,
             Design::Phased(p) => p.status.into(),
             Design::Free(f) => f.status.into(),
+            Design::LeastHeight(l) => l.status,
         }
     }
 
@@ -83,6 +142,7 @@ impl Design {
             Design::Analytic(a) => a.peak_torque_nm,
             Design::Phased(p) => p.peak_torque_nm,
             Design::Free(f) => f.peak_torque_nm,
+            Design::LeastHeight(l) => l.peak_torque_nm,
         }
     }
 
@@ -96,6 +156,10 @@ impl Design {
             ),
             Design::Phased(p) => (p.bend_deg, p.twist_rad, p.phase_durations_s),
             Design::Free(f) => (f.bend_deg, f.twist_rad, f.phase_durations_s),
+            Design::LeastHeight(l) => {
+                let b = l.schedule.phase_bounds();
+                (l.bend_deg, l.twist_rad, [0, 1, 2].map(|i| b[i + 1] - b[i]))
+            }
         }
     }
 
@@ -105,6 +169,7 @@ impl Design {
             Design::Analytic(_) => None,
             Design::Phased(p) => p.sim.as_ref(),
             Design::Free(f) => Some(&f.sim),
+            Design::LeastHeight(_) => None,
         }
     }
 }
@@ -170,7 +235,11 @@ pub struct Judged {
 /// The stage: sample, simulate, judge, summarise. `solve_time_s` is the
 /// method's time (the analytic design's includes its simulation).
 pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
-    let schedule = Schedule::sample(&cfg.cat(), design.plan(), cfg.simulate.samples_per_phase);
+    let schedule = match &design {
+        // already rows: written as they are
+        Design::LeastHeight(l) => l.schedule.clone(),
+        _ => Schedule::sample(&cfg.cat(), design.plan(), cfg.simulate.samples_per_phase),
+    };
     let sim = match design.simulation() {
         Some(s) => Ok(s.clone()),
         None => dynamic_cfg(cfg, design.plan()),
@@ -220,6 +289,7 @@ pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
         status: design.status(),
         verdict: verdict.grade(),
         reason: verdict.reason(),
+        beyond_the_motors: method == Method::Analytic && verdict.misses.iter().any(Miss::is_limit),
         result: Some(n),
     };
     Judged {
@@ -315,12 +385,18 @@ pub fn trace(
 #[derive(Debug, Clone, Serialize)]
 pub struct MethodSummary {
     pub method: &'static str,
-    /// Solver status (`closed-form`, `solved`, `converged`, ...), or `failed`.
+    /// Solver status (`closed-form`, `solved`, `converged`, ...), `failed`,
+    /// or `not-attempted` (the motors cannot do it in this fall).
     pub status: Status,
     pub verdict: Grade,
-    /// Why the method is flagged or failed (absent when ok).
+    /// Why the method is flagged, failed or impossible (absent when ok).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// The seed's analytic schedule is a reference, not a design for these
+    /// motors: when it breaks their limits it is flagged and reported, but
+    /// does not make the run partial (present, `true`, only then).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub beyond_the_motors: bool,
     /// The numbers, absent when the method failed.
     #[serde(flatten)]
     pub result: Option<MethodNumbers>,
@@ -365,11 +441,71 @@ impl MethodSummary {
             status: Status::Failed,
             verdict: Grade::Failed,
             reason: Some(e.to_string()),
+            beyond_the_motors: false,
             result: None,
+        }
+    }
+
+    /// The line of a method not attempted because the motors cannot do it
+    /// in this fall; `why` says what height it needs.
+    pub fn impossible(method: Method, why: &str) -> MethodSummary {
+        MethodSummary {
+            method: method.name(),
+            status: Status::NotAttempted,
+            verdict: Grade::Impossible,
+            reason: Some(why.to_string()),
+            beyond_the_motors: false,
+            result: None,
+        }
+    }
+
+    /// Whether this line makes a run partial: flagged or failed, unless it
+    /// is the reference beyond the motors.
+    pub fn counts_against(&self) -> bool {
+        match self.verdict {
+            Grade::Ok => false,
+            Grade::Flagged => !self.beyond_the_motors,
+            Grade::Failed | Grade::Impossible => true,
         }
     }
 
     pub fn peak(&self) -> Option<f64> {
         self.result.as_ref().map(|r| r.peak_torque_nm)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Which lines make a run partial, over every grade and the reference
+    /// flag: flagged or failed or impossible, unless the flagged line is the
+    /// reference beyond the motors.
+    #[test]
+    fn a_line_counts_against_the_run_unless_ok_or_the_reference_beyond_the_motors() {
+        for (grade, beyond, counts) in [
+            (Grade::Ok, false, false),
+            (Grade::Ok, true, false),
+            (Grade::Flagged, false, true),
+            (Grade::Flagged, true, false),
+            (Grade::Failed, false, true),
+            (Grade::Impossible, false, true),
+        ] {
+            let m = MethodSummary {
+                method: "analytic",
+                status: Status::ClosedForm,
+                verdict: grade,
+                reason: None,
+                beyond_the_motors: beyond,
+                result: None,
+            };
+            assert_eq!(m.counts_against(), counts, "{grade:?} beyond {beyond}");
+        }
+        let m = MethodSummary::impossible(Method::Phased, "needs 5 m");
+        assert_eq!(
+            (m.status, m.verdict),
+            (Status::NotAttempted, Grade::Impossible)
+        );
+        assert!(!m.status.is_usable());
     }
 }

@@ -158,6 +158,11 @@ impl Methods {
         }
     }
 
+    /// A method not attempted: the motors cannot do it in this fall.
+    fn skip(&mut self, method: Method, why: &str) {
+        self.lines.push(MethodSummary::impossible(method, why));
+    }
+
     fn design(&self, method: Method) -> Option<&Design> {
         self.judged
             .iter()
@@ -202,6 +207,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     let mut fastest_free: Option<crate::design::free::FreeResult> = None;
     // the phased least height, when no phased schedule fits this fall
     let mut phased_short: Option<f64> = None;
+    let mut least_seconds = 0.0;
     if limited {
         let clock =
             stages.begin("least drop height (shortest manoeuvre inside the motor envelope)");
@@ -215,12 +221,11 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
                     h.answer
                 })
             });
+        least_seconds = clock.elapsed().as_secs_f64();
         stages.end(clock, a.as_ref().err());
         match a {
-            Ok(Some(a)) => {
-                a.schedule.add_to(&mut done.output, "least-height");
-                answer = Some(a);
-            }
+            // its schedule becomes the least-height method below
+            Ok(Some(a)) => answer = Some(a),
             Ok(None) => {}
             Err(e) => notes_early.push(format!("The least drop height could not be found: {e}")),
         }
@@ -237,38 +242,35 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             a.height_m, a.least_height_m, a.method
         )
     });
-    let skipped = |reason: &String| Error::Unreachable {
-        reason: reason.clone(),
-    };
 
     let clock = stages.begin("phased optimiser (path-timing SOCPs, bend search)");
-    let phased = match &impossible {
-        Some(r) => Err(skipped(r)),
+    match &impossible {
+        Some(reason) => {
+            (stages.progress)(Progress::StageSkipped { reason });
+            done.skip(Method::Phased, reason);
+        }
         None => {
             let mut evaluations = 0;
             let progress = &mut stages.progress;
-            crate::design::phased::optimize(cfg, |e| {
+            let phased = crate::design::phased::optimize(cfg, |e| {
                 evaluations += 1;
                 progress(Progress::Bend {
                     evaluations,
                     bend_deg: e.bend_deg,
                     peak_nm: e.peak_nm,
                 });
-            })
+            });
+            stages.end(clock, phased.as_ref().err());
+            done.add(
+                cfg,
+                Method::Phased,
+                phased.map(|ph| {
+                    let t = ph.solve_time_s;
+                    (Design::Phased(ph), t)
+                }),
+            );
         }
-    };
-    match (&impossible, &phased) {
-        (Some(reason), _) => (stages.progress)(Progress::StageSkipped { reason }),
-        (None, r) => stages.end(clock, r.as_ref().err()),
     }
-    done.add(
-        cfg,
-        Method::Phased,
-        phased.map(|ph| {
-            let t = ph.solve_time_s;
-            (Design::Phased(ph), t)
-        }),
-    );
 
     let clock = stages.begin(
         "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
@@ -285,28 +287,28 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
                 (&analytic_seed, "analytic")
             }
         };
-    let free = match &free_impossible {
-        Some(r) => Err(skipped(r)),
+    match &free_impossible {
+        Some(reason) => {
+            (stages.progress)(Progress::StageSkipped { reason });
+            done.skip(Method::Free, reason);
+        }
         None => {
             let progress = &mut stages.progress;
-            crate::design::free::FreeDesign::new(cfg)
+            let free = crate::design::free::FreeDesign::new(cfg)
                 .from_plan(seed_plan, seed_name)
                 .on_iteration(&mut |it| progress(Progress::Scp(it)))
-                .solve()
+                .solve();
+            stages.end(clock, free.as_ref().err());
+            done.add(
+                cfg,
+                Method::Free,
+                free.map(|fr| {
+                    let t = fr.solve_time_s;
+                    (Design::Free(fr), t)
+                }),
+            );
         }
-    };
-    match (&free_impossible, &free) {
-        (Some(reason), _) => (stages.progress)(Progress::StageSkipped { reason }),
-        (None, r) => stages.end(clock, r.as_ref().err()),
     }
-    done.add(
-        cfg,
-        Method::Free,
-        free.map(|fr| {
-            let t = fr.solve_time_s;
-            (Design::Free(fr), t)
-        }),
-    );
 
     if let Some(a) = answer.as_mut().filter(|a| !a.possible)
         && let Some(m) = done
@@ -317,6 +319,18 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         // a verified free-form schedule inside the envelope settles it
         a.possible = true;
         a.method = m.method;
+    }
+    // the answer's schedule, a method like the others: judged, written,
+    // drawn, animated and exported (it needs its own, longer fall)
+    if let Some(a) = &answer {
+        done.add(
+            cfg,
+            Method::LeastHeight,
+            Ok((
+                Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(cfg, a)),
+                least_seconds,
+            )),
+        );
     }
     if done.lines.iter().all(|m| m.verdict == Grade::Failed) {
         let reasons: Vec<String> = done
@@ -392,10 +406,10 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         max_torque_nm: cfg.limits.max_torque,
         outcome: if answer.as_ref().is_some_and(|a| !a.possible) {
             Outcome::Impossible
-        } else if methods.iter().all(|m| m.verdict == Grade::Ok) {
-            Outcome::Ok
-        } else {
+        } else if methods.iter().any(MethodSummary::counts_against) {
             Outcome::Partial
+        } else {
+            Outcome::Ok
         },
         phased_over_analytic: ratio("phased", "analytic"),
         free_over_phased: ratio("free", "phased"),
@@ -419,7 +433,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             summary.analytic.available_time_s,
             show(summary.free_over_phased),
             show(summary.phased_over_analytic),
-            crate::design::free::iterations_text(&summary.mesh_levels)
+            crate::table::free_design_text(&summary.methods, &summary.mesh_levels)
         ),
     );
     notes.insert(
@@ -433,9 +447,6 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             }
         ),
     );
-    if let Some(a) = &summary.answer {
-        notes.insert(0, a.sentence());
-    }
     if summary.outcome == Outcome::Partial {
         notes.insert(
             0,
@@ -459,22 +470,26 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         max_torque_nm: cfg.limits.max_torque,
         tracks,
     };
+    // (a method the motors cannot do in this fall is the answer, above, not a warning)
     let warnings: Vec<String> = summary
         .methods
         .iter()
-        .filter_map(|m| Some(format!("{}: {}", m.method, m.reason.as_ref()?)))
+        .filter(|m| m.verdict != Grade::Impossible)
+        .filter_map(crate::table::warning)
         .collect();
+    let lead = summary.answer.as_ref().map(report::answer::lead);
     output.add(
         "index.html",
-        report::index_html(
-            &format!("catflip report: {}", cfg.name),
-            &header,
-            &rows,
-            &notes,
-            &warnings,
-            &report::animation::section(&scene),
-            &figure_names,
-        ),
+        report::index_html(&report::Page {
+            title: &format!("catflip report: {}", cfg.name),
+            lead: lead.as_deref(),
+            header: &header,
+            rows: &rows,
+            notes: &notes,
+            warnings: &warnings,
+            animation: &report::animation::section(&scene),
+            figures: &figure_names,
+        }),
     );
     for (name, svg) in figures {
         output.add(name, svg);

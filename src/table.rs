@@ -30,12 +30,28 @@ fn small(x: f64) -> String {
     }
 }
 
-/// A verdict as the table words it: `ok`, `FLAGGED: <why>`, `FAILED: <why>`.
+/// A verdict as the table words it: `ok`, `FLAGGED: <why>`, `FAILED: <why>`,
+/// `not possible: <why>` (the motors cannot do it in this fall: an answer,
+/// not an error).
 pub fn verdict_text(grade: Grade, reason: Option<&str>) -> String {
     match grade {
         Grade::Ok => "ok".to_string(),
         Grade::Flagged => format!("FLAGGED: {}", reason.unwrap_or("")),
         Grade::Failed => format!("FAILED: {}", reason.unwrap_or("")),
+        Grade::Impossible => format!("not possible: {}", reason.unwrap_or("")),
+    }
+}
+
+/// What the seed's analytic schedule is when it breaks the motor limits.
+const REFERENCE: &str = "a reference beyond the motors, not counted";
+
+/// A method's verdict in words, the reference beyond the motors said to be one.
+fn method_verdict(m: &MethodSummary) -> String {
+    let text = verdict_text(m.verdict, m.reason.as_deref());
+    if m.beyond_the_motors {
+        format!("{text} ({REFERENCE})")
+    } else {
+        text
     }
 }
 
@@ -59,17 +75,37 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
         }
         None => row.extend(std::iter::repeat_n("-".to_string(), 9)),
     }
-    row.push(verdict_text(m.verdict, m.reason.as_deref()));
+    row.push(method_verdict(m));
     row
+}
+
+/// How the free-form design went, for the lines under the table: its
+/// meshes and iterations, or that it was not attempted.
+pub fn free_design_text(
+    methods: &[MethodSummary],
+    mesh_levels: &[crate::design::free::MeshLevel],
+) -> String {
+    let free = methods.iter().find(|m| m.method == "free");
+    if free.is_some_and(|m| m.verdict == Grade::Impossible) {
+        "not attempted (the motors cannot do it in this fall), see its row".into()
+    } else {
+        crate::design::free::iterations_text(mesh_levels)
+    }
+}
+
+/// A method's warning line (flagged or failed): its name and reasons.
+pub fn warning(m: &MethodSummary) -> Option<String> {
+    let why = m.reason.as_ref()?;
+    Some(if m.beyond_the_motors {
+        format!("{}: {why} ({REFERENCE})", m.method)
+    } else {
+        format!("{}: {why}", m.method)
+    })
 }
 
 /// The animation's caption of a method: its status and verdict.
 pub fn track_status(m: &MethodSummary) -> String {
-    format!(
-        "{}; {}",
-        m.status,
-        verdict_text(m.verdict, m.reason.as_deref())
-    )
+    format!("{}; {}", m.status, method_verdict(m))
 }
 
 #[cfg(test)]
@@ -81,5 +117,9 @@ mod tests {
         assert_eq!(verdict_text(Grade::Ok, Some("ignored")), "ok");
         assert_eq!(verdict_text(Grade::Flagged, Some("x")), "FLAGGED: x");
         assert_eq!(verdict_text(Grade::Failed, None), "FAILED: ");
+        assert_eq!(
+            verdict_text(Grade::Impossible, Some("needs 3 m")),
+            "not possible: needs 3 m"
+        );
     }
 }

@@ -47,6 +47,9 @@ pub enum Status {
     NumericalError,
     /// No design: the method stopped with an error.
     Failed,
+    /// No design tried: the motors cannot flip the cat in this fall (the
+    /// least-height answer says so and from what height they can).
+    NotAttempted,
 }
 
 impl Status {
@@ -62,7 +65,7 @@ impl Status {
     /// A schedule exists (whether or not it is proven): it can be written,
     /// simulated and judged.
     pub fn is_usable(self) -> bool {
-        self != Status::Failed
+        !matches!(self, Status::Failed | Status::NotAttempted)
     }
 
     /// The name the JSON, CSV and tables use (`iteration-limit`).
@@ -78,6 +81,7 @@ impl Status {
             Status::Unbounded => "unbounded",
             Status::NumericalError => "numerical-error",
             Status::Failed => "failed",
+            Status::NotAttempted => "not-attempted",
         }
     }
 }
@@ -329,6 +333,10 @@ pub enum Grade {
     Flagged,
     /// No result: the method stopped with an error, given as the reason.
     Failed,
+    /// No result, and none possible: the motors cannot do this method's
+    /// manoeuvre in the configured fall. An answer, not an error; the reason
+    /// says what height it needs.
+    Impossible,
 }
 
 /// The judgement of one design: its status and every target it misses.

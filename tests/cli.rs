@@ -405,3 +405,116 @@ fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
     let count = format!("({} SCP iterations", numbers.len());
     assert!(out.contains(&count), "{count} in\n{out}");
 }
+
+/// The robot from its configured 2 m: the motors cannot do it. That is the
+/// answer (exit 4), not a failure: the phased and free-form designs are not
+/// attempted (not `failed`), and the least-height schedule is a method like
+/// the others, judged, written with its simulator controls, replayable, and
+/// the report leads with the answer.
+#[test]
+fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
+    use util::{controls_header, method_line, run_summary};
+    let dir = temp_dir();
+    let (code, s, base, err) = run_summary("robot-universal", &[], dir.path());
+    assert_eq!(code, Some(4), "{err}");
+    assert_eq!(s["outcome"], "impossible");
+    let a = &s["answer"];
+    let least = a["least_height_m"].as_f64().unwrap();
+    assert!(a["possible"] == false && least > 2.0, "{a}");
+    for m in ["phased", "free"] {
+        let l = method_line(&s, m);
+        assert_eq!(l["verdict"], "impossible", "{l}");
+        assert_eq!(l["status"], "not-attempted", "{l}");
+        assert!(l["peak_torque_nm"].is_null(), "{l}");
+        assert!(l["reason"].as_str().unwrap().contains("fall.height"), "{l}");
+    }
+    // the reference: flagged beyond the motors
+    let an = method_line(&s, "analytic");
+    assert!(
+        an["verdict"] == "flagged" && an["beyond_the_motors"] == true,
+        "{an}"
+    );
+    // the least-height method: inside the envelope, flipping, as long as the answer says
+    let lh = method_line(&s, "least-height");
+    assert_eq!(lh["verdict"], "ok", "{lh}");
+    assert!(lh["min_envelope_margin"].as_f64().unwrap() >= -1e-6, "{lh}");
+    let duration: f64 = lh["phase_durations_s"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|d| d.as_f64().unwrap())
+        .sum();
+    let t = a["least_time_s"].as_f64().unwrap();
+    assert!((duration - t).abs() < 1e-9 * t, "{duration} vs {t}");
+    // its controls tile the same manoeuvre at the simulators' steps
+    for sim in ["mujoco", "pybullet"] {
+        let csv = std::fs::read_to_string(base.join(format!("least-height.{sim}.csv"))).unwrap();
+        assert!(csv.contains("method least-height"), "{sim}");
+        let dt: f64 = controls_header(&csv, "dt_s").unwrap().parse().unwrap();
+        let steps: f64 = controls_header(&csv, "steps").unwrap().parse().unwrap();
+        assert!(
+            (dt * steps - t).abs() < 1e-9 * t,
+            "{sim}: {dt} x {steps} vs {t}"
+        );
+    }
+    // the written schedule replays from the height it needs, as the run simulated it
+    let (code, out, err) = util::run(
+        &[
+            "simulate",
+            util::config_path("robot-universal").to_str().unwrap(),
+            "--schedule",
+            base.join("least-height.csv").to_str().unwrap(),
+            "--set",
+            &format!("fall.height={least}"),
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let sim: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let (f, g) = (
+        sim["flip_deg"].as_f64().unwrap(),
+        lh["flip_deg"].as_f64().unwrap(),
+    );
+    assert!((f - g).abs() < 1e-6, "simulate {f} vs run {g} deg");
+    // the report leads with the answer, above the table, and nothing is FAILED
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    let lead = html
+        .find("<section id=\"answer\" class=\"impossible\">")
+        .expect("the answer");
+    assert!(lead < html.find("<table>").unwrap());
+    assert!(html.contains("Not possible from 2 m with these motors."));
+    assert!(html.contains(&format!("{least:.3} m")));
+    assert!(!html.contains("FAILED"), "nothing errored");
+    assert!(html.contains("<td>least-height</td>"));
+    let svg = std::fs::read_to_string(base.join("torque.svg")).unwrap();
+    assert!(svg.contains("least-height"), "the torque figure draws it");
+}
+
+/// The robot from 6 m: possible, its designs sound; the seed's analytic
+/// schedule breaks the motors and is reported, but the run is not partial.
+#[test]
+fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
+    use util::{method_line, run_summary};
+    let dir = temp_dir();
+    let (code, s, base, err) = run_summary("robot-universal", &["fall.height=6"], dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(s["outcome"], "ok");
+    assert!(!err.contains("partial"), "{err}");
+    let an = method_line(&s, "analytic");
+    assert_eq!(an["verdict"], "flagged", "{an}");
+    assert_eq!(an["beyond_the_motors"], true, "{an}");
+    for m in ["phased", "free", "least-height"] {
+        let l = method_line(&s, m);
+        assert_eq!(l["verdict"], "ok", "{l}");
+        assert!(l.get("beyond_the_motors").is_none(), "{l}");
+    }
+    assert_eq!(s["answer"]["possible"], true);
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    let lead = html
+        .find("<section id=\"answer\" class=\"possible\">")
+        .expect("the answer");
+    assert!(lead < html.find("<table>").unwrap());
+    assert!(html.contains("Possible from 6 m with these motors."));
+    assert!(html.contains("a reference beyond the motors, not counted"));
+}

@@ -22,7 +22,7 @@ pub fn summary(s: &RunSummary, report: &Path, files: usize) -> Vec<String> {
         "  free-form / phased peak {}, phased / analytic {}; free-form design: {}",
         show(s.free_over_phased),
         show(s.phased_over_analytic),
-        crate::design::free::iterations_text(&s.mesh_levels)
+        crate::table::free_design_text(&s.methods, &s.mesh_levels)
     ));
     if let Some(a) = &s.answer {
         lines.push(format!("  {}", a.sentence()));

@@ -7,6 +7,7 @@
 //! legends sit in a column beside the plot, never over the data.
 
 pub mod animation;
+pub mod answer;
 mod torque_speed;
 
 pub use torque_speed::{FILE as TORQUE_SPEED_SVG, caption, envelope, torque_speed};
@@ -95,6 +96,7 @@ pub fn style_of(name: &str, i: usize) -> Style {
         "analytic" => STYLES[0],
         "phased" => STYLES[1],
         "free" => STYLES[2],
+        "least-height" => STYLES[3],
         _ => style(i),
     }
 }
@@ -817,16 +819,32 @@ pub fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The report page: a summary table, warnings, the animation and the figures.
-pub fn index_html(
-    title: &str,
-    header: &[&str],
-    rows: &[Vec<String>],
-    notes: &[String],
-    warnings: &[String],
-    animation: &str,
-    figures: &[&str],
-) -> String {
+/// What the report page shows, top to bottom.
+pub struct Page<'a> {
+    pub title: &'a str,
+    /// The answer block ([`answer::lead`]), first under the title.
+    pub lead: Option<&'a str>,
+    pub header: &'a [&'a str],
+    pub rows: &'a [Vec<String>],
+    pub notes: &'a [String],
+    pub warnings: &'a [String],
+    pub animation: &'a str,
+    pub figures: &'a [&'a str],
+}
+
+/// The report page: the answer when there is one ([`answer::lead`]), a
+/// summary table, warnings, the animation and the figures.
+pub fn index_html(page: &Page) -> String {
+    let Page {
+        title,
+        lead,
+        header,
+        rows,
+        notes,
+        warnings,
+        animation,
+        figures,
+    } = *page;
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>");
     h.push_str(&esc(title));
@@ -841,9 +859,18 @@ pub fn index_html(
         ".view canvas{border:1px solid #bbb;cursor:grab;touch-action:none}",
         ".readout{font-family:monospace;font-size:13px}.status{font-size:13px;color:#444}",
         ".controls{display:flex;gap:14px;align-items:center;margin:8px 0}#time{width:320px}",
-        "#errors{color:#b00}</style></head><body>\n"
+        "#errors{color:#b00}"
     ));
-    h.push_str(&format!("<h1>{}</h1>\n<table>\n<tr>", esc(title)));
+    if lead.is_some() {
+        h.push_str(answer::STYLE);
+    }
+    h.push_str("</style></head><body>\n");
+    h.push_str(&format!("<h1>{}</h1>\n", esc(title)));
+    // the robot builder's answer first, above the comparison
+    if let Some(lead) = lead {
+        h.push_str(lead);
+    }
+    h.push_str("<table>\n<tr>");
     for c in header {
         h.push_str(&format!("<th>{}</th>", esc(c)));
     }

@@ -134,3 +134,52 @@ pub fn schedule_peak(csv: &str, per_motor: bool) -> (f64, usize) {
     }
     (peak, rows)
 }
+
+/// `run CONFIG --json` with `overrides` into `dir`: the exit code, the
+/// summary it printed, and the folder of the run's files
+/// (`<dir>/<name>/run[@<overrides>]`).
+pub fn run_summary(
+    name: &str,
+    overrides: &[&str],
+    dir: &Path,
+) -> (Option<i32>, serde_json::Value, PathBuf, String) {
+    let cfg = config_path(name);
+    let mut args = vec!["run", cfg.to_str().unwrap(), "--json", "--out"];
+    let out = dir.display().to_string();
+    args.push(&out);
+    for o in overrides {
+        args.extend(["--set", o]);
+    }
+    let (code, stdout, err) = run(&args, dir);
+    let summary: serde_json::Value = serde_json::from_str(&stdout)
+        .unwrap_or_else(|e| panic!("run {name} {overrides:?} printed no summary ({e}): {err}"));
+    let set = if overrides.is_empty() {
+        "run".to_string()
+    } else {
+        format!("run@{}", overrides.join(","))
+    };
+    let folder = dir.join(summary["name"].as_str().unwrap()).join(set);
+    (code, summary, folder, err)
+}
+
+/// The line of `method` in a run's summary.
+pub fn method_line<'a>(summary: &'a serde_json::Value, method: &str) -> &'a serde_json::Value {
+    summary["methods"]
+        .as_array()
+        .expect("a methods array")
+        .iter()
+        .find(|m| m["method"] == method)
+        .unwrap_or_else(|| panic!("no {method} line in {summary}"))
+}
+
+/// `# key = value` of a controls file's header.
+pub fn controls_header(csv: &str, key: &str) -> Option<String> {
+    csv.lines()
+        .take_while(|l| l.starts_with('#'))
+        .find_map(|l| {
+            l[1..]
+                .trim()
+                .strip_prefix(&format!("{key} = "))
+                .map(String::from)
+        })
+}

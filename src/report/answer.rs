@@ -1,0 +1,81 @@
+//! The report's first block under a motor limit: the robot builder's answer
+//! (can these motors flip it from the configured height, and from what
+//! height they can), before the comparison of the methods.
+
+use super::esc;
+use crate::design::least_height::HeightAnswer;
+
+/// The block's style (added to the page only when it has the block).
+pub const STYLE: &str = concat!(
+    "#answer{border:2px solid;border-radius:6px;padding:8px 16px;margin:0 0 1.2em 0}",
+    "#answer.possible{border-color:#2c7a2c;background:#effaef}",
+    "#answer.impossible{border-color:#b00;background:#fdf0f0}",
+    "#answer .headline{font-size:1.5em;font-weight:bold;margin:4px 0}",
+    "#answer .height{font-size:1.25em;margin:4px 0}"
+);
+
+/// The lower bound on the least drop height, when the answer carries one
+/// (`least_height_lower_bound_m` in the answer's JSON; absent, or null,
+/// when no bound is known).
+pub fn lower_bound(a: &HeightAnswer) -> Option<f64> {
+    serde_json::to_value(a)
+        .ok()?
+        .get("least_height_lower_bound_m")?
+        .as_f64()
+}
+
+/// The headline: possible or not, from the configured height.
+pub fn headline(a: &HeightAnswer) -> String {
+    if a.possible {
+        format!("Possible from {} m with these motors.", a.height_m)
+    } else {
+        format!("Not possible from {} m with these motors.", a.height_m)
+    }
+}
+
+/// The least height found and, when known, its lower bound: `From 3.541 m
+/// (at least 3.200 m) they can`.
+pub fn height_text(a: &HeightAnswer) -> String {
+    let bound = lower_bound(a)
+        .map(|b| format!(" (at least {b:.3} m)"))
+        .unwrap_or_default();
+    if a.possible && a.least_height_m > a.height_m {
+        // a design fits this fall although the least-height one needs more
+        format!(
+            "A verified {} design fits this fall; the least-height design found needs {:.3} m{bound}.",
+            a.method, a.least_height_m
+        )
+    } else {
+        format!(
+            "The least drop height they need: {:.3} m{bound} ({:.4} s of manoeuvre).",
+            a.least_height_m, a.least_time_s
+        )
+    }
+}
+
+/// What the least-height schedule is and where it is shown.
+fn shown_text(a: &HeightAnswer) -> String {
+    let proven = if a.status.is_proven() {
+        format!("the {} time design, {}", a.method, a.status)
+    } else {
+        format!(
+            "the {} time design, verified but not proven shortest: {}",
+            a.method, a.status
+        )
+    };
+    format!(
+        "The shortest manoeuvre found inside the motor envelope ({proven}) is the least-height row below: in the animation, the torque and torque-speed figures, and written as least-height.csv with its simulator controls (least-height.mujoco.csv, least-height.pybullet.csv)."
+    )
+}
+
+/// The block: headline, least height (and bound), and where the
+/// least-height schedule is shown and written.
+pub fn lead(a: &HeightAnswer) -> String {
+    let class = if a.possible { "possible" } else { "impossible" };
+    format!(
+        "<section id=\"answer\" class=\"{class}\">\n<p class=\"headline\">{}</p>\n<p class=\"height\">{}</p>\n<p>{}</p>\n</section>\n",
+        esc(&headline(a)),
+        esc(&height_text(a)),
+        esc(&shown_text(a))
+    )
+}
