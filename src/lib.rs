@@ -20,6 +20,7 @@ pub mod output;
 pub mod pipeline;
 pub mod report;
 pub mod run;
+pub mod size;
 pub mod sweep;
 pub mod verdict;
 pub mod verify;

@@ -8,6 +8,7 @@
 //! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
 mod robustness;
+mod size_cli;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {
