@@ -88,6 +88,13 @@ impl SizeSettings {
 /// curve is designed where it is read.
 pub const RESCALE: f64 = 0.03;
 
+/// How close (relative) a motor on the curve comes to needing exactly the
+/// height when designed afresh: the least-time designs are local optima
+/// whose value moves a little with the problem's numbers (a point is the
+/// design of a motor within [`RESCALE`] of it, scaled), so the tests allow
+/// this much.
+pub const HEIGHT_TOLERANCE: f64 = 0.02;
+
 /// The span of the curve in the ratio `u = T / w0^2`, in decades about the
 /// asymptotes' corner `u_c = T_inf / w_min^2`: from `10^-2 u_c` (the
 /// torque-limited end, no-load speeds about ten times `w_min`) to `10 u_c`
@@ -512,4 +519,43 @@ pub fn gear_csv(a: &SizeAnswer) -> String {
         ));
     }
     s
+}
+
+impl SizeAnswer {
+    /// The answer in plain sentences, for the terminal and the report: the
+    /// curve's ends, the configured motor, the best gear ratio.
+    pub fn sentences(&self) -> Vec<String> {
+        let g = &self.gear;
+        let can = |ok: bool| if ok { "makes it" } else { "does not make it" };
+        vec![
+            format!(
+                "No motor weaker than {:.4} N m stall torque (at any no-load speed) or slower than {:.3} rad/s no-load speed (at any stall torque) flips it from {} m.",
+                self.torque_asymptote_nm, self.speed_asymptote_rad_s, self.height_m
+            ),
+            format!(
+                "The configured motor ({:.4} N m, {:.3} rad/s, gear ratio 1) needs {:.3} m: it {} from {} m.",
+                g.evaluations
+                    .iter()
+                    .find(|e| e.gear_ratio == 1.0)
+                    .map_or(f64::NAN, |e| e.design.stall_torque_nm),
+                g.evaluations
+                    .iter()
+                    .find(|e| e.gear_ratio == 1.0)
+                    .map_or(f64::NAN, |e| e.design.no_load_speed_rad_s),
+                g.configured_least_height_m,
+                can(g.configured_possible),
+                self.height_m
+            ),
+            format!(
+                "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m.",
+                g.best_ratio,
+                g.stall_torque_nm,
+                g.no_load_speed_rad_s,
+                g.least_height_m,
+                g.least_time_s,
+                can(g.possible),
+                self.height_m
+            ),
+        ]
+    }
 }

@@ -19,6 +19,9 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
     out.add(files::CURVE_CSV, catflip::size::curve_csv(&a));
     out.add(files::GEAR_CSV, catflip::size::gear_csv(&a));
     out.add(files::JSON, json.clone());
+    out.add(files::CURVE_SVG, catflip::report::size::curve(&a)?);
+    out.add(files::GEAR_SVG, catflip::report::size::gear(&a)?);
+    out.add("index.html", catflip::report::size::page(&a));
     let written = publisher.publish(out)?;
     let status = if a.is_partial() {
         for f in &a.failed {
@@ -51,16 +54,12 @@ fn print_table(a: &SizeAnswer) {
         a.manoeuvre_time_s
     );
     println!(
-        "  no motor weaker than {:.4} N m stall torque (at any speed) or slower than {:.3} rad/s no-load speed (at any torque) can do it",
-        a.torque_asymptote_nm, a.speed_asymptote_rad_s
-    );
-    println!(
-        "  {:>16} {:>16} {:>14}   design",
+        "  {:>16} {:>18} {:>16}   design",
         "no-load rad/s", "stall torque N m", "T/w0^2 N m s^2"
     );
     for p in &a.curve {
         println!(
-            "  {:>16.4} {:>16.5} {:>14.4e}   {} {}, scaled by {:.4}",
+            "  {:>16.4} {:>18.5} {:>16.4e}   {} {}, scaled by {:.4}",
             p.no_load_speed_rad_s,
             p.stall_torque_nm,
             p.ratio_nms2,
@@ -69,26 +68,8 @@ fn print_table(a: &SizeAnswer) {
             p.scale
         );
     }
-    let g = &a.gear;
-    let can = |ok: bool| if ok { "makes it" } else { "does not make it" };
-    println!(
-        "  configured motor (N = 1): least height {:.3} m: {} from {} m",
-        g.configured_least_height_m,
-        can(g.configured_possible),
-        a.height_m
-    );
-    println!(
-        "  best gear ratio N = {:.4} ({:.4} N m, {:.3} rad/s): least height {:.3} m ({:.4} s): {} from {} m",
-        g.best_ratio,
-        g.stall_torque_nm,
-        g.no_load_speed_rad_s,
-        g.least_height_m,
-        g.least_time_s,
-        can(g.possible),
-        a.height_m
-    );
-    println!(
-        "  {} designs in {:.1} s",
-        a.designs, a.solve_time_s
-    );
+    for s in a.sentences() {
+        println!("  {s}");
+    }
+    println!("  {} designs in {:.1} s", a.designs, a.solve_time_s);
 }

@@ -7,6 +7,7 @@
 //! legends sit in a column beside the plot, never over the data.
 
 pub mod animation;
+pub mod size;
 mod torque_speed;
 
 pub use torque_speed::{FILE as TORQUE_SPEED_SVG, caption, envelope, torque_speed};
@@ -865,7 +866,7 @@ pub fn index_html(
     h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));
-        if let Some(c) = caption(f) {
+        if let Some(c) = caption(f).or_else(|| size::caption(f)) {
             h.push_str(&format!("<figcaption>{}</figcaption>", esc(c)));
         }
         h.push_str("</figure>\n");
