@@ -67,6 +67,12 @@ fn a_motor_on_the_curve_just_makes_it_and_a_weaker_one_does_not() {
         weak.least_height_m
     );
     assert!(weak.least_height_m > on.least_height_m);
+    eprintln!(
+        "on the curve: {} m ({:+.3} %); 5 % weaker: {} m",
+        on.least_height_m,
+        100.0 * rel,
+        weak.least_height_m
+    );
 }
 
 #[test]
@@ -122,6 +128,10 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
     for f in [1.1, 1.0 / 1.1] {
         let n = g.best_ratio * f;
         let d = design_motor(&q, t0 * n, w0 / n).unwrap();
+        eprintln!(
+            "N = {n}: {} m (best N = {}: {} m)",
+            d.least_height_m, g.best_ratio, g.least_height_m
+        );
         assert!(
             d.least_height_m >= g.least_height_m * (1.0 - HEIGHT_TOLERANCE),
             "N = {n}: {} m, better than the best N = {}: {} m",
@@ -147,6 +157,7 @@ fn the_curve_scales_with_the_fall_time_f3() {
         k * p.no_load_speed_rad_s,
     )
     .unwrap();
+    eprintln!("scaled to {other} m: {} m", d.least_height_m);
     assert!(
         (d.least_height_m / other - 1.0).abs() <= HEIGHT_TOLERANCE,
         "scaled to {other} m: needs {} m",
@@ -215,4 +226,102 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
         assert!(err.contains(word), "{args:?}: {err}");
         assert!(!dir.path().join("out").exists(), "{args:?}");
     }
+}
+
+#[test]
+fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
+    // the seed's body with a DC motor: a cheap sizing (2 points, no gear search)
+    let dir = util::temp_dir();
+    let cfg = util::seed_toml();
+    let args = [
+        "size",
+        cfg.to_str().unwrap(),
+        "--height",
+        "10",
+        "--set",
+        "limits.max_torque=0.5",
+        "--set",
+        "limits.no_load_speed=4",
+        "--points",
+        "2",
+        "--gear-evaluations",
+        "0",
+        "--out",
+        "out",
+        "--json",
+    ];
+    let out = util::output(&args, dir.path());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let set = dir
+        .path()
+        .join("out/seed/size-10m@limits.max_torque=0.5,limits.no_load_speed=4");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("size.json")).unwrap()).unwrap();
+    // --json prints what size.json holds
+    let printed: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json, printed);
+    for key in [
+        "height_m",
+        "manoeuvre_time_s",
+        "torque_asymptote_nm",
+        "speed_asymptote_rad_s",
+        "curve",
+        "failed",
+        "gear",
+        "settings",
+        "designs",
+        "solve_time_s",
+    ] {
+        assert!(json.get(key).is_some(), "size.json has no {key}");
+    }
+    assert_eq!(json["height_m"], 10.0);
+    let curve = json["curve"].as_array().unwrap();
+    assert_eq!(curve.len(), 2);
+    for key in [
+        "best_ratio",
+        "stall_torque_nm",
+        "no_load_speed_rad_s",
+        "least_height_m",
+        "least_time_s",
+        "configured_least_height_m",
+        "configured_possible",
+        "possible",
+        "evaluations",
+    ] {
+        assert!(json["gear"].get(key).is_some(), "gear has no {key}");
+    }
+    // the configured ratio alone was designed: it is the best one
+    assert_eq!(json["gear"]["best_ratio"], 1.0);
+    assert_eq!(
+        json["gear"]["least_height_m"],
+        json["gear"]["configured_least_height_m"]
+    );
+    // the CSV rows are the JSON's points, to their printed digits
+    let csv = std::fs::read_to_string(set.join("size.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(lines.next().unwrap().starts_with("no_load_speed_rad_s,stall_torque_nm,"));
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').take(2).map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    for (r, p) in rows.iter().zip(curve) {
+        let w = p["no_load_speed_rad_s"].as_f64().unwrap();
+        let t = p["stall_torque_nm"].as_f64().unwrap();
+        assert!((r[0] / w - 1.0).abs() < 1e-8 && (r[1] / t - 1.0).abs() < 1e-8);
+    }
+    let gear = std::fs::read_to_string(set.join("size-gear.csv")).unwrap();
+    assert!(gear.starts_with("gear_ratio,"));
+    assert_eq!(gear.lines().count(), 2);
+    for f in ["size.svg", "size-gear.svg"] {
+        let svg = std::fs::read_to_string(set.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("</svg>"), "{f}");
+    }
+    let html = std::fs::read_to_string(set.join("index.html")).unwrap();
+    assert!(html.contains("size.svg") && html.contains("size-gear.svg"));
+    assert!(html.contains("No motor weaker than"));
 }
