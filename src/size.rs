@@ -93,7 +93,7 @@ pub const RESCALE: f64 = 0.03;
 /// whose value moves a little with the problem's numbers (a point is the
 /// design of a motor within [`RESCALE`] of it, scaled), so the tests allow
 /// this much.
-pub const HEIGHT_TOLERANCE: f64 = 0.02;
+pub const HEIGHT_TOLERANCE: f64 = 0.01;
 
 /// The span of the curve in the ratio `u = T / w0^2`, in decades about the
 /// asymptotes' corner `u_c = T_inf / w_min^2`: from `10^-2 u_c` (the
@@ -158,6 +158,17 @@ pub struct GearAnswer {
     pub possible: bool,
     /// Every ratio designed, in increasing order.
     pub evaluations: Vec<GearPoint>,
+    /// The least heights the curve's designs predict for the ratios whose
+    /// `T / w0^2` they share (`N = (u / u0)^(1/3)`, F3), by increasing ratio.
+    pub predicted: Vec<GearPrediction>,
+}
+
+/// A gear ratio's least height as a curve point's design predicts it.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GearPrediction {
+    pub gear_ratio: f64,
+    pub least_time_s: f64,
+    pub least_height_m: f64,
 }
 
 /// What `catflip size` answers.
@@ -390,6 +401,15 @@ fn gear_search(
             (n.ln(), n * t_h * p.no_load_speed_rad_s / w0)
         })
         .collect();
+    let mut predictions: Vec<GearPrediction> = predicted
+        .iter()
+        .map(|&(ln_n, t)| GearPrediction {
+            gear_ratio: ln_n.exp(),
+            least_time_s: t,
+            least_height_m: crate::design::envelope::height_for(q, t),
+        })
+        .collect();
+    predictions.sort_by(|a, b| a.gear_ratio.total_cmp(&b.gear_ratio));
     predicted.push((0.0, configured.design.least_time_s));
     predicted.sort_by(|a, b| a.0.total_cmp(&b.0));
     let best = predicted
@@ -464,6 +484,7 @@ fn gear_search(
             configured_possible: fits(configured.design.least_height_m),
             possible: fits(top.design.least_height_m),
             evaluations: evals,
+            predicted: predictions,
         },
         designs,
     ))

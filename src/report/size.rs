@@ -22,6 +22,13 @@ pub fn caption(file: &str) -> Option<&'static str> {
     })
 }
 
+/// A tick label without float noise (`0.6`, not `0.6000000000000001`).
+fn tick(v: &f64) -> String {
+    let s = format!("{:.6}", v);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
+}
+
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
@@ -79,6 +86,10 @@ pub fn curve(a: &SizeAnswer) -> Result<String> {
         c.configure_mesh()
             .x_desc("no-load speed w0 (rad/s), log scale")
             .y_desc("stall torque T (N m), log scale")
+            .x_label_formatter(&tick)
+            .y_label_formatter(&tick)
+            .x_labels(12)
+            .y_labels(12)
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 15))
             .light_line_style(WHITE.mix(0.0))
@@ -149,9 +160,16 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
             .iter()
             .map(|e| (e.gear_ratio, e.design.least_height_m))
             .collect();
-        let xr = log_range(pts.iter().map(|p| p.0));
+        let predicted: Vec<(f64, f64)> = a
+            .gear
+            .predicted
+            .iter()
+            .map(|p| (p.gear_ratio, p.least_height_m))
+            .collect();
+        let xr = log_range(pts.iter().chain(&predicted).map(|p| p.0));
         let (lo, hi) = pts
             .iter()
+            .chain(&predicted)
             .map(|p| p.1)
             .chain([a.height_m])
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
@@ -171,6 +189,8 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
         c.configure_mesh()
             .x_desc("gear ratio N (torque x N, speed / N), log scale")
             .y_desc("least drop height (m)")
+            .x_label_formatter(&tick)
+            .x_labels(12)
             .label_style((FONT, 13))
             .axis_desc_style((FONT, 15))
             .light_line_style(WHITE.mix(0.0))
@@ -182,7 +202,10 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
         ))
         .map_err(perr)?;
         let st = style(1);
-        line(&mut c, &pts, st, 0.0)?;
+        let guess = style(0);
+        line(&mut c, &predicted, guess, 0.0)?;
+        c.draw_series(pts.iter().map(|p| marker(*p, st.marker, st.color)))
+            .map_err(perr)?;
         let g = &a.gear;
         c.draw_series(std::iter::once(marker(
             (1.0, g.configured_least_height_m),
@@ -197,7 +220,8 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
         )))
         .map_err(perr)?;
         let keys = vec![
-            ("least height (one design a point)".into(), Key::Line(st)),
+            ("designed (one least-time design each)".into(), Key::Mark(st)),
+            ("predicted from the curve's designs (F3)".into(), Key::Line(guess)),
             (format!("asked: {} m", a.height_m), Key::Level),
             (
                 format!("N = 1: {:.3} m", g.configured_least_height_m),
