@@ -210,7 +210,11 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
     let l = &cfg.limits;
     for (key, set, what) in [
         ("limits.max_torque", l.max_torque, "stall torque, N m"),
-        ("limits.no_load_speed", l.no_load_speed, "no-load speed, rad/s"),
+        (
+            "limits.no_load_speed",
+            l.no_load_speed,
+            "no-load speed, rad/s",
+        ),
     ] {
         if set.is_none() {
             return Err(Error::Invalid {
@@ -221,6 +225,14 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
                 ),
             });
         }
+    }
+    if cfg.start.angular_velocity.iter().any(|w| *w != 0.0) {
+        // F9: with momentum, a sped-up schedule needs the momentum scaled too
+        return Err(Error::Invalid {
+            key: "start.angular_velocity".into(),
+            value: format!("{:?}", cfg.start.angular_velocity),
+            expected: "catflip size rests on time scaling, which holds for a release without angular momentum only (F9 scales the momentum with the speed): size the motors for a release at rest (start.angular_velocity = [0, 0, 0]) and check the spin with catflip run".into(),
+        });
     }
     let mut q = cfg.clone();
     q.fall.height = height;
@@ -308,8 +320,7 @@ pub fn size(q: &Config, settings: &SizeSettings) -> Result<SizeAnswer> {
     let mut curve = Vec::new();
     let mut failed = Vec::new();
     for i in 0..n {
-        let decade =
-            SPAN_DECADES.0 + (SPAN_DECADES.1 - SPAN_DECADES.0) * i as f64 / (n - 1) as f64;
+        let decade = SPAN_DECADES.0 + (SPAN_DECADES.1 - SPAN_DECADES.0) * i as f64 / (n - 1) as f64;
         let u = u_c * 10f64.powf(decade);
         // guess from the asymptotes: T_inf / T + (w_min / w0)^2 = 1
         let mut w = (t_inf / u + w_min * w_min).sqrt();

@@ -1,6 +1,6 @@
 //! `catflip size`: the command-line face of [`catflip::size`].
 
-use crate::cli::{Common, Status, load, publisher};
+use crate::common::{Common, Status, load, publisher, say};
 use anyhow::Result;
 use catflip::output::Output;
 use catflip::size::{SizeAnswer, SizeSettings, files};
@@ -32,11 +32,11 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
         Status::Ok
     };
     if c.json {
-        println!("{json}");
+        say!("{json}");
         return Ok(status);
     }
     print_table(&a);
-    println!(
+    say!(
         "  report: {} ({} files)",
         dir.join("index.html").display(),
         written.len()
@@ -45,7 +45,7 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
 }
 
 fn print_table(a: &SizeAnswer) {
-    println!(
+    say!(
         "catflip size: {} ({} joint, peak norm {}), from {} m ({:.4} s of manoeuvre)",
         a.name,
         a.joint,
@@ -53,12 +53,14 @@ fn print_table(a: &SizeAnswer) {
         a.height_m,
         a.manoeuvre_time_s
     );
-    println!(
+    say!(
         "  {:>16} {:>18} {:>16}   design",
-        "no-load rad/s", "stall torque N m", "T/w0^2 N m s^2"
+        "no-load rad/s",
+        "stall torque N m",
+        "T/w0^2 N m s^2"
     );
     for p in &a.curve {
-        println!(
+        say!(
             "  {:>16.4} {:>18.5} {:>16.4e}   {} {}, scaled by {:.4}",
             p.no_load_speed_rad_s,
             p.stall_torque_nm,
@@ -69,7 +71,7 @@ fn print_table(a: &SizeAnswer) {
         );
     }
     for s in a.sentences() {
-        println!("  {s}");
+        say!("  {s}");
     }
-    println!("  {} designs in {:.1} s", a.designs, a.solve_time_s);
+    say!("  {} designs in {:.1} s", a.designs, a.solve_time_s);
 }

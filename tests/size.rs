@@ -98,7 +98,9 @@ fn more_speed_never_needs_more_torque_and_no_point_passes_the_asymptotes() {
         assert!(
             (d.stall_torque_nm / d.no_load_speed_rad_s.powi(2) / p.ratio_nms2 - 1.0).abs() < 1e-12
         );
-        assert!((p.stall_torque_nm / p.no_load_speed_rad_s.powi(2) / p.ratio_nms2 - 1.0).abs() < 1e-12);
+        assert!(
+            (p.stall_torque_nm / p.no_load_speed_rad_s.powi(2) / p.ratio_nms2 - 1.0).abs() < 1e-12
+        );
         assert!((d.least_time_s / p.scale - a.manoeuvre_time_s).abs() < 1e-12);
     }
     // the ends: the torque-limited end near the torque asymptote, the
@@ -113,7 +115,10 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
     let a = answer();
     let g = &a.gear;
     let q = robot_question(HEIGHT);
-    let (t0, w0) = (q.limits.max_torque.unwrap(), q.limits.no_load_speed.unwrap());
+    let (t0, w0) = (
+        q.limits.max_torque.unwrap(),
+        q.limits.no_load_speed.unwrap(),
+    );
     // the search's own designs: none better than the best
     for e in &g.evaluations {
         assert!(e.design.least_height_m >= g.least_height_m);
@@ -151,12 +156,7 @@ fn the_curve_scales_with_the_fall_time_f3() {
     let other = 4.0;
     let q = robot_question(other);
     let k = a.manoeuvre_time_s / q.available_time();
-    let d = design_motor(
-        &q,
-        k * k * p.stall_torque_nm,
-        k * p.no_load_speed_rad_s,
-    )
-    .unwrap();
+    let d = design_motor(&q, k * k * p.stall_torque_nm, k * p.no_load_speed_rad_s).unwrap();
     eprintln!("scaled to {other} m: {} m", d.least_height_m);
     assert!(
         (d.least_height_m / other - 1.0).abs() <= HEIGHT_TOLERANCE,
@@ -217,6 +217,11 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
         (vec!["--height", "0.04"], "--height"),
         (vec!["--height", "2", "--points", "1"], "--points"),
         (vec!["--height", "2", "--points", "41"], "--points"),
+        // a spinning release: time scaling needs the momentum scaled too (F9)
+        (
+            vec!["--height", "2", "--set", "start.angular_velocity=[0, 0, 1]"],
+            "start.angular_velocity",
+        ),
     ] {
         let mut all = vec!["size", cfg.to_str().unwrap(), "--out", "out"];
         all.extend(&args);
@@ -304,7 +309,12 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
     // the CSV rows are the JSON's points, to their printed digits
     let csv = std::fs::read_to_string(set.join("size.csv")).unwrap();
     let mut lines = csv.lines();
-    assert!(lines.next().unwrap().starts_with("no_load_speed_rad_s,stall_torque_nm,"));
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("no_load_speed_rad_s,stall_torque_nm,")
+    );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').take(2).map(|x| x.parse().unwrap()).collect())
         .collect();

@@ -113,7 +113,10 @@ pub fn curve(a: &SizeAnswer) -> Result<String> {
                 Key::Line(st),
             ),
             (
-                format!("T >= {:.4} N m, w0 >= {:.3} rad/s", a.torque_asymptote_nm, a.speed_asymptote_rad_s),
+                format!(
+                    "T >= {:.4} N m, w0 >= {:.3} rad/s",
+                    a.torque_asymptote_nm, a.speed_asymptote_rad_s
+                ),
                 Key::DashedLevel,
             ),
         ];
@@ -126,8 +129,11 @@ pub fn curve(a: &SizeAnswer) -> Result<String> {
                 .map(|w| (w, power / w))
                 .filter(|p| p.1 >= yr.0 && p.1 <= yr.1)
                 .collect();
-            c.draw_series(LineSeries::new(gear_line, RGBColor(0x88, 0x88, 0x88).stroke_width(1)))
-                .map_err(perr)?;
+            c.draw_series(LineSeries::new(
+                gear_line,
+                RGBColor(0x88, 0x88, 0x88).stroke_width(1),
+            ))
+            .map_err(perr)?;
             c.draw_series(std::iter::once(Circle::new((w0, t0), 5, BLACK.filled())))
                 .map_err(perr)?;
             keys.push((
@@ -220,8 +226,14 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
         )))
         .map_err(perr)?;
         let keys = vec![
-            ("designed (one least-time design each)".into(), Key::Mark(st)),
-            ("predicted from the curve's designs (F3)".into(), Key::Line(guess)),
+            (
+                "designed (one least-time design each)".into(),
+                Key::Mark(st),
+            ),
+            (
+                "predicted from the curve's designs (F3)".into(),
+                Key::Line(guess),
+            ),
             (format!("asked: {} m", a.height_m), Key::Level),
             (
                 format!("N = 1: {:.3} m", g.configured_least_height_m),
