@@ -277,6 +277,14 @@ pub fn design_motor(q: &Config, torque: f64, no_load: f64) -> Result<MotorDesign
     let cfg = with_motor(q, Some(torque), Some(no_load), speed);
     let h = heights(&cfg, true, |_| {})?.expect("a limited motor has an answer");
     let a = &h.answer;
+    if !a.from_start {
+        // a tilted release: only a free-form design from the start answers
+        return Err(Error::Unreachable {
+            reason: format!(
+                "no design of the motor ({torque} N m, {no_load} rad/s) lands belly-down from the configured [start]"
+            ),
+        });
+    }
     Ok(MotorDesign {
         stall_torque_nm: torque,
         no_load_speed_rad_s: no_load,
