@@ -100,6 +100,20 @@ enum Command {
         #[arg(long)]
         resume: bool,
     },
+    /// The motors needed for a drop height: the stall torque against no-load speed that just makes the flip, and the configured motor's best gear ratio.
+    Size {
+        #[command(flatten)]
+        common: Common,
+        /// The drop height to size the motors for, m (the config's fall.height is not used).
+        #[arg(long)]
+        height: f64,
+        /// Points on the curve (2 to 40), each one least-time design (two when its first guess is off).
+        #[arg(long, default_value_t = catflip::size::SizeSettings::default().points)]
+        points: usize,
+        /// Least-time designs the gear-ratio search adds (0 to 20).
+        #[arg(long, default_value_t = catflip::size::SizeSettings::default().gear_evaluations)]
+        gear_evaluations: usize,
+    },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
         #[command(flatten)]
@@ -245,6 +259,19 @@ pub fn run() -> Result<Status> {
                 threads: threads_or_cores(threads),
                 shard: shard.unwrap_or(Shard::ALL),
                 resume,
+            },
+        ),
+        Command::Size {
+            common,
+            height,
+            points,
+            gear_evaluations,
+        } => crate::size_cli::cmd_size(
+            &common,
+            height,
+            catflip::size::SizeSettings {
+                points,
+                gear_evaluations,
             },
         ),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),

@@ -22,6 +22,7 @@ pub mod output;
 pub mod pipeline;
 pub mod report;
 pub mod run;
+pub mod size;
 pub mod sweep;
 pub mod table;
 pub mod verdict;

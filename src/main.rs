@@ -10,6 +10,7 @@
 mod cli;
 mod common;
 mod robustness;
+mod size_cli;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {

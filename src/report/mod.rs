@@ -8,6 +8,7 @@
 
 pub mod animation;
 pub mod answer;
+pub mod size;
 mod torque_speed;
 
 pub use torque_speed::{FILE as TORQUE_SPEED_SVG, caption, envelope, torque_speed};
@@ -892,7 +893,7 @@ pub fn index_html(page: &Page) -> String {
     h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));
-        if let Some(c) = caption(f) {
+        if let Some(c) = caption(f).or_else(|| size::caption(f)) {
             h.push_str(&format!("<figcaption>{}</figcaption>", esc(c)));
         }
         h.push_str("</figure>\n");

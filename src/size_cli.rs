@@ -1,0 +1,77 @@
+//! `catflip size`: the command-line face of [`catflip::size`].
+
+use crate::common::{Common, Status, load, publisher, say};
+use anyhow::Result;
+use catflip::output::Output;
+use catflip::size::{SizeAnswer, SizeSettings, files};
+
+pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Result<Status> {
+    let cfg = load(c)?;
+    settings.validate()?;
+    let q = catflip::size::question(&cfg, height)?;
+    let publisher = publisher(c, &cfg, &format!("size-{height}m"))?;
+    let dir = publisher.link();
+    let a = catflip::size::size(&q, &settings)?;
+    let json = serde_json::to_value(&a)?;
+    catflip::output::ensure_finite(&json, &[])?;
+    let json = serde_json::to_string_pretty(&json)?;
+    let mut out = Output::default();
+    out.add(files::CURVE_CSV, catflip::size::curve_csv(&a));
+    out.add(files::GEAR_CSV, catflip::size::gear_csv(&a));
+    out.add(files::JSON, json.clone());
+    out.add(files::CURVE_SVG, catflip::report::size::curve(&a)?);
+    out.add(files::GEAR_SVG, catflip::report::size::gear(&a)?);
+    out.add("index.html", catflip::report::size::page(&a));
+    let written = publisher.publish(out)?;
+    let status = if a.is_partial() {
+        for f in &a.failed {
+            eprintln!("warning: a point of the curve FAILED: {f}");
+        }
+        Status::Partial
+    } else {
+        Status::Ok
+    };
+    if c.json {
+        say!("{json}");
+        return Ok(status);
+    }
+    print_table(&a);
+    say!(
+        "  report: {} ({} files)",
+        dir.join("index.html").display(),
+        written.len()
+    );
+    Ok(status)
+}
+
+fn print_table(a: &SizeAnswer) {
+    say!(
+        "catflip size: {} ({} joint, peak norm {}), from {} m ({:.4} s of manoeuvre)",
+        a.name,
+        a.joint,
+        a.peak_norm.name(),
+        a.height_m,
+        a.manoeuvre_time_s
+    );
+    say!(
+        "  {:>16} {:>18} {:>16}   design",
+        "no-load rad/s",
+        "stall torque N m",
+        "T/w0^2 N m s^2"
+    );
+    for p in &a.curve {
+        say!(
+            "  {:>16.4} {:>18.5} {:>16.4e}   {} {}, scaled by {:.4}",
+            p.no_load_speed_rad_s,
+            p.stall_torque_nm,
+            p.ratio_nms2,
+            p.design.method,
+            p.design.status,
+            p.scale
+        );
+    }
+    for s in a.sentences() {
+        say!("  {s}");
+    }
+    say!("  {} designs in {:.1} s", a.designs, a.solve_time_s);
+}

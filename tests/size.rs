@@ -1,0 +1,337 @@
+//! `catflip size`: the motors a drop height needs (issue 30, item 5).
+//!
+//! The expensive checks share one sizing of the robot from 2 m ([`answer`]);
+//! each then designs a few motors itself with the library's least-height
+//! designs, independently of the curve's own arithmetic.
+
+mod util;
+
+use catflip::size::{HEIGHT_TOLERANCE, SizeAnswer, SizeSettings, design_motor, question, size};
+use std::sync::OnceLock;
+
+const HEIGHT: f64 = 2.0;
+
+fn robot_question(height: f64) -> catflip::Config {
+    question(&util::config("robot-universal", &[]), height).unwrap()
+}
+
+/// The robot sized from 2 m with a small curve (4 points, 3 gear designs).
+fn answer() -> &'static SizeAnswer {
+    static ANSWER: OnceLock<SizeAnswer> = OnceLock::new();
+    ANSWER.get_or_init(|| {
+        size(
+            &robot_question(HEIGHT),
+            &SizeSettings {
+                points: 4,
+                gear_evaluations: 3,
+            },
+        )
+        .unwrap()
+    })
+}
+
+/// The point nearest the curve's knee (geometric middle of its ratios),
+/// where both the torque and the speed matter.
+fn knee(a: &SizeAnswer) -> catflip::size::CurvePoint {
+    let corner = a.torque_asymptote_nm / a.speed_asymptote_rad_s.powi(2);
+    *a.curve
+        .iter()
+        .min_by(|p, q| {
+            let d = |x: &catflip::size::CurvePoint| (x.ratio_nms2 / corner).ln().abs();
+            d(p).total_cmp(&d(q))
+        })
+        .unwrap()
+}
+
+#[test]
+fn a_motor_on_the_curve_just_makes_it_and_a_weaker_one_does_not() {
+    let a = answer();
+    assert!(a.failed.is_empty(), "{:?}", a.failed);
+    let p = knee(a);
+    let q = robot_question(HEIGHT);
+    let on = design_motor(&q, p.stall_torque_nm, p.no_load_speed_rad_s).unwrap();
+    let rel = on.least_height_m / HEIGHT - 1.0;
+    assert!(
+        rel.abs() <= HEIGHT_TOLERANCE,
+        "the curve's motor ({} N m, {} rad/s) needs {} m, not {HEIGHT} m",
+        p.stall_torque_nm,
+        p.no_load_speed_rad_s,
+        on.least_height_m
+    );
+    // 5 % less stall torque at the same no-load speed: below the curve
+    let weak = design_motor(&q, 0.95 * p.stall_torque_nm, p.no_load_speed_rad_s).unwrap();
+    assert!(
+        weak.least_height_m > HEIGHT,
+        "5 % weaker ({} N m) still makes it: {} m",
+        0.95 * p.stall_torque_nm,
+        weak.least_height_m
+    );
+    assert!(weak.least_height_m > on.least_height_m);
+    eprintln!(
+        "on the curve: {} m ({:+.3} %); 5 % weaker: {} m",
+        on.least_height_m,
+        100.0 * rel,
+        weak.least_height_m
+    );
+}
+
+#[test]
+fn more_speed_never_needs_more_torque_and_no_point_passes_the_asymptotes() {
+    let a = answer();
+    assert!(a.curve.len() >= 4, "{}", a.curve.len());
+    for w in a.curve.windows(2) {
+        assert!(w[1].no_load_speed_rad_s > w[0].no_load_speed_rad_s);
+        assert!(
+            w[1].stall_torque_nm <= w[0].stall_torque_nm,
+            "{:?} then {:?}",
+            (w[0].no_load_speed_rad_s, w[0].stall_torque_nm),
+            (w[1].no_load_speed_rad_s, w[1].stall_torque_nm)
+        );
+    }
+    // no motor weaker than the stall-only least peak or slower than the
+    // speed-only least speed (within the designs' tolerance)
+    for p in &a.curve {
+        assert!(p.stall_torque_nm >= a.torque_asymptote_nm * (1.0 - HEIGHT_TOLERANCE));
+        assert!(p.no_load_speed_rad_s >= a.speed_asymptote_rad_s * (1.0 - HEIGHT_TOLERANCE));
+        // each point is exactly its design scaled (F3): T / w0^2 kept
+        let d = &p.design;
+        assert!(
+            (d.stall_torque_nm / d.no_load_speed_rad_s.powi(2) / p.ratio_nms2 - 1.0).abs() < 1e-12
+        );
+        assert!(
+            (p.stall_torque_nm / p.no_load_speed_rad_s.powi(2) / p.ratio_nms2 - 1.0).abs() < 1e-12
+        );
+        assert!((d.least_time_s / p.scale - a.manoeuvre_time_s).abs() < 1e-12);
+    }
+    // the ends: the torque-limited end near the torque asymptote, the
+    // speed-limited end near the speed asymptote
+    let (first, last) = (a.curve[0], a.curve[a.curve.len() - 1]);
+    assert!(first.no_load_speed_rad_s < 1.2 * a.speed_asymptote_rad_s);
+    assert!(last.stall_torque_nm < 1.2 * a.torque_asymptote_nm);
+}
+
+#[test]
+fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
+    let a = answer();
+    let g = &a.gear;
+    let q = robot_question(HEIGHT);
+    let (t0, w0) = (
+        q.limits.max_torque.unwrap(),
+        q.limits.no_load_speed.unwrap(),
+    );
+    // the search's own designs: none better than the best
+    for e in &g.evaluations {
+        assert!(e.design.least_height_m >= g.least_height_m);
+        assert!((e.design.stall_torque_nm / e.gear_ratio / t0 - 1.0).abs() < 1e-12);
+        assert!((e.design.no_load_speed_rad_s * e.gear_ratio / w0 - 1.0).abs() < 1e-12);
+    }
+    // the configured ratio (N = 1) is among them, and no better
+    assert!(g.evaluations.iter().any(|e| e.gear_ratio == 1.0));
+    assert!(g.least_height_m <= g.configured_least_height_m);
+    // neighbours 10 % either side, designed afresh, are no better (within
+    // the designs' tolerance: the least height is flat at a minimum)
+    for f in [1.1, 1.0 / 1.1] {
+        let n = g.best_ratio * f;
+        let d = design_motor(&q, t0 * n, w0 / n).unwrap();
+        eprintln!(
+            "N = {n}: {} m (best N = {}: {} m)",
+            d.least_height_m, g.best_ratio, g.least_height_m
+        );
+        assert!(
+            d.least_height_m >= g.least_height_m * (1.0 - HEIGHT_TOLERANCE),
+            "N = {n}: {} m, better than the best N = {}: {} m",
+            d.least_height_m,
+            g.best_ratio,
+            g.least_height_m
+        );
+    }
+}
+
+#[test]
+fn the_curve_scales_with_the_fall_time_f3() {
+    // a motor that just makes it from 2 m, sped up by k = t(2 m) / t(H'),
+    // is k^2 the torque and k the speed: it just makes it from H' (F3).
+    let a = answer();
+    let p = knee(a);
+    let other = 4.0;
+    let q = robot_question(other);
+    let k = a.manoeuvre_time_s / q.available_time();
+    let d = design_motor(&q, k * k * p.stall_torque_nm, k * p.no_load_speed_rad_s).unwrap();
+    eprintln!("scaled to {other} m: {} m", d.least_height_m);
+    assert!(
+        (d.least_height_m / other - 1.0).abs() <= HEIGHT_TOLERANCE,
+        "scaled to {other} m: needs {} m",
+        d.least_height_m
+    );
+}
+
+#[test]
+fn a_config_without_a_torque_speed_line_names_the_keys_to_set() {
+    let dir = util::temp_dir();
+    let cfg = util::seed_toml();
+    let out = util::output(
+        &[
+            "size",
+            cfg.to_str().unwrap(),
+            "--height",
+            "2",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("limits.max_torque"), "{err}");
+    assert!(!dir.path().join("out").exists());
+    // a stall torque alone: the no-load speed is named
+    let out = util::output(
+        &[
+            "size",
+            cfg.to_str().unwrap(),
+            "--height",
+            "2",
+            "--set",
+            "limits.max_torque=0.5",
+            "--out",
+            "out",
+        ],
+        dir.path(),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("limits.no_load_speed"), "{err}");
+    assert!(!dir.path().join("out").exists());
+}
+
+#[test]
+fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
+    let dir = util::temp_dir();
+    let cfg = util::config_path("robot-universal");
+    for (args, word) in [
+        (vec!["--height", "0"], "--height"),
+        (vec!["--height", "-1"], "--height"),
+        (vec!["--height", "1e9"], "--height"),
+        (vec!["--height", "nan"], "--height"),
+        // a fall shorter than the 0.1 s landing margin
+        (vec!["--height", "0.04"], "--height"),
+        (vec!["--height", "2", "--points", "1"], "--points"),
+        (vec!["--height", "2", "--points", "41"], "--points"),
+        // a spinning release: time scaling needs the momentum scaled too (F9)
+        (
+            vec!["--height", "2", "--set", "start.angular_velocity=[0, 0, 1]"],
+            "start.angular_velocity",
+        ),
+    ] {
+        let mut all = vec!["size", cfg.to_str().unwrap(), "--out", "out"];
+        all.extend(&args);
+        let out = util::output(&all, dir.path());
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(word), "{args:?}: {err}");
+        assert!(!dir.path().join("out").exists(), "{args:?}");
+    }
+}
+
+#[test]
+fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
+    // the seed's body with a DC motor: a cheap sizing (2 points, no gear search)
+    let dir = util::temp_dir();
+    let cfg = util::seed_toml();
+    let args = [
+        "size",
+        cfg.to_str().unwrap(),
+        "--height",
+        "10",
+        "--set",
+        "limits.max_torque=0.5",
+        "--set",
+        "limits.no_load_speed=4",
+        "--points",
+        "2",
+        "--gear-evaluations",
+        "0",
+        "--out",
+        "out",
+        "--json",
+    ];
+    let out = util::output(&args, dir.path());
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let set = dir
+        .path()
+        .join("out/seed/size-10m@limits.max_torque=0.5,limits.no_load_speed=4");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("size.json")).unwrap()).unwrap();
+    // --json prints what size.json holds
+    let printed: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json, printed);
+    for key in [
+        "height_m",
+        "manoeuvre_time_s",
+        "torque_asymptote_nm",
+        "speed_asymptote_rad_s",
+        "curve",
+        "failed",
+        "gear",
+        "settings",
+        "designs",
+        "solve_time_s",
+    ] {
+        assert!(json.get(key).is_some(), "size.json has no {key}");
+    }
+    assert_eq!(json["height_m"], 10.0);
+    let curve = json["curve"].as_array().unwrap();
+    assert_eq!(curve.len(), 2);
+    for key in [
+        "best_ratio",
+        "stall_torque_nm",
+        "no_load_speed_rad_s",
+        "least_height_m",
+        "least_time_s",
+        "configured_least_height_m",
+        "configured_possible",
+        "possible",
+        "evaluations",
+    ] {
+        assert!(json["gear"].get(key).is_some(), "gear has no {key}");
+    }
+    // the configured ratio alone was designed: it is the best one
+    assert_eq!(json["gear"]["best_ratio"], 1.0);
+    assert_eq!(
+        json["gear"]["least_height_m"],
+        json["gear"]["configured_least_height_m"]
+    );
+    // the CSV rows are the JSON's points, to their printed digits
+    let csv = std::fs::read_to_string(set.join("size.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert!(
+        lines
+            .next()
+            .unwrap()
+            .starts_with("no_load_speed_rad_s,stall_torque_nm,")
+    );
+    let rows: Vec<Vec<f64>> = lines
+        .map(|l| l.split(',').take(2).map(|x| x.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    for (r, p) in rows.iter().zip(curve) {
+        let w = p["no_load_speed_rad_s"].as_f64().unwrap();
+        let t = p["stall_torque_nm"].as_f64().unwrap();
+        assert!((r[0] / w - 1.0).abs() < 1e-8 && (r[1] / t - 1.0).abs() < 1e-8);
+    }
+    let gear = std::fs::read_to_string(set.join("size-gear.csv")).unwrap();
+    assert!(gear.starts_with("gear_ratio,"));
+    assert_eq!(gear.lines().count(), 2);
+    for f in ["size.svg", "size-gear.svg"] {
+        let svg = std::fs::read_to_string(set.join(f)).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("</svg>"), "{f}");
+    }
+    let html = std::fs::read_to_string(set.join("index.html")).unwrap();
+    assert!(html.contains("size.svg") && html.contains("size-gear.svg"));
+    assert!(html.contains("No motor weaker than"));
+}
