@@ -286,13 +286,14 @@ pub fn page(a: &SizeAnswer) -> String {
         "{} designs in {:.1} s. Each point is one least-time design scaled by time scaling (F3): a motor (T, w0) whose least time is t also fits (k^2 T, k w0) in t / k; see docs/usage.md.",
         a.designs, a.solve_time_s
     ));
-    super::index_html(
-        &format!("catflip size: {} from {} m", a.name, a.height_m),
-        &header,
-        &rows,
-        &notes,
-        &a.failed,
-        "",
-        &[crate::size::files::CURVE_SVG, crate::size::files::GEAR_SVG],
-    )
+    super::index_html(&super::Page {
+        title: &format!("catflip size: {} from {} m", a.name, a.height_m),
+        lead: None,
+        header: &header,
+        rows: &rows,
+        notes: &notes,
+        warnings: &a.failed,
+        animation: "",
+        figures: &[crate::size::files::CURVE_SVG, crate::size::files::GEAR_SVG],
+    })
 }
