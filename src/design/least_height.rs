@@ -40,6 +40,11 @@ pub struct HeightAnswer {
     pub least_height_lower_bound_m: Option<f64>,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
+    /// Whether the answer is a design from the configured start (always at
+    /// the default start). From another start only a free-form design that
+    /// lands answers; without one the numbers are the start at rest's and
+    /// `possible` is false.
+    pub from_start: bool,
     /// The least-height schedule.
     #[serde(skip)]
     pub schedule: Schedule,
@@ -68,6 +73,7 @@ fn answer_for(cfg: &Config, reference: &Config) -> Result<HeightAnswer> {
         status: r.status.into(),
         least_height_lower_bound_m: None,
         flip_error_rad: r.flip_error_rad,
+        from_start: cfg.start.is_default(),
         schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     })
 }
@@ -94,7 +100,16 @@ pub struct Heights {
 /// analytic schedule's least time under the limits, F3/F7, rounded to three
 /// digits so that the reference is the same to the last bit from any
 /// height), with the `time` objective.
+///
+/// From a start with angular momentum the body turns all through the fall,
+/// so the fall itself is part of the question: there the reference is the
+/// config's own drop.
 pub fn reference(cfg: &Config) -> Config {
+    if !cfg.start.is_default() {
+        let mut r = cfg.clone();
+        r.design.objective = Objective::Time;
+        return r;
+    }
     let plan = crate::design::analytic::analytic_plan(cfg);
     let t0 = cfg.available_time();
     let motor = cfg.motor();
@@ -229,7 +244,14 @@ pub fn heights(
         }
     }
     if let Some(fr) = &fastest {
+        if !cfg.start.is_default() {
+            // the phased design is made for the start at rest: from another
+            // start it only seeds the free-form one, which answers
+            answer.least_time_s = f64::INFINITY;
+        }
         answer.improve_with(cfg, fr);
+    } else if !cfg.start.is_default() {
+        answer.possible = false;
     }
     Ok(Some(Heights {
         answer,
@@ -256,9 +278,17 @@ pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
             max_speed_rad_s: Some(usage.max_speed_rad_s),
             envelope_margin: usage.min_margin,
         },
-        &Simulated::Flip {
-            flip_error_rad: fr.flip_error_rad,
-            tilt_deg: fr.tilt_deg,
+        &if cfg.start.is_default() {
+            Simulated::Flip {
+                flip_error_rad: fr.flip_error_rad,
+                tilt_deg: fr.tilt_deg,
+            }
+        } else {
+            Simulated::Landing {
+                flip_error_rad: fr.flip_error_rad,
+                tilt_deg: fr.tilt_deg,
+                landing_error_deg: fr.landing_error_deg,
+            }
         },
     );
     fr.certificate.constraint_violation <= cfg.free.attitude_tolerance
@@ -280,6 +310,7 @@ impl HeightAnswer {
         self.method = "free";
         self.status = fr.status.into();
         self.flip_error_rad = fr.flip_error_rad;
+        self.from_start = true;
         self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
     }
 
@@ -297,7 +328,12 @@ impl HeightAnswer {
             .least_height_lower_bound_m
             .map(|b| format!(" (at least {b:.3} m)"))
             .unwrap_or_default();
-        if self.possible && self.least_height_m > self.height_m {
+        if !self.from_start {
+            format!(
+                "No design found lands belly-down from this start in the fall from {} m (at rest the motors would need {:.3} m).",
+                self.height_m, self.least_height_m
+            )
+        } else if self.possible && self.least_height_m > self.height_m {
             format!(
                 "The flip is possible from {} m: the {} design fits the motors, although the phased least-height design needs {:.3} m.",
                 self.height_m, self.method, self.least_height_m
