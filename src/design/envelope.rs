@@ -707,13 +707,18 @@ pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
 }
 
 /// The least factor `k >= 1` by which a plan's durations must grow for
-/// every row a schedule would carry to be inside the motor envelope: the
+/// every row a schedule would carry (and the dense samples between them)
+/// to be inside the motor envelope: the
 /// same path slowed down (F3: torque falls as `1 / k^2`, speed as `1 / k`),
 /// found by bisection on the rows themselves to a relative `1e-9` (1 when
 /// they are inside already). The returned factor is always inside; a first
 /// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
 pub fn least_stretch(cfg: &Config, plan: &dyn ShapePlan) -> f64 {
-    let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+    // on the dense samples the verdict reads the peak from (a multiple of
+    // the written rows): inside at the rows alone, the peak could still be
+    // a rounding above the stall torque
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let sched = Schedule::sample(&cfg.cat(), plan, dense);
     let motor = cfg.motor();
     let margin = |k: f64| {
         let k2 = k * k;
