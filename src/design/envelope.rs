@@ -706,6 +706,51 @@ pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
     cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
+/// The least factor `k >= 1` by which a plan's durations must grow for
+/// every row a schedule would carry (and the dense samples between them)
+/// to be inside the motor envelope: the
+/// same path slowed down (F3: torque falls as `1 / k^2`, speed as `1 / k`),
+/// found by bisection on the rows themselves to a relative `1e-9` (1 when
+/// they are inside already). The returned factor is always inside; a first
+/// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
+pub fn least_stretch(cfg: &Config, plan: &dyn ShapePlan) -> f64 {
+    // on the dense samples the verdict reads the peak from (a multiple of
+    // the written rows): inside at the rows alone, the peak could still be
+    // a rounding above the stall torque
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let sched = Schedule::sample(&cfg.cat(), plan, dense);
+    let motor = cfg.motor();
+    let margin = |k: f64| {
+        let k2 = k * k;
+        motor
+            .usage(
+                sched
+                    .rows
+                    .iter()
+                    .map(|r| (r.tau.map(|x| x / k2), r.qd.map(|x| x / k))),
+            )
+            .min_margin
+            .unwrap_or(1.0)
+    };
+    let first = margin(1.0);
+    if first >= 0.0 {
+        return 1.0;
+    }
+    let (mut lo, mut hi) = (1.0, 1.0 - 1.5 * first);
+    while margin(hi) < 0.0 && hi < 1e6 {
+        (lo, hi) = (hi, 2.0 * hi);
+    }
+    while hi - lo > 1e-9 * hi {
+        let mid = 0.5 * (lo + hi);
+        if margin(mid) >= 0.0 {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    hi
+}
+
 /// `integral |tau|^2 dt` along a plan (trapezoid on `per_phase` samples a phase), N^2 m^2 s.
 pub fn torque_squared_integral(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize) -> f64 {
     Schedule::sample(cat, plan, per_phase).torque_squared_integral()

@@ -1,0 +1,141 @@
+//! Benchmark: the robot builder's question on the bundled robots with their
+//! real servo (stall torque and torque-speed line), median of several runs,
+//! wall and CPU time (the CPU time of all threads is the steadier measure on
+//! a shared machine; run under `valgrind --tool=callgrind` for instruction
+//! counts).
+//!
+//! `cargo run --release --example bench_robot [-- RUNS [CASE...]]` (default
+//! 3 runs, every case). Cases:
+//! - `run:CONFIG`: `catflip run`'s pipeline (analytic, least height, phased,
+//!   free-form, report; files not written), e.g. `run:robot-universal`;
+//! - `height:CONFIG`: the least-height stage alone, with its answer;
+//! - `free:CONFIG:OBJECTIVE:SEED`: the free-form design inside the motor
+//!   envelope from 6 m (`peak-torque`, `time`, `energy`; `phased`,
+//!   `analytic`), the seeding design not counted.
+//!
+//! The default cases: `run` and `height` on `robot-universal` and
+//! `box-robot`, and the six free-form designs of `robot-universal`.
+use catflip::Config;
+use catflip::design::free::{FreeDesign, Seed};
+use std::time::Instant;
+
+fn median(mut x: Vec<f64>) -> f64 {
+    x.sort_by(f64::total_cmp);
+    let n = x.len();
+    if n % 2 == 1 {
+        x[n / 2]
+    } else {
+        0.5 * (x[n / 2 - 1] + x[n / 2])
+    }
+}
+
+/// CPU time of the whole process (every thread), s.
+fn cpu_s() -> f64 {
+    // SAFETY: getrusage only writes the struct it is given
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) };
+    let tv = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    tv(u.ru_utime) + tv(u.ru_stime)
+}
+
+fn config(name: &str, set: &[String]) -> anyhow::Result<Config> {
+    let path = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+    Ok(Config::load(std::path::Path::new(&path), set)?)
+}
+
+/// One case, timed once: what it printed and the work's wall and CPU seconds.
+fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
+    let parts: Vec<&str> = case.split(':').collect();
+    let (t, c) = (Instant::now(), cpu_s());
+    let text = match parts.as_slice() {
+        ["run", name] => {
+            let cfg = config(name, &[])?;
+            let r = catflip::run::run(&cfg, |_| {})?;
+            let a = r.summary.answer.as_ref();
+            format!(
+                "outcome {:?}; {}",
+                r.summary.outcome,
+                a.map(|a| a.sentence()).unwrap_or_default()
+            )
+        }
+        ["height", name] => {
+            let cfg = config(name, &[])?;
+            let h = catflip::design::least_height::heights(&cfg, true, |_| {})?
+                .ok_or_else(|| anyhow::anyhow!("{name}: no motor limits"))?;
+            format!(
+                "least height {:.4} m ({} {:.5} s), phased {:.4} m",
+                h.answer.least_height_m, h.answer.method, h.answer.least_time_s, h.phased_m
+            )
+        }
+        ["free", name, objective, seed] => {
+            let cfg = config(
+                name,
+                &[
+                    "fall.height=6".into(),
+                    format!("design.objective={objective}"),
+                ],
+            )?;
+            let seed = match *seed {
+                "phased" => Seed::Phased,
+                "analytic" => Seed::Analytic,
+                s => anyhow::bail!("unknown seed {s}"),
+            };
+            let plan = seed.plan(&cfg)?;
+            let (t, c) = (Instant::now(), cpu_s());
+            let r = FreeDesign::new(&cfg)
+                .from_plan(plan.as_ref(), seed.name())
+                .solve()?;
+            return Ok((
+                format!(
+                    "{:.6} ({}), {} SCP iterations ({}), {}",
+                    r.objective_value,
+                    cfg.design.objective.name(),
+                    r.scp_iterations,
+                    catflip::design::free::iterations_text(&r.mesh_levels),
+                    catflip::verdict::Status::from(r.status)
+                ),
+                t.elapsed().as_secs_f64(),
+                cpu_s() - c,
+            ));
+        }
+        _ => anyhow::bail!(
+            "unknown case {case} (run:CONFIG, height:CONFIG, free:CONFIG:OBJECTIVE:SEED)"
+        ),
+    };
+    Ok((text, t.elapsed().as_secs_f64(), cpu_s() - c))
+}
+
+fn main() -> anyhow::Result<()> {
+    let mut args = std::env::args().skip(1);
+    let runs: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(3);
+    let mut cases: Vec<String> = args.collect();
+    if cases.is_empty() {
+        for c in ["robot-universal", "box-robot"] {
+            cases.push(format!("run:{c}"));
+            cases.push(format!("height:{c}"));
+        }
+        for o in ["peak-torque", "time", "energy"] {
+            for s in ["phased", "analytic"] {
+                cases.push(format!("free:robot-universal:{o}:{s}"));
+            }
+        }
+    }
+    println!("{runs} runs per case: median (min) wall s, median CPU s");
+    for case in cases {
+        let (mut wall, mut cpu, mut text) = (Vec::new(), Vec::new(), String::new());
+        for _ in 0..runs {
+            let (t, w, c) = once(&case)?;
+            wall.push(w);
+            cpu.push(c);
+            text = t;
+        }
+        let min = wall.iter().copied().fold(f64::INFINITY, f64::min);
+        println!(
+            "{case:<40} {:>7.3} ({:.3}) {:>7.3}  {text}",
+            median(wall),
+            min,
+            median(cpu)
+        );
+    }
+    Ok(())
+}

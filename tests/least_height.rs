@@ -1,0 +1,125 @@
+//! The robot builder's answer is one answer: the least drop height does not
+//! depend on the height the question is asked from, a weaker motor never
+//! needs less, and the lower bound beside it is below it.
+use catflip::Config;
+use catflip::design::envelope::{least_stretch, usage_of};
+use catflip::design::least_height::{Heights, heights, reference};
+
+fn robot(set: &[String]) -> Config {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/robot-universal.toml");
+    Config::load(std::path::Path::new(path), set).unwrap()
+}
+
+fn least(cfg: &Config) -> Heights {
+    heights(cfg, true, |_| {})
+        .unwrap()
+        .expect("the robot has motor limits")
+}
+
+/// The answers from 1, 2, 6 and 10 m agree: every design of the answer is
+/// made for the reference drop, which depends on the body and motors only
+/// (the stated tolerance is rounding, 1e-9 relative; the designs are the
+/// same to the bit). The question's height only decides `possible`.
+#[test]
+fn the_least_height_is_the_same_from_any_question_height() {
+    let at = |h: f64| robot(&[format!("fall.height={h}")]);
+    for h in [1.0, 6.0, 10.0] {
+        assert_eq!(
+            reference(&at(h)).fall.height,
+            reference(&at(2.0)).fall.height,
+            "reference drop from {h} m"
+        );
+    }
+    let answers: Vec<(f64, Heights)> = [1.0, 2.0, 6.0, 10.0]
+        .into_iter()
+        .map(|h| (h, least(&at(h))))
+        .collect();
+    let first = &answers[0].1.answer;
+    for (h, a) in &answers {
+        let a = &a.answer;
+        assert!(
+            (a.least_height_m - first.least_height_m).abs() <= 1e-9 * first.least_height_m,
+            "from {h} m: {} m, from 1 m: {} m",
+            a.least_height_m,
+            first.least_height_m
+        );
+        assert_eq!(
+            a.possible,
+            a.least_height_m <= *h * (1.0 + 1e-9),
+            "from {h} m"
+        );
+        assert_eq!(a.height_m, *h);
+        // the bound is below the answer, and named in the JSON and the sentence
+        let bound = a
+            .least_height_lower_bound_m
+            .expect("a stall torque bounds it");
+        assert!(
+            bound > 0.0 && bound < a.least_height_m,
+            "{bound} vs {}",
+            a.least_height_m
+        );
+        let json = serde_json::to_value(a).unwrap();
+        assert_eq!(json["least_height_lower_bound_m"].as_f64(), Some(bound));
+        assert!(
+            a.sentence().contains(&format!("(at least {bound:.3} m)")),
+            "{}",
+            a.sentence()
+        );
+    }
+}
+
+/// A motor with 0.8 times the no-load speed never needs less height (the
+/// stated tolerance: 1e-3 relative; the robot's answer is limited by the
+/// speed, so it needs much more).
+#[test]
+fn a_weaker_motor_never_needs_less_height() {
+    let base = robot(&[]);
+    let w0 = base.limits.no_load_speed.unwrap();
+    let weak = robot(&[format!("limits.no_load_speed={}", 0.8 * w0)]);
+    let (a, b) = (least(&base).answer, least(&weak).answer);
+    assert!(
+        b.least_height_m >= a.least_height_m * (1.0 - 1e-3),
+        "0.8 x no-load speed: {} m, the servo: {} m",
+        b.least_height_m,
+        a.least_height_m
+    );
+}
+
+/// The slow-down of a schedule that leaves the envelope is the least one:
+/// the plan stretched by it is inside at every dense sample (the written
+/// rows among them), and 1e-6 less is not.
+#[test]
+fn the_least_stretch_is_inside_and_no_less_would_do() {
+    let cfg = robot(&[]);
+    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let margin = |k: f64| {
+        let mut p = plan.clone();
+        p.durations = p.durations.map(|d| d * k);
+        // on the dense samples the verdict reads (the written rows among them)
+        let dense = catflip::verify::analyze::dense_samples(&cfg);
+        let rows = catflip::design::plan::Schedule::sample(&cfg.cat(), &p, dense).rows;
+        let dense_margin = cfg
+            .motor()
+            .usage(rows.iter().map(|r| (r.tau, r.qd)))
+            .min_margin
+            .unwrap();
+        assert!(dense_margin <= usage_of(&cfg, &p).min_margin.unwrap());
+        dense_margin
+    };
+    assert!(
+        margin(1.0) < 0.0,
+        "the seed's schedule breaks the robot's limits"
+    );
+    let k = least_stretch(&cfg, &plan);
+    assert!(k > 1.0);
+    assert!(margin(k) >= -1e-12, "{}", margin(k));
+    assert!(
+        margin(k * (1.0 - 1e-6)) < 0.0,
+        "{}",
+        margin(k * (1.0 - 1e-6))
+    );
+    // a plan inside already is not slowed
+    let mut slow = plan.clone();
+    slow.durations = slow.durations.map(|d| d * 1.01 * k);
+    assert_eq!(least_stretch(&cfg, &slow), 1.0);
+}
