@@ -7,6 +7,7 @@
 //! (the least drop height and its schedule are written); 130 interrupted
 //! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
+mod recovery_cli;
 mod robustness;
 
 fn main() -> std::process::ExitCode {
