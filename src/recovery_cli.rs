@@ -1,6 +1,6 @@
 //! `catflip recovery`: the command-line face of [`catflip::recovery`].
 
-use crate::cli::{Common, Status, load, publisher};
+use crate::common::{Common, Status, load, publisher, say};
 use anyhow::Result;
 use catflip::interrupt::{Outcome, supervise};
 use catflip::output::Output;
@@ -153,7 +153,7 @@ pub fn cmd_recovery(
         let dir = publisher.link();
         publisher.publish(out)?;
         if c.json {
-            println!("{json}");
+            say!("{json}");
         }
         eprintln!(
             "interrupted: {} of {} lines finished, published as a partial set in {} (its JSON says \"status\": \"partial\"); exit status 130",
@@ -165,10 +165,10 @@ pub fn cmd_recovery(
     }
     let written = publisher.publish(out)?;
     if c.json {
-        println!("{json}");
+        say!("{json}");
         return Ok(Status::Ok);
     }
-    println!(
+    say!(
         "catflip recovery: {} from {} m, {} of {} starts land within {:.4} deg of belly-down ({:.1} s)",
         cfg.name,
         cfg.fall.height,
@@ -177,12 +177,14 @@ pub fn cmd_recovery(
         summary.landing_tolerance_deg,
         clock.elapsed().as_secs_f64()
     );
-    println!(
+    say!(
         "  {:>5} {:>9} {:>24}",
-        "plane", "axis deg", "largest spin rad/s"
+        "plane",
+        "axis deg",
+        "largest spin rad/s"
     );
     for b in &summary.bounds {
-        println!(
+        say!(
             "  {:>5} {:>9.1} {:>24}",
             b.plane.name(),
             b.axis_deg,
@@ -190,7 +192,7 @@ pub fn cmd_recovery(
         );
     }
     for p in written {
-        println!("  wrote {}", p.display());
+        say!("  wrote {}", p.display());
     }
     Ok(Status::Ok)
 }
