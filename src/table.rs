@@ -6,7 +6,7 @@ use crate::pipeline::MethodSummary;
 use crate::verdict::Grade;
 
 /// Columns of the comparison table (terminal and index.html).
-pub const TABLE_HEADER: [&str; 11] = [
+pub const TABLE_HEADER: [&str; 12] = [
     "method",
     "status",
     "peak N m",
@@ -15,6 +15,7 @@ pub const TABLE_HEADER: [&str; 11] = [
     "durations s",
     "flip error rad",
     "tilt deg",
+    "landing deg",
     "sim peak N m",
     "solve s",
     "verdict",
@@ -51,11 +52,12 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
                 small(n.flip_error_rad),
                 small(n.tilt_deg),
+                small(n.landing_error_deg),
                 format!("{:.5}", n.sim_peak_torque_nm),
                 format!("{:.3}", n.solve_time_s),
             ]);
         }
-        None => row.extend(std::iter::repeat_n("-".to_string(), 8)),
+        None => row.extend(std::iter::repeat_n("-".to_string(), 9)),
     }
     row.push(verdict_text(m.verdict, m.reason.as_deref()));
     row

@@ -3,18 +3,20 @@
 The Python face of the catflip Rust library (the same code as the ``catflip``
 command line, called in-process): configs with the CLI's keys and checks,
 the analytic, phased and free-form designs as numpy arrays, their forward
-simulation, the robot's least drop height, sweeps, and the MuJoCo / pyBullet
-models and controls. Every solve releases the GIL; every object is safe to
-share between threads. See docs/python.md.
+simulation, the robot's least drop height, sweeps, the MuJoCo / pyBullet
+models and controls, and the closed-loop controllers (``Controller``). Every
+solve releases the GIL; every object is safe to share between threads. See docs/python.md.
 """
 
 from ._catflip import (
     CatflipError,
     Config,
     ConfigError,
+    Controller,
     Controls,
     Design,
     DesignError,
+    Flight,
     ImpossibleError,
     LeastHeight,
     Run,
@@ -34,9 +36,11 @@ __all__ = [
     "CatflipError",
     "Config",
     "ConfigError",
+    "Controller",
     "Controls",
     "Design",
     "DesignError",
+    "Flight",
     "ImpossibleError",
     "LeastHeight",
     "Run",

@@ -356,3 +356,133 @@ class Controls:
 def controls(design: Design, simulator: SimulatorName = "mujoco") -> Controls:
     """A design's controls for ``simulator``, in its joint coordinates and actuators, as
     ``catflip run`` writes them."""
+
+ControllerKind = Literal["tvlqr", "open-loop", "replan"]
+ArrayLike = Union[Sequence[float], F64]
+
+class Controller:
+    """One of ``catflip robustness``'s controllers along a design, for a simulation loop run
+    outside catflip (MuJoCo, pyBullet, a robot): ``torque(t, state)`` is the correction
+    catflip's own closed loop sends from that measurement (docs/control.md).
+
+    The state (11 floats) is the ``<stem>.tvlqr.csv`` convention: the rear half's attitude
+    ``W R`` as a quaternion ``w, x, y, z`` in the simulators' world (gravity ``-z``),
+    ``lambda`` (3: the angular momentum about the common centre of mass in the rear half's
+    frame, N m s), ``q`` (2) and ``q_dot`` (2): the hinge angles for the universal joint, the
+    ball's rotation vector ``(v1, v2)`` and its rate for the no-twist joint. ``sensed`` builds
+    it from a gyro. Torques are catflip's joint torques (hinge torques; rotation-vector
+    torques for the no-twist joint).
+
+    The TVLQR predicts over its delay under the corrections it already sent, so the
+    controller remembers them: a command at control step ``k`` forgets those from ``k`` on,
+    and one at ``t = 0`` starts a new flight. Safe to share between threads (a lock)."""
+
+    def __init__(self, config: Config, design: Optional[Design] = None,
+                 kind: ControllerKind = "tvlqr") -> None:
+        """The controller ``kind`` along ``design`` (None: the study's own design, the free-form
+        one from the phased seed that ``catflip robustness`` flies) on ``config``'s model and
+        ``[control]`` keys; GIL released.
+
+        ``"tvlqr"``: the time-varying LQR at ``control.rate_hz``, predicting over
+        ``control.delay_ms``, its correction capped at ``control.max_correction`` times the
+        design's peak torque and the sum with the feed-forward kept in the motor envelope at
+        the predicted speed. ``"open-loop"``: today's joint PD (``simulate.pd_*``) on the
+        planned shape, every simulator step. ``"replan"`` raises NotImplementedError:
+        replanning re-solves the design from the measured state, which needs designs from any
+        start, not yet in the library. Another kind raises ConfigError."""
+    @property
+    def kind(self) -> Literal["tvlqr", "open-loop"]:
+        """The study's name of the controller."""
+    def torque(self, t: float, state: ArrayLike) -> F64:
+        """The correction, N m: shape (2,), on top of the feed-forward, from ``state``
+        measured at ``t`` (s since release): catflip's closed-loop command of the control step
+        ``floor(t / period)``. It acts from ``t + delay`` until the next command; the motor is
+        given ``clip(feedforward + correction + noise, qd)``. After the last control step the
+        last correction holds. GIL released; ConfigError for a bad ``t`` or state."""
+    def reset(self) -> None:
+        """Forgets the corrections sent (a new flight)."""
+    def sensed(self, attitude: ArrayLike, q: ArrayLike, qd: ArrayLike, gyro: ArrayLike) -> F64:
+        """The state ``torque`` takes, shape (11,), from the rear half's attitude ``w x y z`` in
+        the simulator's world, the joint angles and rates (2 each) and the gyro on the rear
+        half (3, rad/s, its own frame): ``lambda = J(q) w + K(q) q_dot`` with the model's
+        inertias, as the closed loop's sensors estimate it."""
+    def clip(self, tau: ArrayLike, qd: ArrayLike) -> F64:
+        """The motor envelope of ``[limits]`` (saturation, back-EMF line) on joint torques
+        ``tau`` at joint speed ``qd``: shape (2,), as catflip's plant applies it."""
+    @property
+    def step(self) -> float:
+        """Simulator step h, s: touchdown is at ``steps * h``."""
+    @property
+    def steps(self) -> int:
+        """Simulator steps from release to touchdown."""
+    @property
+    def duration(self) -> float:
+        """Release to touchdown, s."""
+    @property
+    def period(self) -> float:
+        """Time between two commands, s (``open-loop``: one step)."""
+    @property
+    def period_steps(self) -> int:
+        """Simulator steps between two commands."""
+    @property
+    def delay(self) -> float:
+        """The delay the controller predicts over, s (``open-loop``: 0)."""
+    @property
+    def control_steps(self) -> int:
+        """Control steps with a command of their own."""
+    @property
+    def peak_torque(self) -> float:
+        """The design's largest feed-forward torque, N m (the config's norm)."""
+    @property
+    def feedforward(self) -> F64:
+        """The design's torque at every half step ``j h / 2``: shape (2 steps + 1, 2); an RK4
+        step ``j`` uses rows ``2j``, ``2j + 1``, ``2j + 2``."""
+    @property
+    def shape(self) -> F64:
+        """The planned ``(q1, q2, qd1, qd2)`` at every step (the PD's reference): shape (steps + 1, 4)."""
+    @property
+    def nominal(self) -> F64:
+        """The model's state under the feed-forward alone at every step, in ``torque``'s
+        convention: shape (steps + 1, 11)."""
+    @property
+    def gains(self) -> F64:
+        """The TVLQR gains ``K_k`` (``u = -K x``, ``x`` the error of docs/control.md): shape
+        (control steps, 2, 10)."""
+    @property
+    def t_apply(self) -> F64:
+        """When each TVLQR correction starts to act, s: shape (control steps,)."""
+    @property
+    def issued(self) -> F64:
+        """The corrections sent since the last reset, by control step: shape (k, 2)."""
+    def gains_csv(self) -> str:
+        """The gains as ``<stem>.tvlqr.csv`` text. GIL released."""
+    def with_kind(self, kind: ControllerKind) -> Controller:
+        """The same design's controller of another ``kind``, its gains reused (no new design)."""
+    def fly(self, trial: Optional[int] = None, seed: int = 0) -> Flight:
+        """A flight of catflip's closed-loop simulator under this controller: the nominal
+        (``trial=None``) or trial ``trial`` of ``catflip robustness --seed SEED`` (its draws,
+        delay and noises), with every command sent. GIL released."""
+
+class Flight:
+    """A flight of catflip's closed-loop simulator, with every command the controller sent
+    (K commands)."""
+
+    @property
+    def landing_error_deg(self) -> float:
+        """The belly's angle from straight down at touchdown, deg (NaN: diverged)."""
+    @property
+    def max_correction_nm(self) -> float:
+        """Largest correction sent, N m (the motor norm)."""
+    @property
+    def t(self) -> F64:
+        """Measurement time of each command, s: shape (K,)."""
+    @property
+    def measured(self) -> F64:
+        """What the controller measured (sensor noise included), ``Controller.torque``'s
+        convention: shape (K, 11)."""
+    @property
+    def correction(self) -> F64:
+        """The correction sent from each measurement, N m: shape (K, 2)."""
+    @property
+    def draw(self) -> Optional[Dict[str, Any]]:
+        """The trial's draws (``robustness.csv``'s columns) as a dict; None for the nominal."""

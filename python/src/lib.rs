@@ -1385,6 +1385,398 @@ impl Controls {
     }
 }
 
+// --- closed loop ------------------------------------------------------------
+
+use catflip::control::online::{Kind, Online, SimState, from_sim, to_sim};
+
+/// A state argument: 11 floats in the `<stem>.tvlqr.csv` order.
+fn sim_state(state: Vec<f64>) -> PyResult<SimState> {
+    state.try_into().map_err(|v: Vec<f64>| {
+        ConfigError::new_err(format!(
+            "state has {} values; give 11: the rear half's attitude w, x, y, z (simulator's world), lambda (3), q (2), q_dot (2), as Controller.sensed builds it",
+            v.len()
+        ))
+    })
+}
+
+fn pair(v: Vec<f64>, what: &str) -> PyResult<[f64; 2]> {
+    v.try_into().map_err(|v: Vec<f64>| {
+        ConfigError::new_err(format!("{what} has {} values; give 2", v.len()))
+    })
+}
+
+/// One of the study's controllers along a design, for a simulation loop run
+/// outside catflip (MuJoCo, a robot): `torque(t, state)` is what catflip's own
+/// closed loop commands from that measurement.
+#[pyclass(frozen, module = "catflip")]
+struct Controller {
+    online: Mutex<Online>,
+    cfg: Cfg,
+    plan: ControllerPlan,
+}
+
+/// The design a controller follows: a Python `Design`'s, or the study's own.
+enum ControllerPlan {
+    Design(Py<Design>),
+    Study(std::sync::Arc<dyn ShapePlan + Send + Sync>),
+}
+
+impl ControllerPlan {
+    fn plan(&self) -> &dyn ShapePlan {
+        match self {
+            ControllerPlan::Design(d) => d.get().plan.as_ref(),
+            ControllerPlan::Study(p) => p.as_ref(),
+        }
+    }
+}
+
+/// A controller kind by its name; "replan" is refused, naming why.
+fn controller_kind(kind: &str) -> PyResult<Kind> {
+    match kind {
+        "tvlqr" => Ok(Kind::Tvlqr),
+        "open-loop" => Ok(Kind::OpenLoop),
+        "replan" => Err(pyo3::exceptions::PyNotImplementedError::new_err(
+            "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz, which needs designs from any start (a measured attitude, momentum and shape), not yet in the catflip library; use kind=\"tvlqr\" (or \"open-loop\")",
+        )),
+        other => Err(ConfigError::new_err(format!(
+            "unknown controller kind `{other}`; use \"tvlqr\" or \"open-loop\" (\"replan\" is not built yet)"
+        ))),
+    }
+}
+
+/// A flight of catflip's closed-loop simulator, with every command the controller sent.
+#[pyclass(frozen, module = "catflip")]
+struct Flight {
+    landing_error_deg: f64,
+    max_correction_nm: f64,
+    times: Vec<f64>,
+    measured: Vec<SimState>,
+    correction: Vec<[f64; 2]>,
+    draw: Option<serde_json::Value>,
+}
+
+#[pymethods]
+impl Controller {
+    /// The controller `kind` (`"tvlqr"` or `"open-loop"`) along `design` (None: the
+    /// study's design, what `catflip robustness` flies) on `config`'s model and
+    /// `[control]` keys. `"replan"` raises NotImplementedError. GIL released.
+    #[new]
+    #[pyo3(signature = (config, design = None, kind = "tvlqr"))]
+    fn new(
+        py: Python<'_>,
+        config: &Config,
+        design: Option<Py<Design>>,
+        kind: &str,
+    ) -> PyResult<Controller> {
+        let kind = controller_kind(kind)?;
+        let (_, cfg) = config.snapshot();
+        py.detach(move || {
+            let plan = match design {
+                Some(d) => ControllerPlan::Design(d),
+                None => ControllerPlan::Study(std::sync::Arc::new(
+                    catflip::control::robustness::design(&cfg)
+                        .map_err(err)?
+                        .plan,
+                )),
+            };
+            let online = Online::new(&cfg, plan.plan(), kind);
+            Ok(Controller {
+                online: Mutex::new(online),
+                cfg,
+                plan,
+            })
+        })
+    }
+
+    /// `tvlqr` or `open-loop`.
+    #[getter]
+    fn kind(&self) -> &'static str {
+        self.lock().kind.name()
+    }
+
+    /// The correction, N m (catflip's joint torques: hinge torques for the universal joint,
+    /// rotation-vector torques for the no-twist joint), on top of the feed-forward, from
+    /// the measured `state` at time `t`, s: what catflip's closed loop sends. It acts from
+    /// `t + delay` to the next control step. GIL released.
+    fn torque<'py>(
+        &self,
+        py: Python<'py>,
+        t: f64,
+        state: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        if !(t.is_finite() && t >= 0.0) {
+            return Err(ConfigError::new_err(format!(
+                "t = {t}: the time since release, s, is finite and not negative"
+            )));
+        }
+        let s = sim_state(state)?;
+        if s.iter().any(|v| !v.is_finite()) {
+            return Err(ConfigError::new_err(format!(
+                "state {s:?} has a value that is not finite"
+            )));
+        }
+        let u = py.detach(|| {
+            let mut o = self.lock();
+            let k = o.step_at(t);
+            o.correction(k, &from_sim(&s))
+        });
+        Ok(vector(py, u.to_vec()))
+    }
+
+    /// Forgets the corrections sent (a new flight; a command at t = 0 does it too).
+    fn reset(&self) {
+        self.lock().reset();
+    }
+
+    /// The state `torque` takes, from a rear-half attitude `[w, x, y, z]` in the
+    /// simulator's world, the joint angles `q` and rates `qd` (2 each) and the rear
+    /// half's gyro (3, rad/s, its own frame); `lambda` from the model's inertias.
+    fn sensed<'py>(
+        &self,
+        py: Python<'py>,
+        attitude: Vec<f64>,
+        q: Vec<f64>,
+        qd: Vec<f64>,
+        gyro: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let a: [f64; 4] = attitude
+            .try_into()
+            .map_err(|_| ConfigError::new_err("attitude: give 4 values, w x y z"))?;
+        let g: [f64; 3] = gyro
+            .try_into()
+            .map_err(|_| ConfigError::new_err("gyro: give 3 values, rad/s"))?;
+        let s = self.lock().sensed(a, pair(q, "q")?, pair(qd, "qd")?, g);
+        Ok(vector(py, s.to_vec()))
+    }
+
+    /// The motor envelope (saturation and the back-EMF line of `[limits]`) on joint
+    /// torques `tau` at joint speed `qd`, as catflip's plant applies it.
+    fn clip<'py>(
+        &self,
+        py: Python<'py>,
+        tau: Vec<f64>,
+        qd: Vec<f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let c = self.lock().motor.clip(pair(tau, "tau")?, pair(qd, "qd")?);
+        Ok(vector(py, c.to_vec()))
+    }
+
+    /// Simulator step h, s (touchdown at `steps * h`).
+    #[getter]
+    fn step(&self) -> f64 {
+        self.lock().reference.h
+    }
+    /// Simulator steps to touchdown.
+    #[getter]
+    fn steps(&self) -> usize {
+        self.lock().reference.steps
+    }
+    /// Release to touchdown, s.
+    #[getter]
+    fn duration(&self) -> f64 {
+        self.lock().reference.duration()
+    }
+    /// Time between two commands, s (`open-loop`: one simulator step).
+    #[getter]
+    fn period(&self) -> f64 {
+        let o = self.lock();
+        o.period_steps() as f64 * o.reference.h
+    }
+    /// Simulator steps between two commands.
+    #[getter]
+    fn period_steps(&self) -> usize {
+        self.lock().period_steps()
+    }
+    /// The delay the controller predicts over, s (`open-loop`: 0).
+    #[getter]
+    fn delay(&self) -> f64 {
+        let o = self.lock();
+        o.delay_steps() as f64 * o.reference.h
+    }
+    /// Control steps with a command of their own.
+    #[getter]
+    fn control_steps(&self) -> usize {
+        self.lock().control_steps()
+    }
+    /// Largest feed-forward torque, N m (the config's norm).
+    #[getter]
+    fn peak_torque(&self) -> f64 {
+        self.lock().reference.peak_torque
+    }
+    /// The design's feed-forward at every half step, `tau(j h / 2)`: float64, shape (2 steps + 1, 2).
+    #[getter]
+    fn feedforward<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(py, &self.lock().reference.ff)
+    }
+    /// The planned shape `(q1, q2, qd1, qd2)` at every step (the PD's reference): shape (steps + 1, 4).
+    #[getter]
+    fn shape<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let rows: Vec<[f64; 4]> = self
+            .lock()
+            .reference
+            .shape
+            .iter()
+            .map(|(q, qd)| [q[0], q[1], qd[0], qd[1]])
+            .collect();
+        matrix(py, &rows)
+    }
+    /// The model's state under the feed-forward alone at every step, in `torque`'s
+    /// convention: float64, shape (steps + 1, 11).
+    #[getter]
+    fn nominal<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        let rows: Vec<SimState> = self.lock().reference.nominal.iter().map(to_sim).collect();
+        matrix(py, &rows)
+    }
+    /// The TVLQR gains `K_k` (u = -K x): float64, shape (control steps, 2, 10).
+    #[getter]
+    fn gains<'py>(&self, py: Python<'py>) -> Bound<'py, numpy::PyArray3<f64>> {
+        let o = self.lock();
+        let flat: Vec<f64> = o
+            .tvlqr
+            .gains
+            .iter()
+            .flat_map(|g| (0..2).flat_map(move |i| (0..10).map(move |j| g[(i, j)])))
+            .collect();
+        numpy::ndarray::Array3::from_shape_vec((o.tvlqr.gains.len(), 2, 10), flat)
+            .expect("2 x 10 gains")
+            .into_pyarray(py)
+    }
+    /// When each TVLQR correction starts to act, s: shape (control steps,).
+    #[getter]
+    fn t_apply<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        let o = self.lock();
+        let h = o.reference.h;
+        vector(py, o.tvlqr.starts.iter().map(|&s| s as f64 * h).collect())
+    }
+    /// Corrections sent since the last reset, by control step: shape (k, 2).
+    #[getter]
+    fn issued<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(py, self.lock().issued())
+    }
+    /// The gains as the `<stem>.tvlqr.csv` text (`catflip export mjcf CONFIG --schedule S.csv`
+    /// writes it for the schedule read back from its CSV). GIL released.
+    fn gains_csv(&self, py: Python<'_>) -> String {
+        py.detach(|| catflip::control::export::gains_csv(&self.cfg, self.plan.plan()))
+    }
+
+    /// The same design's controller of another `kind`, its gains reused (no new design). GIL released.
+    fn with_kind(&self, py: Python<'_>, kind: &str) -> PyResult<Controller> {
+        let kind = controller_kind(kind)?;
+        let plan = match &self.plan {
+            ControllerPlan::Design(d) => ControllerPlan::Design(d.clone_ref(py)),
+            ControllerPlan::Study(p) => ControllerPlan::Study(p.clone()),
+        };
+        let mut online = self.lock().clone();
+        Ok(py.detach(move || {
+            online.kind = kind;
+            online.reset();
+            Controller {
+                online: Mutex::new(online),
+                cfg: self.cfg.clone(),
+                plan,
+            }
+        }))
+    }
+
+    /// A flight of catflip's closed-loop simulator under this controller: the nominal
+    /// (`trial=None`: the model, the config's start, no delay or noise), or trial `trial`
+    /// of `catflip robustness --seed SEED` (its draws, delay and noises). GIL released.
+    #[pyo3(signature = (trial = None, seed = 0))]
+    fn fly(&self, py: Python<'_>, trial: Option<usize>, seed: u64) -> Flight {
+        py.detach(|| {
+            let o = self.lock().clone();
+            let r = &o.reference;
+            let (draw, flight) = match trial {
+                None => (None, catflip::control::closed_loop::Flight::nominal(r)),
+                Some(i) => {
+                    let (d, f) =
+                        catflip::control::robustness::trial_flight(&self.cfg, r, &o.tvlqr, seed, i);
+                    (Some(d), f)
+                }
+            };
+            let fb = match o.kind {
+                Kind::Tvlqr => catflip::control::closed_loop::Feedback::Tvlqr(&o.tvlqr),
+                Kind::OpenLoop => match &draw {
+                    Some(d) => catflip::control::robustness::open_loop(&o.pd, d),
+                    None => catflip::control::closed_loop::Feedback::JointPd {
+                        kp: o.pd.kp,
+                        kd: o.pd.kd,
+                    },
+                },
+            };
+            let mut log = Vec::new();
+            let landing =
+                catflip::control::closed_loop::fly_logged(r, fb, &o.motor, flight, Some(&mut log));
+            Flight {
+                landing_error_deg: landing.error_deg,
+                max_correction_nm: landing.max_correction_nm,
+                times: log.iter().map(|c| c.step as f64 * r.h).collect(),
+                measured: log.iter().map(|c| to_sim(&c.measured)).collect(),
+                correction: log.iter().map(|c| c.correction).collect(),
+                draw: draw.map(|d| serde_json::to_value(d).expect("serialises")),
+            }
+        })
+    }
+
+    fn __repr__(&self) -> String {
+        let o = self.lock();
+        format!(
+            "Controller(kind={:?}, period={:.6e} s, delay={:.6e} s, {} control steps)",
+            o.kind.name(),
+            o.period_steps() as f64 * o.reference.h,
+            o.delay_steps() as f64 * o.reference.h,
+            o.control_steps()
+        )
+    }
+}
+
+impl Controller {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Online> {
+        self.online.lock().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+#[pymethods]
+impl Flight {
+    /// The belly's angle from straight down at touchdown, deg (NaN: the flight diverged).
+    #[getter]
+    fn landing_error_deg(&self) -> f64 {
+        self.landing_error_deg
+    }
+    /// Largest correction sent, N m (the motor norm).
+    #[getter]
+    fn max_correction_nm(&self) -> f64 {
+        self.max_correction_nm
+    }
+    /// Measurement time of each command, s: shape (K,).
+    #[getter]
+    fn t<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray1<f64>> {
+        vector(py, self.times.clone())
+    }
+    /// What the controller measured (sensor noise included), `torque`'s convention: shape (K, 11).
+    #[getter]
+    fn measured<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(py, &self.measured)
+    }
+    /// The correction sent from each measurement, N m: shape (K, 2).
+    #[getter]
+    fn correction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
+        matrix(py, &self.correction)
+    }
+    /// The trial's draws (the `robustness.csv` columns) as a dict; None for the nominal.
+    #[getter]
+    fn draw<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
+        self.draw.as_ref().map(|d| json_loads(py, d)).transpose()
+    }
+    fn __repr__(&self) -> String {
+        format!(
+            "Flight(landing_error_deg={:.6}, {} commands)",
+            self.landing_error_deg,
+            self.times.len()
+        )
+    }
+}
+
 #[pymodule]
 fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
@@ -1399,6 +1791,8 @@ fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<LeastHeight>()?;
     m.add_class::<Run>()?;
     m.add_class::<Controls>()?;
+    m.add_class::<Controller>()?;
+    m.add_class::<Flight>()?;
     m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(least_height, m)?)?;

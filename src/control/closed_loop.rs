@@ -66,6 +66,21 @@ pub struct Landing {
     pub state: Y,
 }
 
+/// One command of a flight: what the controller measured at simulator step
+/// `step` and the correction it sent (acting from `step` plus the plant's delay).
+#[derive(Debug, Clone, Copy)]
+pub struct Command {
+    pub step: usize,
+    pub measured: Y,
+    pub correction: [f64; 2],
+}
+
+/// The joint PD's correction at step `j` from the measurement `m`.
+pub fn pd_command(r: &Reference, kp: f64, kd: f64, j: usize, m: &Y) -> [f64; 2] {
+    let (q, qd) = r.shape[j.min(r.steps)];
+    [0, 1].map(|i| kp * (q[i] - m[4 + i]) + kd * (qd[i] - m[6 + i]))
+}
+
 /// What the sensors report: attitude, gyro and joint encoders, the momentum
 /// estimated from them with the model's inertias.
 fn measure(r: &Reference, f: &mut Flight, y: &Y) -> Y {
@@ -88,7 +103,19 @@ fn measure(r: &Reference, f: &mut Flight, y: &Y) -> Y {
 
 /// Flies the design `r` under `fb` with the motor `motor` (saturation and
 /// back-EMF at the actual joint speed).
-pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing {
+pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, f: Flight) -> Landing {
+    fly_logged(r, fb, motor, f, None)
+}
+
+/// [`fly`], with every command appended to `log`: what a controller run
+/// outside catflip (the Python package's) is checked against.
+pub fn fly_logged(
+    r: &Reference,
+    fb: Feedback,
+    motor: &Motor,
+    mut f: Flight,
+    mut log: Option<&mut Vec<Command>>,
+) -> Landing {
     let n = r.steps;
     // corrections by the step from which they act
     let mut queue: Vec<Option<[f64; 2]>> = vec![None; n + f.delay_steps + 2];
@@ -105,8 +132,7 @@ pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing
             let u = match fb {
                 Feedback::JointPd { kp, kd } => {
                     let m = measure(r, &mut f, &y);
-                    let (q, qd) = r.shape[j];
-                    Some([0, 1].map(|i| kp * (q[i] - m[4 + i]) + kd * (qd[i] - m[6 + i])))
+                    Some((m, pd_command(r, kp, kd, j, &m)))
                 }
                 Feedback::Tvlqr(tv) => {
                     let k = j / period;
@@ -114,11 +140,18 @@ pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, mut f: Flight) -> Landing
                         let m = measure(r, &mut f, &y);
                         let u = tvlqr_command(r, tv, motor, &issued, k, &m);
                         issued.push(u);
-                        u
+                        (m, u)
                     })
                 }
             };
-            if let Some(u) = u {
+            if let Some((m, u)) = u {
+                if let Some(log) = log.as_deref_mut() {
+                    log.push(Command {
+                        step: j,
+                        measured: m,
+                        correction: u,
+                    });
+                }
                 queue[j + f.delay_steps] = Some(u);
             }
         }

@@ -1,6 +1,7 @@
 //! The TVLQR gains as a CSV beside a schedule's controls, in the
 //! simulators' world (gravity along `-z`, [`crate::export::start::world_map`]).
 
+use super::closed_loop::{Feedback, Flight, fly};
 use super::reference::Reference;
 use super::tvlqr::Tvlqr;
 use crate::config::Config;
@@ -33,6 +34,38 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         dms = cfg.control.delay_ms,
         h = r.h,
     );
+    // what a controller run from this file needs, one `# key = value` a line
+    let motor = cfg.motor();
+    let pd = crate::verify::simulate::Controller::from_config(cfg);
+    let nominal = |fb| fly(&r, fb, &motor, Flight::nominal(&r)).error_deg;
+    let keys = [
+        ("step_s", r.h),
+        ("steps", r.steps as f64),
+        ("period_steps", tv.period_steps as f64),
+        ("delay_steps", tv.delay_steps as f64),
+        ("max_correction_nm", tv.max_correction),
+        ("peak_torque_nm", r.peak_torque),
+        ("pd_kp", pd.kp),
+        ("pd_kd", pd.kd),
+        (
+            "nominal_landing_error_deg_tvlqr",
+            nominal(Feedback::Tvlqr(&tv)),
+        ),
+        (
+            "nominal_landing_error_deg_open_loop",
+            nominal(Feedback::JointPd {
+                kp: pd.kp,
+                kd: pd.kd,
+            }),
+        ),
+    ];
+    s.push_str(
+        "# The closed loop's grid (touchdown at steps * step_s), the correction's cap, the PD gains and\n\
+         # catflip's landing error of the nominal flight (the model, no delay or noise) under each controller:\n",
+    );
+    for (k, v) in keys {
+        s.push_str(&format!("# {k} = {v:.17e}\n"));
+    }
     let mut cols = vec![
         "t_apply_s".to_string(),
         "qnom_w".into(),

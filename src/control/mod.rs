@@ -6,6 +6,7 @@
 pub mod closed_loop;
 pub mod export;
 pub mod figure;
+pub mod online;
 pub mod plant;
 pub mod reference;
 pub mod resume;

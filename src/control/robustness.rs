@@ -118,6 +118,41 @@ pub struct TrialResult {
     pub landing_error_deg: [f64; 2],
 }
 
+/// Trial `trial` of the study seeded by `seed`: its draws and the flight
+/// they make of the design `r` (gains `tv`: the torque noise is redrawn each
+/// of their control periods).
+pub fn trial_flight(
+    cfg: &Config,
+    r: &Reference,
+    tv: &Tvlqr,
+    seed: u64,
+    trial: usize,
+) -> (Draw, Flight) {
+    let p = &cfg.robustness;
+    let draw = Draw::new(cfg, seed, trial);
+    let plant = draw.plant(&r.cat);
+    let flight = Flight {
+        plant,
+        release: release(&plant, &draw.start(cfg)),
+        delay_steps: steps_of(p.delay_ms * 1e-3, r.h),
+        torque_noise: p.torque_noise * r.peak_torque,
+        noise_steps: tv.period_steps,
+        attitude_noise: p.attitude_noise_deg.to_radians(),
+        rate_noise: p.rate_noise_rad_s,
+        rng: Rng::new(seed, trial as u64, 1),
+    };
+    (draw, flight)
+}
+
+/// The open loop of a trial: today's joint PD, its gains off by the draw.
+pub fn open_loop(pd: &Controller, draw: &Draw) -> Feedback<'static> {
+    let f = draw.pd_gain_factor;
+    Feedback::JointPd {
+        kp: pd.kp * f,
+        kd: pd.kd * f,
+    }
+}
+
 /// The design and the gains a study flies.
 pub struct Study<'a> {
     pub cfg: &'a Config,
@@ -147,30 +182,9 @@ impl<'a> Study<'a> {
 
     pub fn trial(&self, trial: usize) -> TrialResult {
         let (cfg, r) = (self.cfg, &self.reference);
-        let p = &cfg.robustness;
-        let draw = Draw::new(cfg, self.seed, trial);
-        let plant = draw.plant(&r.cat);
-        let flight = Flight {
-            plant,
-            release: release(&plant, &draw.start(cfg)),
-            delay_steps: steps_of(p.delay_ms * 1e-3, r.h),
-            torque_noise: p.torque_noise * r.peak_torque,
-            noise_steps: self.tvlqr.period_steps,
-            attitude_noise: p.attitude_noise_deg.to_radians(),
-            rate_noise: p.rate_noise_rad_s,
-            rng: Rng::new(self.seed, trial as u64, 1),
-        };
+        let (draw, flight) = trial_flight(cfg, r, &self.tvlqr, self.seed, trial);
         let motor = cfg.motor();
-        let f = draw.pd_gain_factor;
-        let open = fly(
-            r,
-            Feedback::JointPd {
-                kp: self.pd.kp * f,
-                kd: self.pd.kd * f,
-            },
-            &motor,
-            flight.clone(),
-        );
+        let open = fly(r, open_loop(&self.pd, &draw), &motor, flight.clone());
         let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight);
         TrialResult {
             draw,

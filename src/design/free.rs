@@ -96,6 +96,9 @@ pub struct FreeProblem {
     /// momentum and the landing set (belly down, heading free) instead of
     /// the final attitude `Rz(pi)`.
     pub release: Option<Release>,
+    /// The shape `q` (rad) and its rate `q_dot` (rad/s) at the start, when
+    /// not straight and at rest (a replan from a measured state in flight).
+    pub initial: Option<([f64; 2], [f64; 2])>,
 }
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
@@ -169,6 +172,7 @@ impl FreeProblem {
             second_terms: Default::default(),
             midpoints: true,
             release: Release::of(cfg, time_unit),
+            initial: None,
         }
     }
 
@@ -867,7 +871,23 @@ impl ScpProblem for FreeProblem {
         for (p, k) in [(0, 0), (2, n - 1)] {
             for base in [tr.q(p, k), tr.v(p, k)] {
                 for j in 0..2 {
-                    d.row(&[(var(base + j), 1.0)], -z[base + j]);
+                    match self.initial.filter(|_| p == 0) {
+                        // q + dq = q0; q^ + dq^ = q_dot0 T (T + dT) in problem units
+                        Some((q0, _)) if base == tr.q(p, k) => {
+                            d.row(&[(var(base + j), 1.0)], q0[j] - z[base + j]);
+                        }
+                        Some((_, qd0)) => {
+                            let c = qd0[j] * self.time_unit;
+                            let dur = tr.duration(0);
+                            d.row(
+                                &[(var(base + j), 1.0), (var(dur), -c)],
+                                c * z[dur] - z[base + j],
+                            );
+                        }
+                        None => {
+                            d.row(&[(var(base + j), 1.0)], -z[base + j]);
+                        }
+                    }
                     zero += 1;
                 }
             }
@@ -1322,11 +1342,31 @@ fn design(
     nodes: usize,
     mesh: Mesh,
     first: usize,
-    mut observe: impl FnMut(&ScpIteration),
+    observe: impl FnMut(&ScpIteration),
 ) -> Result<Solved> {
     check_resolvable(cfg, nodes)?;
-    let tr = Transcription::new(3, nodes);
-    let problem = FreeProblem::new(cfg, nodes, z0);
+    design_problem(
+        cfg,
+        FreeProblem::new(cfg, nodes, z0),
+        z0,
+        warm,
+        mesh,
+        first,
+        observe,
+    )
+}
+
+/// [`design`] of a given problem (its start may be another than `cfg`'s: a replan).
+fn design_problem(
+    cfg: &Config,
+    problem: FreeProblem,
+    z0: &[f64],
+    warm: Option<&WarmStart>,
+    mesh: Mesh,
+    first: usize,
+    mut observe: impl FnMut(&ScpIteration),
+) -> Result<Solved> {
+    let tr = problem.tr;
     // what a mesh of the continuation means: its problem and SCP settings
     let (problem, max_iterations, tolerance, conic) = match mesh {
         Mesh::Coarse => (
@@ -1404,6 +1444,111 @@ fn design(
         plan,
         attitude_error,
         node_peak,
+    })
+}
+
+/// The rest of a plan from `t0`, as a plan of three phases starting at 0:
+/// the phases still to come keep their bounds; when fewer than three remain,
+/// the remaining time of the current one is split evenly (a replan's seed).
+struct Remainder<'a> {
+    plan: &'a dyn ShapePlan,
+    t0: f64,
+    bounds: [f64; 4],
+}
+
+impl<'a> Remainder<'a> {
+    fn new(plan: &'a dyn ShapePlan, t0: f64) -> Self {
+        let b = plan.phase_bounds();
+        let end = b[3];
+        let i = (0..3).find(|&i| t0 < b[i + 1]).unwrap_or(2);
+        let cuts: Vec<f64> = match i {
+            0 => vec![b[1], b[2]],
+            1 => vec![0.5 * (t0 + b[2]), b[2]],
+            _ => vec![t0 + (end - t0) / 3.0, t0 + 2.0 * (end - t0) / 3.0],
+        };
+        Remainder {
+            plan,
+            t0,
+            bounds: [0.0, cuts[0] - t0, cuts[1] - t0, end - t0],
+        }
+    }
+}
+
+impl ShapePlan for Remainder<'_> {
+    fn phase_bounds(&self) -> Vec<f64> {
+        self.bounds.to_vec()
+    }
+    fn state_in(&self, i: usize, t: f64) -> crate::design::plan::ShapeState {
+        let mut s = self.plan.state(self.t0 + t);
+        s.phase = crate::design::plan::Phase::ALL[i.min(2)];
+        s
+    }
+}
+
+/// A replan: the free-form design from a state measured in flight.
+#[derive(Debug, Clone)]
+pub struct Replan {
+    /// The new plan, from the measured instant (its time 0) to the end of the manoeuvre.
+    pub plan: CollocationPlan,
+    pub status: ScpStatus,
+    pub scp_iterations: usize,
+    /// The optimiser's own landing error, rad.
+    pub landing_error_rad: f64,
+    /// Wall time of the solve, s.
+    pub seconds: f64,
+}
+
+/// Re-solves the free-form design of `cfg` from the state `y` measured at
+/// time `t` of the flight (`[quaternion, q, q_dot, lambda]`, the closed
+/// loop's: attitude, shape, shape rate, body-frame momentum) over the time
+/// the fall still leaves, to the landing set, seeded by the rest of
+/// `previous` (whose time 0 is the release) and with at most
+/// `max_iterations` SCP iterations on `nodes` per phase. The new plan's time
+/// 0 is `t`.
+pub fn replan(
+    cfg: &Config,
+    previous: &dyn ShapePlan,
+    t: f64,
+    y: &[f64; 11],
+    nodes: usize,
+    max_iterations: usize,
+) -> Result<Replan> {
+    let clock = std::time::Instant::now();
+    let end = previous.duration();
+    let remaining = cfg.available_time() - t;
+    if !(t >= 0.0 && t < end && remaining > 0.0) {
+        return Err(crate::error::Error::Invalid {
+            key: "replan time".into(),
+            value: format!("{t}"),
+            expected: format!("within the manoeuvre, [0, {end})"),
+        });
+    }
+    let mut rc = cfg.clone();
+    let g = rc.fall.gravity;
+    rc.fall.height = 0.5 * g * (remaining + rc.fall.margin).powi(2);
+    rc.free.max_iterations = max_iterations;
+    let seed = Remainder::new(previous, t);
+    let z0 = Transcription::new(3, nodes).sample(&seed);
+    let mut problem = FreeProblem::new(&rc, nodes, &z0);
+    let cat = rc.cat();
+    let att = [y[0], y[1], y[2], y[3]];
+    let lam = nalgebra::Vector3::new(y[8], y[9], y[10]);
+    let l = crate::model::so3::quat_from(&att) * lam;
+    let unit = problem.time_unit;
+    problem.release = Some(Release {
+        attitude: att,
+        momentum: [l.x, l.y, l.z].map(|c| c * unit),
+        tail: rc.fall.margin / unit,
+        inertias: crate::model::momentum::straight_inertias(&cat),
+    });
+    problem.initial = Some(([y[4], y[5]], [y[6], y[7]]));
+    let solved = design_problem(&rc, problem, &z0, None, Mesh::Final, 0, |_| {})?;
+    Ok(Replan {
+        status: solved.res.status,
+        scp_iterations: solved.res.iterations.len(),
+        landing_error_rad: solved.attitude_error,
+        plan: solved.plan,
+        seconds: clock.elapsed().as_secs_f64(),
     })
 }
 

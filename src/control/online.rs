@@ -1,0 +1,209 @@
+//! The study's controllers for a simulation loop catflip does not run
+//! (MuJoCo, pyBullet, a robot): the same commands as [`super::closed_loop`]
+//! computes inside its own flights, from a measurement handed in, with the
+//! state in the simulators' world (the `<stem>.tvlqr.csv` convention).
+//!
+//! The TVLQR predicts over its delay under the corrections it already sent,
+//! so the controller remembers them: a command at control step `k` drops
+//! the history from `k` on (a command at step 0 starts a new flight).
+
+use super::closed_loop::{pd_command, tvlqr_command};
+use super::plant::{Y, attitude, momentum_from_rates};
+use super::reference::Reference;
+use super::tvlqr::Tvlqr;
+use crate::config::Config;
+use crate::design::plan::ShapePlan;
+use crate::export::start::world_map;
+use crate::model::motor::Motor;
+use crate::verify::simulate::Controller;
+
+/// A state in the simulators' world, the `<stem>.tvlqr.csv` columns:
+/// `[w, x, y, z]` the rear half's attitude `W R` (gravity `-z`), `lambda`
+/// (3, the momentum about the common centre of mass in the rear half's
+/// frame, N m s), `q` (2), `q_dot` (2).
+pub type SimState = [f64; 11];
+
+/// Which controller.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Today's joint PD on the planned shape, every simulator step (the study's `open-loop`).
+    OpenLoop,
+    /// The time-varying LQR at `control.rate_hz`, predicting over `control.delay_ms`.
+    Tvlqr,
+}
+
+impl Kind {
+    /// The study's name of the controller.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::OpenLoop => "open-loop",
+            Kind::Tvlqr => "tvlqr",
+        }
+    }
+}
+
+/// catflip's integrator state of a simulator's state.
+pub fn from_sim(s: &SimState) -> Y {
+    let r = world_map().inverse() * crate::model::so3::quat_from(&[s[0], s[1], s[2], s[3]]);
+    [
+        r.w, r.i, r.j, r.k, s[7], s[8], s[9], s[10], s[4], s[5], s[6],
+    ]
+}
+
+/// A simulator's state of catflip's integrator state (the inverse of [`from_sim`]).
+pub fn to_sim(y: &Y) -> SimState {
+    let r = world_map() * attitude(y);
+    [
+        r.w, r.i, r.j, r.k, y[8], y[9], y[10], y[4], y[5], y[6], y[7],
+    ]
+}
+
+/// One controller along one design.
+#[derive(Debug, Clone)]
+pub struct Online {
+    pub kind: Kind,
+    pub reference: Reference,
+    pub tvlqr: Tvlqr,
+    pub motor: Motor,
+    /// Today's PD gains (the open loop's).
+    pub pd: Controller,
+    /// Corrections sent, by control step.
+    issued: Vec<[f64; 2]>,
+}
+
+impl Online {
+    pub fn new(cfg: &Config, plan: &dyn ShapePlan, kind: Kind) -> Online {
+        let reference = Reference::new(cfg, plan);
+        let tvlqr = Tvlqr::new(&reference, &cfg.control);
+        Online {
+            kind,
+            reference,
+            tvlqr,
+            motor: cfg.motor(),
+            pd: Controller::from_config(cfg),
+            issued: Vec::new(),
+        }
+    }
+
+    /// Simulator steps between two commands.
+    pub fn period_steps(&self) -> usize {
+        match self.kind {
+            Kind::OpenLoop => 1,
+            Kind::Tvlqr => self.tvlqr.period_steps,
+        }
+    }
+
+    /// The delay the controller predicts over, simulator steps (the PD: none).
+    pub fn delay_steps(&self) -> usize {
+        match self.kind {
+            Kind::OpenLoop => 0,
+            Kind::Tvlqr => self.tvlqr.delay_steps,
+        }
+    }
+
+    /// Number of control steps with a command of their own (the TVLQR's last
+    /// correction acts until touchdown; the PD commands every step to touchdown).
+    pub fn control_steps(&self) -> usize {
+        match self.kind {
+            Kind::OpenLoop => self.reference.steps,
+            Kind::Tvlqr => self.tvlqr.starts.len(),
+        }
+    }
+
+    /// The control step of a measurement at time `t`: the last one whose
+    /// time (`k` periods) is at or before `t` (to a part in 10^9 of a step).
+    pub fn step_at(&self, t: f64) -> usize {
+        let p = self.period_steps() as f64 * self.reference.h;
+        (t / p + 1e-9).floor().max(0.0) as usize
+    }
+
+    /// A simulator's state from what a robot's sensors give: the rear half's
+    /// attitude `W R` (`[w, x, y, z]`), the joint angles and rates and the
+    /// gyro on the rear half (rad/s, its own frame); `lambda = J(q) w + K(q) q_dot`
+    /// with the model's inertias, as the closed loop's sensors estimate it.
+    pub fn sensed(
+        &self,
+        attitude: [f64; 4],
+        q: [f64; 2],
+        qd: [f64; 2],
+        gyro: [f64; 3],
+    ) -> SimState {
+        let l = momentum_from_rates(&self.reference.cat, q, qd, gyro);
+        [
+            attitude[0],
+            attitude[1],
+            attitude[2],
+            attitude[3],
+            l[0],
+            l[1],
+            l[2],
+            q[0],
+            q[1],
+            qd[0],
+            qd[1],
+        ]
+    }
+
+    /// Forgets the corrections sent (a new flight).
+    pub fn reset(&mut self) {
+        self.issued.clear();
+    }
+
+    /// The corrections sent so far, by control step.
+    pub fn issued(&self) -> &[[f64; 2]] {
+        &self.issued
+    }
+
+    /// The correction, N m (catflip's joint torques), on top of the
+    /// feed-forward, from the measurement `m` taken at control step `k`:
+    /// what the closed loop of [`super::closed_loop::fly`] sends there.
+    /// After the last control step the last correction holds.
+    pub fn correction(&mut self, k: usize, m: &Y) -> [f64; 2] {
+        if k >= self.control_steps() {
+            return self.issued.last().copied().unwrap_or([0.0; 2]);
+        }
+        // a step skipped sent nothing
+        self.issued.resize(k, [0.0; 2]);
+        let u = match self.kind {
+            Kind::OpenLoop => pd_command(&self.reference, self.pd.kp, self.pd.kd, k, m),
+            Kind::Tvlqr => tvlqr_command(
+                &self.reference,
+                &self.tvlqr,
+                &self.motor,
+                &self.issued,
+                k,
+                m,
+            ),
+        };
+        self.issued.push(u);
+        u
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_simulators_state_maps_back_exactly_enough() {
+        let y: Y = {
+            let q =
+                nalgebra::UnitQuaternion::from_scaled_axis(nalgebra::Vector3::new(0.3, -1.1, 2.0));
+            [q.w, q.i, q.j, q.k, 0.1, -0.2, 0.3, -0.4, 0.5, -0.6, 0.7]
+        };
+        let back = from_sim(&to_sim(&y));
+        for i in 0..11 {
+            assert!(
+                (back[i] - y[i]).abs() < 1e-15,
+                "{i}: {} vs {}",
+                back[i],
+                y[i]
+            );
+        }
+        // W sends catflip's up (x) to the simulators' z
+        let s = to_sim(&[1.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]);
+        let w = crate::model::so3::quat_from(&[s[0], s[1], s[2], s[3]]);
+        let up = w * nalgebra::Vector3::x();
+        assert!((up - nalgebra::Vector3::z()).norm() < 1e-15);
+    }
+}
