@@ -114,6 +114,39 @@ enum Command {
         #[arg(long, default_value_t = catflip::size::SizeSettings::default().gear_evaluations)]
         gear_evaluations: usize,
     },
+    /// Recovery map: from which spins and tilts at release the body, its motors and its height still land belly-down.
+    Recovery {
+        #[command(flatten)]
+        common: Common,
+        /// Axis angles per plane, evenly over the turn (1 to 24; default 4).
+        #[arg(long)]
+        axes: Option<usize>,
+        /// Spin magnitudes per axis after zero (1 to 20; default 2).
+        #[arg(long)]
+        spins: Option<usize>,
+        /// Largest spin of the grid, rad/s (0 to 50; default 1).
+        #[arg(long = "max-spin", value_name = "W")]
+        max_spin: Option<f64>,
+        /// Tilt angles per axis after zero, 0 for none (0 to 20; default 2).
+        #[arg(long)]
+        tilts: Option<usize>,
+        /// Largest tilt of the grid, degrees (0 to 180; default 30).
+        #[arg(long = "max-tilt", value_name = "DEG")]
+        max_tilt: Option<f64>,
+        /// Bisection steps of the largest recoverable spin per axis (0 to 12; default 3).
+        #[arg(long)]
+        bisect: Option<usize>,
+        /// SCP iteration limit of each design of the map (5 to 1000; default 40).
+        #[arg(long = "max-iterations")]
+        max_iterations: Option<usize>,
+        /// Lines designed at once (default: the machine's cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// K/N: only the K-th of N contiguous runs of whole lines; the
+        /// shards' CSVs concatenate into the whole map's.
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+    },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
         #[command(flatten)]
@@ -274,6 +307,30 @@ pub fn run() -> Result<Status> {
                 gear_evaluations,
             },
         ),
+        Command::Recovery {
+            common,
+            axes,
+            spins,
+            max_spin,
+            tilts,
+            max_tilt,
+            bisect,
+            max_iterations,
+            threads,
+            shard,
+        } => {
+            let d = catflip::recovery::Grid::default();
+            let grid = catflip::recovery::Grid {
+                axes: axes.unwrap_or(d.axes),
+                spins: spins.unwrap_or(d.spins),
+                max_spin: max_spin.unwrap_or(d.max_spin),
+                tilts: tilts.unwrap_or(d.tilts),
+                max_tilt_deg: max_tilt.unwrap_or(d.max_tilt_deg),
+                bisect: bisect.unwrap_or(d.bisect),
+                max_iterations: max_iterations.unwrap_or(d.max_iterations),
+            };
+            crate::recovery_cli::cmd_recovery(&common, grid, threads, shard.as_deref())
+        }
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
             common,

@@ -20,6 +20,7 @@ pub mod interrupt;
 pub mod model;
 pub mod output;
 pub mod pipeline;
+pub mod recovery;
 pub mod report;
 pub mod run;
 pub mod size;

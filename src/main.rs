@@ -9,6 +9,7 @@
 //! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
 mod common;
+mod recovery_cli;
 mod robustness;
 mod size_cli;
 

@@ -1,0 +1,245 @@
+//! `catflip recovery`: the command-line face of [`catflip::recovery`].
+
+use crate::common::{Common, Status, load, publisher, say};
+use anyhow::Result;
+use catflip::interrupt::{Outcome, supervise};
+use catflip::output::Output;
+use catflip::recovery::{Bound, Grid, LineResult, figures, shard_lines, to_csv, tolerance_deg};
+use catflip::sweep::resume::SweepStatus;
+use serde::Serialize;
+use std::sync::{Arc, Mutex};
+
+/// The map's JSON summary.
+#[derive(Serialize)]
+struct Summary<'a> {
+    status: SweepStatus,
+    name: &'a str,
+    height_m: f64,
+    landing_tolerance_deg: f64,
+    motors_limited: bool,
+    grid: &'a Grid,
+    /// `K/N`.
+    shard: String,
+    /// Lines of the shard, and those finished.
+    lines: usize,
+    lines_finished: usize,
+    starts: usize,
+    starts_landing: usize,
+    /// The largest recoverable spin per spin axis.
+    bounds: Vec<&'a Bound>,
+    results: &'a [LineResult],
+}
+
+pub fn cmd_recovery(
+    c: &Common,
+    grid: Grid,
+    threads: Option<usize>,
+    shard: Option<&str>,
+) -> Result<Status> {
+    let cfg = load(c)?;
+    grid.validate()?;
+    if threads == Some(0) {
+        return Err(catflip::Error::Usage(
+            "--threads 0: at least one line must be designed at a time; give --threads 1 or more, or leave it out for one per core".into(),
+        )
+        .into());
+    }
+    let shard: catflip::sweep::Shard = match shard {
+        Some(s) => s.parse()?,
+        None => catflip::sweep::Shard::ALL,
+    };
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    let all = grid.lines();
+    let range = shard_lines(shard, all.len());
+    if range.is_empty() {
+        eprintln!(
+            "warning: shard {}/{} holds no lines: the map has {} lines (axes and families); use at most that many shards",
+            shard.index,
+            shard.count,
+            all.len()
+        );
+    }
+    let lines = all[range.clone()].to_vec();
+    let suffix = shard.suffix();
+    let publisher = publisher(c, &cfg, &format!("recovery{suffix}"))?;
+    let quiet = c.json;
+    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let clock = std::time::Instant::now();
+    let store = Arc::new(Mutex::new(vec![None; lines.len()]));
+    let interrupt = catflip::interrupt::Interrupt::catch()?;
+    let work = {
+        let (cfg, grid, store, lines) = (cfg.clone(), grid.clone(), store.clone(), lines.clone());
+        move || -> catflip::Result<()> {
+            if !quiet {
+                eprintln!("  recovery: designing from the start at rest ...");
+            }
+            let origin = catflip::recovery::Origin::new(&cfg, &grid)?;
+            catflip::recovery::compute_into(&origin, &lines, threads, &store, |done, total| {
+                if quiet {
+                    return;
+                }
+                let line = catflip::sweep::progress_line(
+                    "recovery",
+                    done,
+                    total,
+                    clock.elapsed().as_secs_f64(),
+                )
+                .replace(" points", " lines");
+                if live {
+                    eprint!("\r  {line}");
+                } else {
+                    eprintln!("  {line}");
+                }
+            });
+            Ok(())
+        }
+    };
+    let outcome = supervise(&interrupt, work);
+    if !quiet && live {
+        eprintln!();
+    }
+    let interrupted = match outcome {
+        Outcome::Finished(r) => {
+            r?;
+            false
+        }
+        Outcome::Interrupted => true,
+    };
+    let results: Vec<LineResult> = store
+        .lock()
+        .unwrap_or_else(|p| p.into_inner())
+        .clone()
+        .into_iter()
+        .flatten()
+        .collect();
+    let points = || results.iter().flat_map(|l| &l.points);
+    let summary = Summary {
+        status: if interrupted {
+            SweepStatus::Partial
+        } else {
+            SweepStatus::Complete
+        },
+        name: &cfg.name,
+        height_m: cfg.fall.height,
+        landing_tolerance_deg: tolerance_deg(&cfg),
+        motors_limited: cfg.motor().is_limited(),
+        grid: &grid,
+        shard: format!("{}/{}", shard.index, shard.count),
+        lines: lines.len(),
+        lines_finished: results.len(),
+        starts: points().count(),
+        starts_landing: points().filter(|p| p.outcome.lands()).count(),
+        bounds: results.iter().filter_map(|l| l.bound.as_ref()).collect(),
+        results: &results,
+    };
+    let json = serde_json::to_string_pretty(&summary)?;
+    let mut out = Output::default();
+    out.add(
+        format!("recovery{suffix}.csv"),
+        to_csv(&results, range.start == 0),
+    );
+    out.add(format!("recovery{suffix}.json"), json.clone());
+    let figs = figures(&results, &grid)?;
+    let names: Vec<String> = figs.iter().map(|f| f.0.clone()).collect();
+    for (name, svg) in figs {
+        out.add(name, svg);
+    }
+    out.add("index.html", report(&cfg, &summary, &names));
+    if interrupted {
+        let dir = publisher.link();
+        publisher.publish(out)?;
+        if c.json {
+            say!("{json}");
+        }
+        eprintln!(
+            "interrupted: {} of {} lines finished, published as a partial set in {} (its JSON says \"status\": \"partial\"); exit status 130",
+            results.len(),
+            lines.len(),
+            dir.display()
+        );
+        return Ok(Status::Interrupted);
+    }
+    let written = publisher.publish(out)?;
+    if c.json {
+        say!("{json}");
+        return Ok(Status::Ok);
+    }
+    say!(
+        "catflip recovery: {} from {} m, {} of {} starts land within {:.4} deg of belly-down ({:.1} s)",
+        cfg.name,
+        cfg.fall.height,
+        summary.starts_landing,
+        summary.starts,
+        summary.landing_tolerance_deg,
+        clock.elapsed().as_secs_f64()
+    );
+    say!(
+        "  {:>5} {:>9} {:>24}",
+        "plane",
+        "axis deg",
+        "largest spin rad/s"
+    );
+    for b in &summary.bounds {
+        say!(
+            "  {:>5} {:>9.1} {:>24}",
+            b.plane.name(),
+            b.axis_deg,
+            bound_text(b)
+        );
+    }
+    for p in written {
+        say!("  wrote {}", p.display());
+    }
+    Ok(Status::Ok)
+}
+
+fn bound_text(b: &Bound) -> String {
+    match b.first_miss_rad_s {
+        None => format!(">= {:.4}", b.largest_spin_rad_s),
+        Some(m) => format!("{:.4} (misses at {:.4})", b.largest_spin_rad_s, m),
+    }
+}
+
+/// The set's report: the bounds, the counts, and the figures linked.
+fn report(cfg: &catflip::Config, s: &Summary, figures: &[String]) -> String {
+    let rows: Vec<Vec<String>> = s
+        .bounds
+        .iter()
+        .map(|b| {
+            vec![
+                b.plane.name().to_string(),
+                format!("{:.1}", b.axis_deg),
+                bound_text(b),
+            ]
+        })
+        .collect();
+    let notes = vec![format!(
+        "{} of {} starts land within {:.4} deg of belly-down from {} m (recovery{}.csv has every start; {} lines of {}).",
+        s.starts_landing,
+        s.starts,
+        s.landing_tolerance_deg,
+        cfg.fall.height,
+        if s.shard == "1/1" {
+            String::new()
+        } else {
+            format!(" shard {}", s.shard)
+        },
+        s.lines_finished,
+        s.lines
+    )];
+    let figs: Vec<&str> = figures.iter().map(String::as_str).collect();
+    catflip::report::index_html(&catflip::report::Page {
+        title: &format!("Recovery map: {}", cfg.name),
+        lead: None,
+        header: &["plane", "axis deg", "largest recoverable spin rad/s"],
+        rows: &rows,
+        notes: &notes,
+        warnings: &[],
+        animation: "",
+        figures: &figs,
+    })
+}

@@ -1,0 +1,177 @@
+//! Recovery maps (`catflip recovery`): the start at rest lands, a spin
+//! about the spine the design handles is recoverable, the map is symmetric
+//! where the body is, shards concatenate to the whole map, the figures are SVG.
+
+mod util;
+
+use catflip::recovery::{Family, Grid, LineResult, Outcome, map};
+use catflip::sweep::Shard;
+
+/// Spins about the spine alone: the y-z plane at 0 and 180 deg (`+z`, `-z`).
+fn spine_grid(max_spin: f64) -> Grid {
+    Grid {
+        axes: 2,
+        spins: 1,
+        max_spin,
+        tilts: 0,
+        bisect: 0,
+        ..Default::default()
+    }
+}
+
+fn spine_map() -> Vec<LineResult> {
+    let lines = map(&util::seed(&[]), &spine_grid(0.5), 2, Shard::ALL).expect("a map");
+    assert_eq!(lines.len(), 2);
+    assert_eq!(lines[0].line.axis(), [0.0, 0.0, 1.0]);
+    assert_eq!(lines[1].line.axis(), [0.0, 0.0, -1.0]);
+    lines
+}
+
+#[test]
+fn the_start_at_rest_lands_and_a_spin_about_the_spine_is_recoverable() {
+    let lines = spine_map();
+    for l in &lines {
+        let zero = &l.points[0];
+        assert_eq!((zero.family, zero.magnitude), (Family::Spin, 0.0));
+        assert_eq!(zero.outcome, Outcome::Lands);
+        assert!(zero.landing_error_deg < 1e-4, "{}", zero.landing_error_deg);
+        // the schedule made for the start at rest lands from it too
+        assert!(
+            zero.open_loop_error_deg < 1e-3,
+            "{}",
+            zero.open_loop_error_deg
+        );
+        let spun = &l.points[1];
+        assert_eq!(spun.magnitude, 0.5);
+        assert_eq!(spun.outcome, Outcome::Lands, "{spun:?}");
+        assert!(spun.landing_error_deg < 1e-3, "{spun:?}");
+        // while the open-loop schedule misses by degrees (issue 26's table: 25 deg)
+        assert!(spun.open_loop_error_deg > 5.0, "{spun:?}");
+        let b = l.bound.as_ref().expect("a spin line has its bound");
+        assert!(b.at_least() && b.largest_spin_rad_s == 0.5, "{b:?}");
+    }
+}
+
+/// The seed's halves are alike and the landing set is symmetric: a spin of
+/// -w about the spine lands as +w does, and the schedule made for the start
+/// at rest misses from both by the same angle (the spin's extra turn about
+/// the spine, one way or the other).
+#[test]
+fn a_spin_of_minus_w_about_the_spine_maps_as_plus_w() {
+    let lines = spine_map();
+    let (p, m) = (&lines[0].points[1], &lines[1].points[1]);
+    assert_eq!(p.outcome, m.outcome);
+    assert!((p.landing_error_deg - m.landing_error_deg).abs() < 1e-3);
+    let rel = (p.open_loop_error_deg - m.open_loop_error_deg).abs() / p.open_loop_error_deg;
+    assert!(
+        rel < SYMMETRY_TOLERANCE,
+        "{} against {}",
+        p.open_loop_error_deg,
+        m.open_loop_error_deg
+    );
+}
+
+/// Relative: the replays integrate to rtol 1e-10; on the seed they agree to 2e-7.
+const SYMMETRY_TOLERANCE: f64 = 1e-5;
+
+fn recovery(dir: &std::path::Path, extra: &[&str]) -> (Option<i32>, String, String) {
+    let seed = util::seed_toml();
+    let mut args = vec![
+        "recovery",
+        seed.to_str().unwrap(),
+        "--axes",
+        "2",
+        "--spins",
+        "1",
+        "--max-spin",
+        "0.3",
+        "--tilts",
+        "1",
+        "--max-tilt",
+        "10",
+        "--bisect",
+        "0",
+        "--threads",
+        "2",
+        "--out",
+        "out",
+    ];
+    args.extend_from_slice(extra);
+    util::run(&args, dir)
+}
+
+#[test]
+fn shards_concatenate_to_the_whole_map_and_the_figures_are_svg() {
+    let dir = util::temp_dir();
+    let (code, out, err) = recovery(dir.path(), &[]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    let set = dir.path().join("out/seed/recovery");
+    let whole = std::fs::read_to_string(set.join("recovery.csv")).unwrap();
+    // two spin lines and two tilt lines, two starts each, and the header
+    assert_eq!(whole.lines().count(), 9, "{whole}");
+    let mut joined = String::new();
+    for k in 1..=3 {
+        let shard = format!("{k}/3");
+        let (code, out, err) = recovery(dir.path(), &["--shard", &shard]);
+        assert_eq!(code, Some(0), "{shard}: {out}{err}");
+        let f = dir
+            .path()
+            .join(format!("out/seed/recovery.shard-{k}-of-3"))
+            .join(format!("recovery.shard-{k}-of-3.csv"));
+        joined.push_str(&std::fs::read_to_string(f).unwrap());
+    }
+    assert_eq!(joined, whole);
+    let html = std::fs::read_to_string(set.join("index.html")).unwrap();
+    for f in [
+        "recovery-spin.svg",
+        "recovery-landing-spin.svg",
+        "recovery-landing-tilt.svg",
+    ] {
+        assert!(html.contains(&format!("src=\"{f}\"")), "{f} not linked");
+        let svg = std::fs::read_to_string(set.join(f)).unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{f}: {e}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg", "{f}");
+        assert!(
+            svg.contains("<polyline") || svg.contains("<path"),
+            "{f} draws nothing"
+        );
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(set.join("recovery.json")).unwrap()).unwrap();
+    assert_eq!(json["status"], "complete");
+    assert_eq!(json["starts"], 8);
+    assert_eq!(json["bounds"].as_array().unwrap().len(), 2);
+}
+
+#[test]
+fn grid_sizes_out_of_range_are_refused_with_the_flag_and_range_and_nothing_written() {
+    for (flag, value, range) in [
+        ("--axes", "0", "[1, 24]"),
+        ("--axes", "25", "[1, 24]"),
+        ("--spins", "21", "[1, 20]"),
+        ("--max-spin", "0", "(0, 50]"),
+        ("--max-spin", "51", "(0, 50]"),
+        ("--tilts", "21", "[0, 20]"),
+        ("--max-tilt", "181", "(0, 180]"),
+        ("--bisect", "13", "[0, 12]"),
+        ("--max-iterations", "4", "[5, 1000]"),
+    ] {
+        let dir = util::temp_dir();
+        let seed = util::seed_toml();
+        let args = [
+            "recovery",
+            seed.to_str().unwrap(),
+            flag,
+            value,
+            "--out",
+            "out",
+        ];
+        let (code, _, err) = util::run(&args, dir.path());
+        assert_eq!(code, Some(2), "{flag} {value}: {err}");
+        assert!(err.contains(flag) && err.contains(range), "{err}");
+        assert!(
+            !dir.path().join("out").exists(),
+            "{flag} {value} wrote files"
+        );
+    }
+}
