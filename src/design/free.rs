@@ -4,9 +4,10 @@
 //! Decision variables: `q, dq/ds, d2q/ds2` at `N` nodes in each of the three
 //! phases (normalised time `s`) and the three phase durations
 //! ([`Transcription`], first-order-hold acceleration). Objective
-//! (`design.objective`): the peak joint torque at the nodes and interval
-//! midpoints, `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact inverse
-//! dynamics in normalised time (F3); the manoeuvre time (sum of the
+//! (`design.objective`): the peak joint torque at the check points (each
+//! node and the quarter points of each interval, [`CHECKS_PER_INTERVAL`]),
+//! `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact inverse dynamics
+//! in normalised time (F3); the manoeuvre time (sum of the
 //! durations); or the energy `integral |tau|^2 dt` (Simpson weights). Exact
 //! constraints (linear rows and cones of the subproblem): straight and at rest
 //! at both ends, continuity of `q` across phases, the collocation defects
@@ -27,7 +28,9 @@
 //! From a seed, a peak-torque design without a torque-speed line or speed
 //! limit is solved on coarser meshes first (a third of the nodes, or half,
 //! and so on while 20 or more remain per phase), loosely, and each starts
-//! the next ([`coarse_start`], mesh continuation).
+//! the next ([`coarse_start`], mesh continuation); the coarsest is also
+//! solved from other analytic schedules ([`other_starts`]) and the lowest
+//! design continued.
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
@@ -339,8 +342,8 @@ impl FreeProblem {
     }
 
     /// Normalised-time state at the torque check points of phase `p`: every
-    /// node and every interval midpoint (the midpoints bound the torque between
-    /// nodes to second order; none [`FreeProblem::at_nodes_only`]), with the interpolation coefficients on
+    /// node and the points between, evenly spaced ([`CHECKS_PER_INTERVAL`];
+    /// none [`FreeProblem::at_nodes_only`]), with the interpolation coefficients on
     /// `(q_k, q^_k, q^^_k, q^^_{k+1})` of interval `k`.
     fn check_points(&self, z: &[f64], p: usize) -> Vec<CheckPoint> {
         let tr = &self.tr;
