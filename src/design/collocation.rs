@@ -202,6 +202,16 @@ impl Transcription {
 pub struct CollocationPlan {
     pub tr: Transcription,
     pub z: Vec<f64>,
+    /// From a start with angular momentum: the attitude along the plan, whose
+    /// momentum enters the feed-forward torque (docs/model.md section 8).
+    pub track: Option<crate::design::release::Track>,
+}
+
+impl CollocationPlan {
+    /// A plan at zero momentum.
+    pub fn new(tr: Transcription, z: Vec<f64>) -> Self {
+        CollocationPlan { tr, z, track: None }
+    }
 }
 
 impl ShapePlan for CollocationPlan {
@@ -227,6 +237,21 @@ impl ShapePlan for CollocationPlan {
             qdd: it.a.map(|x| x / (dur * dur)),
             phase: Phase::ALL[i.min(2)],
         }
+    }
+
+    /// The inverse dynamics along the plan, with the momentum's part
+    /// `g(q, q_dot, lambda)` when the plan starts with angular momentum.
+    fn torque_in(&self, cat: &crate::model::Cat, i: usize, t: f64) -> [f64; 2] {
+        let st = self.state_in(i, t);
+        let tau = crate::model::dynamics::inverse_dynamics(cat, st.q, st.qd, st.qdd);
+        let Some(track) = &self.track else {
+            return tau;
+        };
+        let b = self.phase_bounds();
+        let s = ((t - b[i]) / (b[i + 1] - b[i])).clamp(0.0, 1.0);
+        let lam = track.body_momentum(cat, &self.tr, &self.z, i, s);
+        let g = crate::model::momentum::momentum_torque(cat, st.q, st.qd, lam);
+        [tau[0] + g[0], tau[1] + g[1]]
     }
 }
 
@@ -264,7 +289,7 @@ mod tests {
         let plan = crate::design::analytic::plan(1.0, 3.0, [0.3, 0.5, 0.4]);
         let tr = Transcription::new(3, 7);
         let z = tr.sample(&plan);
-        let cp = CollocationPlan { tr, z };
+        let cp = CollocationPlan::new(tr, z);
         for i in 0..3 {
             let b = plan.phase_bounds();
             // just after node 3, so that the interval starting there is used

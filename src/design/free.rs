@@ -37,6 +37,7 @@ use crate::design::collocation::{CollocationPlan, Transcription};
 use crate::design::conic::{Cone, ConicData, ConicSettings};
 use crate::design::objective::Objective;
 use crate::design::plan::ShapePlan;
+use crate::design::release::Release;
 use crate::design::scp::{
     Certificate, Cost, Executor, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus,
     Triplets, Values, WarmStart,
@@ -95,6 +96,10 @@ pub struct FreeProblem {
     /// ([`CHECKS_PER_INTERVAL`]; one, the node, on a coarse mesh of the
     /// continuation, [`FreeProblem::at_nodes_only`]).
     checks: usize,
+    /// A start other than upside down at rest: the attitude map with
+    /// momentum and the landing set (belly down, heading free) instead of
+    /// the final attitude `Rz(pi)`.
+    pub release: Option<Release>,
 }
 
 /// Torque check points per interval on the design's own mesh: the node and
@@ -176,8 +181,10 @@ impl FreeProblem {
             objective: cfg.design.objective,
             scales,
             second_terms: Default::default(),
+            release: Release::of(cfg, time_unit),
             checks: CHECKS_PER_INTERVAL,
         }
+        .with_checks(CHECKS_PER_INTERVAL)
     }
 
     /// The problem with the torque checked at the nodes only: half the
@@ -220,10 +227,19 @@ impl FreeProblem {
         self.checks * (self.tr.nodes - 1) + 1
     }
 
-    /// Check points per interval ([`CHECKS_PER_INTERVAL`]), at least one.
+    /// Check points per interval ([`CHECKS_PER_INTERVAL`]), at least one;
+    /// at most two from a spinning start, whose momentum the attitude map
+    /// knows at its sub-steps only (nodes and midpoints, [`Release::path`]).
     pub fn with_checks(mut self, checks: usize) -> Self {
-        self.checks = checks.max(1);
+        let most = if self.release.is_some() { 2 } else { usize::MAX };
+        self.checks = checks.clamp(1, most);
         self
+    }
+
+    /// Whether the interval midpoints are check points (for the attitude
+    /// map's momentum at them, [`Release::path`]).
+    fn midpoints(&self) -> bool {
+        self.checks > 1
     }
 
     /// The objective's unit in physical terms: N m (peak), s (time) or
@@ -335,6 +351,17 @@ impl FreeProblem {
         (r, g)
     }
 
+    /// The optimiser's own terminal error, rad: the attitude error's norm,
+    /// or from another start the landing error.
+    pub fn terminal_error(&self, z: &[f64]) -> f64 {
+        match &self.release {
+            Some(rel) => {
+                rel.landing_error(rel.path(&self.cat, &self.tr, z, self.midpoints(), false).end)
+            }
+            None => Self::attitude_error(&self.attitude(z, false).0).norm(),
+        }
+    }
+
     /// Attitude error `log(Rz(pi)' R)`, rad.
     pub fn attitude_error(r: &Matrix3<f64>) -> Vector3<f64> {
         let target = Matrix3::from_diagonal(&Vector3::new(-1.0, -1.0, 1.0));
@@ -407,11 +434,17 @@ impl FreeProblem {
         if want_grad {
             seconds.clear();
         }
+        let mus = self
+            .release
+            .map(|r| r.path(&self.cat, tr, z, self.midpoints(), false).mu);
+        let mut point = 0;
         for p in 0..3 {
             let t = z[tr.duration(p)];
             let (s2, s3) = (1.0 / (t * t * it), -2.0 / (t * t * t * it));
             for ((k, q, v, a, coef), &weight) in self.check_points(z, p).into_iter().zip(&weights) {
-                let rows = if want_grad {
+                let mu = mus.as_ref().map(|m| m[point]);
+                point += 1;
+                let mut rows = if want_grad {
                     // normalised-time inverse dynamics; physical torque = tau^ / T^2
                     let terms = ShapeTerms::second(&self.cat, q);
                     seconds.push((q, terms));
@@ -439,6 +472,27 @@ impl FreeProblem {
                         grad: [0.0; 9],
                     })
                 };
+                if let Some(mu) = mu {
+                    // the momentum's part g(q, q^, mu), mu = T_p R' l: exact in
+                    // the local shape and the duration, lagged in the attitude
+                    let (g, dg) = Release::torque(&self.cat, q, v, mu);
+                    let dmu = want_grad.then(|| Release::torque_dmu(&self.cat, q, v, mu));
+                    for i in 0..2 {
+                        let row = &mut rows[i];
+                        if let Some(dmu) = dmu {
+                            for l in 0..2 {
+                                for idx in 0..4 {
+                                    row.grad[4 * l + idx] += (dg[i][l] * coef[0][idx]
+                                        + dg[i][2 + l] * coef[1][idx])
+                                        * s2;
+                                }
+                            }
+                            let along: f64 = (0..3).map(|c| dmu[i][c] * mu[c] / t).sum();
+                            row.grad[8] += g[i] * s3 + along * s2;
+                        }
+                        row.value += g[i] * s2;
+                    }
+                }
                 out.push(TorquePoint {
                     phase: p,
                     interval: k,
@@ -771,8 +825,16 @@ impl ScpProblem for FreeProblem {
 
     fn evaluate(&self, z: &[f64]) -> Values {
         let mut r = self.rate_continuity(z, 0, None);
-        let (rf, _) = self.attitude(z, false);
-        r.extend(Self::attitude_error(&rf).iter());
+        match &self.release {
+            Some(rel) => {
+                let end = rel.path(&self.cat, &self.tr, z, self.midpoints(), false).end;
+                r.extend(rel.landing(end).0);
+            }
+            None => {
+                let (rf, _) = self.attitude(z, false);
+                r.extend(Self::attitude_error(&rf).iter());
+            }
+        }
         let (terms, limited) = self.terms_of(&self.torque_points(z, false));
         Values {
             terms: terms.iter().map(|t| t.value).collect(),
@@ -784,15 +846,29 @@ impl ScpProblem for FreeProblem {
     fn linearize(&self, z: &[f64]) -> Linearization {
         let mut rj: Triplets = Vec::new();
         let mut residual = self.rate_continuity(z, 0, Some(&mut rj));
-        let (rf, g) = self.attitude(z, true);
-        let e = Self::attitude_error(&rf);
-        let je = right_jacobian_inv(&e) * rf.transpose();
         let row0 = residual.len();
-        residual.extend(e.iter());
-        for (col, gc) in g.iter().enumerate() {
-            let d = je * gc;
-            for i in 0..3 {
-                rj.push((row0 + i, col, d[i]));
+        if let Some(rel) = &self.release {
+            let path = rel.path(&self.cat, &self.tr, z, self.midpoints(), true);
+            let (e, de) = rel.landing(path.end);
+            residual.extend(e);
+            for (col, sc) in path.end_jac.iter().enumerate() {
+                for i in 0..2 {
+                    let d: f64 = (0..4).map(|c| de[i][c] * sc[c]).sum();
+                    if d != 0.0 {
+                        rj.push((row0 + i, col, d));
+                    }
+                }
+            }
+        } else {
+            let (rf, g) = self.attitude(z, true);
+            let e = Self::attitude_error(&rf);
+            let je = right_jacobian_inv(&e) * rf.transpose();
+            residual.extend(e.iter());
+            for (col, gc) in g.iter().enumerate() {
+                let d = je * gc;
+                for i in 0..3 {
+                    rj.push((row0 + i, col, d[i]));
+                }
             }
         }
         let pts = self.torque_points(z, true);
@@ -966,6 +1042,8 @@ pub struct FreeResult {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (dynamic sim), deg.
+    pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
     /// From the kinematic simulation of the planned shape.
@@ -1412,13 +1490,21 @@ fn design(
     res.objective *= unit;
     let node_peak = crate::design::scp::peak_of(&problem.torques(&res.z), 2, problem.norm)
         * problem.torque_unit;
-    let (rf, _) = problem.attitude(&res.z, false);
-    let attitude_error = FreeProblem::attitude_error(&rf).norm();
+    let attitude_error = problem.terminal_error(&res.z);
     let z_scaled = std::mem::take(&mut res.z);
     res.z = problem.to_physical(&z_scaled);
+    let track = problem.release.map(|r| {
+        crate::design::release::Track::new(
+            r.in_seconds(problem.time_unit),
+            &problem.cat,
+            &tr,
+            &res.z,
+        )
+    });
     let plan = CollocationPlan {
         tr,
         z: res.z.clone(),
+        track,
     };
     Ok(Solved {
         res,
@@ -1458,8 +1544,11 @@ fn inside_envelope(
         }
         let stretch = least_stretch(cfg, &solved.plan, 1.0 - 1.5 * margin);
         let total: f64 = solved.plan.phase_bounds()[3];
-        let room = cfg.design.objective == Objective::Time
-            || total * stretch <= cfg.available_time() * (1.0 + 1e-12);
+        // slowing the same path down keeps its attitude only at zero
+        // momentum (F2; F10): from another start the problem is solved again
+        let room = (cfg.design.objective == Objective::Time
+            || total * stretch <= cfg.available_time() * (1.0 + 1e-12))
+            && cfg.start.is_default();
         if room {
             for p in 0..3 {
                 let i = tr.duration(p);
@@ -1545,11 +1634,11 @@ fn optimize_start(
     let start = std::time::Instant::now();
     let solved = design(cfg, z0, warm, nodes, Mesh::Final, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
-        return Err(infeasible(cfg, solved.node_peak));
+        return Err(infeasible(cfg, &solved));
     }
     let solved = inside_envelope(cfg, solved, nodes, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
-        return Err(infeasible(cfg, solved.node_peak));
+        return Err(infeasible(cfg, &solved));
     }
     let Solved {
         res,
@@ -1595,6 +1684,7 @@ fn optimize_start(
         flip_deg: sim.flip_deg,
         flip_error_rad: sim.flip_error_rad,
         tilt_deg: sim.tilt_deg,
+        landing_error_deg: sim.landing_error_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
         kinematic_flip_error_rad: kin.flip_error_rad,
@@ -1623,7 +1713,18 @@ fn optimize_start(
 /// The error when the SCP cannot meet the motor limits in the fall: with a
 /// torque limit alone, F7's least height for the design's peak; otherwise
 /// the pointer to the `time` objective.
-fn infeasible(cfg: &Config, node_peak: f64) -> crate::error::Error {
+fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
+    let node_peak = solved.node_peak;
+    if !cfg.start.is_default() && solved.attitude_error > cfg.free.attitude_tolerance.max(1e-6) {
+        // the landing, not the motors: what the optimiser could not undo
+        return crate::error::Error::Unreachable {
+            reason: format!(
+                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), and an end-over-end spin keeps tumbling the spine; try a start closer to upside down at rest, a higher fall.height, or the universal joint",
+                cfg.fall.height,
+                solved.attitude_error.to_degrees()
+            ),
+        };
+    }
     let motor = cfg.motor();
     if motor.no_load_speed.is_none()
         && motor.max_speed.is_none()

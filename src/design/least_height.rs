@@ -136,6 +136,11 @@ pub fn heights(
         }
     }
     if let Some(fr) = &fastest {
+        if !cfg.start.is_default() {
+            // the phased design is made for the start at rest: from another
+            // start it only seeds the free-form one, which answers
+            answer.least_time_s = f64::INFINITY;
+        }
         answer.improve_with(cfg, fr);
     }
     Ok(Some(Heights {
@@ -163,9 +168,17 @@ pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
             max_speed_rad_s: Some(usage.max_speed_rad_s),
             envelope_margin: usage.min_margin,
         },
-        &Simulated::Flip {
-            flip_error_rad: fr.flip_error_rad,
-            tilt_deg: fr.tilt_deg,
+        &if cfg.start.is_default() {
+            Simulated::Flip {
+                flip_error_rad: fr.flip_error_rad,
+                tilt_deg: fr.tilt_deg,
+            }
+        } else {
+            Simulated::Landing {
+                flip_error_rad: fr.flip_error_rad,
+                tilt_deg: fr.tilt_deg,
+                landing_error_deg: fr.landing_error_deg,
+            }
         },
     );
     fr.certificate.constraint_violation <= cfg.free.attitude_tolerance

@@ -13,6 +13,7 @@ pub mod objective;
 pub mod path;
 pub mod phased;
 pub mod plan;
+pub mod release;
 pub mod scp;
 pub mod timing;
 pub mod twist;

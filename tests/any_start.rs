@@ -1,0 +1,110 @@
+//! Free-form designs from starts other than upside down at rest (MODEL.md
+//! section 6): checked against catflip's independent simulators, which
+//! integrate the attitude and momentum with their own adaptive method.
+
+mod util;
+
+use catflip::design::free::{FreeDesign, FreeResult};
+use catflip::design::plan::ShapePlan;
+use catflip::design::scp::ScpStatus;
+use catflip::verify::ode::OdeSettings;
+use catflip::verify::simulate::{Controller, dynamic_landing, kinematic_from};
+
+fn tight() -> OdeSettings {
+    OdeSettings {
+        rtol: 1e-11,
+        atol: 1e-13,
+        ..Default::default()
+    }
+}
+
+fn design(sets: &[&str]) -> (catflip::Config, FreeResult) {
+    let cfg = util::seed(sets);
+    let r = FreeDesign::new(&cfg)
+        .solve()
+        .expect("a design from this start");
+    (cfg, r)
+}
+
+/// The design lands belly-down by its own map, by a kinematic replay of its
+/// shape path from the start, and by the dynamic simulation of its torque
+/// with feed-forward alone (no PD): the feed-forward carries the momentum.
+fn lands(sets: &[&str]) {
+    let (cfg, r) = design(sets);
+    assert_eq!(r.status, ScpStatus::Converged, "{sets:?}");
+    assert!(
+        r.attitude_error_rad < 1e-6,
+        "{sets:?}: own map {}",
+        r.attitude_error_rad
+    );
+    let cat = cfg.cat();
+    let start = cfg.start.start();
+    let mut kin = kinematic_from(&cat, &r.plan, &start, &tight()).unwrap();
+    kin.land(&cat, cfg.fall.margin);
+    assert!(
+        kin.landing_error_deg < 1e-4,
+        "{sets:?}: kinematic replay lands {} deg off",
+        kin.landing_error_deg
+    );
+    let mut ff = Controller::from_config(&cfg);
+    (ff.kp, ff.kd) = (0.0, 0.0);
+    let dyn_ff = dynamic_landing(&cat, &r.plan, &ff, &tight(), &start, cfg.fall.margin).unwrap();
+    assert!(
+        dyn_ff.landing_error_deg < 1e-3,
+        "{sets:?}: feed-forward alone lands {} deg off",
+        dyn_ff.landing_error_deg
+    );
+    // and today's schedule, made for the start at rest, does not
+    let today = FreeDesign::new(&util::seed(&[])).solve().unwrap();
+    let mut off = kinematic_from(&cat, &today.plan, &start, &tight()).unwrap();
+    off.land(&cat, cfg.fall.margin);
+    assert!(
+        off.landing_error_deg > 5.0,
+        "{sets:?}: {}",
+        off.landing_error_deg
+    );
+    assert!(r.plan.duration() <= cfg.available_time() * (1.0 + 1e-9));
+}
+
+#[test]
+fn a_design_from_a_spin_about_the_spine_lands_belly_down() {
+    lands(&["start.angular_velocity=[0, 0, 0.5]"]);
+}
+
+#[test]
+fn a_design_from_a_roll_tilt_lands_belly_down() {
+    lands(&["start.rotation_deg=[0, 0, 30]"]);
+}
+
+#[test]
+fn a_design_from_a_spin_and_a_roll_tilt_together_lands_belly_down() {
+    lands(&[
+        "start.angular_velocity=[0, 0, -0.3]",
+        "start.rotation_deg=[0, 0, -20]",
+    ]);
+}
+
+/// At zero momentum a no-twist cat cannot tilt its spine (F1), so a pitched
+/// start cannot land belly-down: an answer naming the start, not a motor
+/// failure.
+#[test]
+fn a_pitched_start_is_answered_as_unlandable() {
+    let cfg = util::seed(&["start.rotation_deg=[0, 5, 0]"]);
+    let e = FreeDesign::new(&cfg)
+        .solve()
+        .expect_err("a pitched no-twist cat")
+        .to_string();
+    assert!(e.contains("cannot land belly-down from this start"), "{e}");
+    assert!(e.contains("start.rotation_deg"), "{e}");
+}
+
+/// The default start keeps today's problem (full attitude `Rz(pi)`), bit for bit.
+#[test]
+fn the_default_start_is_todays_problem() {
+    let a = FreeDesign::new(&util::seed(&[])).solve().unwrap();
+    let b = FreeDesign::new(&util::seed(&["start.rotation_deg=[0, 0, 0]"]))
+        .solve()
+        .unwrap();
+    assert_eq!(a.plan.z, b.plan.z);
+    assert!(a.plan.track.is_none());
+}
