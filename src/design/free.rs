@@ -29,7 +29,7 @@
 //! limit is solved on coarser meshes first (a third of the nodes, or half,
 //! and so on while 20 or more remain per phase), loosely, and each starts
 //! the next ([`coarse_start`], mesh continuation); the coarsest is also
-//! solved from other analytic schedules ([`other_starts`]) and the lowest
+//! solved from the analytic schedule ([`other_starts`]) and the lower
 //! design continued.
 
 use crate::config::Config;
@@ -1375,25 +1375,24 @@ fn coarse_start(
 }
 
 /// The other starts of the coarsest mesh: the configured analytic schedule
-/// (`configured`, unless it is the seed) and two others of its family (bend of 30 and 90 degrees between the
-/// halves, the twist given 70 % of the time), whose designs end in other
-/// local optima of the peak. The seed's per-motor design at 40 nodes per
-/// phase from twelve such schedules (theta 30 to 90 degrees, three splits)
-/// ended between 0.31883 and 0.32372 N m; from the phased seed 0.32435.
-/// The lowest coarse design is continued: the phased seed's design and the
-/// analytic's then share a basin.
+/// (`configured`, unless it is the seed), whose designs end in another
+/// local optimum of the peak than the phased seed's: the seed's per-motor
+/// design ended at 0.3281 N m from the phased seed and 0.3209 from the
+/// analytic one. The lower coarse design is continued, so the two seeds
+/// share a basin. Two more analytic starts (bends of 30 and 90 degrees
+/// between the halves, the twist given 70 % of the time) lowered the seed's
+/// designs further (per motor 0.318833 N m, Euclidean 0.405018, against
+/// 0.319627 and 0.406166 with the analytic start alone) but made them 3
+/// to 4 times slower (`bench_free`: 1.9 to 3.0 s a case instead of 0.5 to
+/// 1.0 s on a loaded machine); from twelve analytic schedules (bends of 30
+/// to 90 degrees, three splits) the 40-node design ended between 0.31883
+/// and 0.32372 N m.
 fn other_starts(cfg: &Config, configured: bool) -> Vec<Config> {
-    let mut out = Vec::new();
     if configured {
-        out.push(cfg.clone());
+        vec![cfg.clone()]
+    } else {
+        Vec::new()
     }
-    for theta in [30.0, 90.0] {
-        let mut c = cfg.clone();
-        c.analytic.theta_deg = theta;
-        c.analytic.split = [0.15, 0.7, 0.15];
-        out.push(c);
-    }
-    out
 }
 
 /// An SCP solution before verification.
