@@ -210,6 +210,12 @@ def parse_args(engine, default_tol):
     p.add_argument("--ff-tol-deg", type=float, default=0.05,
                    help="largest |flip - catflip's flip| of the feed-forward-only replay of an "
                    "optimised, unsaturated schedule, deg (default 0.05)")
+    p.add_argument("--land-tol-deg", type=float, default=None,
+                   help="largest landing error (the belly's angle from straight down) of every replay, "
+                   "feed-forward only and with PD, of the methods in --land-methods: for designs made "
+                   "from the configured start (default: not checked)")
+    p.add_argument("--land-methods", default="free",
+                   help="comma-separated methods whose landing --land-tol-deg checks (default: free)")
     return p.parse_args()
 
 
@@ -244,7 +250,7 @@ def load_summary(out):
     return s
 
 
-def report(engine, summary, results, flip_tol, ff_tol):
+def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_methods=(), land_modes=None):
     """Prints the table; returns the list of failures. `flip_tol` maps a mode to
     the largest |flip - catflip's| allowed, deg; `ff_tol` (or None) bounds the
     feed-forward-only flip of optimised, unsaturated schedules."""
@@ -261,6 +267,10 @@ def report(engine, summary, results, flip_tol, ff_tol):
         print(f"  {name:<9} {mode:<5} {r['flip_deg']:16.9f} {m['flip_deg']:16.9f} {diff:10.2e} "
               f"{r['tilt_deg']:10.2e} {r['landing_deg']:12.6f} {land:12.6f} {ldiff:10.2e} "
               f"{r['shape_error_rad']:13.2e} {r['peak_nm']:10.5f} {m['sim_peak_torque_nm']:11.5f}")
+        if land_tol is not None and name in land_methods and (land_modes is None or mode in land_modes) \
+                and not r["landing_deg"] <= land_tol:
+            fails.append(f"{name}: {mode} replay lands {r['landing_deg']:.3e} deg from belly-down "
+                         f"(> {land_tol:g}, --land-tol-deg)")
         if mode in flip_tol and not abs(ldiff) <= flip_tol[mode]:
             fails.append(f"{name}: {mode} replay lands {ldiff:.3e} deg from catflip's landing (> {flip_tol[mode]:g})")
         # a schedule that asks more than the motors give (a peak over the stall torque, or

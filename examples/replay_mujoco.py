@@ -212,7 +212,8 @@ def main():
             model.opt.timestep = c["dt"]
         for mode in ("ff", "pd"):
             results.append((method, mode, replay(model, c, mode == "pd")))
-    fails += report("MuJoCo", summary, results, {"pd": args.tol_deg}, args.ff_tol_deg)
+    fails += report("MuJoCo", summary, results, {"pd": args.tol_deg}, args.ff_tol_deg,
+                    args.land_tol_deg, args.land_methods.split(","))
     if summary["joint"] == "universal":
         pd_flips = {m: r["flip_deg"] for m, mode, r in results if mode == "pd"}
         fails += check_urdf(out, name, model, controls, pd_flips)

@@ -174,7 +174,9 @@ def main():
                                 quat_conj(pd["attitude"]), half["attitude"]))),
                             peak_nm=2.0 * half["peak_nm"] - pd["peak_nm"])
         results += [(method, "pd", pd), (method, "pd/2", half), (method, "pd-x", extrapolated)]
-    fails = report("pyBullet", summary, results, {"pd-x": args.tol_deg}, None)
+    # pyBullet's landing is checked on its step-error-free extrapolation (pd-x)
+    fails = report("pyBullet", summary, results, {"pd-x": args.tol_deg}, None,
+                   args.land_tol_deg, args.land_methods.split(","), ("pd-x",))
     print("  pd/2 = the same rows with two pyBullet steps each (dt/2); pd-x = 2 pd/2 - pd, the flip and peak\n"
           "  with pyBullet's first-order integration error (2 (pd - pd/2)) removed: that one must agree with catflip.")
     finish(fails)

@@ -1,37 +1,17 @@
-//! Argument parsing into a checked configuration, and the terminal tables.
+//! Arguments parsed into a checked invocation, then each command's call
+//! into the library; the tables and progress lines are the library's
+//! ([`catflip::console`]).
 
+use crate::common::{Common, Status, flag, load, publisher, say, say_lines};
 use anyhow::Result;
-use catflip::Config;
-use catflip::output::{Output, Publisher};
+use catflip::console;
+use catflip::output::{Output, with_verdict};
 use catflip::pipeline::{Design, Method};
-use catflip::sweep::Methods;
-use catflip::verdict;
+use catflip::sweep::{Methods, Shard, SweepSpec};
+use catflip::verdict::{self, Grade};
 use catflip::verify::analyze::{analyze, verify};
-use catflip::verify::simulate::SimReport;
-use clap::{Args, Parser, Subcommand};
+use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};
-
-/// Set once stdout turned out to be a closed pipe: later lines are dropped.
-static STDOUT_GONE: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// `println!` that stops printing, instead of panicking, when stdout is a
-/// closed pipe (`catflip ... --json | head`); the command still finishes
-/// and exits with its own status (3 partial, 4 impossible), which a
-/// `pipefail` script needs.
-macro_rules! say {
-    ($($t:tt)*) => {{
-        use std::io::Write as _;
-        use std::sync::atomic::Ordering;
-        if !STDOUT_GONE.load(Ordering::Relaxed) {
-            if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
-                if e.kind() != std::io::ErrorKind::BrokenPipe {
-                    eprintln!("error: writing to stdout: {e}");
-                }
-                STDOUT_GONE.store(true, Ordering::Relaxed);
-            }
-        }
-    }};
-}
 
 #[derive(Parser)]
 #[command(
@@ -42,23 +22,6 @@ macro_rules! say {
 struct Cli {
     #[command(subcommand)]
     command: Command,
-}
-
-#[derive(Args, Clone)]
-pub(crate) struct Common {
-    /// TOML configuration (see configs/).
-    pub(crate) config: PathBuf,
-    /// Override a config key, e.g. `--set cat.joint=universal` (repeatable).
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    pub(crate) set: Vec<String>,
-    /// Print JSON instead of the table: one object (`sweep`: an array of
-    /// its points; `export` has no table and lists the files it wrote
-    /// either way).
-    #[arg(long)]
-    pub(crate) json: bool,
-    /// Folder that receives `<name>/`.
-    #[arg(long, default_value = "output")]
-    pub(crate) out: PathBuf,
 }
 
 #[derive(Subcommand)]
@@ -81,8 +44,8 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// KEY=FROM:TO:COUNT, e.g. fall.height=0.5:10:40.
-        #[arg(long = "set-range", value_name = "KEY=FROM:TO:COUNT", value_parser = parsed::<catflip::sweep::SweepSpec>)]
-        range: catflip::sweep::SweepSpec,
+        #[arg(long = "set-range", value_name = "KEY=FROM:TO:COUNT", value_parser = parsed::<SweepSpec>)]
+        range: SweepSpec,
         /// Methods to compute, comma separated (default all three).
         #[arg(
             long,
@@ -97,8 +60,8 @@ enum Command {
         /// K/N: compute only the K-th of N disjoint slices of the grid (for a
         /// batch scheduler's job array); the shards' CSVs concatenate into the
         /// whole sweep's.
-        #[arg(long, value_name = "K/N", value_parser = parsed::<catflip::sweep::Shard>)]
-        shard: Option<catflip::sweep::Shard>,
+        #[arg(long, value_name = "K/N", value_parser = parsed::<Shard>)]
+        shard: Option<Shard>,
         /// Continue an interrupted sweep (same range, shard, methods and
         /// config) from the partial set it published.
         #[arg(long)]
@@ -120,18 +83,18 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// Trials (at most 1000000).
-        #[arg(long, default_value_t = 1000)]
+        #[arg(long, default_value_t = 1000, value_parser = trials)]
         trials: usize,
         /// Seed of the study: each trial's draws follow from it and the trial's index.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Trials flown at once (default: the machine's cores).
-        #[arg(long)]
-        threads: Option<usize>,
+        /// Trials flown at once, at least 1 (default: the machine's cores).
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        threads: Option<u32>,
         /// K/N: fly only the K-th of N contiguous slices of the trials; the
         /// shards' CSVs concatenate into the whole study's.
-        #[arg(long, value_name = "K/N")]
-        shard: Option<String>,
+        #[arg(long, value_name = "K/N", value_parser = parsed::<Shard>)]
+        shard: Option<Shard>,
         /// Continue an interrupted study (same trials, seed, shard and
         /// config) from the partial set it published.
         #[arg(long)]
@@ -194,6 +157,29 @@ fn parsed<T: std::str::FromStr<Err = catflip::Error>>(s: &str) -> Result<T, Stri
     s.parse().map_err(|e: catflip::Error| e.to_string())
 }
 
+/// `--trials`: a count in `[1, MAX_TRIALS]`.
+fn trials(s: &str) -> Result<usize, String> {
+    let max = catflip::config::MAX_TRIALS;
+    match s.parse::<usize>() {
+        Ok(n) if (1..=max).contains(&n) => Ok(n),
+        _ => Err(catflip::Error::Invalid {
+            key: "--trials".into(),
+            value: s.into(),
+            expected: format!("must be in [1, {max}]"),
+        }
+        .to_string()),
+    }
+}
+
+/// Threads to use: as asked, else one per core.
+fn threads_or_cores(threads: Option<u32>) -> usize {
+    threads.map(|t| t as usize).unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    })
+}
+
 /// What `optimize` designs: the phased design, or the free-form one from a seed.
 #[derive(Clone, Copy)]
 enum Optimizer {
@@ -215,56 +201,6 @@ impl Optimizer {
     }
 }
 
-/// Loads and checks the config; likely unit slips are warned about on stderr.
-pub(crate) fn load(c: &Common) -> Result<Config> {
-    let cfg = Config::load(&c.config, &c.set)?;
-    for s in cfg.slips() {
-        eprintln!("warning: {s}");
-    }
-    Ok(cfg)
-}
-
-fn out_dir(c: &Common, cfg: &Config) -> PathBuf {
-    c.out.join(&cfg.name)
-}
-
-/// Starts the command's output set `<out>/<name>/<set>` before any work, so
-/// that an unwritable `--out` fails at once. With `--set` overrides the set
-/// is named after them too ([`catflip::output::set_name`]).
-pub(crate) fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
-    Ok(Publisher::begin(
-        &out_dir(c, cfg),
-        &catflip::output::set_name(set, &c.set),
-    )?)
-}
-
-/// How a command that finished ended: the exit status tells them apart.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Status {
-    /// Every result meets its targets (exit 0).
-    Ok,
-    /// Results were written, but some are flagged or failed (exit 3).
-    Partial,
-    /// The motors cannot flip the cat from the configured height; the least
-    /// height and its schedule were written (exit 4).
-    Impossible,
-    /// A signal stopped the command; what it finished was published as a
-    /// partial set (exit 130).
-    Interrupted,
-}
-
-fn status_of(partial: bool) -> Status {
-    if partial { Status::Partial } else { Status::Ok }
-}
-
-/// Prints a flagged verdict on stderr and says whether there was one.
-fn flag(what: &str, reason: Option<String>) -> bool {
-    if let Some(r) = &reason {
-        eprintln!("warning: {what} is FLAGGED: {r}");
-    }
-    reason.is_some()
-}
-
 pub fn run() -> Result<Status> {
     let cli = Cli::parse();
     match cli.command {
@@ -284,8 +220,8 @@ pub fn run() -> Result<Status> {
                 phased: methods.contains(&MethodArg::Phased),
                 free: methods.contains(&MethodArg::Free),
             },
-            threads.map(|t| t as usize),
-            shard.unwrap_or(catflip::sweep::Shard::ALL),
+            threads_or_cores(threads),
+            shard.unwrap_or(Shard::ALL),
             resume,
         ),
         Command::Export {
@@ -303,11 +239,13 @@ pub fn run() -> Result<Status> {
             resume,
         } => crate::robustness::cmd_robustness(
             &common,
-            trials,
-            seed,
-            threads,
-            shard.as_deref(),
-            resume,
+            crate::robustness::StudyArgs {
+                trials,
+                seed,
+                threads: threads_or_cores(threads),
+                shard: shard.unwrap_or(Shard::ALL),
+                resume,
+            },
         ),
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -319,15 +257,6 @@ pub fn run() -> Result<Status> {
     }
 }
 
-/// A number that may be absent, to `digits` decimals, else `-`.
-fn maybe(x: Option<f64>, digits: usize) -> String {
-    x.map_or_else(|| "-".into(), |v| format!("{v:.digits$}"))
-}
-
-fn row(label: &str, value: String) {
-    say!("  {label:<34} {value}");
-}
-
 fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "analyze")?;
@@ -336,10 +265,7 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     let reason = verdict.reason();
     let mut v = serde_json::to_value(&a)?;
     catflip::output::ensure_finite(&v, &[])?;
-    v["verdict"] = serde_json::to_value(verdict.grade())?;
-    if let Some(r) = &reason {
-        v["reason"] = r.clone().into();
-    }
+    with_verdict(&mut v, verdict.grade(), reason.clone());
     let json = serde_json::to_string_pretty(&v)?;
     let mut out = Output::default();
     sched.add_to(&mut out, "analytic");
@@ -349,99 +275,10 @@ fn cmd_analyze(c: &Common) -> Result<Status> {
     flag("the seed's schedule", reason);
     if c.json {
         say!("{json}");
-        return Ok(Status::Ok);
-    }
-    let cf = &a.closed;
-    say!("catflip analyze: {} ({} joint)", a.name, a.joint);
-    row(
-        "fall time",
-        format!(
-            "{:.4} s (manoeuvre {:.4} s)",
-            cf.fall_time_s, cf.available_time_s
-        ),
-    );
-    row(
-        "theta / bend",
-        format!("{:.3} / {:.3} deg", cf.theta_deg, cf.bend_deg),
-    );
-    row(
-        "I_t, I_a, I_yy",
-        format!("{:.6}, {:.6}, {:.6} kg m^2", cf.i_t, cf.i_a, cf.i_yy),
-    );
-    row("C", format!("{:.6}", cf.c));
-    row("twist pi/C", format!("{:.6} rad", cf.twist_rad));
-    row(
-        "omega0 (twist phase)",
-        format!("{:.4} rad/s", cf.omega0_rad_s),
-    );
-    row(
-        "one-turn theta (F6)",
-        format!("{:.3} deg", cf.one_turn_theta_deg),
-    );
-    row(
-        "phase durations",
-        format!(
-            "{:.4} / {:.4} / {:.4} s",
-            cf.phase_durations_s[0], cf.phase_durations_s[1], cf.phase_durations_s[2]
-        ),
-    );
-    row(
-        "seed I* estimate (E7)",
-        format!("{:.4} N m", cf.seed_torque_estimate_nm),
-    );
-    row(
-        "true peak torque",
-        format!(
-            "{:.4} N m (fold {:.4}, twist {:.4}, unfold {:.4}; {:.2}x the estimate)",
-            a.peak_torque_nm,
-            a.phase_peak_torque_nm[0],
-            a.phase_peak_torque_nm[1],
-            a.phase_peak_torque_nm[2],
-            a.peak_over_seed_estimate
-        ),
-    );
-    row(
-        "flip (kinematic sim)",
-        format!("{:.9} deg (error {:.2e} rad)", a.flip_deg, a.flip_error_rad),
-    );
-    row("tilt", format!("{:.3e} deg", a.tilt_deg));
-    row(
-        "momentum drift",
-        format!("{:.2e} N m s", a.momentum_drift_nms),
-    );
-    for w in written {
-        row("wrote", w.display().to_string());
+    } else {
+        say_lines(console::design::analysis(&a, &written).lines());
     }
     Ok(Status::Ok)
-}
-
-fn print_sim(title: &str, r: &SimReport) {
-    say!("{title}");
-    row(
-        "flip",
-        format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
-    );
-    row("tilt", format!("{:.3e} deg", r.tilt_deg));
-    row(
-        "final shape / rate error",
-        format!(
-            "{:.2e} rad / {:.2e} rad/s",
-            r.final_shape_error_rad, r.final_rate_error_rad_s
-        ),
-    );
-    row(
-        "max tracking error",
-        format!("{:.2e} rad", r.max_tracking_error_rad),
-    );
-    row(
-        "peak applied torque",
-        format!("{:.4} N m", r.peak_torque_nm),
-    );
-    row(
-        "momentum drift",
-        format!("{:.2e} N m s", r.momentum_drift_nms),
-    );
-    row("accepted steps", format!("{}", r.steps));
 }
 
 /// Reads a schedule file, refusing one far larger than any schedule that
@@ -458,14 +295,19 @@ fn read_bounded(p: &Path) -> std::io::Result<String> {
     std::fs::read_to_string(p)
 }
 
-fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
-    let cfg = load(c)?;
-    let text = match schedule {
+/// The text of `--schedule`, read before any work (bad input: exit 2).
+fn schedule_text(schedule: Option<&Path>) -> Result<Option<String>> {
+    Ok(match schedule {
         Some(p) => Some(read_bounded(p).map_err(|e| {
             catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
         })?),
         None => None,
-    };
+    })
+}
+
+fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
+    let cfg = load(c)?;
+    let text = schedule_text(schedule)?;
     let publisher = publisher(c, &cfg, "simulate")?;
     let (source, report) = match (schedule, text) {
         (Some(p), Some(text)) => {
@@ -478,13 +320,6 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
             ("analytic schedule".to_string(), verify(&cfg, &plan)?)
         }
     };
-    let mut trace = String::from("t_s,flip_rad,tilt_rad,q1_rad,q2_rad,tau1_nm,tau2_nm\n");
-    for p in &report.trace {
-        trace.push_str(&format!(
-            "{:.9},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n",
-            p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
-        ));
-    }
     let reason = verdict::flip_reason(
         report.flip_error_rad,
         report.tilt_deg,
@@ -492,102 +327,22 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     );
     catflip::output::ensure_finite(&serde_json::to_value(&report)?, &[])?;
     let mut out = Output::default();
-    out.add("simulation.csv", trace);
+    out.add("simulation.csv", report.trace_csv());
     let written = publisher.publish(out)?;
     let partial = flag("the simulated schedule", reason.clone());
     if c.json {
         let mut v = serde_json::to_value(&report)?;
         v["source"] = serde_json::Value::String(source);
-        v["verdict"] = (if partial { "flagged" } else { "ok" }).into();
-        if let Some(r) = reason {
-            v["reason"] = r.into();
-        }
+        let grade = if partial { Grade::Flagged } else { Grade::Ok };
+        with_verdict(&mut v, grade, reason);
         say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
-        print_sim(
-            &format!(
-                "catflip simulate: {} ({source}, dynamic, {})",
-                cfg.name,
-                if cfg.simulate.pd {
-                    "feed-forward + PD"
-                } else {
-                    "feed-forward only"
-                }
-            ),
-            &report,
-        );
-        for w in written {
-            row("wrote", w.display().to_string());
-        }
+        let title = console::design::simulation_title(&cfg, &source);
+        let mut t = console::design::simulation(&title, &report);
+        t.wrote(&written);
+        say_lines(t.lines());
     }
-    Ok(status_of(partial))
-}
-
-/// The rows both optimisers print: timing, verification, solve time, files.
-fn design_rows(
-    durations: [f64; 3],
-    sim: (f64, f64, f64, f64),
-    solve: String,
-    written: Vec<PathBuf>,
-) {
-    let d = durations;
-    row(
-        "phase durations",
-        format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
-    );
-    row(
-        "flip (dynamic sim)",
-        format!("{:.6} deg (error {:.2e} rad)", sim.0, sim.1),
-    );
-    row("tilt", format!("{:.3e} deg", sim.2));
-    row("sim peak torque", format!("{:.5} N m", sim.3));
-    row("solve time", solve);
-    for w in written {
-        row("wrote", w.display().to_string());
-    }
-}
-
-/// The name serde gives a unit enum value (`criticality`), for display only.
-fn shown<T: serde::Serialize>(v: &T) -> String {
-    match serde_json::to_value(v) {
-        Ok(serde_json::Value::String(s)) => s,
-        other => format!("{other:?}"),
-    }
-}
-
-/// `--verbose`: one line per SCP iteration, and a line where each mesh
-/// begins (mesh continuation: the trust radius starts again there).
-struct IterationTable {
-    verbose: bool,
-}
-
-impl catflip::design::free::Observer for IterationTable {
-    fn iteration(&mut self, it: &catflip::design::scp::ScpIteration) {
-        if self.verbose {
-            eprintln!(
-                "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
-                it.iteration,
-                it.merit,
-                it.objective,
-                it.infeasibility,
-                it.radius,
-                it.rho,
-                if it.accepted {
-                    "ok"
-                } else if it.tentative {
-                    "try"
-                } else {
-                    "rej"
-                },
-                it.solve_ms
-            );
-        }
-    }
-    fn mesh(&mut self, nodes: usize) {
-        if self.verbose {
-            eprintln!("  -- {nodes} nodes per phase");
-        }
-    }
+    Ok(Status::of(partial))
 }
 
 fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
@@ -600,26 +355,21 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     let design = match optimizer {
         Optimizer::Phased => Design::Phased(catflip::design::phased::optimize(&cfg, |e| {
             if verbose {
-                eprintln!(
-                    "  bend {:8.3} deg   unit peak {:>10} N m s^2   peak {:>9} N m",
-                    e.bend_deg,
-                    maybe(e.unit_peak, 5),
-                    maybe(e.peak_nm, 5)
-                );
+                eprintln!("{}", console::progress::bend_line(e));
             }
         })?),
         Optimizer::Free(seed) => {
             if verbose {
-                let objective = cfg.design.objective.short_name();
                 eprintln!(
-                    "  iter      merit {objective:>10}     infeas     radius        rho  step   ms"
+                    "{}",
+                    console::progress::iteration_header(cfg.design.objective.short_name())
                 );
             }
             Design::Free(
                 catflip::design::free::FreeDesign::new(&cfg)
                     .seed(seed)
                     .check_mesh()
-                    .observe(&mut IterationTable { verbose })
+                    .observe(&mut console::progress::IterationTable { verbose })
                     .solve()?,
             )
         }
@@ -650,10 +400,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             "phase_durations_s",
         ],
     )?;
-    json["verdict"] = serde_json::to_value(judged.verdict.grade())?;
-    if let Some(r) = reason {
-        json["reason"] = r.into();
-    }
+    with_verdict(&mut json, judged.verdict.grade(), reason);
     let json = serde_json::to_string_pretty(&json)?;
     let mut out = Output::default();
     judged.add_files(&mut out);
@@ -661,281 +408,47 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     let written = publisher.publish(out)?;
     if c.json {
         say!("{json}");
-        return Ok(status_of(partial));
+        return Ok(Status::of(partial));
     }
     match &judged.design {
-        Design::Phased(r) => print_phased(&cfg, r, written),
-        Design::Free(r) => print_free(&cfg, r, written),
+        Design::Phased(r) => say_lines(console::design::phased(&cfg, r, &written).lines()),
+        Design::Free(r) => say_lines(console::design::free(&cfg, r, &written).lines()),
         Design::Analytic(_) => {}
     }
-    Ok(status_of(partial))
-}
-
-/// `optimize --mode phased`'s table.
-fn print_phased(cfg: &Config, r: &catflip::design::phased::PhasedResult, written: Vec<PathBuf>) {
-    say!(
-        "catflip optimize --mode phased: {} ({} joint), status {}",
-        cfg.name,
-        cfg.cat.joint.name(),
-        verdict::Status::from(r.status)
-    );
-    row(
-        "peak torque",
-        format!(
-            "{:.5} N m (SOCP bound {})",
-            r.peak_torque_nm,
-            maybe(r.socp_peak_torque_nm, 5)
-        ),
-    );
-    row(
-        "bend / theta",
-        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
-    );
-    row("twist", format!("{:.6} rad", r.twist_rad));
-    row(
-        "seed cosine schedule, same bend",
-        format!(
-            "{:.5} N m ({:.2}x the optimum)",
-            r.analytic_peak_same_bend_nm, r.improvement_factor
-        ),
-    );
-    design_rows(
-        r.phase_durations_s,
-        (
-            r.flip_deg,
-            r.flip_error_rad,
-            r.tilt_deg,
-            r.sim_peak_torque_nm,
-        ),
-        format!(
-            "{:.3} s ({} bend evaluations)",
-            r.solve_time_s,
-            r.evaluations.len()
-        ),
-        written,
-    );
-}
-
-/// `optimize --mode free`'s table.
-fn print_free(cfg: &Config, r: &catflip::design::free::FreeResult, written: Vec<PathBuf>) {
-    say!(
-        "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
-        cfg.name,
-        cfg.cat.joint.name(),
-        verdict::Status::from(r.status),
-        r.seed
-    );
-    row(
-        &format!("objective ({})", r.objective.name()),
-        format!(
-            "{:.6} {} (manoeuvre {:.4} s)",
-            r.objective_value,
-            r.objective.unit(),
-            r.manoeuvre_time_s
-        ),
-    );
-    row(
-        "peak torque",
-        format!(
-            "{:.5} N m (at check points {:.5})",
-            r.peak_torque_nm, r.node_peak_torque_nm
-        ),
-    );
-    row(
-        "largest bend / theta",
-        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
-    );
-    row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
-    let cert = &r.certificate;
-    row(
-        "certificate",
-        format!(
-            "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {})",
-            cert.step,
-            cert.constraint_violation,
-            cert.criticality,
-            shown(&cert.rule)
-        ),
-    );
-    if let Some(m) = &r.mesh_check {
-        row(
-            "mesh check (N vs 2N)",
-            format!(
-                "{:.5} {} at {} nodes per phase ({:+.2} %), {}",
-                m.objective_value,
-                r.objective.unit(),
-                m.nodes,
-                100.0 * m.relative_change,
-                verdict::Status::from(m.status)
-            ),
-        );
-    }
-    design_rows(
-        r.phase_durations_s,
-        (
-            r.flip_deg,
-            r.flip_error_rad,
-            r.tilt_deg,
-            r.sim_peak_torque_nm,
-        ),
-        format!(
-            "{:.3} s ({})",
-            r.solve_time_s,
-            catflip::design::free::iterations_text(&r.mesh_levels)
-        ),
-        written,
-    );
-}
-
-/// Stage lines on stderr; live iteration counters when stderr is a terminal.
-fn progress_display(quiet: bool) -> impl FnMut(catflip::run::Progress) {
-    use catflip::run::Progress;
-    use std::io::{IsTerminal, Write};
-    let live = std::io::stderr().is_terminal() && !quiet;
-    move |p| {
-        if quiet {
-            return;
-        }
-        let mut e = std::io::stderr();
-        match p {
-            Progress::Stage { index, total, name } => {
-                let _ = write!(e, "[{index}/{total}] {name} ...");
-                if live {
-                    let _ = writeln!(e);
-                }
-            }
-            Progress::StageDone { seconds } => {
-                if live {
-                    let _ = write!(e, "\r\x1b[2K");
-                }
-                let _ = writeln!(e, " done in {seconds:.2} s");
-            }
-            Progress::StageFailed { seconds, reason } => {
-                if live {
-                    let _ = write!(e, "\r\x1b[2K");
-                }
-                let _ = writeln!(e, " FAILED after {seconds:.2} s: {reason}");
-            }
-            Progress::StageSkipped { reason } => {
-                if live {
-                    let _ = write!(e, "\r\x1b[2K");
-                }
-                let _ = writeln!(e, " not attempted: {reason}");
-            }
-            Progress::Bend {
-                evaluations,
-                bend_deg,
-                peak_nm,
-            } if live => {
-                let _ = write!(
-                    e,
-                    "\r\x1b[2K      bend evaluation {evaluations:3}: {bend_deg:7.2} deg -> {} N m",
-                    maybe(peak_nm, 5)
-                );
-            }
-            Progress::Scp(it) if live => {
-                let _ = write!(
-                    e,
-                    "\r\x1b[2K      SCP iteration {:3}: peak {:.5} N m, max |r| {:.1e}, radius {:.1e}",
-                    it.iteration, it.objective, it.infeasibility, it.radius
-                );
-            }
-            _ => {}
-        }
-        let _ = e.flush();
-    }
+    Ok(Status::of(partial))
 }
 
 fn cmd_run(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "run")?;
     let dir = publisher.link();
-    let r = catflip::run::run(&cfg, progress_display(c.json))?;
-    let partial = r.is_partial();
-    let status = if r.is_impossible() {
-        Status::Impossible
-    } else {
-        status_of(partial)
-    };
+    let r = catflip::run::run(&cfg, console::progress::stages(c.json))?;
+    let outcome = r.summary.outcome;
     let written = publisher.publish(r.output)?;
     if c.json {
         say!("{}", serde_json::to_string_pretty(&r.summary)?);
-        return Ok(status);
+        return Ok(outcome.into());
     }
-    let s = &r.summary;
-    say!();
-    say!(
-        "catflip run: {} ({} joint, peak norm {})",
-        s.name,
-        s.joint,
-        s.peak_norm.name()
-    );
-    let header = catflip::run::TABLE_HEADER;
-    let rows: Vec<Vec<String>> = s.methods.iter().map(catflip::run::table_row).collect();
-    // the last column (verdict) is left as is: it holds the reasons
-    let widths: Vec<usize> = (0..header.len() - 1)
-        .map(|j| {
-            rows.iter()
-                .map(|r| r[j].len())
-                .chain([header[j].len()])
-                .max()
-                .unwrap()
-        })
-        .collect();
-    let line = |cells: Vec<String>| {
-        let parts: Vec<String> = cells
-            .iter()
-            .enumerate()
-            .map(|(j, c)| match widths.get(j) {
-                Some(w) => format!("{c:>w$}"),
-                None => c.to_string(),
-            })
-            .collect();
-        say!("  {}", parts.join("  "));
-    };
-    line(header.iter().map(|h| h.to_string()).collect());
-    for row in rows {
-        line(row);
+    say_lines(console::run::summary(
+        &r.summary,
+        &dir.join("index.html"),
+        written.len(),
+    ));
+    if let Some(word) = console::run::closing(outcome) {
+        eprintln!("{word}");
     }
-    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
-    say!(
-        "  free-form / phased peak {}, phased / analytic {}; free-form design: {}",
-        show(s.free_over_phased),
-        show(s.phased_over_analytic),
-        catflip::design::free::iterations_text(&s.mesh_levels)
-    );
-    if let Some(a) = &s.answer {
-        say!("  {}", a.sentence());
-    }
-    say!(
-        "  report: {} ({} files)",
-        dir.join("index.html").display(),
-        written.len()
-    );
-    if status == Status::Impossible {
-        eprintln!("the flip is not possible from this height: exit status 4");
-    } else if partial {
-        eprintln!(
-            "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3"
-        );
-    }
-    Ok(status)
+    Ok(outcome.into())
 }
 
 fn cmd_sweep(
     c: &Common,
-    spec: &catflip::sweep::SweepSpec,
+    spec: &SweepSpec,
     m: Methods,
-    threads: Option<usize>,
-    shard: catflip::sweep::Shard,
+    threads: usize,
+    shard: Shard,
     resume: bool,
 ) -> Result<Status> {
     let cfg = load(c)?;
-    let threads = threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
     let quiet = c.json;
     // a file-name-safe key (an unknown key is refused below, but names the staging first)
     let key: String = spec
@@ -952,14 +465,7 @@ fn cmd_sweep(
     let key = format!("{key}{}", shard.suffix());
     if shard.points(spec.count).is_empty() {
         // a job array wider than the grid: legitimate, but worth a word
-        eprintln!(
-            "warning: shard {}/{} holds no points: shards take whole continuation chunks of {} points, and the {} points make {}; use at most that many shards",
-            shard.index,
-            shard.count,
-            catflip::sweep::CHUNK,
-            spec.count,
-            spec.count.div_ceil(catflip::sweep::CHUNK)
-        );
+        eprintln!("{}", console::sweep::empty_shard_warning(shard, spec.count));
     }
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     // a live bar on a terminal, plain lines otherwise
@@ -1018,29 +524,14 @@ fn cmd_sweep(
     }
     let slots = store.lock().unwrap_or_else(|p| p.into_inner()).clone();
     let state = state.with_points(slots);
+    let points = state.finished();
+    let limit = cfg.limits.max_torque;
     if let catflip::interrupt::Outcome::Finished(r) = outcome {
         r?;
     } else {
         // published as a partial set, the unfinished points left running
-        let points = state.finished();
-        let mut out = Output::default();
-        out.add(
-            format!("sweep-{key}.csv"),
-            catflip::sweep::to_csv(&spec.key, &points),
-        );
-        if !points.is_empty() {
-            for (name, svg) in
-                catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)?
-            {
-                out.add(name, svg);
-            }
-        }
-        out.add(
-            catflip::sweep::resume::SweepState::file_name(&key),
-            state.to_json(),
-        );
         let dir = publisher.link();
-        publisher.publish(out)?;
+        publisher.publish(state.output(&key, &spec.key, limit, true)?)?;
         if c.json {
             say!("{}", serde_json::to_string_pretty(&points)?);
         }
@@ -1052,92 +543,29 @@ fn cmd_sweep(
         );
         return Ok(Status::Interrupted);
     }
-    let points = state.finished();
-    let partial = points.iter().any(|p| p.error.is_some());
-    let mut out = Output::default();
-    out.add(
-        format!("sweep-{key}.csv"),
-        catflip::sweep::to_csv(&spec.key, &points),
-    );
-    for (name, svg) in catflip::sweep::figures(&key, &spec.key, &points, cfg.limits.max_torque)? {
-        out.add(name, svg);
-    }
-    out.add(
-        catflip::sweep::resume::SweepState::file_name(&key),
-        state.to_json(),
-    );
-    let written = publisher.publish(out)?;
-    if partial {
-        eprintln!(
-            "warning: partial result: {} of {} points have errors (see the error column); exit status 3",
-            points.iter().filter(|p| p.error.is_some()).count(),
-            points.len()
-        );
+    let written = publisher.publish(state.output(&key, &spec.key, limit, false)?)?;
+    let warning = console::sweep::partial_warning(&points);
+    if let Some(w) = &warning {
+        eprintln!("{w}");
     }
     if c.json {
         say!("{}", serde_json::to_string_pretty(&points)?);
-        return Ok(status_of(partial));
+    } else {
+        say_lines(console::sweep::points(
+            &cfg.name, spec, &points, threads, &written,
+        ));
     }
-    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
-    say!(
-        "catflip sweep: {} over {} ({}, {} at a time)",
-        cfg.name,
-        spec.key,
-        plural(points.len(), "point"),
-        threads
-    );
-    let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
-    // the least drop heights, when a torque limit gives them
-    let heights = points
-        .iter()
-        .any(|p| p.least_height_phased_m.is_some() || p.least_height_free_m.is_some());
-    let mut head = format!(
-        "  {:>12} {:>12} {:>12} {:>12}",
-        spec.key, "analytic N m", "phased N m", "free N m"
-    );
-    if heights {
-        head += &format!(" {:>14} {:>14}", "phased h_min m", "free h_min m");
-    }
-    say!("{head}");
-    for p in &points {
-        let mut line = format!(
-            "  {:>12.5} {:>12} {:>12} {:>12}",
-            p.value,
-            show(p.analytic_peak_nm),
-            show(p.phased_peak_nm),
-            show(p.free_peak_nm),
-        );
-        if heights {
-            line += &format!(
-                " {:>14} {:>14}",
-                show(p.least_height_phased_m),
-                show(p.least_height_free_m)
-            );
-        }
-        if let Some(e) = &p.error {
-            line += &format!("  error: {e}");
-        }
-        say!("{line}");
-    }
-    for w in written {
-        row("wrote", w.display().to_string());
-    }
-    Ok(status_of(partial))
+    Ok(Status::of(warning.is_some()))
 }
 
 fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Result<Status> {
-    use catflip::export::controls::{Controls, Simulator};
+    use catflip::export::controls::Simulator;
     let cfg = load(c)?;
     let set = match format {
         ExportFormat::Urdf => "export-urdf",
         ExportFormat::Mjcf => "export-mjcf",
     };
-    let text = match schedule {
-        Some(p) => Some(read_bounded(p).map_err(|e| {
-            catflip::Error::Usage(format!("cannot read schedule {}: {e}", p.display()))
-        })?),
-        None => None,
-    };
+    let text = schedule_text(schedule)?;
     let publisher = publisher(c, &cfg, set)?;
     let (name, text_model, sim) = match format {
         ExportFormat::Urdf => (
@@ -1160,16 +588,7 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
             .and_then(|s| s.to_str())
             .unwrap_or("schedule")
             .to_string();
-        let controls = Controls::sample(&cfg, &s, sim);
-        out.add(
-            format!("{stem}.{}.csv", sim.name()),
-            controls.to_csv(&cfg, &stem),
-        );
-        // the closed loop's gains along the same schedule (issue 27)
-        out.add(
-            format!("{stem}.tvlqr.csv"),
-            catflip::control::export::gains_csv(&cfg, &s),
-        );
+        catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim);
     }
     for w in publisher.publish(out)? {
         say!("wrote {}", w.display());

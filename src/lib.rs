@@ -7,8 +7,10 @@
 //! - [`report`] and [`export`]: figures and HTML, simulator models and controls.
 //!
 //! [`run`] and [`sweep`] drive the whole pipeline; [`config`] checks the input
-//! and [`output`] writes a command's files all together or not at all.
+//! and [`output`] writes a command's files all together or not at all;
+//! [`table`] and [`console`] word the results for the report and the terminal.
 pub mod config;
+pub mod console;
 pub mod control;
 pub mod design;
 pub mod error;
@@ -21,6 +23,7 @@ pub mod pipeline;
 pub mod report;
 pub mod run;
 pub mod sweep;
+pub mod table;
 pub mod verdict;
 pub mod verify;
 

@@ -7,14 +7,15 @@
 //! (the least drop height and its schedule are written); 130 interrupted
 //! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
+mod common;
 mod robustness;
 
 fn main() -> std::process::ExitCode {
     match cli::run() {
-        Ok(cli::Status::Ok) => std::process::ExitCode::SUCCESS,
-        Ok(cli::Status::Partial) => std::process::ExitCode::from(3),
-        Ok(cli::Status::Impossible) => std::process::ExitCode::from(4),
-        Ok(cli::Status::Interrupted) => {
+        Ok(common::Status::Ok) => std::process::ExitCode::SUCCESS,
+        Ok(common::Status::Partial) => std::process::ExitCode::from(3),
+        Ok(common::Status::Impossible) => std::process::ExitCode::from(4),
+        Ok(common::Status::Interrupted) => {
             std::process::ExitCode::from(catflip::interrupt::EXIT_INTERRUPTED)
         }
         Err(e) => {

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::output::Output;
 use crate::pipeline::{self, Design, Judged, Method};
 use crate::report::{self, MethodTrace};
+use crate::table::{TABLE_HEADER, table_row, track_status};
 use crate::verdict::Grade;
 use crate::verify::analyze::analyze;
 use serde::Serialize;
@@ -445,8 +446,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     // the animation: each simulated method, with its table status and verdict
     for t in &mut tracks {
         if let Some(m) = summary.methods.iter().find(|m| m.method == t.name) {
-            let row = table_row(m);
-            t.status = format!("{}; {}", row[1], row[row.len() - 1]);
+            t.status = track_status(m);
         }
     }
     tracks.retain(|t| t.frames.len() > 1);
@@ -492,6 +492,5 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     })
 }
 
-/// Columns of the comparison table, one line of it (terminal and
-/// index.html) and a method's summary line: see [`crate::pipeline`].
-pub use crate::pipeline::{MethodNumbers, MethodSummary, TABLE_HEADER, table_row};
+/// A method's summary line: see [`crate::pipeline`] (its table: [`crate::table`]).
+pub use crate::pipeline::{MethodNumbers, MethodSummary};

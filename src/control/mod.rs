@@ -8,6 +8,7 @@ pub mod export;
 pub mod figure;
 pub mod plant;
 pub mod reference;
+pub mod resume;
 pub mod rng;
 pub mod robustness;
 pub mod tvlqr;

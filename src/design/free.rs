@@ -1729,9 +1729,14 @@ fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
         // the landing, not the motors: what the optimiser could not undo
         return crate::error::Error::Unreachable {
             reason: format!(
-                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), and an end-over-end spin keeps tumbling the spine; try a start closer to upside down at rest, a higher fall.height, or the universal joint",
+                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height",
                 cfg.fall.height,
-                solved.attitude_error.to_degrees()
+                solved.attitude_error.to_degrees(),
+                if cfg.cat.joint == crate::model::Joint::NoTwist {
+                    "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine). "
+                } else {
+                    ""
+                }
             ),
         };
     }

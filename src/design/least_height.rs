@@ -36,6 +36,11 @@ pub struct HeightAnswer {
     pub status: Status,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
+    /// Whether the answer is a design from the configured start (always at
+    /// the default start). From another start only a free-form design that
+    /// lands answers; without one the numbers are the start at rest's and
+    /// `possible` is false.
+    pub from_start: bool,
     /// The least-height schedule.
     #[serde(skip)]
     pub schedule: Schedule,
@@ -59,6 +64,7 @@ pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
         method: "phased",
         status: r.status.into(),
         flip_error_rad: r.flip_error_rad,
+        from_start: cfg.start.is_default(),
         schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
     }))
 }
@@ -142,6 +148,8 @@ pub fn heights(
             answer.least_time_s = f64::INFINITY;
         }
         answer.improve_with(cfg, fr);
+    } else if !cfg.start.is_default() {
+        answer.possible = false;
     }
     Ok(Some(Heights {
         answer,
@@ -200,6 +208,7 @@ impl HeightAnswer {
         self.method = "free";
         self.status = fr.status.into();
         self.flip_error_rad = fr.flip_error_rad;
+        self.from_start = true;
         self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
     }
 
@@ -213,7 +222,12 @@ impl HeightAnswer {
                 self.method, self.status
             )
         };
-        if self.possible && self.least_height_m > self.height_m {
+        if !self.from_start {
+            format!(
+                "No design found lands belly-down from this start in the fall from {} m (at rest the motors would need {:.3} m).",
+                self.height_m, self.least_height_m
+            )
+        } else if self.possible && self.least_height_m > self.height_m {
             format!(
                 "The flip is possible from {} m: the {} design fits the motors, although the phased least-height design needs {:.3} m.",
                 self.height_m, self.method, self.least_height_m

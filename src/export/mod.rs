@@ -38,3 +38,21 @@ pub fn add_simulator_files(cfg: &Config, out: &mut Output, methods: &[(&str, &dy
         }
     }
 }
+
+/// What `export --schedule` writes beside the model: the schedule's
+/// controls for `sim` at its time step (`<stem>.<sim>.csv`) and the closed
+/// loop's gains along it (`<stem>.tvlqr.csv`).
+pub fn add_schedule_files(
+    cfg: &Config,
+    out: &mut Output,
+    schedule: &crate::design::plan::Schedule,
+    stem: &str,
+    sim: controls::Simulator,
+) {
+    let c = controls::Controls::sample(cfg, schedule, sim);
+    out.add(format!("{stem}.{}.csv", sim.name()), c.to_csv(cfg, stem));
+    out.add(
+        format!("{stem}.tvlqr.csv"),
+        crate::control::export::gains_csv(cfg, schedule),
+    );
+}

@@ -85,6 +85,28 @@ impl SweepState {
         }
     }
 
+    /// The files a sweep publishes: `sweep-<file_key>.csv` of the finished
+    /// points, their figures (left out of an interrupted sweep with none
+    /// finished) and this state; `key` labels the columns and axes.
+    pub fn output(
+        &self,
+        file_key: &str,
+        key: &str,
+        limit: Option<f64>,
+        interrupted: bool,
+    ) -> Result<crate::output::Output> {
+        let points = self.finished();
+        let mut out = crate::output::Output::default();
+        out.add(format!("sweep-{file_key}.csv"), super::to_csv(key, &points));
+        if !(interrupted && points.is_empty()) {
+            for (name, svg) in super::figures(file_key, key, &points, limit)? {
+                out.add(name, svg);
+            }
+        }
+        out.add(Self::file_name(file_key), self.to_json());
+        Ok(out)
+    }
+
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a sweep state serialises")
     }

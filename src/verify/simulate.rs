@@ -82,6 +82,18 @@ impl SimReport {
         self.landing_error_deg = landing_error(&r).to_degrees();
     }
 
+    /// `simulation.csv`: the flown trace, a row per accepted step.
+    pub fn trace_csv(&self) -> String {
+        let mut csv = String::from("t_s,flip_rad,tilt_rad,q1_rad,q2_rad,tau1_nm,tau2_nm\n");
+        for p in &self.trace {
+            csv.push_str(&format!(
+                "{:.9},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e},{:.12e}\n",
+                p.t, p.flip, p.tilt, p.q[0], p.q[1], p.tau[0], p.tau[1]
+            ));
+        }
+        csv
+    }
+
     /// The report of a simulation that failed: every number NaN (null in JSON).
     pub fn failed() -> SimReport {
         SimReport {

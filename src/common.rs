@@ -1,0 +1,114 @@
+//! What every command shares: the config arguments, loading the config,
+//! starting the output set, printing to stdout, and how a command ended.
+
+use anyhow::Result;
+use catflip::Config;
+use catflip::output::Publisher;
+use clap::Args;
+use std::path::PathBuf;
+
+/// Set once stdout turned out to be a closed pipe: later lines are dropped.
+pub(crate) static STDOUT_GONE: std::sync::atomic::AtomicBool =
+    std::sync::atomic::AtomicBool::new(false);
+
+/// `println!` that stops printing, instead of panicking, when stdout is a
+/// closed pipe (`catflip ... --json | head`); the command still finishes
+/// and exits with its own status (3 partial, 4 impossible), which a
+/// `pipefail` script needs.
+macro_rules! say {
+    ($($t:tt)*) => {{
+        use std::io::Write as _;
+        use std::sync::atomic::Ordering;
+        if !$crate::common::STDOUT_GONE.load(Ordering::Relaxed) {
+            if let Err(e) = writeln!(std::io::stdout(), $($t)*) {
+                if e.kind() != std::io::ErrorKind::BrokenPipe {
+                    eprintln!("error: writing to stdout: {e}");
+                }
+                $crate::common::STDOUT_GONE.store(true, Ordering::Relaxed);
+            }
+        }
+    }};
+}
+pub(crate) use say;
+
+/// Prints a table's lines with [`say!`].
+pub(crate) fn say_lines<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) {
+    for l in lines {
+        say!("{}", l.as_ref());
+    }
+}
+
+#[derive(Args, Clone)]
+pub(crate) struct Common {
+    /// TOML configuration (see configs/).
+    pub(crate) config: PathBuf,
+    /// Override a config key, e.g. `--set cat.joint=universal` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub(crate) set: Vec<String>,
+    /// Print JSON instead of the table: one object (`sweep`: an array of
+    /// its points; `export` has no table and lists the files it wrote
+    /// either way).
+    #[arg(long)]
+    pub(crate) json: bool,
+    /// Folder that receives `<name>/`.
+    #[arg(long, default_value = "output")]
+    pub(crate) out: PathBuf,
+}
+
+/// Loads and checks the config; likely unit slips are warned about on stderr.
+pub(crate) fn load(c: &Common) -> Result<Config> {
+    let cfg = Config::load(&c.config, &c.set)?;
+    for s in cfg.slips() {
+        eprintln!("warning: {s}");
+    }
+    Ok(cfg)
+}
+
+/// Starts the command's output set `<out>/<name>/<set>` before any work, so
+/// that an unwritable `--out` fails at once. With `--set` overrides the set
+/// is named after them too ([`catflip::output::set_name`]).
+pub(crate) fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher> {
+    Ok(Publisher::begin(
+        &c.out.join(&cfg.name),
+        &catflip::output::set_name(set, &c.set),
+    )?)
+}
+
+/// How a command that finished ended: the exit status tells them apart.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Status {
+    /// Every result meets its targets (exit 0).
+    Ok,
+    /// Results were written, but some are flagged or failed (exit 3).
+    Partial,
+    /// The motors cannot flip the cat from the configured height; the least
+    /// height and its schedule were written (exit 4).
+    Impossible,
+    /// A signal stopped the command; what it finished was published as a
+    /// partial set (exit 130).
+    Interrupted,
+}
+
+impl Status {
+    pub(crate) fn of(partial: bool) -> Status {
+        if partial { Status::Partial } else { Status::Ok }
+    }
+}
+
+impl From<catflip::run::Outcome> for Status {
+    fn from(o: catflip::run::Outcome) -> Status {
+        match o {
+            catflip::run::Outcome::Ok => Status::Ok,
+            catflip::run::Outcome::Partial => Status::Partial,
+            catflip::run::Outcome::Impossible => Status::Impossible,
+        }
+    }
+}
+
+/// Prints a flagged verdict on stderr and says whether there was one.
+pub(crate) fn flag(what: &str, reason: Option<String>) -> bool {
+    if let Some(r) = &reason {
+        eprintln!("warning: {what} is FLAGGED: {r}");
+    }
+    reason.is_some()
+}

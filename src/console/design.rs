@@ -1,0 +1,270 @@
+//! The tables of the one-design commands: `analyze` (the seed's closed
+//! forms), `simulate` (a schedule flown) and `optimize` (a phased or
+//! free-form design).
+
+use super::Rows;
+use super::table::{maybe, shown};
+use crate::config::Config;
+use crate::design::free::FreeResult;
+use crate::design::phased::PhasedResult;
+use crate::verdict::Status;
+use crate::verify::analyze::Analysis;
+use crate::verify::simulate::SimReport;
+use std::path::PathBuf;
+
+/// `analyze`'s table: the closed forms and the cosine schedule's numbers.
+pub fn analysis(a: &Analysis, written: &[PathBuf]) -> Rows {
+    let cf = &a.closed;
+    let mut t = Rows::titled(format!("catflip analyze: {} ({} joint)", a.name, a.joint));
+    t.row(
+        "fall time",
+        format!(
+            "{:.4} s (manoeuvre {:.4} s)",
+            cf.fall_time_s, cf.available_time_s
+        ),
+    )
+    .row(
+        "theta / bend",
+        format!("{:.3} / {:.3} deg", cf.theta_deg, cf.bend_deg),
+    )
+    .row(
+        "I_t, I_a, I_yy",
+        format!("{:.6}, {:.6}, {:.6} kg m^2", cf.i_t, cf.i_a, cf.i_yy),
+    )
+    .row("C", format!("{:.6}", cf.c))
+    .row("twist pi/C", format!("{:.6} rad", cf.twist_rad))
+    .row(
+        "omega0 (twist phase)",
+        format!("{:.4} rad/s", cf.omega0_rad_s),
+    )
+    .row(
+        "one-turn theta (F6)",
+        format!("{:.3} deg", cf.one_turn_theta_deg),
+    )
+    .row(
+        "phase durations",
+        format!(
+            "{:.4} / {:.4} / {:.4} s",
+            cf.phase_durations_s[0], cf.phase_durations_s[1], cf.phase_durations_s[2]
+        ),
+    )
+    .row(
+        "seed I* estimate (E7)",
+        format!("{:.4} N m", cf.seed_torque_estimate_nm),
+    )
+    .row(
+        "true peak torque",
+        format!(
+            "{:.4} N m (fold {:.4}, twist {:.4}, unfold {:.4}; {:.2}x the estimate)",
+            a.peak_torque_nm,
+            a.phase_peak_torque_nm[0],
+            a.phase_peak_torque_nm[1],
+            a.phase_peak_torque_nm[2],
+            a.peak_over_seed_estimate
+        ),
+    )
+    .row(
+        "flip (kinematic sim)",
+        format!("{:.9} deg (error {:.2e} rad)", a.flip_deg, a.flip_error_rad),
+    )
+    .row("tilt", format!("{:.3e} deg", a.tilt_deg))
+    .row(
+        "momentum drift",
+        format!("{:.2e} N m s", a.momentum_drift_nms),
+    )
+    .wrote(written);
+    t
+}
+
+/// `simulate`'s table: what the flown schedule did.
+pub fn simulation(title: &str, r: &SimReport) -> Rows {
+    let mut t = Rows::titled(title);
+    t.row(
+        "flip",
+        format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
+    )
+    .row("tilt", format!("{:.3e} deg", r.tilt_deg))
+    .row(
+        "final shape / rate error",
+        format!(
+            "{:.2e} rad / {:.2e} rad/s",
+            r.final_shape_error_rad, r.final_rate_error_rad_s
+        ),
+    )
+    .row(
+        "max tracking error",
+        format!("{:.2e} rad", r.max_tracking_error_rad),
+    )
+    .row(
+        "peak applied torque",
+        format!("{:.4} N m", r.peak_torque_nm),
+    )
+    .row(
+        "momentum drift",
+        format!("{:.2e} N m s", r.momentum_drift_nms),
+    )
+    .row("accepted steps", format!("{}", r.steps));
+    t
+}
+
+/// `simulate`'s title: the config, the schedule's source and the controller.
+pub fn simulation_title(cfg: &Config, source: &str) -> String {
+    format!(
+        "catflip simulate: {} ({source}, dynamic, {})",
+        cfg.name,
+        if cfg.simulate.pd {
+            "feed-forward + PD"
+        } else {
+            "feed-forward only"
+        }
+    )
+}
+
+/// The verification numbers of a design, as both optimisers' tables show them.
+pub struct Verified {
+    pub phase_durations_s: [f64; 3],
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    pub sim_peak_torque_nm: f64,
+}
+
+/// The rows both optimisers print: timing, verification, solve time, files.
+fn design_rows(t: &mut Rows, v: &Verified, solve: String, written: &[PathBuf]) {
+    let d = v.phase_durations_s;
+    t.row(
+        "phase durations",
+        format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
+    )
+    .row(
+        "flip (dynamic sim)",
+        format!("{:.6} deg (error {:.2e} rad)", v.flip_deg, v.flip_error_rad),
+    )
+    .row("tilt", format!("{:.3e} deg", v.tilt_deg))
+    .row(
+        "sim peak torque",
+        format!("{:.5} N m", v.sim_peak_torque_nm),
+    )
+    .row("solve time", solve)
+    .wrote(written);
+}
+
+/// `optimize --mode phased`'s table.
+pub fn phased(cfg: &Config, r: &PhasedResult, written: &[PathBuf]) -> Rows {
+    let mut t = Rows::titled(format!(
+        "catflip optimize --mode phased: {} ({} joint), status {}",
+        cfg.name,
+        cfg.cat.joint.name(),
+        Status::from(r.status)
+    ));
+    t.row(
+        "peak torque",
+        format!(
+            "{:.5} N m (SOCP bound {})",
+            r.peak_torque_nm,
+            maybe(r.socp_peak_torque_nm, 5)
+        ),
+    )
+    .row(
+        "bend / theta",
+        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+    )
+    .row("twist", format!("{:.6} rad", r.twist_rad))
+    .row(
+        "seed cosine schedule, same bend",
+        format!(
+            "{:.5} N m ({:.2}x the optimum)",
+            r.analytic_peak_same_bend_nm, r.improvement_factor
+        ),
+    );
+    design_rows(
+        &mut t,
+        &Verified {
+            phase_durations_s: r.phase_durations_s,
+            flip_deg: r.flip_deg,
+            flip_error_rad: r.flip_error_rad,
+            tilt_deg: r.tilt_deg,
+            sim_peak_torque_nm: r.sim_peak_torque_nm,
+        },
+        format!(
+            "{:.3} s ({} bend evaluations)",
+            r.solve_time_s,
+            r.evaluations.len()
+        ),
+        written,
+    );
+    t
+}
+
+/// `optimize --mode free`'s table.
+pub fn free(cfg: &Config, r: &FreeResult, written: &[PathBuf]) -> Rows {
+    let mut t = Rows::titled(format!(
+        "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
+        cfg.name,
+        cfg.cat.joint.name(),
+        Status::from(r.status),
+        r.seed
+    ));
+    t.row(
+        &format!("objective ({})", r.objective.name()),
+        format!(
+            "{:.6} {} (manoeuvre {:.4} s)",
+            r.objective_value,
+            r.objective.unit(),
+            r.manoeuvre_time_s
+        ),
+    )
+    .row(
+        "peak torque",
+        format!(
+            "{:.5} N m (at check points {:.5})",
+            r.peak_torque_nm, r.node_peak_torque_nm
+        ),
+    )
+    .row(
+        "largest bend / theta",
+        format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
+    )
+    .row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+    let cert = &r.certificate;
+    t.row(
+        "certificate",
+        format!(
+            "step {:.2e}, constraint violation {:.2e} rad, criticality {:.2e} (stop: {})",
+            cert.step,
+            cert.constraint_violation,
+            cert.criticality,
+            shown(&cert.rule)
+        ),
+    );
+    if let Some(m) = &r.mesh_check {
+        t.row(
+            "mesh check (N vs 2N)",
+            format!(
+                "{:.5} {} at {} nodes per phase ({:+.2} %), {}",
+                m.objective_value,
+                r.objective.unit(),
+                m.nodes,
+                100.0 * m.relative_change,
+                Status::from(m.status)
+            ),
+        );
+    }
+    design_rows(
+        &mut t,
+        &Verified {
+            phase_durations_s: r.phase_durations_s,
+            flip_deg: r.flip_deg,
+            flip_error_rad: r.flip_error_rad,
+            tilt_deg: r.tilt_deg,
+            sim_peak_torque_nm: r.sim_peak_torque_nm,
+        },
+        format!(
+            "{:.3} s ({})",
+            r.solve_time_s,
+            crate::design::free::iterations_text(&r.mesh_levels)
+        ),
+        written,
+    );
+    t
+}

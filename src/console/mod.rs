@@ -1,0 +1,13 @@
+//! What the terminal shows: each command's result table and the progress
+//! lines of long stages. The functions return the lines; the binary prints
+//! them (and stops printing when stdout is a closed pipe), so the text is
+//! the library's and the same wherever it is shown.
+
+pub mod design;
+pub mod progress;
+pub mod robustness;
+pub mod run;
+pub mod sweep;
+pub mod table;
+
+pub use table::{Columns, Rows};

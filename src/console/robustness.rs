@@ -1,0 +1,53 @@
+//! `robustness`'s table: each controller's success rate, its confidence
+//! interval and landing-error percentiles; and the study's progress bar.
+
+use crate::control::robustness::Summary;
+use std::path::PathBuf;
+
+/// The study's table over `trials` trials `range` of `total`, `seed` its seed.
+pub fn study(
+    summary: &Summary,
+    trials: usize,
+    range: std::ops::Range<usize>,
+    total: usize,
+    seed: u64,
+    written: &[PathBuf],
+) -> Vec<String> {
+    let mut lines = vec![
+        format!(
+            "catflip robustness: {trials} trials {}..{} of {total} (seed {seed}), landing within {} deg of belly-down",
+            range.start, range.end, summary.max_tilt_deg
+        ),
+        format!(
+            "  {:<10} {:>9} {:>17} {:>9} {:>9} {:>9}",
+            "controller", "success", "95 % CI", "p50 deg", "p99 deg", "max deg"
+        ),
+    ];
+    for s in &summary.controllers {
+        lines.push(format!(
+            "  {:<10} {:>8.1}% {:>7.1}%-{:>6.1}% {:>9.3} {:>9.3} {:>9.3}",
+            s.name,
+            100.0 * s.success_rate,
+            100.0 * s.ci95[0],
+            100.0 * s.ci95[1],
+            s.landing_error_deg.p50,
+            s.landing_error_deg.p99,
+            s.landing_error_deg.max
+        ));
+    }
+    for p in written {
+        lines.push(format!("  wrote {}", p.display()));
+    }
+    lines
+}
+
+/// The progress bar after `done` of `total` trials, `seconds` in.
+pub fn progress_line(done: usize, total: usize, seconds: f64) -> String {
+    let w = 30;
+    let filled = w * done / total.max(1);
+    format!(
+        "robustness [{}{}] {done}/{total} trials, {seconds:.1} s",
+        "#".repeat(filled),
+        "-".repeat(w - filled)
+    )
+}

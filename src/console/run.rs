@@ -1,0 +1,43 @@
+//! `run`'s table: the methods compared, their ratios, the robot's answer
+//! and where the report is; and the closing word on stderr.
+
+use crate::run::{Outcome, RunSummary};
+use std::path::Path;
+
+/// The lines `run` prints on stdout (a blank line after the stage lines).
+pub fn summary(s: &RunSummary, report: &Path, files: usize) -> Vec<String> {
+    let mut lines = vec![
+        String::new(),
+        format!(
+            "catflip run: {} ({} joint, peak norm {})",
+            s.name,
+            s.joint,
+            s.peak_norm.name()
+        ),
+    ];
+    let rows = s.methods.iter().map(crate::table::table_row).collect();
+    lines.extend(super::Columns::new(&crate::table::TABLE_HEADER, rows).lines());
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+    lines.push(format!(
+        "  free-form / phased peak {}, phased / analytic {}; free-form design: {}",
+        show(s.free_over_phased),
+        show(s.phased_over_analytic),
+        crate::design::free::iterations_text(&s.mesh_levels)
+    ));
+    if let Some(a) = &s.answer {
+        lines.push(format!("  {}", a.sentence()));
+    }
+    lines.push(format!("  report: {} ({files} files)", report.display()));
+    lines
+}
+
+/// What `run` says on stderr at the end about its exit status, if anything.
+pub fn closing(outcome: Outcome) -> Option<&'static str> {
+    match outcome {
+        Outcome::Ok => None,
+        Outcome::Impossible => Some("the flip is not possible from this height: exit status 4"),
+        Outcome::Partial => Some(
+            "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3",
+        ),
+    }
+}

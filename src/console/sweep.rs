@@ -1,0 +1,83 @@
+//! `sweep`'s table: a line per point with each method's peak (and least
+//! drop heights under a torque limit), and its closing warnings.
+
+use crate::sweep::{SweepPoint, SweepSpec};
+use std::path::PathBuf;
+
+/// The sweep's table, `threads` the points computed at once.
+pub fn points(
+    name: &str,
+    spec: &SweepSpec,
+    points: &[SweepPoint],
+    threads: usize,
+    written: &[PathBuf],
+) -> Vec<String> {
+    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    let mut lines = vec![format!(
+        "catflip sweep: {} over {} ({}, {} at a time)",
+        name,
+        spec.key,
+        plural(points.len(), "point"),
+        threads
+    )];
+    let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
+    // the least drop heights, when a torque limit gives them
+    let heights = points
+        .iter()
+        .any(|p| p.least_height_phased_m.is_some() || p.least_height_free_m.is_some());
+    let mut head = format!(
+        "  {:>12} {:>12} {:>12} {:>12}",
+        spec.key, "analytic N m", "phased N m", "free N m"
+    );
+    if heights {
+        head += &format!(" {:>14} {:>14}", "phased h_min m", "free h_min m");
+    }
+    lines.push(head);
+    for p in points {
+        let mut line = format!(
+            "  {:>12.5} {:>12} {:>12} {:>12}",
+            p.value,
+            show(p.analytic_peak_nm),
+            show(p.phased_peak_nm),
+            show(p.free_peak_nm),
+        );
+        if heights {
+            line += &format!(
+                " {:>14} {:>14}",
+                show(p.least_height_phased_m),
+                show(p.least_height_free_m)
+            );
+        }
+        if let Some(e) = &p.error {
+            line += &format!("  error: {e}");
+        }
+        lines.push(line);
+    }
+    let mut t = super::Rows::default();
+    t.wrote(written);
+    lines.extend(t.into_lines());
+    lines
+}
+
+/// The warning of a sweep some of whose points have errors.
+pub fn partial_warning(points: &[SweepPoint]) -> Option<String> {
+    let bad = points.iter().filter(|p| p.error.is_some()).count();
+    (bad > 0).then(|| {
+        format!(
+            "warning: partial result: {bad} of {} points have errors (see the error column); exit status 3",
+            points.len()
+        )
+    })
+}
+
+/// The warning of a shard that holds no points of a `count`-point grid.
+pub fn empty_shard_warning(shard: crate::sweep::Shard, count: usize) -> String {
+    format!(
+        "warning: shard {}/{} holds no points: shards take whole continuation chunks of {} points, and the {} points make {}; use at most that many shards",
+        shard.index,
+        shard.count,
+        crate::sweep::CHUNK,
+        count,
+        count.div_ceil(crate::sweep::CHUNK)
+    )
+}

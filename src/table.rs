@@ -1,0 +1,85 @@
+//! The comparison table of the methods, shared by the terminal
+//! ([`crate::console::run`]) and the report (index.html, the animation's
+//! captions): its columns, one line per method, and a verdict in words.
+
+use crate::pipeline::MethodSummary;
+use crate::verdict::Grade;
+
+/// Columns of the comparison table (terminal and index.html).
+pub const TABLE_HEADER: [&str; 12] = [
+    "method",
+    "status",
+    "peak N m",
+    "energy N2m2s",
+    "bend deg",
+    "durations s",
+    "flip error rad",
+    "tilt deg",
+    "landing deg",
+    "sim peak N m",
+    "solve s",
+    "verdict",
+];
+
+/// A small number in the table: `0` for exact zero, else 3 significant digits.
+fn small(x: f64) -> String {
+    if x == 0.0 {
+        "0".into()
+    } else {
+        format!("{x:.2e}")
+    }
+}
+
+/// A verdict as the table words it: `ok`, `FLAGGED: <why>`, `FAILED: <why>`.
+pub fn verdict_text(grade: Grade, reason: Option<&str>) -> String {
+    match grade {
+        Grade::Ok => "ok".to_string(),
+        Grade::Flagged => format!("FLAGGED: {}", reason.unwrap_or("")),
+        Grade::Failed => format!("FAILED: {}", reason.unwrap_or("")),
+    }
+}
+
+/// One line of the comparison table; a failed method shows `-` for its numbers.
+pub fn table_row(m: &MethodSummary) -> Vec<String> {
+    let mut row = vec![m.method.to_string(), m.status.to_string()];
+    match &m.result {
+        Some(n) => {
+            let d = n.phase_durations_s;
+            row.extend([
+                format!("{:.5}", n.peak_torque_nm),
+                format!("{:.4e}", n.energy_n2m2s),
+                format!("{:.2}", n.bend_deg),
+                format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
+                small(n.flip_error_rad),
+                small(n.tilt_deg),
+                small(n.landing_error_deg),
+                format!("{:.5}", n.sim_peak_torque_nm),
+                format!("{:.3}", n.solve_time_s),
+            ]);
+        }
+        None => row.extend(std::iter::repeat_n("-".to_string(), 9)),
+    }
+    row.push(verdict_text(m.verdict, m.reason.as_deref()));
+    row
+}
+
+/// The animation's caption of a method: its status and verdict.
+pub fn track_status(m: &MethodSummary) -> String {
+    format!(
+        "{}; {}",
+        m.status,
+        verdict_text(m.verdict, m.reason.as_deref())
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_verdict_reads_as_the_grade_and_its_reason() {
+        assert_eq!(verdict_text(Grade::Ok, Some("ignored")), "ok");
+        assert_eq!(verdict_text(Grade::Flagged, Some("x")), "FLAGGED: x");
+        assert_eq!(verdict_text(Grade::Failed, None), "FAILED: ");
+    }
+}
