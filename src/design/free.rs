@@ -1601,9 +1601,9 @@ fn least_stretch(cfg: &Config, plan: &CollocationPlan, most: f64) -> f64 {
         return most;
     }
     let motor = cfg.motor();
-    let rows =
-        crate::design::plan::Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase)
-            .rows;
+    // the dense samples (the written rows among them), where the reported peak is read
+    let dense = crate::verify::analyze::dense_samples(cfg);
+    let rows = crate::design::plan::Schedule::sample(&cfg.cat(), plan, dense).rows;
     let inside = |s: f64| {
         rows.iter().all(|r| {
             let tau = r.tau.map(|t| t / (s * s));
@@ -2281,7 +2281,10 @@ mod tests {
             for ph in 0..3 {
                 p.z[tr.duration(ph)] *= f;
             }
-            crate::design::envelope::usage_of(&cfg, &p)
+            let dense = crate::verify::analyze::dense_samples(&cfg);
+            let rows = crate::design::plan::Schedule::sample(&cfg.cat(), &p, dense).rows;
+            cfg.motor()
+                .usage(rows.iter().map(|r| (r.tau, r.qd)))
                 .min_margin
                 .unwrap()
         };
