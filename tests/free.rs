@@ -818,3 +818,47 @@ fn the_certificate_backs_the_status() {
         }
     }
 }
+
+/// Issue 30 item 3: the coarsest mesh also solves the analytic start, so
+/// the per-motor design from the phased seed and from the analytic one end
+/// in the same basin (0.3281 and 0.3209 N m apart before); the torque is
+/// checked at the quarter points, so the dense peak is within 0.3 % of the
+/// checked one (0.55 % with node and midpoint only); and the design is
+/// within 1.5 % of the same design re-optimised at twice the nodes.
+#[test]
+fn the_per_motor_designs_from_both_seeds_agree_and_hold_between_check_points() {
+    let c = cfg("seed", &["limits.norm=per-motor"]);
+    let solve = |seed| {
+        catflip::design::free::FreeDesign::new(&c)
+            .seed(seed)
+            .check_mesh()
+            .solve()
+            .unwrap()
+    };
+    let (ph, an) = (
+        solve(catflip::design::free::Seed::Phased),
+        solve(catflip::design::free::Seed::Analytic),
+    );
+    let rel = |a: f64, b: f64| (a - b).abs() / b;
+    assert!(
+        rel(ph.peak_torque_nm, an.peak_torque_nm) < 5e-3,
+        "{} vs {}",
+        ph.peak_torque_nm,
+        an.peak_torque_nm
+    );
+    for r in [&ph, &an] {
+        assert_eq!(r.status, ScpStatus::Converged);
+        assert!(
+            r.peak_torque_nm <= r.node_peak_torque_nm * 1.003,
+            "dense {} vs checked {}",
+            r.peak_torque_nm,
+            r.node_peak_torque_nm
+        );
+        let fine = r.mesh_check.as_ref().unwrap().peak_torque_nm;
+        assert!(
+            rel(r.peak_torque_nm, fine) < 1.5e-2,
+            "{} vs {fine}",
+            r.peak_torque_nm
+        );
+    }
+}

@@ -4,9 +4,10 @@
 //! Decision variables: `q, dq/ds, d2q/ds2` at `N` nodes in each of the three
 //! phases (normalised time `s`) and the three phase durations
 //! ([`Transcription`], first-order-hold acceleration). Objective
-//! (`design.objective`): the peak joint torque at the nodes and interval
-//! midpoints, `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact inverse
-//! dynamics in normalised time (F3); the manoeuvre time (sum of the
+//! (`design.objective`): the peak joint torque at the check points (each
+//! node and the quarter points of each interval, [`CHECKS_PER_INTERVAL`]),
+//! `tau = tau^(q, q^, q^^) / T_p^2` with `tau^` the exact inverse dynamics
+//! in normalised time (F3); the manoeuvre time (sum of the
 //! durations); or the energy `integral |tau|^2 dt` (Simpson weights). Exact
 //! constraints (linear rows and cones of the subproblem): straight and at rest
 //! at both ends, continuity of `q` across phases, the collocation defects
@@ -27,7 +28,9 @@
 //! From a seed, a peak-torque design without a torque-speed line or speed
 //! limit is solved on coarser meshes first (a third of the nodes, or half,
 //! and so on while 20 or more remain per phase), loosely, and each starts
-//! the next ([`coarse_start`], mesh continuation).
+//! the next ([`coarse_start`], mesh continuation); the coarsest is also
+//! solved from the analytic schedule ([`other_starts`]) and the lower
+//! design continued.
 
 use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
@@ -89,9 +92,10 @@ pub struct FreeProblem {
     /// linearisation, in [`FreeProblem::check_points`] order: the Hessian at
     /// the same point reads them instead of evaluating them again.
     second_terms: std::cell::RefCell<Vec<([f64; 2], ShapeTerms)>>,
-    /// Whether the torque is checked at the interval midpoints too (true
-    /// but on a coarse mesh of the continuation, [`FreeProblem::at_nodes_only`]).
-    midpoints: bool,
+    /// Torque check points per interval, evenly spaced from its first node
+    /// ([`CHECKS_PER_INTERVAL`]; one, the node, on a coarse mesh of the
+    /// continuation, [`FreeProblem::at_nodes_only`]).
+    checks: usize,
     /// A start other than upside down at rest: the attitude map with
     /// momentum and the landing set (belly down, heading free) instead of
     /// the final attitude `Rz(pi)`.
@@ -100,6 +104,16 @@ pub struct FreeProblem {
     /// not straight and at rest (a replan from a measured state in flight).
     pub initial: Option<([f64; 2], [f64; 2])>,
 }
+
+/// Torque check points per interval on the design's own mesh: the node and
+/// the quarter points. With the node and midpoint only, the torque between
+/// them broke the limits by the mesh's second-order error: the seed's
+/// per-motor design peaked 0.55 % above its check points, and the robot's
+/// least time was stretched from 0.7428 to 0.7496 s to bring its written
+/// rows back inside the torque-speed line. Four (a spacing of `h / 4`, the
+/// five points a quarter apart of an IPOPT reference) cut that excess
+/// sixteen-fold from the node's spacing.
+pub const CHECKS_PER_INTERVAL: usize = 4;
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
 /// (clamped to it with a torque-speed line): no schedule that flips the cat
@@ -170,10 +184,11 @@ impl FreeProblem {
             objective: cfg.design.objective,
             scales,
             second_terms: Default::default(),
-            midpoints: true,
             release: Release::of(cfg, time_unit),
             initial: None,
+            checks: CHECKS_PER_INTERVAL,
         }
+        .with_checks(CHECKS_PER_INTERVAL)
     }
 
     /// The problem with the torque checked at the nodes only: half the
@@ -192,7 +207,7 @@ impl FreeProblem {
     /// seed's per-motor design at 120 nodes per phase lower (0.317146
     /// instead of 0.317362).
     pub fn at_nodes_only(mut self) -> Self {
-        self.midpoints = false;
+        self.checks = 1;
         self
     }
 
@@ -210,14 +225,29 @@ impl FreeProblem {
         3 * 2 * self.points_per_phase()
     }
 
-    /// Torque check points per phase: every node and every interval
-    /// midpoint, or every node ([`FreeProblem::check_points`]).
+    /// Torque check points per phase: every node and, on each interval, the
+    /// points between ([`FreeProblem::check_points`]).
     fn points_per_phase(&self) -> usize {
-        if self.midpoints {
-            2 * self.tr.nodes - 1
+        self.checks * (self.tr.nodes - 1) + 1
+    }
+
+    /// Check points per interval ([`CHECKS_PER_INTERVAL`]), at least one;
+    /// at most two from a spinning start, whose momentum the attitude map
+    /// knows at its sub-steps only (nodes and midpoints, [`Release::path`]).
+    pub fn with_checks(mut self, checks: usize) -> Self {
+        let most = if self.release.is_some() {
+            2
         } else {
-            self.tr.nodes
-        }
+            usize::MAX
+        };
+        self.checks = checks.clamp(1, most);
+        self
+    }
+
+    /// Whether the interval midpoints are check points (for the attitude
+    /// map's momentum at them, [`Release::path`]).
+    fn midpoints(&self) -> bool {
+        self.checks > 1
     }
 
     /// The objective's unit in physical terms: N m (peak), s (time) or
@@ -333,9 +363,10 @@ impl FreeProblem {
     /// or from another start the landing error.
     pub fn terminal_error(&self, z: &[f64]) -> f64 {
         match &self.release {
-            Some(rel) => {
-                rel.landing_error(rel.path(&self.cat, &self.tr, z, self.midpoints, false).end)
-            }
+            Some(rel) => rel.landing_error(
+                rel.path(&self.cat, &self.tr, z, self.midpoints(), false)
+                    .end,
+            ),
             None => Self::attitude_error(&self.attitude(z, false).0).norm(),
         }
     }
@@ -347,8 +378,8 @@ impl FreeProblem {
     }
 
     /// Normalised-time state at the torque check points of phase `p`: every
-    /// node and every interval midpoint (the midpoints bound the torque between
-    /// nodes to second order; none [`FreeProblem::at_nodes_only`]), with the interpolation coefficients on
+    /// node and the points between, evenly spaced ([`CHECKS_PER_INTERVAL`];
+    /// none [`FreeProblem::at_nodes_only`]), with the interpolation coefficients on
     /// `(q_k, q^_k, q^^_k, q^^_{k+1})` of interval `k`.
     fn check_points(&self, z: &[f64], p: usize) -> Vec<CheckPoint> {
         let tr = &self.tr;
@@ -356,12 +387,9 @@ impl FreeProblem {
         for k in 0..tr.nodes {
             let kk = k.min(tr.nodes - 2);
             let d = tr.interval(z, p, kk);
+            let m = self.checks;
             for c in if k < tr.nodes - 1 {
-                if self.midpoints {
-                    vec![0.0, 0.5]
-                } else {
-                    vec![0.0]
-                }
+                (0..m).map(|j| j as f64 / m as f64).collect()
             } else {
                 vec![1.0]
             } {
@@ -377,17 +405,29 @@ impl FreeProblem {
     /// (only the energy objective reads them, which has no coarse meshes).
     fn quadrature(&self) -> Vec<f64> {
         let h = self.tr.h();
+        let m = self.checks;
         let mut w = Vec::with_capacity(self.points_per_phase());
-        if !self.midpoints {
-            let last = self.tr.nodes - 1;
-            w.extend((0..=last).map(|k| if k == 0 || k == last { h / 2.0 } else { h }));
+        if m % 2 == 1 {
+            // trapezoid on the points (h / m apart)
+            let (step, last) = (h / m as f64, self.points_per_phase() - 1);
+            w.extend((0..=last).map(|i| {
+                if i == 0 || i == last {
+                    step / 2.0
+                } else {
+                    step
+                }
+            }));
             return w;
         }
+        // composite Simpson on the points: (h / m) / 3 [1, 4, 2, 4, ..., 4, 1]
+        let third = h / m as f64 / 3.0;
         for k in 0..self.tr.nodes - 1 {
-            w.push(if k == 0 { h / 6.0 } else { h / 3.0 });
-            w.push(2.0 * h / 3.0);
+            w.push(if k == 0 { third } else { 2.0 * third });
+            for j in 1..m {
+                w.push(if j % 2 == 1 { 4.0 * third } else { 2.0 * third });
+            }
         }
-        w.push(h / 6.0);
+        w.push(third);
         w
     }
 
@@ -405,7 +445,7 @@ impl FreeProblem {
         }
         let mus = self
             .release
-            .map(|r| r.path(&self.cat, tr, z, self.midpoints, false).mu);
+            .map(|r| r.path(&self.cat, tr, z, self.midpoints(), false).mu);
         let mut point = 0;
         for p in 0..3 {
             let t = z[tr.duration(p)];
@@ -796,7 +836,9 @@ impl ScpProblem for FreeProblem {
         let mut r = self.rate_continuity(z, 0, None);
         match &self.release {
             Some(rel) => {
-                let end = rel.path(&self.cat, &self.tr, z, self.midpoints, false).end;
+                let end = rel
+                    .path(&self.cat, &self.tr, z, self.midpoints(), false)
+                    .end;
                 r.extend(rel.landing(end).0);
             }
             None => {
@@ -817,7 +859,7 @@ impl ScpProblem for FreeProblem {
         let mut residual = self.rate_continuity(z, 0, Some(&mut rj));
         let row0 = residual.len();
         if let Some(rel) = &self.release {
-            let path = rel.path(&self.cat, &self.tr, z, self.midpoints, true);
+            let path = rel.path(&self.cat, &self.tr, z, self.midpoints(), true);
             let (e, de) = rel.landing(path.end);
             residual.extend(e);
             for (col, sc) in path.end_jac.iter().enumerate() {
@@ -1106,7 +1148,14 @@ fn from_plan(
     let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
     let z0 = if cfg.free.mesh_continuation && !cfg.uses_envelope() {
-        coarse_start(cfg, seed_plan, nodes, observe, &mut levels)
+        coarse_start(
+            cfg,
+            seed_plan,
+            seed == "analytic",
+            nodes,
+            observe,
+            &mut levels,
+        )
     } else {
         seed_start()
     };
@@ -1196,8 +1245,14 @@ enum Mesh {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct MeshLevel {
     pub nodes: usize,
+    /// The seed's start's iterations (the ones observed and recorded).
     pub scp_iterations: usize,
     pub converged: bool,
+    /// Starts solved on this mesh, the seed's included ([`other_starts`]).
+    pub starts: usize,
+    /// Iterations of the other start the mesh continued from, when one
+    /// beat the seed's (0 otherwise).
+    pub other_iterations: usize,
 }
 
 impl MeshLevel {
@@ -1269,6 +1324,7 @@ fn recorded(levels: &[Coarse]) -> usize {
 fn coarse_start(
     cfg: &Config,
     seed_plan: &dyn crate::design::plan::ShapePlan,
+    seed_is_analytic: bool,
     nodes: usize,
     observe: &mut dyn Observer,
     levels: &mut Vec<Coarse>,
@@ -1277,20 +1333,57 @@ fn coarse_start(
     let Some(coarse) = coarser(nodes) else {
         return tr.sample(seed_plan);
     };
-    let z0 = coarse_start(cfg, seed_plan, coarse, observe, levels);
+    let z0 = coarse_start(cfg, seed_plan, seed_is_analytic, coarse, observe, levels);
     let mut its = Vec::new();
     observe.mesh(coarse);
     let first = recorded(levels);
-    let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, first, |it| {
-        observe.iteration(it);
-        its.push(*it);
+    // the coarsest mesh also solves the other starts, beside the seed's
+    let others = if coarser(coarse).is_none() {
+        other_starts(cfg, !seed_is_analytic)
+    } else {
+        Vec::new()
+    };
+    let (solved, other) = std::thread::scope(|scope| {
+        let other = scope.spawn(|| {
+            others
+                .iter()
+                .filter_map(|c| {
+                    let z = Transcription::new(3, coarse)
+                        .sample(&crate::design::analytic::analytic_plan(c));
+                    let mut n = 0;
+                    let s = design(cfg, &z, None, coarse, Mesh::Coarse, 0, |_| n += 1).ok()?;
+                    (s.res.status == ScpStatus::Converged).then_some((s, n))
+                })
+                .min_by(|a, b| a.0.res.objective.total_cmp(&b.0.res.objective))
+        });
+        let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, first, |it| {
+            observe.iteration(it);
+            its.push(*it);
+        });
+        (
+            solved,
+            other
+                .join()
+                .unwrap_or_else(|e| std::panic::resume_unwind(e)),
+        )
     });
-    let converged = matches!(&solved, Ok(s) if s.res.status == ScpStatus::Converged);
+    let mut converged = matches!(&solved, Ok(s) if s.res.status == ScpStatus::Converged);
+    let mut other_iterations = 0;
+    let solved = match (solved, other) {
+        (Ok(s), Some((o, n))) if !converged || o.res.objective < s.res.objective => {
+            converged = true;
+            other_iterations = n;
+            Ok(o)
+        }
+        (s, _) => s,
+    };
     levels.push((
         MeshLevel {
             nodes: coarse,
             scp_iterations: its.len(),
             converged,
+            starts: 1 + others.len(),
+            other_iterations,
         },
         its,
     ));
@@ -1298,6 +1391,27 @@ fn coarse_start(
         Ok(s) if converged => tr.sample(&s.plan),
         // the finer mesh starts from the seed again
         _ => tr.sample(seed_plan),
+    }
+}
+
+/// The other starts of the coarsest mesh: the configured analytic schedule
+/// (`configured`, unless it is the seed), whose designs end in another
+/// local optimum of the peak than the phased seed's: the seed's per-motor
+/// design ended at 0.3281 N m from the phased seed and 0.3209 from the
+/// analytic one. The lower coarse design is continued, so the two seeds
+/// share a basin. Two more analytic starts (bends of 30 and 90 degrees
+/// between the halves, the twist given 70 % of the time) lowered the seed's
+/// designs further (per motor 0.318833 N m, Euclidean 0.405018, against
+/// 0.319627 and 0.406166 with the analytic start alone) but made them 3
+/// to 4 times slower (`bench_free`: 1.9 to 3.0 s a case instead of 0.5 to
+/// 1.0 s on a loaded machine); from twelve analytic schedules (bends of 30
+/// to 90 degrees, three splits) the 40-node design ended between 0.31883
+/// and 0.32372 N m.
+fn other_starts(cfg: &Config, configured: bool) -> Vec<Config> {
+    if configured {
+        vec![cfg.clone()]
+    } else {
+        Vec::new()
     }
 }
 
@@ -1701,6 +1815,8 @@ fn optimize_start(
             nodes,
             scp_iterations: res.iterations.len(),
             converged: res.status == ScpStatus::Converged,
+            starts: 1,
+            other_iterations: 0,
         }],
         z_scaled,
         warm: res.warm.clone(),
@@ -2100,7 +2216,7 @@ mod tests {
         let n = 8;
         let tr = Transcription::new(3, n);
         let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
-        let full = FreeProblem::new(&cfg, n, &z0);
+        let full = FreeProblem::new(&cfg, n, &z0).with_checks(2);
         let nodes = FreeProblem::new(&cfg, n, &z0).at_nodes_only();
         let z = full.to_scaled(&z0);
         assert_eq!(nodes.torques_len(), 3 * 2 * n);
@@ -2191,12 +2307,103 @@ mod tests {
             .collect();
         let kept: Vec<[f64; 2]> = p.second_terms.borrow().iter().map(|e| e.0).collect();
         assert_eq!(kept, shapes);
-        assert_eq!(shapes.len(), 3 * (2 * 8 - 1));
+        assert_eq!(shapes.len(), 3 * (CHECKS_PER_INTERVAL * 7 + 1));
         assert_eq!(p.hessian(&z, &y, &[]), want, "cached at the same point");
         // a linearisation elsewhere must not stand in for this point
         let _ = p.linearize(&moved);
         assert_eq!(p.hessian(&z, &y, &[]), want, "cached elsewhere");
         assert_ne!(p.hessian(&moved, &y, &[]), want);
+    }
+
+    /// The design mesh's quadrature is composite Simpson on its check
+    /// points: exact for cubics in `s`, and the points are evenly spaced.
+    #[test]
+    fn the_check_points_quarter_each_interval_and_integrate_cubics_exactly() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+        let cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
+        let n = 6;
+        let tr = Transcription::new(3, n);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
+        let p = FreeProblem::new(&cfg, n, &z0);
+        assert_eq!(p.points_per_phase(), CHECKS_PER_INTERVAL * (n - 1) + 1);
+        let w = p.quadrature();
+        let s_at = |i: usize| i as f64 / (p.points_per_phase() - 1) as f64;
+        for (k, exact) in [1.0, 0.5, 1.0 / 3.0, 0.25].into_iter().enumerate() {
+            let q: f64 = w
+                .iter()
+                .enumerate()
+                .map(|(i, w)| w * s_at(i).powi(k as i32))
+                .sum();
+            assert!((q - exact).abs() < 1e-14, "s^{k}: {q} vs {exact}");
+        }
+        // the points' normalised times, from their interval and coefficient
+        let z = p.to_scaled(&z0);
+        let h = tr.h();
+        for (i, (k, q, ..)) in p.check_points(&z, 1).into_iter().enumerate() {
+            let c = (s_at(i) - k as f64 * h) / h;
+            let want = tr.interval(&z, 1, k).at(c).q;
+            assert!(
+                (q[0] - want[0]).abs() < 1e-12 && (q[1] - want[1]).abs() < 1e-12,
+                "point {i}"
+            );
+        }
+    }
+
+    /// Slowing a schedule down by `s` divides its torques by `s^2` and its
+    /// speeds by `s` (F3), so the least stretch found on the rows is the
+    /// least one for the slowed plan: inside the envelope at it, outside
+    /// just below it.
+    #[test]
+    fn the_least_stretch_brings_the_slowed_schedule_just_inside_the_envelope() {
+        let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
+        let load = |extra: &[String]| {
+            let mut o = vec!["limits.norm=per-motor".to_string()];
+            o.extend_from_slice(extra);
+            Config::load(std::path::Path::new(path), &o).unwrap()
+        };
+        let cfg = load(&[]);
+        let tr = Transcription::new(3, 12);
+        let plan =
+            CollocationPlan::new(tr, tr.sample(&crate::design::analytic::analytic_plan(&cfg)));
+        let rows = crate::design::plan::Schedule::sample(&cfg.cat(), &plan, 50).rows;
+        let peak = rows
+            .iter()
+            .map(|r| r.tau[0].abs().max(r.tau[1].abs()))
+            .fold(0.0, f64::max);
+        let top = rows
+            .iter()
+            .map(|r| r.qd[0].abs().max(r.qd[1].abs()))
+            .fold(0.0, f64::max);
+        // a torque-speed line 20 % short of the schedule's peak
+        let cfg = load(&[
+            format!("limits.max_torque={}", 0.8 * peak),
+            format!("limits.no_load_speed={}", 4.0 * top),
+            "simulate.samples_per_phase=50".into(),
+        ]);
+        let s = crate::design::envelope::least_stretch(&cfg, &plan);
+        assert!(s > 1.05 && s < 3.0, "{s}");
+        let slowed = |f: f64| {
+            let mut p = plan.clone();
+            for ph in 0..3 {
+                p.z[tr.duration(ph)] *= f;
+            }
+            let dense = crate::verify::analyze::dense_samples(&cfg);
+            let rows = crate::design::plan::Schedule::sample(&cfg.cat(), &p, dense).rows;
+            cfg.motor()
+                .usage(rows.iter().map(|r| (r.tau, r.qd)))
+                .min_margin
+                .unwrap()
+        };
+        assert!(slowed(s) >= -1e-9, "{}", slowed(s));
+        assert!(slowed(s * (1.0 - 1e-6)) < 0.0);
+        // nothing to do inside the envelope
+        assert_eq!(
+            crate::design::envelope::least_stretch(
+                &load(&[format!("limits.max_torque={}", 2.0 * peak)]),
+                &plan,
+            ),
+            1.0
+        );
     }
 
     fn inverse_dynamics_at(cat: &Cat, x: [f64; 6]) -> [f64; 2] {

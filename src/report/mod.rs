@@ -931,6 +931,8 @@ mod tests {
             nodes: 40,
             scp_iterations: 2,
             converged: true,
+            starts: 1,
+            other_iterations: 0,
         }];
         for (objective, word) in [
             (Objective::Time, "time"),
