@@ -1656,6 +1656,9 @@ pub fn replan(
         inertias: crate::model::momentum::straight_inertias(&cat),
     });
     problem.initial = Some(([y[4], y[5]], [y[6], y[7]]));
+    // the check points the attitude map knows the momentum at
+    let checks = problem.checks;
+    let problem = problem.with_checks(checks);
     let solved = design_problem(&rc, problem, &z0, None, Mesh::Final, 0, |_| {})?;
     Ok(Replan {
         status: solved.res.status,
