@@ -6,15 +6,9 @@ use catflip::Config;
 use catflip::design::free::{FreeResult, Seed};
 use std::time::Instant;
 
-fn median(mut x: Vec<f64>) -> f64 {
-    x.sort_by(f64::total_cmp);
-    let n = x.len();
-    if n % 2 == 1 {
-        x[n / 2]
-    } else {
-        0.5 * (x[n / 2 - 1] + x[n / 2])
-    }
-}
+#[path = "common/mod.rs"]
+mod common;
+use common::median;
 
 /// The seeding design (phased, or the analytic schedule, which costs
 /// nothing) and the SCP, timed together, without the mesh check.
