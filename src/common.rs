@@ -74,6 +74,28 @@ pub(crate) fn publisher(c: &Common, cfg: &Config, set: &str) -> Result<Publisher
     )?)
 }
 
+/// Publishes an interrupted command's finished part as a partial set,
+/// prints its JSON when `--json` asked, and says on stderr what finished
+/// (`done`, e.g. "11 of 20 trials") and how to go on (`then`, may be empty).
+pub(crate) fn publish_partial(
+    publisher: Publisher,
+    out: catflip::output::Output,
+    json: Option<&str>,
+    done: &str,
+    then: &str,
+) -> Result<Status> {
+    let dir = publisher.link();
+    publisher.publish(out)?;
+    if let Some(json) = json {
+        say!("{json}");
+    }
+    eprintln!(
+        "interrupted: {done} finished, published as a partial set in {} (its JSON says \"status\": \"partial\"){then}; exit status 130",
+        dir.display()
+    );
+    Ok(Status::Interrupted)
+}
+
 /// How a command that finished ended: the exit status tells them apart.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Status {

@@ -1,6 +1,6 @@
 //! `catflip recovery`: the command-line face of [`catflip::recovery`].
 
-use crate::common::{Common, Status, load, publisher, say};
+use crate::common::{Common, Status, load, publish_partial, publisher, say};
 use anyhow::Result;
 use catflip::interrupt::{Outcome, supervise};
 use catflip::output::Output;
@@ -150,18 +150,13 @@ pub fn cmd_recovery(
     }
     out.add("index.html", report(&cfg, &summary, &names));
     if interrupted {
-        let dir = publisher.link();
-        publisher.publish(out)?;
-        if c.json {
-            say!("{json}");
-        }
-        eprintln!(
-            "interrupted: {} of {} lines finished, published as a partial set in {} (its JSON says \"status\": \"partial\"); exit status 130",
-            results.len(),
-            lines.len(),
-            dir.display()
+        return publish_partial(
+            publisher,
+            out,
+            c.json.then_some(json.as_str()),
+            &format!("{} of {} lines", results.len(), lines.len()),
+            "",
         );
-        return Ok(Status::Interrupted);
     }
     let written = publisher.publish(out)?;
     if c.json {

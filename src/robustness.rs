@@ -1,6 +1,6 @@
 //! `catflip robustness`: the command-line face of [`catflip::control::robustness`].
 
-use crate::common::{Common, Status, load, publisher, say, say_lines};
+use crate::common::{Common, Status, load, publish_partial, publisher, say, say_lines};
 use anyhow::Result;
 use catflip::control::resume::{Published, StudyState};
 use catflip::control::robustness::{
@@ -129,18 +129,13 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     );
     if interrupted {
         // published as a partial set, the trials in flight left unfinished
-        let dir = publisher.link();
-        publisher.publish(out)?;
-        if c.json {
-            say!("{json}");
-        }
-        eprintln!(
-            "interrupted: {} of {} trials finished, published as a partial set in {} (its JSON says \"status\": \"partial\"); the same command with --resume continues it; exit status 130",
-            results.len(),
-            range.len(),
-            dir.display()
+        return publish_partial(
+            publisher,
+            out,
+            c.json.then_some(json.as_str()),
+            &format!("{} of {} trials", results.len(), range.len()),
+            "; the same command with --resume continues it",
         );
-        return Ok(Status::Interrupted);
     }
     let written = publisher.publish(out)?;
     if c.json {
