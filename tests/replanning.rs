@@ -37,9 +37,17 @@ fn on_the_nominal_model_replanning_flies_the_design() {
     let closed = fly(&r, Feedback::Tvlqr(&tv), &motor, Flight::nominal(&r));
     let re = fly(&r, Feedback::Replan(&tv, &rp), &motor, Flight::nominal(&r));
     assert!(!re.replans.is_empty());
-    // a plan is taken only where it lands the model better than the design does
+    // a taken plan's nominal starts where the model is: nothing to correct
     assert!(
-        re.error_deg <= closed.error_deg + 1e-6 && re.error_deg < 0.05,
+        re.max_correction_nm < 1e-9 * r.peak_torque,
+        "correction {} N m on the nominal",
+        re.max_correction_nm
+    );
+    // a plan is taken only where it lands the model better than the plan in use (to
+    // the model's sensitivity over the rest of the fall: its first step is flown
+    // again on the taken plan's first torque sample)
+    assert!(
+        re.error_deg <= closed.error_deg + 1e-3 && re.error_deg < 0.05,
         "replanning lands {} deg, the TVLQR {} deg",
         re.error_deg,
         closed.error_deg

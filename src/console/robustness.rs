@@ -38,7 +38,7 @@ pub fn study(
     }
     if timing.replans > 0 {
         lines.push(format!(
-            "  replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms; {} over the {:.1} ms control period",
+            "  replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} over the {:.1} ms control period",
             timing.replans,
             timing.taken,
             timing.worse,
@@ -47,6 +47,9 @@ pub fn study(
             1e3 * timing.median_s,
             1e3 * timing.p99_s,
             1e3 * timing.max_s,
+            1e3 * timing.solve_median_s,
+            1e3 * timing.solve_p99_s,
+            1e3 * timing.solve_max_s,
             timing.over_period,
             1e3 * timing.period_s
         ));

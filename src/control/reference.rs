@@ -60,6 +60,13 @@ impl Reference {
     /// torque scale; the sample at `from` itself (shared with the end of
     /// the step before) is the new plan's.
     pub fn splice(&mut self, from: usize, y: Y, plan: &dyn ShapePlan) {
+        self.replace_plan(from, plan);
+        self.fly_from(from, y);
+    }
+
+    /// The feed-forward and the planned shape from step `from` on: `plan`'s,
+    /// its time 0 at that step.
+    pub fn replace_plan(&mut self, from: usize, plan: &dyn ShapePlan) {
         let (cat, h, steps) = (self.cat, self.h, self.steps);
         let t0 = h * from as f64;
         let b = plan.phase_bounds();
@@ -77,6 +84,12 @@ impl Reference {
             let s = plan.state((h * j as f64 - t0).min(end));
             self.shape[j] = (s.q, s.qd);
         }
+    }
+
+    /// The nominal from step `from` on: the model flown from `y` there under
+    /// the feed-forward.
+    pub fn fly_from(&mut self, from: usize, y: Y) {
+        let (cat, h, steps) = (self.cat, self.h, self.steps);
         self.nominal[from] = y;
         for j in from..steps {
             let ff = &self.ff;

@@ -86,8 +86,11 @@ pub enum Outcome {
 pub struct Record {
     /// Control step whose measurement it started from.
     pub step: usize,
-    /// Wall time of the replan, s: the solve and the comparison of the two plans.
+    /// Wall time of the replan, s: the prediction, the solve, the comparison
+    /// of the two plans and the splice of the one taken.
     pub seconds: f64,
+    /// Of which the solve (`free::replan`), s.
+    pub solve_seconds: f64,
     pub outcome: Outcome,
 }
 
@@ -129,11 +132,22 @@ pub struct InFlight {
     candidate: Option<(SharedPlan, f64)>,
     /// Replans in a row the chain has not been taken.
     misses: usize,
+    /// The control step of the last full comparison and the landing error,
+    /// rad, it found for the plan in use.
+    in_use: Option<(usize, f64)>,
     pub records: Vec<Record>,
 }
 
 /// Replans in a row after which an untaken chain restarts from the plan in use.
 const CHAIN_RESTART: usize = 8;
+
+/// The screen's steps (simulator steps), how many control steps its
+/// reference landing holds, and its slack, rad: a plan whose landing on the
+/// screen's long steps is over twice the reference plus the slack is
+/// dropped without the full comparison.
+const SCREEN: usize = 4;
+const REFRESH: usize = 5;
+const SCREEN_SLACK: f64 = 0.02;
 
 impl InFlight {
     pub fn new(design: SharedPlan) -> InFlight {
@@ -142,6 +156,7 @@ impl InFlight {
             offset: 0.0,
             candidate: None,
             misses: 0,
+            in_use: None,
             records: Vec::new(),
         }
     }
@@ -174,12 +189,15 @@ impl InFlight {
             return;
         }
         let clock = std::time::Instant::now();
-        let y = predict(r, tv, motor, issued, k * tv.period_steps, s, m);
+        // (the step before `s` ends on the sample at `s`, which a plan taken replaces)
+        let before = predict(r, tv, motor, issued, k * tv.period_steps, s - 1, m);
+        let y = predict(r, tv, motor, issued, s - 1, s, &before);
         let from = Shifted {
             plan: base.as_ref(),
             offset,
         };
         let solved = crate::design::free::replan(&rp.cfg, &from, t, &y, rp.nodes, rp.iterations);
+        let solve_seconds = solved.as_ref().map_or(0.0, |re| re.seconds);
         let late =
             |c: &std::time::Instant| rp.budget_s.is_some_and(|b| c.elapsed().as_secs_f64() > b);
         let outcome = match solved {
@@ -188,30 +206,39 @@ impl InFlight {
             Ok(re) if !re.landing_error_rad.is_finite() => Outcome::Failed,
             Ok(re) => {
                 let new: SharedPlan = Arc::new(re.plan);
-                // the plan in use as the TVLQR flies it; the new one's nominal
-                // starts at the predicted state, so the TVLQR adds nothing to it
-                let now = landing_under(r, s, &y, |j| r.ff[j], Some((tv, motor)));
-                let next = landing_under(
-                    r,
-                    s,
-                    &y,
-                    |j| {
-                        torque_of(
-                            new.as_ref(),
-                            &r.cat,
-                            0.5 * r.h * (j as f64 - 2.0 * s as f64),
-                        )
-                    },
-                    None,
-                );
+                let ff = |j: usize| {
+                    torque_of(
+                        new.as_ref(),
+                        &r.cat,
+                        0.5 * r.h * (j as f64 - 2.0 * s as f64),
+                    )
+                };
+                // screened first on long steps against the last comparison's
+                // landing of the plan in use: most one-iteration plans land far worse
+                let hopeless = self.in_use.is_some_and(|(at, est)| {
+                    k < at + REFRESH
+                        && landing_under(r, s, &y, ff, None, SCREEN) > 2.0 * est + SCREEN_SLACK
+                });
+                let (now, next) = if hopeless {
+                    (0.0, f64::INFINITY)
+                } else {
+                    // the plan in use as the TVLQR flies it; the new one's nominal
+                    // starts at the predicted state, so the TVLQR adds nothing to it
+                    let now = landing_under(r, s, &y, |j| r.ff[j], Some((tv, motor)), 1);
+                    self.in_use = Some((k, now));
+                    (now, landing_under(r, s, &y, ff, None, 1))
+                };
                 if late(&clock) {
                     Outcome::Late
                 } else if next <= now {
-                    r.splice(s, y, new.as_ref());
+                    r.replace_plan(s, new.as_ref());
+                    let y = predict(r, tv, motor, issued, s - 1, s, &before);
+                    r.fly_from(s, y);
                     self.plan = new;
                     self.offset = t;
                     self.candidate = None;
                     self.misses = 0;
+                    self.in_use = None;
                     Outcome::Taken
                 } else {
                     self.misses += 1;
@@ -226,6 +253,7 @@ impl InFlight {
         self.records.push(Record {
             step: k,
             seconds: clock.elapsed().as_secs_f64(),
+            solve_seconds,
             outcome,
         });
     }
@@ -244,20 +272,24 @@ fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
 /// The landing error, rad, of the model flown from `y` at step `from` to
 /// touchdown under the feed-forward `ff(half step)` and, with `tvlqr`, its
 /// gains about the nominal of `r` (each correction from the state at its
-/// start, no delay), on the simulator's steps: what two plans are compared
-/// by. (On steps four times as long the comparison misjudged spinning
-/// flights, whose landing is sensitive, and took plans that landed worse.)
+/// start, no delay), on steps of `stride` simulator steps (the last ones
+/// single): two plans are compared on the simulator's own steps (on steps
+/// four times as long the comparison misjudged spinning flights, whose
+/// landing is sensitive, and took plans that landed worse), the long steps
+/// only screen.
 fn landing_under(
     r: &Reference,
     from: usize,
     y: &Y,
     ff: impl Fn(usize) -> [f64; 2],
     tvlqr: Option<(&Tvlqr, &Motor)>,
+    stride: usize,
 ) -> f64 {
     let mut y = *y;
     let mut j = from;
     let mut u = [0.0; 2];
     while j < r.steps {
+        let n = if j + stride <= r.steps { stride } else { 1 };
         if let Some((tv, motor)) = tvlqr
             && let Some(k) = tv.interval_at(j)
             && tv.starts[k] == j
@@ -271,12 +303,12 @@ fn landing_under(
             u = [c[0], c[1]];
         }
         let motor = tvlqr.map(|(_, m)| m);
-        y = super::plant::rk4(&r.cat, &y, r.h, |st, ys| {
-            let f = ff(2 * j + st);
+        y = super::plant::rk4(&r.cat, &y, r.h * n as f64, |st, ys| {
+            let f = ff(2 * j + n * st);
             let t = [f[0] + u[0], f[1] + u[1]];
             motor.map_or(t, |m| m.clip(t, [ys[6], ys[7]]))
         });
-        j += 1;
+        j += n;
     }
     if !y.iter().all(|v| v.is_finite()) {
         return f64::INFINITY;

@@ -370,10 +370,14 @@ pub struct ReplanTiming {
     pub failed: usize,
     pub late: usize,
     pub worse: usize,
-    /// Wall time of one replan, s.
+    /// Wall time of one replan, s (prediction, solve, comparison, splice).
     pub median_s: f64,
     pub p99_s: f64,
     pub max_s: f64,
+    /// Of which the solve, s.
+    pub solve_median_s: f64,
+    pub solve_p99_s: f64,
+    pub solve_max_s: f64,
     /// The control period, s, and the replans that took longer.
     pub period_s: f64,
     pub over_period: usize,
@@ -384,6 +388,8 @@ pub fn replan_timing(results: &[TrialResult], period_s: f64) -> ReplanTiming {
     let count = |o: Outcome| all.iter().filter(|r| r.outcome == o).count();
     let mut t: Vec<f64> = all.iter().map(|r| r.seconds).collect();
     t.sort_by(f64::total_cmp);
+    let mut solve: Vec<f64> = all.iter().map(|r| r.solve_seconds).collect();
+    solve.sort_by(f64::total_cmp);
     ReplanTiming {
         replans: all.len(),
         taken: count(Outcome::Taken),
@@ -393,6 +399,9 @@ pub fn replan_timing(results: &[TrialResult], period_s: f64) -> ReplanTiming {
         median_s: percentile(&t, 0.5),
         p99_s: percentile(&t, 0.99),
         max_s: t.last().copied().unwrap_or(f64::NAN),
+        solve_median_s: percentile(&solve, 0.5),
+        solve_p99_s: percentile(&solve, 0.99),
+        solve_max_s: solve.last().copied().unwrap_or(f64::NAN),
         period_s,
         over_period: t.iter().filter(|&&x| x > period_s).count(),
     }
