@@ -8,6 +8,7 @@ use crate::config::Config;
 use crate::design::plan::ShapePlan;
 use crate::model::Cat;
 use crate::model::momentum::Start;
+use crate::model::motor::Motor;
 
 /// A design sampled for the closed loop.
 #[derive(Debug, Clone)]
@@ -61,7 +62,7 @@ impl Reference {
     /// the step before) is the new plan's.
     pub fn splice(&mut self, from: usize, y: Y, plan: &dyn ShapePlan) {
         self.replace_plan(from, plan);
-        self.fly_from(from, y);
+        self.fly_from(from, y, None);
     }
 
     /// The feed-forward and the planned shape from step `from` on: `plan`'s,
@@ -87,13 +88,16 @@ impl Reference {
     }
 
     /// The nominal from step `from` on: the model flown from `y` there under
-    /// the feed-forward.
-    pub fn fly_from(&mut self, from: usize, y: Y) {
+    /// the feed-forward, inside `motor`'s envelope when given (a replan's plan
+    /// may leave it by what one SCP iteration leaves unmet; a design does not).
+    pub fn fly_from(&mut self, from: usize, y: Y, motor: Option<&Motor>) {
         let (cat, h, steps) = (self.cat, self.h, self.steps);
         self.nominal[from] = y;
         for j in from..steps {
             let ff = &self.ff;
-            self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, _| ff[2 * j + s]);
+            self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, ys| {
+                motor.map_or(ff[2 * j + s], |m| m.clip(ff[2 * j + s], [ys[6], ys[7]]))
+            });
         }
     }
 

@@ -205,6 +205,7 @@ impl InFlight {
             Ok(_) if late(&clock) => Outcome::Late,
             Ok(re) if !re.landing_error_rad.is_finite() => Outcome::Failed,
             Ok(re) => {
+                let own = re.landing_error_rad;
                 let new: SharedPlan = Arc::new(re.plan);
                 let ff = |j: usize| {
                     torque_of(
@@ -215,25 +216,29 @@ impl InFlight {
                 };
                 // screened first on long steps against the last comparison's
                 // landing of the plan in use: most one-iteration plans land far worse
+                // (the solve's own landing error is a free first screen: its
+                // one-iteration plans landed worse in the simulator than on
+                // their own map in every case measured)
                 let hopeless = self.in_use.is_some_and(|(at, est)| {
+                    let bar = 2.0 * est + SCREEN_SLACK;
                     k < at + REFRESH
-                        && landing_under(r, s, &y, ff, None, SCREEN) > 2.0 * est + SCREEN_SLACK
+                        && (own > bar || landing_under(r, s, &y, ff, None, motor, SCREEN) > bar)
                 });
                 let (now, next) = if hopeless {
                     (0.0, f64::INFINITY)
                 } else {
                     // the plan in use as the TVLQR flies it; the new one's nominal
                     // starts at the predicted state, so the TVLQR adds nothing to it
-                    let now = landing_under(r, s, &y, |j| r.ff[j], Some((tv, motor)), 1);
+                    let now = landing_under(r, s, &y, |j| r.ff[j], Some(tv), motor, 1);
                     self.in_use = Some((k, now));
-                    (now, landing_under(r, s, &y, ff, None, 1))
+                    (now, landing_under(r, s, &y, ff, None, motor, 1))
                 };
                 if late(&clock) {
                     Outcome::Late
                 } else if next <= now {
                     r.replace_plan(s, new.as_ref());
                     let y = predict(r, tv, motor, issued, s - 1, s, &before);
-                    r.fly_from(s, y);
+                    r.fly_from(s, y, Some(motor));
                     self.plan = new;
                     self.offset = t;
                     self.candidate = None;
@@ -270,7 +275,8 @@ fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
 }
 
 /// The landing error, rad, of the model flown from `y` at step `from` to
-/// touchdown under the feed-forward `ff(half step)` and, with `tvlqr`, its
+/// touchdown under the feed-forward `ff(half step)` (inside `motor`'s
+/// envelope) and, with `tvlqr`, its
 /// gains about the nominal of `r` (each correction from the state at its
 /// start, no delay), on steps of `stride` simulator steps (the last ones
 /// single): two plans are compared on the simulator's own steps (on steps
@@ -282,7 +288,8 @@ fn landing_under(
     from: usize,
     y: &Y,
     ff: impl Fn(usize) -> [f64; 2],
-    tvlqr: Option<(&Tvlqr, &Motor)>,
+    tvlqr: Option<&Tvlqr>,
+    motor: &Motor,
     stride: usize,
 ) -> f64 {
     let mut y = *y;
@@ -290,7 +297,7 @@ fn landing_under(
     let mut u = [0.0; 2];
     while j < r.steps {
         let n = if j + stride <= r.steps { stride } else { 1 };
-        if let Some((tv, motor)) = tvlqr
+        if let Some(tv) = tvlqr
             && let Some(k) = tv.interval_at(j)
             && tv.starts[k] == j
         {
@@ -302,11 +309,9 @@ fn landing_under(
             }
             u = [c[0], c[1]];
         }
-        let motor = tvlqr.map(|(_, m)| m);
         y = super::plant::rk4(&r.cat, &y, r.h * n as f64, |st, ys| {
             let f = ff(2 * j + n * st);
-            let t = [f[0] + u[0], f[1] + u[1]];
-            motor.map_or(t, |m| m.clip(t, [ys[6], ys[7]]))
+            motor.clip([f[0] + u[0], f[1] + u[1]], [ys[6], ys[7]])
         });
         j += n;
     }
