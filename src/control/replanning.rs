@@ -175,7 +175,7 @@ impl InFlight {
         k: usize,
         m: &Y,
     ) {
-        if k % rp.every.max(1) != 0 || k + 1 >= tv.starts.len() {
+        if !k.is_multiple_of(rp.every.max(1)) || k + 1 >= tv.starts.len() {
             return;
         }
         let s = tv.starts[k + 1];
