@@ -9,6 +9,8 @@
 //! - `run:CONFIG`: `catflip run`'s pipeline (analytic, least height, phased,
 //!   free-form, report; files not written), e.g. `run:robot-universal`;
 //! - `height:CONFIG`: the least-height stage alone, with its answer;
+//! - `parts:CONFIG`: the least-height stage's four designs one after the
+//!   other in one thread, each timed (wall/CPU s);
 //! - `free:CONFIG:OBJECTIVE:SEED`: the free-form design inside the motor
 //!   envelope from 6 m (`peak-torque`, `time`, `energy`; `phased`,
 //!   `analytic`), the seeding design not counted.
@@ -61,6 +63,57 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
                 h.answer.least_height_m, h.answer.method, h.answer.least_time_s, h.phased_m
             )
         }
+        ["parts", name] => {
+            // the least-height stage's designs one by one, in one thread
+            let cfg = config(name, &[])?;
+            let reference = catflip::design::least_height::reference(&cfg);
+            let mut out = Vec::new();
+            let mut lap = |what: &str, text: String, t: &mut (Instant, f64)| {
+                out.push(format!(
+                    "{what} {:.3}/{:.3} s: {text}",
+                    t.0.elapsed().as_secs_f64(),
+                    cpu_s() - t.1
+                ));
+                *t = (Instant::now(), cpu_s());
+            };
+            let mut t = (Instant::now(), cpu_s());
+            let ph = catflip::design::phased::optimize(&reference, |_| {})?;
+            lap("phased", format!("{:.5} s", ph.manoeuvre_time_s), &mut t);
+            let plan = catflip::design::analytic::analytic_plan(&reference);
+            let fr = FreeDesign::new(&reference)
+                .from_plan(&plan, "analytic")
+                .solve()?;
+            lap(
+                "free(analytic)",
+                format!("{:.5} s, {} it", fr.manoeuvre_time_s, fr.scp_iterations),
+                &mut t,
+            );
+            if let Some((least, sr)) = catflip::design::least_height::stall_only(&reference)? {
+                lap(
+                    "stall-only",
+                    format!(
+                        "{least:.5} s, {} it ({})",
+                        sr.scp_iterations,
+                        catflip::design::free::iterations_text(&sr.mesh_levels)
+                    ),
+                    &mut t,
+                );
+                let mut plan = sr.plan.clone();
+                for i in 0..plan.tr.phases {
+                    let d = plan.tr.duration(i);
+                    plan.z[d] *= least / sr.manoeuvre_time_s;
+                }
+                let fr = FreeDesign::new(&reference)
+                    .from_plan(&plan, "stall-only")
+                    .solve()?;
+                lap(
+                    "free(stall-only)",
+                    format!("{:.5} s, {} it", fr.manoeuvre_time_s, fr.scp_iterations),
+                    &mut t,
+                );
+            }
+            out.join("; ")
+        }
         ["free", name, objective, seed] => {
             let cfg = config(
                 name,
@@ -81,19 +134,20 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
                 .solve()?;
             return Ok((
                 format!(
-                    "{:.6} ({}), {} SCP iterations ({}), {}",
+                    "{:.6} ({}), {} SCP iterations ({}), {}, SCP and envelope {:.3} s wall",
                     r.objective_value,
                     cfg.design.objective.name(),
                     r.scp_iterations,
                     catflip::design::free::iterations_text(&r.mesh_levels),
-                    catflip::verdict::Status::from(r.status)
+                    catflip::verdict::Status::from(r.status),
+                    r.solve_time_s
                 ),
                 t.elapsed().as_secs_f64(),
                 cpu_s() - c,
             ));
         }
         _ => anyhow::bail!(
-            "unknown case {case} (run:CONFIG, height:CONFIG, free:CONFIG:OBJECTIVE:SEED)"
+            "unknown case {case} (run:CONFIG, height:CONFIG, parts:CONFIG, free:CONFIG:OBJECTIVE:SEED)"
         ),
     };
     Ok((text, t.elapsed().as_secs_f64(), cpu_s() - c))

@@ -1365,6 +1365,12 @@ impl MeshLevel {
 /// The iteration limit of a coarse mesh: it only starts the finer one
 /// (the coarse meshes of issue 11's cases took 7 to 16; the seed's per-motor
 /// design from the analytic seed, on a path since left, crawled past 50).
+/// A coarse design stopped by the limit leaves the fine mesh to start from
+/// the seed, where an iteration costs about ten coarse ones (the box
+/// robot's stall-only design hit 25 at 20 nodes and took 59 more at 60);
+/// a limit of 60 made its least-height stage 40 % cheaper but, with the
+/// added check points, its least time 0.12 % longer (docs/benchmarks.md,
+/// `bench_robot`), so it stays at 25.
 const COARSE_MAX_ITERATIONS: usize = 25;
 
 /// "17 SCP iterations, 8 at 20 and 9 at 40 nodes per phase", or "9 SCP
