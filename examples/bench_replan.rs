@@ -19,7 +19,7 @@
 use catflip::Config;
 use catflip::control::plant::{Y, attitude, rk4};
 use catflip::control::reference::Reference;
-use catflip::design::free::{FreeDesign, Replanner, replan};
+use catflip::design::free::{FreeDesign, Replanner, Seed, replan};
 use catflip::design::plan::ShapePlan;
 use catflip::design::scp::ScpStatus;
 use catflip::model::momentum::{landing_error, straight_inertias};
@@ -44,7 +44,10 @@ fn main() -> anyhow::Result<()> {
         format!("{root}/configs/{name}.toml")
     };
     let cfg = Config::load(std::path::Path::new(&path), &overrides)?;
-    let d = FreeDesign::new(&cfg).solve()?;
+    // the robot near its least height: the phased seed does not fit, the analytic one starts it
+    let d = FreeDesign::new(&cfg)
+        .solve()
+        .or_else(|_| FreeDesign::new(&cfg).seed(Seed::Analytic).solve())?;
     let period = 1.0 / cfg.control.rate_hz;
     println!(
         "{name} {}: design {:.4} N m peak, manoeuvre {:.4} s; {nodes} nodes per phase, at most {iterations} SCP iterations; control period {period:.4} s",
