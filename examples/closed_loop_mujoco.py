@@ -56,7 +56,7 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from replay_common import landing_of, quat_conj, quat_log, quat_mul, right_jacobian  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-CONTROLLERS = ("open-loop", "tvlqr")
+CONTROLLERS = ("open-loop", "tvlqr", "replan")
 # W: catflip's world to the simulators' (catflip x -> z, z -> x, y -> -y), src/export/start.rs
 W = np.array([0.0, math.sqrt(0.5), 0.0, math.sqrt(0.5)])
 MASK = (1 << 64) - 1
@@ -133,7 +133,7 @@ def draws_of_csv(path):
                      "inertia_error": [f("inertia_error_rear"), f("inertia_error_front")],
                      "length_error": [f("length_error_rear"), f("length_error_front")],
                      "pd_gain_factor": f("pd_gain_factor")},
-                    {"open-loop": f("open_loop_landing_error_deg"), "tvlqr": f("tvlqr_landing_error_deg")}))
+                    {name: f(name.replace("-", "_") + "_landing_error_deg") for name in CONTROLLERS}))
     return out
 
 
@@ -287,6 +287,8 @@ class Stage:
     t0 = 0.0
     h = 1.0
     extra = np.zeros(2)
+    # the feed-forward of the plan in use, when it changes in flight (replanning)
+    ff = None
 
 
 # the stage the control callback works for: the flight's, or a prediction's inside a command
@@ -310,7 +312,7 @@ def make_callback(robot, ctl, stage):
     def control(m, d):
         stage = _STAGE[0]
         s = int(round(2.0 * (d.time - stage.t0) / stage.h))
-        f = ff[2 * stage.j + min(max(s, 0), 2)]
+        f = (ff if stage.ff is None else stage.ff)[2 * stage.j + min(max(s, 0), 2)]
         if robot.ball:
             v = quat_log(d.qpos[robot.qa:robot.qa + 4])
             jri, jdot_vd, vd = ball_kinematics(v, d.qvel[va:va + 3])
@@ -373,6 +375,9 @@ def fly(robot, ctl, start_sim, body_rate, d=None, plant=None):
             if j % period == 0 and j // period < ctl.control_steps:
                 meas = measure(robot, ctl, data, rng, noise)
                 queue[j + delay] = gain * ctl.torque(j * ctl.step, meas)
+                if ctl.replans:
+                    # a replan changes the feed-forward from the instant its plan acts on
+                    stage.ff = ctl.feedforward
             if j % noise["steps"] == 0 and noise["torque"] > 0:
                 tnoise = np.array([noise["torque"] * rng.normal(), noise["torque"] * rng.normal()])
             if queue[j] is not None:
@@ -394,9 +399,14 @@ class PackageController:
 
     def __init__(self, c):
         self.c = c
-        for k in ("step", "steps", "period_steps", "control_steps", "feedforward", "peak_torque"):
+        self.replans = c.kind == "replan"
+        for k in ("step", "steps", "period_steps", "control_steps", "peak_torque"):
             setattr(self, k, getattr(self.c, k))
         self.torque, self.sensed, self.clip, self.reset = self.c.torque, self.c.sensed, self.c.clip, self.c.reset
+
+    @property
+    def feedforward(self):
+        return self.c.feedforward
 
     def nominal_landing(self):
         return self.c.fly().landing_error_deg
@@ -622,6 +632,9 @@ class CsvController:
     TVLQR of `<stem>.tvlqr.csv` (predicting over its delay with MuJoCo's model of the
     robot), the PD on the planned shape of `<stem>.mujoco.csv`, whose held torques are
     the feed-forward."""
+
+    # replanning needs the package: this route has the open loop and the TVLQR
+    replans = False
 
     def __init__(self, robot, gains_csv, controls_csv, kind):
         from replay_common import read_controls

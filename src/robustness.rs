@@ -4,7 +4,7 @@ use crate::common::{Common, Status, load, publish_partial, publisher, say, say_l
 use anyhow::Result;
 use catflip::control::resume::{Published, StudyState};
 use catflip::control::robustness::{
-    DEFAULT_MAX_TILT_DEG, Study, TrialResult, shard_range, summarise, to_csv,
+    DEFAULT_MAX_TILT_DEG, Study, TrialResult, replan_timing, shard_range, summarise, to_csv,
 };
 use catflip::interrupt::{Outcome, supervise};
 use catflip::output::Output;
@@ -67,7 +67,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         let (cfg, store, range) = (cfg.clone(), store.clone(), range.clone());
         move || -> catflip::Result<()> {
             let design = catflip::control::robustness::design(&cfg)?;
-            let study = Study::new(&cfg, &design.plan, seed);
+            let study = Study::new(&cfg, Arc::new(design.plan), seed);
             study.run_into(range, threads, &store, |done, total| {
                 if quiet || (!live && done % (total / 20).max(1) != 0 && done != total) {
                     return;
@@ -118,6 +118,12 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         to_csv(&results, range.start == 0),
     );
     out.add(format!("robustness{suffix}.json"), json.clone());
+    // wall times: beside the study's files, not in them (they differ run to run)
+    let timing = replan_timing(&results, cfg.control.period());
+    out.add(
+        format!("robustness{suffix}.timing.json"),
+        serde_json::to_string_pretty(&timing)?,
+    );
     if !results.is_empty()
         && let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
     {
@@ -143,6 +149,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     } else {
         say_lines(catflip::console::robustness::study(
             &summary,
+            &timing,
             results.len(),
             range,
             trials,

@@ -378,7 +378,7 @@ class Controller:
     and one at ``t = 0`` starts a new flight. Safe to share between threads (a lock)."""
 
     def __init__(self, config: Config, design: Optional[Design] = None,
-                 kind: ControllerKind = "tvlqr") -> None:
+                 kind: ControllerKind = "tvlqr", budget_s: Optional[float] = None) -> None:
         """The controller ``kind`` along ``design`` (None: the study's own design, the free-form
         one from the phased seed that ``catflip robustness`` flies) on ``config``'s model and
         ``[control]`` keys; GIL released.
@@ -387,11 +387,15 @@ class Controller:
         ``control.delay_ms``, its correction capped at ``control.max_correction`` times the
         design's peak torque and the sum with the feed-forward kept in the motor envelope at
         the predicted speed. ``"open-loop"``: today's joint PD (``simulate.pd_*``) on the
-        planned shape, every simulator step. ``"replan"`` raises NotImplementedError:
-        replanning re-solves the design from the measured state, which needs designs from any
-        start, not yet in the library. Another kind raises ConfigError."""
+        planned shape, every simulator step. ``"replan"``: the same TVLQR about a plan solved
+        again in flight each ``control.replan_every`` periods (``control.replan_nodes`` nodes,
+        ``control.replan_iterations`` SCP iterations) from the state predicted where the new
+        plan acts, taken when the model lands better under it; ``feedforward`` then changes
+        from that instant on. ``budget_s``: a replan taking longer (wall clock) is dropped
+        (None: none is, as in catflip's deterministic study; a robot sets its control period).
+        Another kind, or a negative budget, raises ConfigError."""
     @property
-    def kind(self) -> Literal["tvlqr", "open-loop"]:
+    def kind(self) -> ControllerKind:
         """The study's name of the controller."""
     def torque(self, t: float, state: ArrayLike) -> F64:
         """The correction, N m: shape (2,), on top of the feed-forward, from ``state``
@@ -435,8 +439,9 @@ class Controller:
         """The design's largest feed-forward torque, N m (the config's norm)."""
     @property
     def feedforward(self) -> F64:
-        """The design's torque at every half step ``j h / 2``: shape (2 steps + 1, 2); an RK4
-        step ``j`` uses rows ``2j``, ``2j + 1``, ``2j + 2``."""
+        """The torque of the plan in use at every half step ``j h / 2``: shape (2 steps + 1, 2);
+        an RK4 step ``j`` uses rows ``2j``, ``2j + 1``, ``2j + 2``. The design's, but for the
+        replanning controller, whose replans change it from the instant their plan acts on."""
     @property
     def shape(self) -> F64:
         """The planned ``(q1, q2, qd1, qd2)`` at every step (the PD's reference): shape (steps + 1, 4)."""

@@ -382,7 +382,7 @@ const FINITE: [&str; 6] = [
     "phase_durations_s",
 ];
 
-type Plan = Box<dyn ShapePlan + Send + Sync>;
+type Plan = std::sync::Arc<dyn ShapePlan + Send + Sync>;
 
 #[pyclass(frozen, module = "catflip")]
 /// A designed schedule: what `catflip optimize --mode free|phased` (or `analyze`) writes.
@@ -447,7 +447,7 @@ fn run_design(
                 let json = serde_json::to_value(&r).expect("serialises");
                 catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
                 (
-                    Box::new(r.plan),
+                    std::sync::Arc::new(r.plan),
                     sched,
                     json,
                     status,
@@ -473,7 +473,7 @@ fn run_design(
                 let json = serde_json::to_value(&r).expect("serialises");
                 catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
                 (
-                    Box::new(r.plan),
+                    std::sync::Arc::new(r.plan),
                     sched,
                     json,
                     status,
@@ -500,7 +500,7 @@ fn run_design(
                 let json = serde_json::to_value(&a).expect("serialises");
                 catflip::output::ensure_finite(&json, &[]).map_err(err)?;
                 (
-                    Box::new(a.plan),
+                    std::sync::Arc::new(a.plan),
                     sched,
                     json,
                     status,
@@ -1428,18 +1428,22 @@ impl ControllerPlan {
             ControllerPlan::Study(p) => p.as_ref(),
         }
     }
+    fn shared(&self) -> Plan {
+        match self {
+            ControllerPlan::Design(d) => d.get().plan.clone(),
+            ControllerPlan::Study(p) => p.clone(),
+        }
+    }
 }
 
-/// A controller kind by its name; "replan" is refused, naming why.
+/// A controller kind by its name.
 fn controller_kind(kind: &str) -> PyResult<Kind> {
     match kind {
         "tvlqr" => Ok(Kind::Tvlqr),
         "open-loop" => Ok(Kind::OpenLoop),
-        "replan" => Err(pyo3::exceptions::PyNotImplementedError::new_err(
-            "kind=\"replan\" is not built yet: replanning re-solves the free-form design from the measured state at control.rate_hz; the re-solve from any start is in the catflip library (free::replan) but not yet in the closed loop, and it misses the control period (docs/control.md); use kind=\"tvlqr\" (or \"open-loop\")",
-        )),
+        "replan" => Ok(Kind::Replan),
         other => Err(ConfigError::new_err(format!(
-            "unknown controller kind `{other}`; use \"tvlqr\" or \"open-loop\" (\"replan\" is not built yet)"
+            "unknown controller kind `{other}`; use \"tvlqr\", \"replan\" or \"open-loop\""
         ))),
     }
 }
@@ -1457,18 +1461,27 @@ struct Flight {
 
 #[pymethods]
 impl Controller {
-    /// The controller `kind` (`"tvlqr"` or `"open-loop"`) along `design` (None: the
-    /// study's design, what `catflip robustness` flies) on `config`'s model and
-    /// `[control]` keys. `"replan"` raises NotImplementedError. GIL released.
+    /// The controller `kind` (`"tvlqr"`, `"replan"` or `"open-loop"`) along `design`
+    /// (None: the study's design, what `catflip robustness` flies) on `config`'s model
+    /// and `[control]` keys. `budget_s`: the replanning controller drops a replan that
+    /// takes longer (wall clock; None: none is dropped, as in catflip's study). GIL released.
     #[new]
-    #[pyo3(signature = (config, design = None, kind = "tvlqr"))]
+    #[pyo3(signature = (config, design = None, kind = "tvlqr", budget_s = None))]
     fn new(
         py: Python<'_>,
         config: &Config,
         design: Option<Py<Design>>,
         kind: &str,
+        budget_s: Option<f64>,
     ) -> PyResult<Controller> {
         let kind = controller_kind(kind)?;
+        if let Some(b) = budget_s
+            && !(b.is_finite() && b >= 0.0)
+        {
+            return Err(ConfigError::new_err(format!(
+                "budget_s = {b}: a replan's wall-clock budget, s, is finite and not negative (None: no budget)"
+            )));
+        }
         let (_, cfg) = config.snapshot();
         py.detach(move || {
             let plan = match design {
@@ -1479,7 +1492,8 @@ impl Controller {
                         .plan,
                 )),
             };
-            let online = Online::new(&cfg, plan.plan(), kind);
+            let mut online = Online::new(&cfg, plan.shared(), kind);
+            online.replanning.budget_s = budget_s;
             Ok(Controller {
                 online: Mutex::new(online),
                 cfg,
@@ -1488,7 +1502,7 @@ impl Controller {
         })
     }
 
-    /// `tvlqr` or `open-loop`.
+    /// `tvlqr`, `replan` or `open-loop`.
     #[getter]
     fn kind(&self) -> &'static str {
         self.lock().kind.name()
@@ -1603,7 +1617,8 @@ impl Controller {
     fn peak_torque(&self) -> f64 {
         self.lock().reference.peak_torque
     }
-    /// The design's feed-forward at every half step, `tau(j h / 2)`: float64, shape (2 steps + 1, 2).
+    /// The feed-forward of the plan in use at every half step, `tau(j h / 2)` (a replan
+    /// changes it from the instant its plan acts on): float64, shape (2 steps + 1, 2).
     #[getter]
     fn feedforward<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(py, &self.lock().reference.ff)
@@ -1685,7 +1700,7 @@ impl Controller {
     fn fly(&self, py: Python<'_>, trial: Option<usize>, seed: u64) -> Flight {
         py.detach(|| {
             let o = self.lock().clone();
-            let r = &o.reference;
+            let r = &o.design;
             let (draw, flight) = match trial {
                 None => (None, catflip::control::closed_loop::Flight::nominal(r)),
                 Some(i) => {
@@ -1696,6 +1711,9 @@ impl Controller {
             };
             let fb = match o.kind {
                 Kind::Tvlqr => catflip::control::closed_loop::Feedback::Tvlqr(&o.tvlqr),
+                Kind::Replan => {
+                    catflip::control::closed_loop::Feedback::Replan(&o.tvlqr, &o.replanning)
+                }
                 Kind::OpenLoop => match &draw {
                     Some(d) => catflip::control::robustness::open_loop(&o.pd, d),
                     None => catflip::control::closed_loop::Feedback::JointPd {

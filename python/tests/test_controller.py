@@ -1,7 +1,7 @@
 """catflip.Controller against catflip's own closed loop (the Rust flights of
 `catflip robustness`): the same corrections from the same measurements, zero
 correction on the nominal, the study's landing errors, the GIL released, and
-the documented refusal of kind="replan".
+the replanning controller's budget.
 
 The binary is $CATFLIP_BIN, else target/release/catflip (as test_catflip.py).
 """
@@ -48,19 +48,26 @@ def replay(c, flight):
 
 
 @pytest.mark.parametrize("name", ["seed", "robot"])
-@pytest.mark.parametrize("kind", ["tvlqr", "open-loop"])
+@pytest.mark.parametrize("kind", ["tvlqr", "open-loop", "replan"])
 @pytest.mark.parametrize("trial", [None, 3], ids=["nominal", "trial3"])
 def test_torque_equals_the_rust_closed_loop(name, kind, trial):
     c = controller(name, kind)
     f = c.fly(trial=trial, seed=7)
     assert f.measured.shape == (len(f.t), 11) and f.correction.shape == (len(f.t), 2)
-    assert len(f.t) == (c.control_steps if kind == "tvlqr" else c.steps)
+    assert len(f.t) == (c.steps if kind == "open-loop" else c.control_steps)
     u = replay(c, f)
     scale = c.peak_torque
-    assert np.abs(u - f.correction).max() <= 1e-12 * scale, np.abs(u - f.correction).max()
-    assert np.allclose(c.issued, f.correction, rtol=0, atol=1e-12 * scale)
+    # a replan solves from the measurement as the simulators' world gives it back, equal
+    # to the last bits only; the SCP carries that to about 1e-5 of the peak by touchdown
+    tol = (1e-4 if kind == "replan" else 1e-12) * scale
+    assert np.abs(u - f.correction).max() <= tol, np.abs(u - f.correction).max()
+    assert np.allclose(c.issued, f.correction, rtol=0, atol=tol)
     if trial is None and kind == "tvlqr":
         assert np.abs(f.correction).max() <= 1e-9 * scale
+    elif trial is None and kind == "replan":
+        # a replan's plan starts at the predicted state: on the model the TVLQR adds only
+        # what keeps a one-iteration plan's torque inside the motor envelope
+        assert np.abs(f.correction).max() <= 1e-3 * scale
     elif trial is None:
         # the PD tracks the plan's shape, which the model's motion under the feed-forward
         # follows to the design's tolerance only (the robot's design rides its motor
@@ -128,7 +135,8 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
     code, out, err = cli("robustness", SEED, "--trials", "3", "--seed", "5", "--json", out=tmp_path)
     assert code == 0, err
     rows = list(csv.DictReader(open(next(tmp_path.rglob("robustness.csv")))))
-    for kind, col in (("tvlqr", "tvlqr_landing_error_deg"), ("open-loop", "open_loop_landing_error_deg")):
+    for kind, col in (("tvlqr", "tvlqr_landing_error_deg"), ("open-loop", "open_loop_landing_error_deg"),
+                      ("replan", "replan_landing_error_deg")):
         c = controller("seed", kind)
         for row in rows:
             f = c.fly(trial=int(row["trial"]), seed=5)
@@ -136,13 +144,23 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
             assert f.draw["tilt_deg"] == float(row["tilt_deg"])
 
 
-def test_replan_is_refused_naming_why():
-    with pytest.raises(NotImplementedError, match="replan.*not built yet.*any start.*closed loop"):
-        catflip.Controller(config("seed"), kind="replan")
-    with pytest.raises(NotImplementedError, match="replan.*not built yet"):
-        controller("seed").with_kind("replan")
+def test_a_replan_over_its_budget_leaves_the_tvlqr_flying():
+    # no replan finishes in no time: every one is dropped, the TVLQR about the design flies
+    late = catflip.Controller(config("seed"), kind="replan", budget_s=0.0)
+    tv = controller("seed")
+    a, b = late.fly(trial=3, seed=7), tv.fly(trial=3, seed=7)
+    assert a.landing_error_deg == b.landing_error_deg
+    assert np.array_equal(a.correction, b.correction)
+    assert np.array_equal(late.feedforward, tv.feedforward)
+
+
+def test_unknown_kinds_and_bad_budgets_are_refused():
     with pytest.raises(catflip.ConfigError, match="unknown controller kind `lqr`"):
         catflip.Controller(config("seed"), kind="lqr")
+    with pytest.raises(catflip.ConfigError, match="unknown controller kind `lqr`"):
+        controller("seed").with_kind("lqr")
+    with pytest.raises(catflip.ConfigError, match="budget_s = -1"):
+        catflip.Controller(config("seed"), kind="replan", budget_s=-1.0)
 
 
 def test_bad_arguments_raise_config_errors():

@@ -40,10 +40,11 @@ def main() -> None:
     print(f"{tvlqr!r}: gains {gains.shape}, first torque {tau}, state {state.shape}, "
           f"nominal corrections <= {largest:.1e} N m, trial 0 lands {landing:.3f} deg, "
           f"PD every {pd.period:.2e} s")
-    try:
-        tvlqr.with_kind("replan")
-    except NotImplementedError as e:
-        print(f"replan: {e}")
+    # the replanning controller on a robot's clock: a replan over the period is dropped
+    replan = catflip.Controller(config, kind="replan", budget_s=tvlqr.period)
+    kind: catflip.ControllerKind = replan.kind
+    first: npt.NDArray[np.float64] = replan.torque(0.0, replan.nominal[0])
+    print(f"{kind}: first correction {first}, feed-forward {replan.feedforward.shape}")
 
 
 if __name__ == "__main__":

@@ -37,6 +37,13 @@ pub struct ControlConfig {
     /// peak torque (default 2): far from the design a linear gain asks for
     /// torques no actuator has; the motor envelope, when set, clips as well.
     pub max_correction: f64,
+    /// Collocation nodes per phase of a replan in flight (default 10).
+    pub replan_nodes: usize,
+    /// SCP iterations of a replan at most (default 1: a real-time iteration,
+    /// each replan warm-started from the last).
+    pub replan_iterations: usize,
+    /// Control periods from one replan to the next (default 1).
+    pub replan_every: usize,
 }
 
 impl Default for ControlConfig {
@@ -52,6 +59,9 @@ impl Default for ControlConfig {
             rate_weight: 0.1,
             torque_weight: 1.0,
             max_correction: 2.0,
+            replan_nodes: 10,
+            replan_iterations: 1,
+            replan_every: 1,
         }
     }
 }
@@ -99,6 +109,24 @@ impl ControlConfig {
             self.max_correction,
             self.max_correction > 0.0 && self.max_correction <= 1e6,
             "must be in (0, 1e6] times the design's peak torque",
+        )?;
+        check(
+            "control.replan_nodes",
+            self.replan_nodes as f64,
+            (4..=100).contains(&self.replan_nodes),
+            "must be in [4, 100] nodes per phase (a replan must fit a control period)",
+        )?;
+        check(
+            "control.replan_iterations",
+            self.replan_iterations as f64,
+            (1..=100).contains(&self.replan_iterations),
+            "must be in [1, 100] SCP iterations",
+        )?;
+        check(
+            "control.replan_every",
+            self.replan_every as f64,
+            (1..=1000).contains(&self.replan_every),
+            "must be in [1, 1000] control periods",
         )?;
         Ok(())
     }

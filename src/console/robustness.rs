@@ -1,12 +1,13 @@
 //! `robustness`'s table: each controller's success rate, its confidence
 //! interval and landing-error percentiles; and the study's progress bar.
 
-use crate::control::robustness::Summary;
+use crate::control::robustness::{ReplanTiming, Summary};
 use std::path::PathBuf;
 
 /// The study's table over `trials` trials `range` of `total`, `seed` its seed.
 pub fn study(
     summary: &Summary,
+    timing: &ReplanTiming,
     trials: usize,
     range: std::ops::Range<usize>,
     total: usize,
@@ -33,6 +34,24 @@ pub fn study(
             s.landing_error_deg.p50,
             s.landing_error_deg.p99,
             s.landing_error_deg.max
+        ));
+    }
+    if timing.replans > 0 {
+        lines.push(format!(
+            "  replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} over the {:.1} ms control period",
+            timing.replans,
+            timing.taken,
+            timing.worse,
+            timing.failed,
+            timing.late,
+            1e3 * timing.median_s,
+            1e3 * timing.p99_s,
+            1e3 * timing.max_s,
+            1e3 * timing.solve_median_s,
+            1e3 * timing.solve_p99_s,
+            1e3 * timing.solve_max_s,
+            timing.over_period,
+            1e3 * timing.period_s
         ));
     }
     for p in written {

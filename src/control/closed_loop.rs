@@ -4,6 +4,7 @@
 
 use super::plant::{Y, attitude, error, gyro, momentum_from_rates, rk4};
 use super::reference::Reference;
+use super::replanning::{InFlight, Record, Replanning};
 use super::rng::Rng;
 use super::tvlqr::Tvlqr;
 use crate::model::Cat;
@@ -18,6 +19,8 @@ pub enum Feedback<'a> {
     JointPd { kp: f64, kd: f64 },
     /// Time-varying LQR on the full state, at its control rate, predicting over its delay.
     Tvlqr(&'a Tvlqr),
+    /// The TVLQR about a plan solved again in flight ([`super::replanning`]).
+    Replan(&'a Tvlqr, &'a Replanning),
 }
 
 /// How the flight differs from the design's.
@@ -56,7 +59,7 @@ impl Flight {
 }
 
 /// How a flight ended.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct Landing {
     /// The belly's angle from straight down at touchdown, deg (NaN: diverged).
     pub error_deg: f64,
@@ -64,6 +67,8 @@ pub struct Landing {
     pub max_correction_nm: f64,
     /// The state at touchdown.
     pub state: Y,
+    /// The replans of the flight, in order (none but under [`Feedback::Replan`]).
+    pub replans: Vec<Record>,
 }
 
 /// One command of a flight: what the controller measured at simulator step
@@ -124,8 +129,27 @@ pub fn fly_logged(
     let mut max_corr = 0.0f64;
     let mut y = f.release;
     let period = match fb {
-        Feedback::Tvlqr(tv) => tv.period_steps,
+        Feedback::Tvlqr(tv) | Feedback::Replan(tv, _) => tv.period_steps,
         Feedback::JointPd { .. } => 1,
+    };
+    // a replanning flight changes its own copy of the reference
+    let mut replanned = match fb {
+        Feedback::Replan(_, rp) => Some((r.clone(), InFlight::new(rp.design.clone()))),
+        _ => None,
+    };
+    let finish = |y: Y, max_corr: f64, replanned: Option<(Reference, InFlight)>| {
+        let error_deg = if y.iter().all(|v| v.is_finite()) {
+            let rm = *attitude(&y).to_rotation_matrix().matrix();
+            landing_error(&rm).to_degrees()
+        } else {
+            f64::NAN
+        };
+        Landing {
+            error_deg,
+            max_correction_nm: max_corr,
+            state: y,
+            replans: replanned.map(|(_, p)| p.records).unwrap_or_default(),
+        }
     };
     for j in 0..n {
         if j % period == 0 {
@@ -140,6 +164,17 @@ pub fn fly_logged(
                         let m = measure(r, &mut f, &y);
                         let u = tvlqr_command(r, tv, motor, &issued, k, &m);
                         issued.push(u);
+                        (m, u)
+                    })
+                }
+                Feedback::Replan(tv, rp) => {
+                    let k = j / period;
+                    let (live, plan) = replanned.as_mut().expect("a replanning flight");
+                    (k < tv.starts.len()).then(|| {
+                        let m = measure(live, &mut f, &y);
+                        let u = tvlqr_command(live, tv, motor, &issued, k, &m);
+                        issued.push(u);
+                        plan.replan(live, rp, tv, motor, &issued, k, &m);
                         (m, u)
                     })
                 }
@@ -166,24 +201,43 @@ pub fn fly_logged(
             max_corr = max_corr.max(motor.norm.of(u));
         }
         let plant = f.plant;
-        y = rk4(&plant, &y, r.h, |s, ys| {
-            let ff = r.ff_at(j, s);
+        let live = replanned.as_ref().map_or(r, |(l, _)| l);
+        y = rk4(&plant, &y, live.h, |s, ys| {
+            let ff = live.ff_at(j, s);
             motor.clip([0, 1].map(|i| ff[i] + acting[i] + noise[i]), [ys[6], ys[7]])
         });
         if !y.iter().all(|v| v.is_finite()) {
-            return Landing {
-                error_deg: f64::NAN,
-                max_correction_nm: max_corr,
-                state: y,
-            };
+            return finish(y, max_corr, replanned);
         }
     }
-    let rm = *attitude(&y).to_rotation_matrix().matrix();
-    Landing {
-        error_deg: landing_error(&rm).to_degrees(),
-        max_correction_nm: max_corr,
-        state: y,
+    finish(y, max_corr, replanned)
+}
+
+/// The model's state at step `to` from the measurement `m` at step `from`,
+/// under the feed-forward of `r` and the corrections `issued` acting as the
+/// TVLQR `tv` sends them (in the motor envelope at the predicted speed).
+pub fn predict(
+    r: &Reference,
+    tv: &Tvlqr,
+    motor: &Motor,
+    issued: &[[f64; 2]],
+    from: usize,
+    to: usize,
+    m: &Y,
+) -> Y {
+    let mut yp = *m;
+    for i in from..to {
+        let u = tv
+            .interval_at(i)
+            .and_then(|c| issued.get(c))
+            .copied()
+            .unwrap_or([0.0; 2]);
+        yp = rk4(&r.cat, &yp, r.h, |st, ys| {
+            let ff = r.ff_at(i, st);
+            motor.clip([ff[0] + u[0], ff[1] + u[1]], [ys[6], ys[7]])
+        });
     }
+    yp
 }
 
 /// The TVLQR's correction `k` from the measurement `m` taken `delay` steps
@@ -200,18 +254,7 @@ pub fn tvlqr_command(
     m: &Y,
 ) -> [f64; 2] {
     let s = tv.starts[k];
-    let mut yp = *m;
-    for i in s - tv.delay_steps..s {
-        let u = tv
-            .interval_at(i)
-            .and_then(|c| issued.get(c))
-            .copied()
-            .unwrap_or([0.0; 2]);
-        yp = rk4(&r.cat, &yp, r.h, |st, ys| {
-            let ff = r.ff_at(i, st);
-            motor.clip([ff[0] + u[0], ff[1] + u[1]], [ys[6], ys[7]])
-        });
-    }
+    let yp = predict(r, tv, motor, issued, s - tv.delay_steps, s, m);
     let x = error(&yp, &r.nominal[s]);
     let mut u = -(tv.gains[k] * x);
     let size = motor.norm.of([u[0], u[1]]);

@@ -9,6 +9,7 @@ pub mod figure;
 pub mod online;
 pub mod plant;
 pub mod reference;
+pub mod replanning;
 pub mod resume;
 pub mod rng;
 pub mod robustness;

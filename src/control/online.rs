@@ -10,9 +10,9 @@
 use super::closed_loop::{pd_command, tvlqr_command};
 use super::plant::{Y, attitude, momentum_from_rates};
 use super::reference::Reference;
+use super::replanning::{InFlight, Record, Replanning, SharedPlan};
 use super::tvlqr::Tvlqr;
 use crate::config::Config;
-use crate::design::plan::ShapePlan;
 use crate::export::start::world_map;
 use crate::model::motor::Motor;
 use crate::verify::simulate::Controller;
@@ -30,6 +30,8 @@ pub enum Kind {
     OpenLoop,
     /// The time-varying LQR at `control.rate_hz`, predicting over `control.delay_ms`.
     Tvlqr,
+    /// The TVLQR about a plan solved again in flight ([`super::replanning`]).
+    Replan,
 }
 
 impl Kind {
@@ -38,6 +40,7 @@ impl Kind {
         match self {
             Kind::OpenLoop => "open-loop",
             Kind::Tvlqr => "tvlqr",
+            Kind::Replan => "replan",
         }
     }
 }
@@ -59,37 +62,51 @@ pub fn to_sim(y: &Y) -> SimState {
 }
 
 /// One controller along one design.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct Online {
     pub kind: Kind,
+    /// The plan in use (replanning changes it in flight).
     pub reference: Reference,
+    /// The design's, what a new flight starts on.
+    pub design: Reference,
     pub tvlqr: Tvlqr,
     pub motor: Motor,
     /// Today's PD gains (the open loop's).
     pub pd: Controller,
+    /// How the replanning controller replans (its budget: None unless set).
+    pub replanning: Replanning,
+    in_flight: InFlight,
     /// Corrections sent, by control step.
     issued: Vec<[f64; 2]>,
 }
 
 impl Online {
-    pub fn new(cfg: &Config, plan: &dyn ShapePlan, kind: Kind) -> Online {
-        let reference = Reference::new(cfg, plan);
+    pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> Online {
+        let reference = Reference::new(cfg, plan.as_ref());
         let tvlqr = Tvlqr::new(&reference, &cfg.control);
         Online {
             kind,
+            design: reference.clone(),
             reference,
             tvlqr,
             motor: cfg.motor(),
             pd: Controller::from_config(cfg),
+            in_flight: InFlight::new(plan.clone()),
+            replanning: Replanning::new(cfg, plan),
             issued: Vec::new(),
         }
+    }
+
+    /// The replans of the flight so far.
+    pub fn replans(&self) -> &[Record] {
+        &self.in_flight.records
     }
 
     /// Simulator steps between two commands.
     pub fn period_steps(&self) -> usize {
         match self.kind {
             Kind::OpenLoop => 1,
-            Kind::Tvlqr => self.tvlqr.period_steps,
+            Kind::Tvlqr | Kind::Replan => self.tvlqr.period_steps,
         }
     }
 
@@ -97,7 +114,7 @@ impl Online {
     pub fn delay_steps(&self) -> usize {
         match self.kind {
             Kind::OpenLoop => 0,
-            Kind::Tvlqr => self.tvlqr.delay_steps,
+            Kind::Tvlqr | Kind::Replan => self.tvlqr.delay_steps,
         }
     }
 
@@ -106,7 +123,7 @@ impl Online {
     pub fn control_steps(&self) -> usize {
         match self.kind {
             Kind::OpenLoop => self.reference.steps,
-            Kind::Tvlqr => self.tvlqr.starts.len(),
+            Kind::Tvlqr | Kind::Replan => self.tvlqr.starts.len(),
         }
     }
 
@@ -144,9 +161,13 @@ impl Online {
         ]
     }
 
-    /// Forgets the corrections sent (a new flight).
+    /// Forgets the corrections sent and the replans (a new flight, on the design).
     pub fn reset(&mut self) {
         self.issued.clear();
+        if self.kind == Kind::Replan {
+            self.reference = self.design.clone();
+        }
+        self.in_flight = InFlight::new(self.replanning.design.clone());
     }
 
     /// The corrections sent so far, by control step.
@@ -162,11 +183,14 @@ impl Online {
         if k >= self.control_steps() {
             return self.issued.last().copied().unwrap_or([0.0; 2]);
         }
+        if k == 0 {
+            self.reset();
+        }
         // a step skipped sent nothing
         self.issued.resize(k, [0.0; 2]);
         let u = match self.kind {
             Kind::OpenLoop => pd_command(&self.reference, self.pd.kp, self.pd.kd, k, m),
-            Kind::Tvlqr => tvlqr_command(
+            Kind::Tvlqr | Kind::Replan => tvlqr_command(
                 &self.reference,
                 &self.tvlqr,
                 &self.motor,
@@ -176,6 +200,17 @@ impl Online {
             ),
         };
         self.issued.push(u);
+        if self.kind == Kind::Replan {
+            self.in_flight.replan(
+                &mut self.reference,
+                &self.replanning,
+                &self.tvlqr,
+                &self.motor,
+                &self.issued,
+                k,
+                m,
+            );
+        }
         u
     }
 }

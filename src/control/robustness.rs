@@ -5,10 +5,11 @@
 
 use super::closed_loop::{Feedback, Flight, fly};
 use super::reference::{Reference, release};
+use super::replanning::SharedPlan;
+use super::replanning::{Outcome, Record, Replanning};
 use super::rng::Rng;
 use super::tvlqr::{Tvlqr, steps_of};
 use crate::config::Config;
-use crate::design::plan::ShapePlan;
 use crate::model::momentum::Start;
 use crate::model::{Cat, Half};
 use crate::verify::simulate::Controller;
@@ -18,7 +19,7 @@ use serde::Serialize;
 pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
 
 /// The controllers a study compares, in the order of the CSV's columns.
-pub const CONTROLLERS: [&str; 2] = ["open-loop", "tvlqr"];
+pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 
 /// The design a study flies: the free-form one from the phased seed, as
 /// `run` makes it, or from the analytic seed where the phased family cannot fit.
@@ -112,10 +113,14 @@ impl Draw {
 }
 
 /// A trial's outcome: the landing error under each of [`CONTROLLERS`].
-#[derive(Debug, Clone, Copy, Serialize)]
+#[derive(Debug, Clone, Serialize)]
 pub struct TrialResult {
     pub draw: Draw,
-    pub landing_error_deg: [f64; 2],
+    pub landing_error_deg: [f64; 3],
+    /// The replanning controller's replans (wall times: not part of the
+    /// study's deterministic files; empty for trials read back from a CSV).
+    #[serde(skip)]
+    pub replans: Vec<Record>,
 }
 
 /// Trial `trial` of the study seeded by `seed`: its draws and the flight
@@ -160,11 +165,12 @@ pub struct Study<'a> {
     pub reference: Reference,
     pub tvlqr: Tvlqr,
     pub pd: Controller,
+    pub replanning: Replanning,
 }
 
 impl<'a> Study<'a> {
-    pub fn new(cfg: &'a Config, plan: &dyn ShapePlan, seed: u64) -> Study<'a> {
-        let reference = Reference::new(cfg, plan);
+    pub fn new(cfg: &'a Config, plan: SharedPlan, seed: u64) -> Study<'a> {
+        let reference = Reference::new(cfg, plan.as_ref());
         let tvlqr = Tvlqr::new(&reference, &cfg.control);
         Study {
             cfg,
@@ -172,6 +178,7 @@ impl<'a> Study<'a> {
             reference,
             tvlqr,
             pd: Controller::from_config(cfg),
+            replanning: Replanning::new(cfg, plan),
         }
     }
 
@@ -185,10 +192,13 @@ impl<'a> Study<'a> {
         let (draw, flight) = trial_flight(cfg, r, &self.tvlqr, self.seed, trial);
         let motor = cfg.motor();
         let open = fly(r, open_loop(&self.pd, &draw), &motor, flight.clone());
-        let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight);
+        let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight.clone());
+        let fb = Feedback::Replan(&self.tvlqr, &self.replanning);
+        let replan = fly(r, fb, &motor, flight);
         TrialResult {
             draw,
-            landing_error_deg: [open.error_deg, closed.error_deg],
+            landing_error_deg: [open.error_deg, closed.error_deg, replan.error_deg],
+            replans: replan.replans,
         }
     }
 
@@ -351,8 +361,54 @@ pub fn summarise(results: &[TrialResult], seed: u64, max_tilt_deg: f64, keep: us
     }
 }
 
+/// The replanning controller's replans over a study's flown trials: wall
+/// times on this machine, so outside the study's deterministic files.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplanTiming {
+    pub replans: usize,
+    pub taken: usize,
+    pub failed: usize,
+    pub late: usize,
+    pub worse: usize,
+    /// Wall time of one replan, s (prediction, solve, comparison, splice).
+    pub median_s: f64,
+    pub p99_s: f64,
+    pub max_s: f64,
+    /// Of which the solve, s.
+    pub solve_median_s: f64,
+    pub solve_p99_s: f64,
+    pub solve_max_s: f64,
+    /// The control period, s, and the replans that took longer.
+    pub period_s: f64,
+    pub over_period: usize,
+}
+
+pub fn replan_timing(results: &[TrialResult], period_s: f64) -> ReplanTiming {
+    let all: Vec<&Record> = results.iter().flat_map(|r| &r.replans).collect();
+    let count = |o: Outcome| all.iter().filter(|r| r.outcome == o).count();
+    let mut t: Vec<f64> = all.iter().map(|r| r.seconds).collect();
+    t.sort_by(f64::total_cmp);
+    let mut solve: Vec<f64> = all.iter().map(|r| r.solve_seconds).collect();
+    solve.sort_by(f64::total_cmp);
+    ReplanTiming {
+        replans: all.len(),
+        taken: count(Outcome::Taken),
+        failed: count(Outcome::Failed),
+        late: count(Outcome::Late),
+        worse: count(Outcome::Worse),
+        median_s: percentile(&t, 0.5),
+        p99_s: percentile(&t, 0.99),
+        max_s: t.last().copied().unwrap_or(f64::NAN),
+        solve_median_s: percentile(&solve, 0.5),
+        solve_p99_s: percentile(&solve, 0.99),
+        solve_max_s: solve.last().copied().unwrap_or(f64::NAN),
+        period_s,
+        over_period: t.iter().filter(|&&x| x > period_s).count(),
+    }
+}
+
 /// The CSV header: the draws, then each controller's landing error.
-pub const CSV_HEADER: &str = "trial,spin_x_rad_s,spin_y_rad_s,spin_z_rad_s,tilt_deg,tilt_axis_deg,mass_error_rear,mass_error_front,inertia_error_rear,inertia_error_front,length_error_rear,length_error_front,pd_gain_factor,open_loop_landing_error_deg,tvlqr_landing_error_deg";
+pub const CSV_HEADER: &str = "trial,spin_x_rad_s,spin_y_rad_s,spin_z_rad_s,tilt_deg,tilt_axis_deg,mass_error_rear,mass_error_front,inertia_error_rear,inertia_error_front,length_error_rear,length_error_front,pd_gain_factor,open_loop_landing_error_deg,tvlqr_landing_error_deg,replan_landing_error_deg";
 
 /// Rows of `results`; with the header only for the first shard, so that
 /// the shards' files concatenate into the whole study's.
@@ -379,6 +435,7 @@ pub fn to_csv(results: &[TrialResult], header: bool) -> String {
             d.pd_gain_factor,
             r.landing_error_deg[0],
             r.landing_error_deg[1],
+            r.landing_error_deg[2],
         ]
         .iter()
         .map(|x| format!("{x:e}"))
@@ -405,8 +462,8 @@ pub fn from_csv(text: &str) -> std::result::Result<Vec<TrialResult>, String> {
         let v: Vec<f64> = cells
             .map(|c| c.parse().map_err(|_| bad("not a number")))
             .collect::<std::result::Result<_, _>>()?;
-        if v.len() != 14 {
-            return Err(bad("not 15 columns"));
+        if v.len() != 15 {
+            return Err(bad("not 16 columns"));
         }
         out.push(TrialResult {
             draw: Draw {
@@ -419,7 +476,8 @@ pub fn from_csv(text: &str) -> std::result::Result<Vec<TrialResult>, String> {
                 length_error: [v[9], v[10]],
                 pd_gain_factor: v[11],
             },
-            landing_error_deg: [v[12], v[13]],
+            landing_error_deg: [v[12], v[13], v[14]],
+            replans: Vec::new(),
         });
     }
     Ok(out)
@@ -459,7 +517,9 @@ mod tests {
                 landing_error_deg: [
                     0.1 + 0.2 * t as f64,
                     if t == 5 { f64::NAN } else { 1e-300 / 3.0 },
+                    std::f64::consts::PI * t as f64,
                 ],
+                replans: Vec::new(),
             })
             .collect();
         for header in [true, false] {
@@ -469,13 +529,13 @@ mod tests {
             for (a, b) in results.iter().zip(&back) {
                 assert_eq!(a.draw.trial, b.draw.trial);
                 assert_eq!(a.draw.tilt_deg.to_bits(), b.draw.tilt_deg.to_bits());
-                for c in 0..2 {
+                for c in 0..3 {
                     let (x, y) = (a.landing_error_deg[c], b.landing_error_deg[c]);
                     assert!(x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()));
                 }
             }
         }
-        assert!(from_csv("3,1,2\n").unwrap_err().contains("15 columns"));
+        assert!(from_csv("3,1,2\n").unwrap_err().contains("16 columns"));
     }
 
     #[test]
