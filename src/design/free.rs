@@ -50,6 +50,9 @@ use crate::verify::simulate::SimReport;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
+mod replanning;
+pub use replanning::{Replan, Replanner, replan};
+
 /// A torque check point: interval index, normalised `(q, q^, q^^)`, and the
 /// interpolation coefficients of `q`, `q^`, `q^^` on the interval's node values.
 type CheckPoint = (usize, [f64; 2], [f64; 2], [f64; 2], [[f64; 4]; 3]);
@@ -300,19 +303,29 @@ impl FreeProblem {
     /// exact constraints: one small QP, so that a sampled seed (or a
     /// neighbour's solution) is a feasible start.
     pub fn project(&self, z: &[f64]) -> Result<Vec<f64>> {
+        let d = self.projection_data(z);
+        let (st, dz, _) = crate::design::conic::ConicSolver::new(&d)?.solve();
+        if !st.ok() {
+            return Err(Self::projection_failed(st));
+        }
+        Ok(z.iter().zip(&dz).map(|(a, b)| a + b).collect())
+    }
+
+    /// The projection's program: the least scaled step onto the exact constraints.
+    fn projection_data(&self, z: &[f64]) -> ConicData {
         let mut d = ConicData::new(self.dim());
         d.p_diag = Some(self.scales.iter().map(|s| 1.0 / (s * s)).collect());
         self.add_constraints(&mut d, z, &|i| i);
-        let (st, dz, _) = crate::design::conic::ConicSolver::new(&d)?.solve();
-        if !st.ok() {
-            return Err(crate::error::Error::Solver {
-                what: "projecting the free-form seed onto the constraints".into(),
-                status: format!("{st:?}"),
-                hint: "check limits.max_bend_deg and fall.margin (the seed cannot be made to fit them)"
-                    .into(),
-            });
+        d
+    }
+
+    fn projection_failed(st: crate::design::conic::SolveStatus) -> crate::error::Error {
+        crate::error::Error::Solver {
+            what: "projecting the free-form seed onto the constraints".into(),
+            status: format!("{st:?}"),
+            hint: "check limits.max_bend_deg and fall.margin (the seed cannot be made to fit them)"
+                .into(),
         }
-        Ok(z.iter().zip(&dz).map(|(a, b)| a + b).collect())
     }
 
     fn with_durations_times(&self, z: &[f64], k: f64) -> Vec<f64> {
@@ -516,7 +529,11 @@ impl FreeProblem {
                 if let Some(mu) = mu {
                     // the momentum's part g(q, q^, mu), mu = T_p R' l: exact in
                     // the local shape and the duration, lagged in the attitude
-                    let (g, dg) = Release::torque(&self.cat, q, v, mu);
+                    let (g, dg) = if want_grad {
+                        Release::torque(&self.cat, q, v, mu)
+                    } else {
+                        (Release::torque_value(&self.cat, q, v, mu), [[0.0; 4]; 2])
+                    };
                     let dmu = want_grad.then(|| Release::torque_dmu(&self.cat, q, v, mu));
                     for i in 0..2 {
                         let row = &mut rows[i];
@@ -1659,114 +1676,6 @@ fn design_problem(
         plan,
         attitude_error,
         node_peak,
-    })
-}
-
-/// The rest of a plan from `t0`, as a plan of three phases starting at 0:
-/// the phases still to come keep their bounds; when fewer than three remain,
-/// the remaining time of the current one is split evenly (a replan's seed).
-struct Remainder<'a> {
-    plan: &'a dyn ShapePlan,
-    t0: f64,
-    bounds: [f64; 4],
-}
-
-impl<'a> Remainder<'a> {
-    fn new(plan: &'a dyn ShapePlan, t0: f64) -> Self {
-        let b = plan.phase_bounds();
-        let end = b[3];
-        let i = (0..3).find(|&i| t0 < b[i + 1]).unwrap_or(2);
-        let cuts: Vec<f64> = match i {
-            0 => vec![b[1], b[2]],
-            1 => vec![0.5 * (t0 + b[2]), b[2]],
-            _ => vec![t0 + (end - t0) / 3.0, t0 + 2.0 * (end - t0) / 3.0],
-        };
-        Remainder {
-            plan,
-            t0,
-            bounds: [0.0, cuts[0] - t0, cuts[1] - t0, end - t0],
-        }
-    }
-}
-
-impl ShapePlan for Remainder<'_> {
-    fn phase_bounds(&self) -> Vec<f64> {
-        self.bounds.to_vec()
-    }
-    fn state_in(&self, i: usize, t: f64) -> crate::design::plan::ShapeState {
-        let mut s = self.plan.state(self.t0 + t);
-        s.phase = crate::design::plan::Phase::ALL[i.min(2)];
-        s
-    }
-}
-
-/// A replan: the free-form design from a state measured in flight.
-#[derive(Debug, Clone)]
-pub struct Replan {
-    /// The new plan, from the measured instant (its time 0) to the end of the manoeuvre.
-    pub plan: CollocationPlan,
-    pub status: ScpStatus,
-    pub scp_iterations: usize,
-    /// The optimiser's own landing error, rad.
-    pub landing_error_rad: f64,
-    /// Wall time of the solve, s.
-    pub seconds: f64,
-}
-
-/// Re-solves the free-form design of `cfg` from the state `y` measured at
-/// time `t` of the flight (`[quaternion, q, q_dot, lambda]`, the closed
-/// loop's: attitude, shape, shape rate, body-frame momentum) over the time
-/// the fall still leaves, to the landing set, seeded by the rest of
-/// `previous` (whose time 0 is the release) and with at most
-/// `max_iterations` SCP iterations on `nodes` per phase. The new plan's time
-/// 0 is `t`.
-pub fn replan(
-    cfg: &Config,
-    previous: &dyn ShapePlan,
-    t: f64,
-    y: &[f64; 11],
-    nodes: usize,
-    max_iterations: usize,
-) -> Result<Replan> {
-    let clock = std::time::Instant::now();
-    let end = previous.duration();
-    let remaining = cfg.available_time() - t;
-    if !(t >= 0.0 && t < end && remaining > 0.0) {
-        return Err(crate::error::Error::Invalid {
-            key: "replan time".into(),
-            value: format!("{t}"),
-            expected: format!("within the manoeuvre, [0, {end})"),
-        });
-    }
-    let mut rc = cfg.clone();
-    let g = rc.fall.gravity;
-    rc.fall.height = 0.5 * g * (remaining + rc.fall.margin).powi(2);
-    rc.free.max_iterations = max_iterations;
-    let seed = Remainder::new(previous, t);
-    let z0 = Transcription::new(3, nodes).sample(&seed);
-    let mut problem = FreeProblem::new(&rc, nodes, &z0);
-    let cat = rc.cat();
-    let att = [y[0], y[1], y[2], y[3]];
-    let lam = nalgebra::Vector3::new(y[8], y[9], y[10]);
-    let l = crate::model::so3::quat_from(&att) * lam;
-    let unit = problem.time_unit;
-    problem.release = Some(Release {
-        attitude: att,
-        momentum: [l.x, l.y, l.z].map(|c| c * unit),
-        tail: rc.fall.margin / unit,
-        inertias: crate::model::momentum::straight_inertias(&cat),
-    });
-    problem.initial = Some(([y[4], y[5]], [y[6], y[7]]));
-    // the check points the attitude map knows the momentum at
-    let checks = problem.checks;
-    let problem = problem.with_checks(checks);
-    let solved = design_problem(&rc, problem, &z0, None, Mesh::Final, 0, |_| {})?;
-    Ok(Replan {
-        status: solved.res.status,
-        scp_iterations: solved.res.iterations.len(),
-        landing_error_rad: solved.attitude_error,
-        plan: solved.plan,
-        seconds: clock.elapsed().as_secs_f64(),
     })
 }
 

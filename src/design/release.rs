@@ -52,6 +52,18 @@ pub struct Path {
     pub end_jac: Vec<[f64; 4]>,
 }
 
+/// A Runge-Kutta sub-step's inputs: the quaternion (4), then its interval's
+/// eight node values (component 0 then 1) and the phase duration.
+const INPUTS: usize = 13;
+
+/// One sub-step's derivative: `dx[r][dir]`, the next quaternion's component
+/// `r` in input `dir` ([`INPUTS`]), and the columns of `z` of the inputs
+/// after the quaternion.
+struct StepDerivative {
+    dx: [[f64; INPUTS]; 4],
+    columns: [usize; INPUTS - 4],
+}
+
 fn dual<const N: usize>(x: f64, i: usize) -> DualSVec64<N> {
     DualSVec64::<N>::from_re(x).derivative(i)
 }
@@ -115,16 +127,15 @@ impl Release {
         want_jac: bool,
     ) -> Path {
         let n = tr.nodes;
-        let dim = tr.dim();
         let mut x = self.attitude;
-        let mut s = if want_jac {
-            vec![[0.0; 4]; dim]
-        } else {
-            Vec::new()
-        };
         let hs = tr.h() / SUB as f64;
         let mut mu = Vec::new();
         let mut knots = Vec::new();
+        // with `want_jac`, each sub-step's derivative in its own inputs
+        // (reverse mode: the final quaternion's Jacobian is accumulated
+        // backwards from these, a 4x4 product per step instead of a
+        // forward sweep over every column)
+        let mut steps: Vec<StepDerivative> = Vec::new();
         for p in 0..3 {
             let dur = z[tr.duration(p)];
             let dcol = tr.duration(p);
@@ -140,7 +151,8 @@ impl Release {
                     let pts = [0.0, 0.5, 0.5, 1.0].map(|f| d.at(c0 + f / SUB as f64));
                     let a = [0.0, 0.5, 0.5, 1.0];
                     let mut ks = [[0.0; 4]; 4];
-                    let mut kj: Vec<Vec<[f64; 4]>> = Vec::new();
+                    // dK_stage / d(x, local inputs), 4 rows by INPUTS
+                    let mut dk = [[[0.0; INPUTS]; 4]; 4];
                     for stage in 0..4 {
                         let it = &pts[stage];
                         let xs: [f64; 4] = std::array::from_fn(|i| {
@@ -163,56 +175,81 @@ impl Release {
                         );
                         ks[stage] = f.map(|c| c.re);
                         let g: [[f64; 9]; 4] = f.map(|c| grad(&c));
-                        // stage state's Jacobian: S + a h K_{stage-1}
-                        let mut out = vec![[0.0; 4]; dim];
-                        for (col, o) in out.iter_mut().enumerate() {
-                            let mut sx = s[col];
+                        // the stage state's derivative: identity in x plus a h dK_{stage-1}
+                        let mut dxs = [[0.0; INPUTS]; 4];
+                        for i in 0..4 {
+                            dxs[i][i] = 1.0;
                             if stage > 0 {
-                                for i in 0..4 {
-                                    sx[i] += a[stage] * hs * kj[stage - 1][col][i];
+                                for dir in 0..INPUTS {
+                                    dxs[i][dir] += a[stage] * hs * dk[stage - 1][i][dir];
                                 }
-                            }
-                            if sx == [0.0; 4] {
-                                continue;
-                            }
-                            for r in 0..4 {
-                                o[r] = (0..4).map(|i| g[r][i] * sx[i]).sum();
                             }
                         }
                         for r in 0..4 {
+                            let row = &mut dk[stage][r];
+                            for (dir, o) in row.iter_mut().enumerate() {
+                                *o = (0..4).map(|i| g[r][i] * dxs[i][dir]).sum();
+                            }
                             for comp in 0..2 {
-                                for (idx, &col) in cols[comp].iter().enumerate() {
-                                    out[col][r] +=
+                                for idx in 0..4 {
+                                    row[4 + 4 * comp + idx] +=
                                         g[r][4 + comp] * it.dq[idx] + g[r][6 + comp] * it.dv[idx];
                                 }
                             }
-                            out[dcol][r] += g[r][8];
+                            row[12] += g[r][8];
                         }
-                        kj.push(out);
                     }
                     for i in 0..4 {
                         x[i] += hs / 6.0 * (ks[0][i] + 2.0 * ks[1][i] + 2.0 * ks[2][i] + ks[3][i]);
                     }
                     if want_jac {
-                        for (col, sc) in s.iter_mut().enumerate() {
-                            for i in 0..4 {
-                                sc[i] += hs / 6.0
-                                    * (kj[0][col][i]
-                                        + 2.0 * kj[1][col][i]
-                                        + 2.0 * kj[2][col][i]
-                                        + kj[3][col][i]);
+                        let mut dx = [[0.0; INPUTS]; 4];
+                        for i in 0..4 {
+                            dx[i][i] = 1.0;
+                            for dir in 0..INPUTS {
+                                dx[i][dir] += hs / 6.0
+                                    * (dk[0][i][dir]
+                                        + 2.0 * dk[1][i][dir]
+                                        + 2.0 * dk[2][i][dir]
+                                        + dk[3][i][dir]);
                             }
                         }
+                        let mut columns = [dcol; INPUTS - 4];
+                        columns[..4].copy_from_slice(&cols[0]);
+                        columns[4..8].copy_from_slice(&cols[1]);
+                        steps.push(StepDerivative { dx, columns });
                     }
                 }
             }
             mu.push(self.mu(x, dur));
         }
+        let mut end_jac = Vec::new();
+        if want_jac {
+            end_jac = vec![[0.0; 4]; tr.dim()];
+            // psi = d end / d (the state after the step), from the end back
+            let mut psi = [[0.0; 4]; 4];
+            for (i, row) in psi.iter_mut().enumerate() {
+                row[i] = 1.0;
+            }
+            for st in steps.iter().rev() {
+                for (c, &col) in st.columns.iter().enumerate() {
+                    for r in 0..4 {
+                        end_jac[col][r] += (0..4).map(|i| psi[r][i] * st.dx[i][4 + c]).sum::<f64>();
+                    }
+                }
+                let before = psi;
+                for r in 0..4 {
+                    for c in 0..4 {
+                        psi[r][c] = (0..4).map(|i| before[r][i] * st.dx[i][c]).sum();
+                    }
+                }
+            }
+        }
         Path {
             mu,
             knots,
             end: x,
-            end_jac: s,
+            end_jac,
         }
     }
 
@@ -265,6 +302,12 @@ impl Release {
             mu.map(DualSVec64::<4>::from_re),
         );
         (g.map(|c| c.re), g.map(|c| grad(&c)))
+    }
+
+    /// The momentum part `g(q, q^, mu)` alone, in plain `f64` (a value
+    /// without its gradient: a fifth of [`Release::torque`]'s work).
+    pub fn torque_value(cat: &Cat, q: [f64; 2], v: [f64; 2], mu: [f64; 3]) -> [f64; 2] {
+        momentum_torque(cat, q, v, mu)
     }
 
     /// `d g / d mu` at a check point (3 columns per torque component).

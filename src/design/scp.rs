@@ -1184,9 +1184,11 @@ fn scaled_max(d: impl Iterator<Item = f64>, scales: &[f64]) -> f64 {
     d.zip(scales).fold(0.0, |m, (d, s)| m.max(d.abs() / s))
 }
 
-/// Fixed-pattern Clarabel solvers reused across iterations.
+/// Fixed-pattern Clarabel solvers reused across iterations, and across the
+/// runs of problems with one pattern ([`Executor::run_reusing`]: a replan's
+/// subproblems are the last one's with other values).
 #[derive(Default)]
-struct Solvers {
+pub struct Solvers {
     subproblem: Option<ConicSolver>,
     correction: Option<ConicSolver>,
     bounded_correction: Option<ConicSolver>,
@@ -1939,10 +1941,24 @@ impl<'a> Executor<'a> {
         z0: Vec<f64>,
         observer: &mut dyn Observer,
     ) -> Result<ScpResult> {
+        self.run_reusing(p, z0, observer, &mut Solvers::default())
+    }
+
+    /// [`Executor::run`] with the conic solvers of an earlier run (their
+    /// setup and symbolic factorisation are kept where the pattern fits),
+    /// left in `solvers` for the next.
+    pub fn run_reusing(
+        &self,
+        p: &dyn ScpProblem,
+        z0: Vec<f64>,
+        observer: &mut dyn Observer,
+        solvers: &mut Solvers,
+    ) -> Result<ScpResult> {
         self.settings.validate()?;
         let clock = Instant::now();
         let scp = Scp::new(p, self.settings);
         let mut state = scp.init(z0, self.warm);
+        state.solvers = std::mem::take(solvers);
         let mut iterations = Vec::new();
         let mut termination = Termination::IterationLimit;
         for _ in 0..self.settings.max_iterations {
@@ -1963,6 +1979,7 @@ impl<'a> Executor<'a> {
             }
         }
         let seconds = clock.elapsed().as_secs_f64();
+        *solvers = std::mem::take(&mut state.solvers);
         Ok(scp.finish(state, termination, iterations, seconds))
     }
 }
