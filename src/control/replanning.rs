@@ -1,5 +1,6 @@
 //! Replanning in flight: at each replan instant the free-form design is
-//! solved again ([`crate::design::free::replan`]) from the state predicted
+//! solved again ([`crate::design::free::Replanner`], one per flight, warm
+//! from replan to replan) from the state predicted
 //! at the instant the new plan can act (one control period to compute it,
 //! then the actuator delay), warm-started from the plan in use, over the
 //! time the fall still leaves. The new plan's feed-forward and the nominal
@@ -17,7 +18,8 @@ use super::plant::{Y, attitude};
 use super::reference::Reference;
 use super::tvlqr::Tvlqr;
 use crate::config::Config;
-use crate::design::plan::{ShapePlan, ShapeState};
+use crate::design::free::Replanner;
+use crate::design::plan::ShapePlan;
 use crate::model::Cat;
 use crate::model::momentum::landing_error;
 use crate::model::motor::Motor;
@@ -89,31 +91,9 @@ pub struct Record {
     /// Wall time of the replan, s: the prediction, the solve, the comparison
     /// of the two plans and the splice of the one taken.
     pub seconds: f64,
-    /// Of which the solve (`free::replan`), s.
+    /// Of which the solve (`Replanner::replan`), s.
     pub solve_seconds: f64,
     pub outcome: Outcome,
-}
-
-/// A plan seen from the release: `plan`'s time 0 is the flight's `offset`.
-struct Shifted<'a> {
-    plan: &'a dyn ShapePlan,
-    offset: f64,
-}
-
-impl ShapePlan for Shifted<'_> {
-    fn phase_bounds(&self) -> Vec<f64> {
-        let mut b = self.plan.phase_bounds();
-        for v in &mut b[1..] {
-            *v += self.offset;
-        }
-        b
-    }
-    fn state_in(&self, i: usize, t: f64) -> ShapeState {
-        self.plan.state_in(i, (t - self.offset).max(0.0))
-    }
-    fn torque_in(&self, cat: &Cat, i: usize, t: f64) -> [f64; 2] {
-        self.plan.torque_in(cat, i, (t - self.offset).max(0.0))
-    }
 }
 
 /// The plan a replanning flight is on, and the one its replans iterate on.
@@ -123,7 +103,6 @@ impl ShapePlan for Shifted<'_> {
 /// the real-time iteration), and the flight switches to the chain's latest
 /// plan when the model, flown from the predicted state, lands better under
 /// it than under the plan in use.
-#[derive(Clone)]
 pub struct InFlight {
     plan: SharedPlan,
     /// Flight time of the plan's time 0, s.
@@ -136,6 +115,23 @@ pub struct InFlight {
     /// rad, it found for the plan in use.
     in_use: Option<(usize, f64)>,
     pub records: Vec<Record>,
+    /// The flight's solver state (made at its first replan), warm from replan to replan.
+    replanner: Option<Replanner>,
+}
+
+impl Clone for InFlight {
+    /// A copy starts its solver state afresh (the next replan makes it).
+    fn clone(&self) -> Self {
+        InFlight {
+            plan: self.plan.clone(),
+            offset: self.offset,
+            candidate: self.candidate.clone(),
+            misses: self.misses,
+            in_use: self.in_use,
+            records: self.records.clone(),
+            replanner: None,
+        }
+    }
 }
 
 /// Replans in a row after which an untaken chain restarts from the plan in use.
@@ -158,6 +154,7 @@ impl InFlight {
             misses: 0,
             in_use: None,
             records: Vec::new(),
+            replanner: None,
         }
     }
 
@@ -192,11 +189,12 @@ impl InFlight {
         // (the step before `s` ends on the sample at `s`, which a plan taken replaces)
         let before = predict(r, tv, motor, issued, k * tv.period_steps, s - 1, m);
         let y = predict(r, tv, motor, issued, s - 1, s, &before);
-        let from = Shifted {
-            plan: base.as_ref(),
-            offset,
-        };
-        let solved = crate::design::free::replan(&rp.cfg, &from, t, &y, rp.nodes, rp.iterations);
+        let solved = match &mut self.replanner {
+            Some(p) => Ok(p),
+            None => Replanner::new(&rp.cfg, rp.nodes)
+                .map(|p| self.replanner.insert(p.real_time())),
+        }
+        .and_then(|p| p.replan(base.as_ref(), offset, t, &y, rp.iterations));
         let solve_seconds = solved.as_ref().map_or(0.0, |re| re.seconds);
         let late =
             |c: &std::time::Instant| rp.budget_s.is_some_and(|b| c.elapsed().as_secs_f64() > b);
