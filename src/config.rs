@@ -711,7 +711,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).
-pub const UNITS: [(&str, &str); 50] = [
+pub const UNITS: [(&str, &str); 53] = [
     ("cat.mass", "kg"),
     ("cat.length", "m"),
     ("cat.radius", "m"),
@@ -752,6 +752,9 @@ pub const UNITS: [(&str, &str); 50] = [
     ("control.rate_weight", "weight"),
     ("control.torque_weight", "weight"),
     ("control.max_correction", "design peak torques"),
+    ("control.replan_nodes", "nodes per phase"),
+    ("control.replan_iterations", "count"),
+    ("control.replan_every", "control periods"),
     ("robustness.tilt_deg", "deg"),
     ("robustness.mass_error", "relative"),
     ("robustness.inertia_error", "relative"),
