@@ -7,10 +7,33 @@ use super::reference::Reference;
 use super::replanning::{InFlight, Record, Replanning};
 use super::rng::Rng;
 use super::tvlqr::Tvlqr;
+use crate::export::start::world_map;
 use crate::model::Cat;
 use crate::model::momentum::landing_error;
 use crate::model::motor::Motor;
 use nalgebra::{UnitQuaternion, Vector3};
+
+/// A state in the simulators' world, the `<stem>.tvlqr.csv` columns:
+/// `[w, x, y, z]` the rear half's attitude `W R` (gravity `-z`), `lambda`
+/// (3, the momentum about the common centre of mass in the rear half's
+/// frame, N m s), `q` (2), `q_dot` (2).
+pub type SimState = [f64; 11];
+
+/// catflip's integrator state of a simulator's state.
+pub fn from_sim(s: &SimState) -> Y {
+    let r = world_map().inverse() * crate::model::so3::quat_from(&[s[0], s[1], s[2], s[3]]);
+    [
+        r.w, r.i, r.j, r.k, s[7], s[8], s[9], s[10], s[4], s[5], s[6],
+    ]
+}
+
+/// A simulator's state of catflip's integrator state (the inverse of [`from_sim`]).
+pub fn to_sim(y: &Y) -> SimState {
+    let r = world_map() * attitude(y);
+    [
+        r.w, r.i, r.j, r.k, y[8], y[9], y[10], y[4], y[5], y[6], y[7],
+    ]
+}
 
 /// What closes the loop.
 #[derive(Debug, Clone, Copy)]
@@ -128,6 +151,9 @@ pub fn fly_logged(
     let (mut acting, mut noise) = ([0.0; 2], [0.0; 2]);
     let mut max_corr = 0.0f64;
     let mut y = f.release;
+    // the full-state controllers act on the measurement as a simulator's world
+    // gives it back (what `Online` is handed), to the last bit: a replan carries
+    // those bits on, so the Python controller's flights are these
     let period = match fb {
         Feedback::Tvlqr(tv) | Feedback::Replan(tv, _) => tv.period_steps,
         Feedback::JointPd { .. } => 1,
@@ -162,7 +188,8 @@ pub fn fly_logged(
                     let k = j / period;
                     (k < tv.starts.len()).then(|| {
                         let m = measure(r, &mut f, &y);
-                        let u = tvlqr_command(r, tv, motor, &issued, k, &m);
+                        let seen = from_sim(&to_sim(&m));
+                        let u = tvlqr_command(r, tv, motor, &issued, k, &seen);
                         issued.push(u);
                         (m, u)
                     })
@@ -172,9 +199,10 @@ pub fn fly_logged(
                     let (live, plan) = replanned.as_mut().expect("a replanning flight");
                     (k < tv.starts.len()).then(|| {
                         let m = measure(live, &mut f, &y);
-                        let u = tvlqr_command(live, tv, motor, &issued, k, &m);
+                        let seen = from_sim(&to_sim(&m));
+                        let u = tvlqr_command(live, tv, motor, &issued, k, &seen);
                         issued.push(u);
-                        plan.replan(live, rp, tv, motor, &issued, k, &m);
+                        plan.replan(live, rp, tv, motor, &issued, k, &seen);
                         (m, u)
                     })
                 }

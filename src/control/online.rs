@@ -7,21 +7,15 @@
 //! so the controller remembers them: a command at control step `k` drops
 //! the history from `k` on (a command at step 0 starts a new flight).
 
+pub use super::closed_loop::{SimState, from_sim, to_sim};
 use super::closed_loop::{pd_command, tvlqr_command};
-use super::plant::{Y, attitude, momentum_from_rates};
+use super::plant::{Y, momentum_from_rates};
 use super::reference::Reference;
 use super::replanning::{InFlight, Record, Replanning, SharedPlan};
 use super::tvlqr::Tvlqr;
 use crate::config::Config;
-use crate::export::start::world_map;
 use crate::model::motor::Motor;
 use crate::verify::simulate::Controller;
-
-/// A state in the simulators' world, the `<stem>.tvlqr.csv` columns:
-/// `[w, x, y, z]` the rear half's attitude `W R` (gravity `-z`), `lambda`
-/// (3, the momentum about the common centre of mass in the rear half's
-/// frame, N m s), `q` (2), `q_dot` (2).
-pub type SimState = [f64; 11];
 
 /// Which controller.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -43,22 +37,6 @@ impl Kind {
             Kind::Replan => "replan",
         }
     }
-}
-
-/// catflip's integrator state of a simulator's state.
-pub fn from_sim(s: &SimState) -> Y {
-    let r = world_map().inverse() * crate::model::so3::quat_from(&[s[0], s[1], s[2], s[3]]);
-    [
-        r.w, r.i, r.j, r.k, s[7], s[8], s[9], s[10], s[4], s[5], s[6],
-    ]
-}
-
-/// A simulator's state of catflip's integrator state (the inverse of [`from_sim`]).
-pub fn to_sim(y: &Y) -> SimState {
-    let r = world_map() * attitude(y);
-    [
-        r.w, r.i, r.j, r.k, y[8], y[9], y[10], y[4], y[5], y[6], y[7],
-    ]
 }
 
 /// One controller along one design.
