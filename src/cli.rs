@@ -2,7 +2,7 @@
 //! into the library; the tables and progress lines are the library's
 //! ([`catflip::console`]).
 
-use crate::common::{Common, Status, flag, load, publisher, say, say_lines};
+use crate::common::{Common, Progress, Status, flag, load, publisher, say, say_lines};
 use anyhow::Result;
 use catflip::console;
 use catflip::output::{Output, with_verdict};
@@ -553,8 +553,7 @@ fn cmd_sweep(
         eprintln!("{}", console::sweep::empty_shard_warning(shard, spec.count));
     }
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
-    // a live bar on a terminal, plain lines otherwise
-    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let progress = Progress::new(quiet);
     let clock = std::time::Instant::now();
     let state = catflip::sweep::resume::SweepState::new(spec, shard, m, &cfg);
     let kept = if resume {
@@ -585,28 +584,18 @@ fn cmd_sweep(
                 shard,
                 &store,
                 |done, total| {
-                    if quiet {
-                        return;
-                    }
-                    let line = catflip::sweep::progress_line(
+                    progress.show(&catflip::sweep::progress_line(
                         &spec.key,
                         done,
                         total,
                         clock.elapsed().as_secs_f64(),
-                    );
-                    if live {
-                        eprint!("\r  {line}");
-                    } else {
-                        eprintln!("  {line}");
-                    }
+                    ))
                 },
             )
         }
     };
     let outcome = catflip::interrupt::supervise(&interrupt, work);
-    if !quiet && live {
-        eprintln!();
-    }
+    progress.finish();
     let slots = store.lock().unwrap_or_else(|p| p.into_inner()).clone();
     let state = state.with_points(slots);
     let points = state.finished();

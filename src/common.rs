@@ -38,6 +38,42 @@ pub(crate) fn say_lines<S: AsRef<str>>(lines: impl IntoIterator<Item = S>) {
     }
 }
 
+/// A long command's progress on stderr: one line rewritten in place on a
+/// terminal, a line per report in a log, nothing with `--json`.
+#[derive(Clone, Copy)]
+pub(crate) struct Progress {
+    quiet: bool,
+    live: bool,
+}
+
+impl Progress {
+    pub(crate) fn new(quiet: bool) -> Progress {
+        let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+        Progress { quiet, live }
+    }
+
+    /// Whether the line is rewritten in place (a terminal), so every report can be shown.
+    pub(crate) fn is_live(&self) -> bool {
+        self.live
+    }
+
+    pub(crate) fn show(&self, line: &str) {
+        if self.quiet {
+        } else if self.live {
+            eprint!("\r  {line}");
+        } else {
+            eprintln!("  {line}");
+        }
+    }
+
+    /// Ends the line rewritten in place.
+    pub(crate) fn finish(&self) {
+        if !self.quiet && self.live {
+            eprintln!();
+        }
+    }
+}
+
 #[derive(Args, Clone)]
 pub(crate) struct Common {
     /// TOML configuration (see configs/).

@@ -1,6 +1,6 @@
 //! `catflip recovery`: the command-line face of [`catflip::recovery`].
 
-use crate::common::{Common, Status, load, publish_partial, publisher, say};
+use crate::common::{Common, Progress, Status, load, publish_partial, publisher, say};
 use anyhow::Result;
 use catflip::interrupt::{Outcome, supervise};
 use catflip::output::Output;
@@ -67,7 +67,7 @@ pub fn cmd_recovery(
     let suffix = shard.suffix();
     let publisher = publisher(c, &cfg, &format!("recovery{suffix}"))?;
     let quiet = c.json;
-    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let progress = Progress::new(quiet);
     let clock = std::time::Instant::now();
     let store = Arc::new(Mutex::new(vec![None; lines.len()]));
     let interrupt = catflip::interrupt::Interrupt::catch()?;
@@ -79,29 +79,19 @@ pub fn cmd_recovery(
             }
             let origin = catflip::recovery::Origin::new(&cfg, &grid)?;
             catflip::recovery::compute_into(&origin, &lines, threads, &store, |done, total| {
-                if quiet {
-                    return;
-                }
                 let line = catflip::sweep::progress_line(
                     "recovery",
                     done,
                     total,
                     clock.elapsed().as_secs_f64(),
-                )
-                .replace(" points", " lines");
-                if live {
-                    eprint!("\r  {line}");
-                } else {
-                    eprintln!("  {line}");
-                }
+                );
+                progress.show(&line.replace(" points", " lines"));
             });
             Ok(())
         }
     };
     let outcome = supervise(&interrupt, work);
-    if !quiet && live {
-        eprintln!();
-    }
+    progress.finish();
     let interrupted = match outcome {
         Outcome::Finished(r) => {
             r?;

@@ -1,6 +1,6 @@
 //! `catflip robustness`: the command-line face of [`catflip::control::robustness`].
 
-use crate::common::{Common, Status, load, publish_partial, publisher, say, say_lines};
+use crate::common::{Common, Progress, Status, load, publish_partial, publisher, say, say_lines};
 use anyhow::Result;
 use catflip::control::resume::{Published, StudyState};
 use catflip::control::robustness::{
@@ -58,7 +58,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     }
     let max_tilt_deg = cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG);
     let quiet = c.json;
-    let live = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let progress = Progress::new(quiet);
     let clock = std::time::Instant::now();
     // the trials land in a store this thread reads when a signal stops the study
     let store = Arc::new(Mutex::new(kept));
@@ -69,27 +69,20 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             let design = catflip::control::robustness::design(&cfg)?;
             let study = Study::new(&cfg, Arc::new(design.plan), seed);
             study.run_into(range, threads, &store, |done, total| {
-                if quiet || (!live && done % (total / 20).max(1) != 0 && done != total) {
-                    return;
-                }
-                let line = catflip::console::robustness::progress_line(
-                    done,
-                    total,
-                    clock.elapsed().as_secs_f64(),
-                );
-                if live {
-                    eprint!("\r  {line}");
-                } else {
-                    eprintln!("  {line}");
+                // a log gets a line per 5 % of the trials
+                if progress.is_live() || done % (total / 20).max(1) == 0 || done == total {
+                    progress.show(&catflip::console::robustness::progress_line(
+                        done,
+                        total,
+                        clock.elapsed().as_secs_f64(),
+                    ));
                 }
             });
             Ok(())
         }
     };
     let outcome = supervise(&interrupt, work);
-    if !quiet && live {
-        eprintln!();
-    }
+    progress.finish();
     let slots = store.lock().unwrap_or_else(|p| p.into_inner()).clone();
     let interrupted = match outcome {
         Outcome::Finished(r) => {
