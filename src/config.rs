@@ -8,7 +8,7 @@
 use crate::design::spec::{
     AnalyticSettings, DesignSpec, Fall, FreeSettings, PhasedSettings, SimulateSettings,
 };
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, check};
 use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -110,18 +110,6 @@ pub struct LimitsConfig {
     pub no_load_speed: Option<f64>,
     /// rad/s, hard joint speed limit (default: none).
     pub max_speed: Option<f64>,
-}
-
-fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::Invalid {
-            key: key.into(),
-            value: ranges::show(value),
-            expected: expected.into(),
-        })
-    }
 }
 
 /// The parser's messages name Rust's types ("expected f64"); the user
@@ -291,28 +279,7 @@ impl Config {
             f.margin < 0.95 * ft,
             &format!("must leave time to move: less than 95 % of the fall time {ft:.4} s"),
         )?;
-        let a = &self.analytic;
-        check(
-            "analytic.theta_deg",
-            a.theta_deg,
-            a.theta_deg > 0.0 && a.theta_deg < 180.0,
-            "must be in (0, 180) degrees",
-        )?;
-        for (i, x) in a.split.iter().enumerate() {
-            check(
-                &format!("analytic.split[{i}]"),
-                *x,
-                *x > 0.0,
-                "each fraction must be > 0",
-            )?;
-        }
-        let sum: f64 = a.split.iter().sum();
-        check(
-            "analytic.split",
-            sum,
-            (sum - 1.0).abs() < 1e-9,
-            "fractions must sum to 1 (sum shown)",
-        )?;
+        self.analytic.validate()?;
         if let Some(t) = self.limits.max_torque {
             check("limits.max_torque", t, t > 0.0, "must be > 0 N m")?;
         }
@@ -342,100 +309,9 @@ impl Config {
                 "must be in (0, 180) degrees",
             )?;
         }
-        let s = &self.simulate;
-        check(
-            "simulate.rtol",
-            s.rtol,
-            s.rtol > 0.0 && s.rtol <= 1e-2,
-            "must be in (0, 1e-2]",
-        )?;
-        check(
-            "simulate.atol",
-            s.atol,
-            s.atol > 0.0 && s.atol <= 1e-2,
-            "must be in (0, 1e-2]",
-        )?;
-        check(
-            "simulate.pd_bandwidth_hz",
-            s.pd_bandwidth_hz,
-            s.pd_bandwidth_hz > 0.0,
-            "must be > 0 Hz",
-        )?;
-        check(
-            "simulate.pd_damping",
-            s.pd_damping,
-            s.pd_damping > 0.0,
-            "must be > 0",
-        )?;
-        check(
-            "simulate.flip_tolerance",
-            s.flip_tolerance,
-            s.flip_tolerance > 0.0 && s.flip_tolerance <= std::f64::consts::PI,
-            "must be in (0, pi] rad",
-        )?;
-        let n = s.samples_per_phase as f64;
-        check(
-            "simulate.samples_per_phase",
-            n,
-            (2.0..=30_000.0).contains(&n),
-            "must be in 2..=30000",
-        )?;
-        let p = &self.phased;
-        check(
-            "phased.nodes",
-            p.nodes as f64,
-            (4..=2000).contains(&p.nodes),
-            "must be in 4..=2000",
-        )?;
-        check(
-            "phased.bend_min_deg",
-            p.bend_min_deg,
-            p.bend_min_deg > 0.0,
-            "must be > 0 degrees",
-        )?;
-        check(
-            "phased.bend_max_deg",
-            p.bend_max_deg,
-            p.bend_max_deg > p.bend_min_deg && p.bend_max_deg < 180.0,
-            "must exceed phased.bend_min_deg and be < 180 degrees",
-        )?;
-        check(
-            "phased.scan_points",
-            p.scan_points as f64,
-            (3..=200).contains(&p.scan_points),
-            "must be in 3..=200",
-        )?;
-        check(
-            "phased.bend_tol_deg",
-            p.bend_tol_deg,
-            p.bend_tol_deg > 0.0,
-            "must be > 0 degrees",
-        )?;
-        let fr = &self.free;
-        check(
-            "free.nodes",
-            fr.nodes as f64,
-            (4..=400).contains(&fr.nodes),
-            "must be in 4..=400",
-        )?;
-        check(
-            "free.max_iterations",
-            fr.max_iterations as f64,
-            fr.max_iterations >= 1,
-            "must be >= 1",
-        )?;
-        check(
-            "free.tolerance",
-            fr.tolerance,
-            fr.tolerance > 0.0 && fr.tolerance < 1.0,
-            "must be in (0, 1)",
-        )?;
-        check(
-            "free.attitude_tolerance",
-            fr.attitude_tolerance,
-            fr.attitude_tolerance > 0.0,
-            "must be > 0 rad",
-        )?;
+        self.simulate.validate()?;
+        self.phased.validate()?;
+        self.free.validate()?;
         self.start.validate()?;
         self.land.validate()?;
         self.control.validate()?;

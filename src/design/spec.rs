@@ -10,6 +10,7 @@
 //! `Config::validate` checks their ranges.
 
 use crate::design::objective::Objective;
+use crate::error::{Result, check};
 use crate::model::momentum::Start;
 use crate::model::motor::Motor;
 use crate::model::{Cat, TorqueNorm};
@@ -201,7 +202,156 @@ impl Default for FreeSettings {
     }
 }
 
+impl AnalyticSettings {
+    /// The ranges of `analytic.*` (docs/configuration.md).
+    pub fn validate(&self) -> Result<()> {
+        check(
+            "analytic.theta_deg",
+            self.theta_deg,
+            self.theta_deg > 0.0 && self.theta_deg < 180.0,
+            "must be in (0, 180) degrees",
+        )?;
+        for (i, x) in self.split.iter().enumerate() {
+            check(
+                &format!("analytic.split[{i}]"),
+                *x,
+                *x > 0.0,
+                "each fraction must be > 0",
+            )?;
+        }
+        let sum: f64 = self.split.iter().sum();
+        check(
+            "analytic.split",
+            sum,
+            (sum - 1.0).abs() < 1e-9,
+            "fractions must sum to 1 (sum shown)",
+        )?;
+        Ok(())
+    }
+}
+
+impl SimulateSettings {
+    /// The ranges of `simulate.*` (docs/configuration.md).
+    pub fn validate(&self) -> Result<()> {
+        check(
+            "simulate.rtol",
+            self.rtol,
+            self.rtol > 0.0 && self.rtol <= 1e-2,
+            "must be in (0, 1e-2]",
+        )?;
+        check(
+            "simulate.atol",
+            self.atol,
+            self.atol > 0.0 && self.atol <= 1e-2,
+            "must be in (0, 1e-2]",
+        )?;
+        check(
+            "simulate.pd_bandwidth_hz",
+            self.pd_bandwidth_hz,
+            self.pd_bandwidth_hz > 0.0,
+            "must be > 0 Hz",
+        )?;
+        check(
+            "simulate.pd_damping",
+            self.pd_damping,
+            self.pd_damping > 0.0,
+            "must be > 0",
+        )?;
+        check(
+            "simulate.flip_tolerance",
+            self.flip_tolerance,
+            self.flip_tolerance > 0.0 && self.flip_tolerance <= std::f64::consts::PI,
+            "must be in (0, pi] rad",
+        )?;
+        let n = self.samples_per_phase as f64;
+        check(
+            "simulate.samples_per_phase",
+            n,
+            (2.0..=30_000.0).contains(&n),
+            "must be in 2..=30000",
+        )?;
+        Ok(())
+    }
+}
+
+impl PhasedSettings {
+    /// The ranges of `phased.*` (docs/configuration.md).
+    pub fn validate(&self) -> Result<()> {
+        check(
+            "phased.nodes",
+            self.nodes as f64,
+            (4..=2000).contains(&self.nodes),
+            "must be in 4..=2000",
+        )?;
+        check(
+            "phased.bend_min_deg",
+            self.bend_min_deg,
+            self.bend_min_deg > 0.0,
+            "must be > 0 degrees",
+        )?;
+        check(
+            "phased.bend_max_deg",
+            self.bend_max_deg,
+            self.bend_max_deg > self.bend_min_deg && self.bend_max_deg < 180.0,
+            "must exceed phased.bend_min_deg and be < 180 degrees",
+        )?;
+        check(
+            "phased.scan_points",
+            self.scan_points as f64,
+            (3..=200).contains(&self.scan_points),
+            "must be in 3..=200",
+        )?;
+        check(
+            "phased.bend_tol_deg",
+            self.bend_tol_deg,
+            self.bend_tol_deg > 0.0,
+            "must be > 0 degrees",
+        )?;
+        Ok(())
+    }
+}
+
+impl FreeSettings {
+    /// The ranges of `free.*` (docs/configuration.md).
+    pub fn validate(&self) -> Result<()> {
+        check(
+            "free.nodes",
+            self.nodes as f64,
+            (4..=400).contains(&self.nodes),
+            "must be in 4..=400",
+        )?;
+        check(
+            "free.max_iterations",
+            self.max_iterations as f64,
+            self.max_iterations >= 1,
+            "must be >= 1",
+        )?;
+        check(
+            "free.tolerance",
+            self.tolerance,
+            self.tolerance > 0.0 && self.tolerance < 1.0,
+            "must be in (0, 1)",
+        )?;
+        check(
+            "free.attitude_tolerance",
+            self.attitude_tolerance,
+            self.attitude_tolerance > 0.0,
+            "must be > 0 rad",
+        )?;
+        Ok(())
+    }
+}
+
 impl DesignSpec {
+    /// The settings' ranges, as `Config::validate` checks them (the body,
+    /// fall, motors and start a spec from a config has already passed).
+    pub fn validate(&self) -> Result<()> {
+        self.analytic.validate()?;
+        self.simulate.validate()?;
+        self.phased.validate()?;
+        self.free.validate()
+    }
+
     /// The same problem dropped from `height`, m.
     pub fn with_height(&self, height: f64) -> DesignSpec {
         let mut s = self.clone();
@@ -284,5 +434,50 @@ impl DesignSpec {
         .map(|(k, _)| *k)
         .collect::<Vec<_>>()
         .join(", ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::error::Error;
+
+    /// The defaults pass their own checks, and a setting out of range is
+    /// refused under its config key.
+    #[test]
+    fn defaults_validate_and_a_bad_setting_names_its_key() {
+        let seed = include_str!("../../configs/seed.toml");
+        let spec = crate::test_support::spec_of(seed, "seed", &[]);
+        spec.validate().unwrap();
+        let key = |spec: &DesignSpec| match spec.validate() {
+            Err(Error::Invalid { key, .. }) => key,
+            other => panic!("{other:?}"),
+        };
+        let mut bad = spec.clone();
+        bad.phased.bend_max_deg = bad.phased.bend_min_deg;
+        assert_eq!(key(&bad), "phased.bend_max_deg");
+        let mut bad = spec.clone();
+        bad.free.tolerance = 1.0;
+        assert_eq!(key(&bad), "free.tolerance");
+        let mut bad = spec.clone();
+        bad.simulate.samples_per_phase = 1;
+        assert_eq!(key(&bad), "simulate.samples_per_phase");
+        let mut bad = spec;
+        bad.analytic.split = [0.5, 0.5, 0.5];
+        assert_eq!(key(&bad), "analytic.split");
+    }
+
+    /// A variant changes its one part and keeps the rest.
+    #[test]
+    fn a_variant_changes_only_its_part() {
+        let seed = include_str!("../../configs/seed.toml");
+        let spec = crate::test_support::spec_of(seed, "seed", &[]);
+        let high = spec.with_height(2.0 * spec.fall.height);
+        assert_eq!(high.fall.height, 2.0 * spec.fall.height);
+        assert!(high.available_time() > spec.available_time());
+        assert_eq!(high.with_height(spec.fall.height), spec);
+        let timed = spec.with_objective(Objective::Time);
+        assert!(timed.uses_envelope() && !spec.uses_envelope());
+        assert_eq!(timed.with_objective(spec.objective), spec);
     }
 }
