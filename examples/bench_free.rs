@@ -14,9 +14,9 @@ use common::median;
 /// nothing) and the SCP, timed together, without the mesh check.
 fn design(cfg: &Config, seed: Seed) -> anyhow::Result<(FreeResult, f64, f64)> {
     let t = Instant::now();
-    let plan = seed.plan(cfg)?;
+    let plan = seed.plan(&cfg.design_spec())?;
     let seed_s = t.elapsed().as_secs_f64();
-    let r = catflip::design::free::FreeDesign::new(cfg)
+    let r = catflip::design::free::FreeDesign::new(&cfg.design_spec())
         .from_plan(plan.as_ref(), seed.name())
         .solve()?;
     // the SCP's own time (without the verification simulations)

@@ -51,7 +51,7 @@ fn main() -> anyhow::Result<()> {
         let base = Config::load(std::path::Path::new(&path), &set)?;
         let mut extra = set.clone();
         if base.limits.max_torque.is_none() {
-            let p = optimize(&base, |_| {})?;
+            let p = optimize(&base.design_spec(), |_| {})?;
             extra.push(format!("limits.max_torque={}", 1.2 * p.peak_torque_nm));
         }
         for objective in ["peak-torque", "time", "energy"] {
@@ -63,7 +63,7 @@ fn main() -> anyhow::Result<()> {
             for _ in 0..runs {
                 let w0 = work();
                 let t = Instant::now();
-                let r = optimize(&cfg, |_| {});
+                let r = optimize(&cfg.design_spec(), |_| {});
                 times.push(t.elapsed().as_secs_f64());
                 last = Some((r, work() - w0));
             }
@@ -83,7 +83,7 @@ fn main() -> anyhow::Result<()> {
                     // the free-form design seeded by it, once (its own time,
                     // the seed's not counted): never worse than the phased one
                     let t = Instant::now();
-                    let fr = catflip::design::free::FreeDesign::new(&cfg)
+                    let fr = catflip::design::free::FreeDesign::new(&cfg.design_spec())
                         .from_plan(&r.plan, "phased")
                         .solve();
                     let s = t.elapsed().as_secs_f64();

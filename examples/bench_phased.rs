@@ -13,7 +13,7 @@ fn main() -> anyhow::Result<()> {
     let mut result = None;
     for _ in 0..runs {
         let t = Instant::now();
-        let r = catflip::design::phased::optimize(&cfg, |_| {})?;
+        let r = catflip::design::phased::optimize(&cfg.design_spec(), |_| {})?;
         times.push((t.elapsed().as_secs_f64(), r.solve_time_s));
         result = Some(r);
     }

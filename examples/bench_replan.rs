@@ -45,9 +45,11 @@ fn main() -> anyhow::Result<()> {
     };
     let cfg = Config::load(std::path::Path::new(&path), &overrides)?;
     // the robot near its least height: the phased seed does not fit, the analytic one starts it
-    let d = FreeDesign::new(&cfg)
-        .solve()
-        .or_else(|_| FreeDesign::new(&cfg).seed(Seed::Analytic).solve())?;
+    let d = FreeDesign::new(&cfg.design_spec()).solve().or_else(|_| {
+        FreeDesign::new(&cfg.design_spec())
+            .seed(Seed::Analytic)
+            .solve()
+    })?;
     let period = 1.0 / cfg.control.rate_hz;
     println!(
         "{name} {}: design {:.4} N m peak, manoeuvre {:.4} s; {nodes} nodes per phase, at most {iterations} SCP iterations; control period {period:.4} s",
@@ -115,7 +117,14 @@ fn single_replans(
         let mut y = r.nominal[j];
         y[6] += 0.2;
         y[7] -= 0.1;
-        let re = replan(cfg, plan, j as f64 * r.h, &y, nodes, iterations)?;
+        let re = replan(
+            &cfg.design_spec(),
+            plan,
+            j as f64 * r.h,
+            &y,
+            nodes,
+            iterations,
+        )?;
         converged += usize::from(re.status == ScpStatus::Converged);
         times.push(re.seconds);
         t += 10.0 * period;
@@ -168,7 +177,7 @@ fn flight(
         }
     };
     let start = catflip::control::reference::release(&cat, &cfg.start.start());
-    let mut replanner = Replanner::new(cfg, nodes)?.real_time();
+    let mut replanner = Replanner::new(&cfg.design_spec(), nodes)?.real_time();
     let mut plan = design.clone();
     let mut origin = 0.0;
     let mut y = start;

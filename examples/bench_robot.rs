@@ -56,7 +56,7 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
         }
         ["height", name] => {
             let cfg = config(name, &[])?;
-            let h = catflip::design::least_height::heights(&cfg, true, |_| {})?
+            let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})?
                 .ok_or_else(|| anyhow::anyhow!("{name}: no motor limits"))?;
             format!(
                 "least height {:.4} m ({} {:.5} s), phased {:.4} m",
@@ -66,7 +66,7 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
         ["parts", name] => {
             // the least-height stage's designs one by one, in one thread
             let cfg = config(name, &[])?;
-            let reference = catflip::design::least_height::reference(&cfg);
+            let reference = catflip::design::least_height::reference(&cfg.design_spec());
             let mut out = Vec::new();
             let mut lap = |what: &str, text: String, t: &mut (Instant, f64)| {
                 out.push(format!(
@@ -127,9 +127,9 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
                 "analytic" => Seed::Analytic,
                 s => anyhow::bail!("unknown seed {s}"),
             };
-            let plan = seed.plan(&cfg)?;
+            let plan = seed.plan(&cfg.design_spec())?;
             let (t, c) = (Instant::now(), cpu_s());
-            let r = FreeDesign::new(&cfg)
+            let r = FreeDesign::new(&cfg.design_spec())
                 .from_plan(plan.as_ref(), seed.name())
                 .solve()?;
             return Ok((

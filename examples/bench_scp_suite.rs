@@ -45,8 +45,8 @@ fn main() -> anyhow::Result<()> {
         )?;
         let nodes = nodes.unwrap_or(cfg.free.nodes);
         let t = Instant::now();
-        let plan = seed.plan(&cfg)?;
-        let r = catflip::design::free::FreeDesign::new(&cfg)
+        let plan = seed.plan(&cfg.design_spec())?;
+        let r = catflip::design::free::FreeDesign::new(&cfg.design_spec())
             .from_plan(plan.as_ref(), seed.name())
             .nodes(nodes)
             .solve()?;

@@ -54,7 +54,7 @@ fn main() -> anyhow::Result<()> {
                 let mut last = None;
                 for _ in 0..runs {
                     let t = Instant::now();
-                    let r = FreeDesign::new(&cfg).solve();
+                    let r = FreeDesign::new(&cfg.design_spec()).solve();
                     times.push(t.elapsed().as_secs_f64());
                     last = Some(r);
                 }

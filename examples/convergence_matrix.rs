@@ -58,7 +58,8 @@ fn main() -> anyhow::Result<()> {
                 ov.push(format!("design.objective={objective}"));
                 let base = Config::load(std::path::Path::new(&path), &ov[..extra.len() + 1])?;
                 if objective == "time" && !base.motor().is_limited() {
-                    let peak = catflip::design::phased::optimize(&base, |_| {})?.peak_torque_nm;
+                    let peak = catflip::design::phased::optimize(&base.design_spec(), |_| {})?
+                        .peak_torque_nm;
                     ov.push(format!("limits.max_torque={}", 1.5 * peak));
                 }
                 let cfg = Config::load(std::path::Path::new(&path), &ov)?;
@@ -66,20 +67,28 @@ fn main() -> anyhow::Result<()> {
                     let clock = Instant::now();
                     let r = match seed {
                         Seed::Phased => {
-                            catflip::design::phased::optimize(&cfg, |_| {}).and_then(|ph| {
-                                FreeDesign::new(&cfg).from_plan(&ph.plan, "phased").solve()
-                            })
+                            catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).and_then(
+                                |ph| {
+                                    FreeDesign::new(&cfg.design_spec())
+                                        .from_plan(&ph.plan, "phased")
+                                        .solve()
+                                },
+                            )
                         }
-                        Seed::Analytic => FreeDesign::new(&cfg)
-                            .from_plan(&catflip::design::analytic::analytic_plan(&cfg), "analytic")
+                        Seed::Analytic => FreeDesign::new(&cfg.design_spec())
+                            .from_plan(
+                                &catflip::design::analytic::analytic_plan(&cfg.design_spec()),
+                                "analytic",
+                            )
                             .solve(),
                     };
                     let s = clock.elapsed().as_secs_f64();
                     match r {
                         Ok(r) => {
-                            let margin = catflip::design::envelope::usage_of(&cfg, &r.plan)
-                                .min_margin
-                                .map_or("-".to_string(), |m| format!("{m:.1e}"));
+                            let margin =
+                                catflip::design::envelope::usage_of(&cfg.design_spec(), &r.plan)
+                                    .min_margin
+                                    .map_or("-".to_string(), |m| format!("{m:.1e}"));
                             println!(
                                 "{:<30} {:<10} {:<12} {:<9} {:>15} {:>12} {:>5} {:>9.1e} {:>9.1e} {:>9} {:>7.2}",
                                 name,

@@ -10,12 +10,12 @@ fn main() -> anyhow::Result<()> {
         .nth(1)
         .unwrap_or_else(|| "configs/domestic-cat.toml".into());
     let cfg = Config::load(std::path::Path::new(&path), &[])?;
-    let phased = catflip::design::phased::optimize(&cfg, |_| {})?;
+    let phased = catflip::design::phased::optimize(&cfg.design_spec(), |_| {})?;
     println!(
         "phased: peak {:.4} N m at bend {:.1} deg",
         phased.peak_torque_nm, phased.bend_deg
     );
-    let free = catflip::design::free::FreeDesign::new(&cfg)
+    let free = catflip::design::free::FreeDesign::new(&cfg.design_spec())
         .from_plan(&phased.plan, "phased")
         .on_iteration(&mut |it| {
             println!(

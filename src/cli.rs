@@ -344,7 +344,7 @@ pub fn run() -> Result<Status> {
 fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "analyze")?;
-    let a = analyze(&cfg)?;
+    let a = analyze(&cfg.design_spec(), &cfg.name)?;
     let (sched, verdict) = catflip::pipeline::judge_analysis(&cfg, &a);
     let reason = verdict.reason();
     let mut v = serde_json::to_value(&a)?;
@@ -395,13 +395,18 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
     let publisher = publisher(c, &cfg, "simulate")?;
     let (source, report) = match (schedule, text) {
         (Some(p), Some(text)) => {
-            let s =
-                catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
-            (p.display().to_string(), verify(&cfg, &s)?)
+            let s = catflip::verify::simulate::read_schedule(
+                &cfg.design_spec(),
+                &cfg.name,
+                &text,
+                &p.display().to_string(),
+            )?;
+            (p.display().to_string(), verify(&cfg.design_spec(), &s)?)
         }
         _ => {
-            let plan = catflip::design::analytic::analytic_plan(&cfg);
-            ("analytic schedule".to_string(), verify(&cfg, &plan)?)
+            let spec = cfg.design_spec();
+            let plan = catflip::design::analytic::analytic_plan(&spec);
+            ("analytic schedule".to_string(), verify(&spec, &plan)?)
         }
     };
     let reason = verdict::flip_reason(
@@ -436,8 +441,9 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         Optimizer::Free(_) => "optimize-free",
     };
     let publisher = publisher(c, &cfg, set)?;
+    let spec = cfg.design_spec();
     let design = match optimizer {
-        Optimizer::Phased => Design::Phased(catflip::design::phased::optimize(&cfg, |e| {
+        Optimizer::Phased => Design::Phased(catflip::design::phased::optimize(&spec, |e| {
             if verbose {
                 eprintln!("{}", console::progress::bend_line(e));
             }
@@ -450,7 +456,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
                 );
             }
             Design::Free(
-                catflip::design::free::FreeDesign::new(&cfg)
+                catflip::design::free::FreeDesign::new(&spec)
                     .seed(seed)
                     .check_mesh()
                     .observe(&mut console::progress::IterationTable { verbose })
@@ -656,7 +662,12 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
     let mut out = Output::default();
     out.add(name, text_model);
     if let (Some(p), Some(text)) = (schedule, text) {
-        let s = catflip::verify::simulate::read_schedule(&cfg, &text, &p.display().to_string())?;
+        let s = catflip::verify::simulate::read_schedule(
+            &cfg.design_spec(),
+            &cfg.name,
+            &text,
+            &p.display().to_string(),
+        )?;
         let stem = p
             .file_stem()
             .and_then(|s| s.to_str())

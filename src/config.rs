@@ -5,7 +5,10 @@
 //! `--set a.b=value` overrides are applied to the TOML tree before parsing, so
 //! they go through the same checks.
 
-use crate::error::{Error, Result};
+use crate::design::spec::{
+    AnalyticSettings, DesignSpec, Fall, FreeSettings, PhasedSettings, SimulateSettings,
+};
+use crate::error::{Error, Result, check};
 use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -22,19 +25,19 @@ pub struct Config {
     /// Names the output folder `output/<name>/`.
     pub name: String,
     pub cat: CatConfig,
-    pub fall: FallConfig,
+    pub fall: Fall,
     #[serde(default)]
-    pub analytic: AnalyticConfig,
+    pub analytic: AnalyticSettings,
     #[serde(default)]
     pub limits: LimitsConfig,
     #[serde(default)]
     pub design: DesignConfig,
     #[serde(default)]
-    pub simulate: SimulateConfig,
+    pub simulate: SimulateSettings,
     #[serde(default)]
-    pub phased: PhasedConfig,
+    pub phased: PhasedSettings,
     #[serde(default)]
-    pub free: FreeConfig,
+    pub free: FreeSettings,
     /// `[body]`: general rigid halves, given or read from a URDF / MJCF
     /// (default: none, the cylinders of `[cat]`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -83,59 +86,6 @@ fn default_joint() -> Joint {
     Joint::NoTwist
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FallConfig {
-    /// m, drop height.
-    pub height: f64,
-    /// m/s^2 (default 9.81).
-    #[serde(default = "default_gravity")]
-    pub gravity: f64,
-    /// s left free before landing (default 0).
-    #[serde(default)]
-    pub margin: f64,
-}
-
-fn default_gravity() -> f64 {
-    9.81
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct AnalyticConfig {
-    /// Angle between the halves during the twist, degrees (default 45, the seed's pi/4).
-    pub theta_deg: f64,
-    /// Fractions of the manoeuvre time for fold, twist, unfold (default 0.2, 0.6, 0.2).
-    #[serde(deserialize_with = "three_fractions")]
-    pub split: [f64; 3],
-    /// Use the seed's transverse inertia `m (r^2 + l^2)/12` (erratum E1) to reproduce
-    /// its printed example (default false).
-    pub seed_inertia: bool,
-}
-
-/// `analytic.split`: exactly three numbers, no more, no fewer.
-fn three_fractions<'de, D: serde::Deserializer<'de>>(
-    d: D,
-) -> std::result::Result<[f64; 3], D::Error> {
-    let v: Vec<f64> = Vec::deserialize(d)?;
-    <[f64; 3]>::try_from(v.as_slice()).map_err(|_| {
-        serde::de::Error::custom(format!(
-            "analytic.split needs exactly 3 fractions (fold, twist, unfold), got {}",
-            v.len()
-        ))
-    })
-}
-
-impl Default for AnalyticConfig {
-    fn default() -> Self {
-        Self {
-            theta_deg: 45.0,
-            split: [0.2, 0.6, 0.2],
-            seed_inertia: false,
-        }
-    }
-}
-
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields, default)]
 pub struct DesignConfig {
@@ -160,109 +110,6 @@ pub struct LimitsConfig {
     pub no_load_speed: Option<f64>,
     /// rad/s, hard joint speed limit (default: none).
     pub max_speed: Option<f64>,
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct SimulateConfig {
-    /// Relative tolerance of the adaptive integrator (default 1e-10).
-    pub rtol: f64,
-    /// Absolute tolerance (default 1e-12).
-    pub atol: f64,
-    /// Add PD tracking of the planned shape to the feed-forward torque (default true).
-    pub pd: bool,
-    /// PD bandwidth, Hz, about the straight cat's inertia (default 10).
-    pub pd_bandwidth_hz: f64,
-    /// PD damping ratio (default 1).
-    pub pd_damping: f64,
-    /// Rows per phase in written schedules (default 200).
-    pub samples_per_phase: usize,
-    /// Largest flip error and spine tilt of a simulated design, rad, beyond
-    /// which the design is flagged as missing the flip (default 0.01).
-    pub flip_tolerance: f64,
-}
-
-impl Default for SimulateConfig {
-    fn default() -> Self {
-        Self {
-            rtol: 1e-10,
-            atol: 1e-12,
-            pd: true,
-            pd_bandwidth_hz: 10.0,
-            pd_damping: 1.0,
-            samples_per_phase: 200,
-            flip_tolerance: 0.01,
-        }
-    }
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct PhasedConfig {
-    /// Grid intervals per phase of the path-timing SOCP (default 40).
-    pub nodes: usize,
-    /// Bend search range, degrees (default 5 to 170).
-    pub bend_min_deg: f64,
-    pub bend_max_deg: f64,
-    /// Points of the coarse bend scan before refinement (default 12).
-    pub scan_points: usize,
-    /// Bend tolerance of the refinement, degrees (default 0.05).
-    pub bend_tol_deg: f64,
-}
-
-impl Default for PhasedConfig {
-    fn default() -> Self {
-        Self {
-            nodes: 40,
-            bend_min_deg: 5.0,
-            bend_max_deg: 170.0,
-            scan_points: 12,
-            bend_tol_deg: 0.05,
-        }
-    }
-}
-
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct FreeConfig {
-    /// Collocation nodes per phase (default 40).
-    pub nodes: usize,
-    /// SCP iteration limit (default 150).
-    pub max_iterations: usize,
-    /// Stop when the predicted improvement falls below this fraction of the merit (default 1e-4).
-    pub tolerance: f64,
-    /// Flip tolerance of the converged design, rad (default 1e-6).
-    pub attitude_tolerance: f64,
-    /// Mesh continuation of peak-torque designs without a torque-speed
-    /// line or speed limit (default true): from a
-    /// seed, solve at a third of the nodes first (or half; again while that
-    /// leaves at least 20 per phase), loosely, and refine; see
-    /// `design::free::coarse_start`.
-    pub mesh_continuation: bool,
-}
-
-impl Default for FreeConfig {
-    fn default() -> Self {
-        Self {
-            nodes: 40,
-            max_iterations: 150,
-            tolerance: 1e-4,
-            attitude_tolerance: 1e-6,
-            mesh_continuation: true,
-        }
-    }
-}
-
-fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
-    if ok && value.is_finite() {
-        Ok(())
-    } else {
-        Err(Error::Invalid {
-            key: key.into(),
-            value: ranges::show(value),
-            expected: expected.into(),
-        })
-    }
 }
 
 /// The parser's messages name Rust's types ("expected f64"); the user
@@ -432,28 +279,7 @@ impl Config {
             f.margin < 0.95 * ft,
             &format!("must leave time to move: less than 95 % of the fall time {ft:.4} s"),
         )?;
-        let a = &self.analytic;
-        check(
-            "analytic.theta_deg",
-            a.theta_deg,
-            a.theta_deg > 0.0 && a.theta_deg < 180.0,
-            "must be in (0, 180) degrees",
-        )?;
-        for (i, x) in a.split.iter().enumerate() {
-            check(
-                &format!("analytic.split[{i}]"),
-                *x,
-                *x > 0.0,
-                "each fraction must be > 0",
-            )?;
-        }
-        let sum: f64 = a.split.iter().sum();
-        check(
-            "analytic.split",
-            sum,
-            (sum - 1.0).abs() < 1e-9,
-            "fractions must sum to 1 (sum shown)",
-        )?;
+        self.analytic.validate()?;
         if let Some(t) = self.limits.max_torque {
             check("limits.max_torque", t, t > 0.0, "must be > 0 N m")?;
         }
@@ -483,100 +309,9 @@ impl Config {
                 "must be in (0, 180) degrees",
             )?;
         }
-        let s = &self.simulate;
-        check(
-            "simulate.rtol",
-            s.rtol,
-            s.rtol > 0.0 && s.rtol <= 1e-2,
-            "must be in (0, 1e-2]",
-        )?;
-        check(
-            "simulate.atol",
-            s.atol,
-            s.atol > 0.0 && s.atol <= 1e-2,
-            "must be in (0, 1e-2]",
-        )?;
-        check(
-            "simulate.pd_bandwidth_hz",
-            s.pd_bandwidth_hz,
-            s.pd_bandwidth_hz > 0.0,
-            "must be > 0 Hz",
-        )?;
-        check(
-            "simulate.pd_damping",
-            s.pd_damping,
-            s.pd_damping > 0.0,
-            "must be > 0",
-        )?;
-        check(
-            "simulate.flip_tolerance",
-            s.flip_tolerance,
-            s.flip_tolerance > 0.0 && s.flip_tolerance <= std::f64::consts::PI,
-            "must be in (0, pi] rad",
-        )?;
-        let n = s.samples_per_phase as f64;
-        check(
-            "simulate.samples_per_phase",
-            n,
-            (2.0..=30_000.0).contains(&n),
-            "must be in 2..=30000",
-        )?;
-        let p = &self.phased;
-        check(
-            "phased.nodes",
-            p.nodes as f64,
-            (4..=2000).contains(&p.nodes),
-            "must be in 4..=2000",
-        )?;
-        check(
-            "phased.bend_min_deg",
-            p.bend_min_deg,
-            p.bend_min_deg > 0.0,
-            "must be > 0 degrees",
-        )?;
-        check(
-            "phased.bend_max_deg",
-            p.bend_max_deg,
-            p.bend_max_deg > p.bend_min_deg && p.bend_max_deg < 180.0,
-            "must exceed phased.bend_min_deg and be < 180 degrees",
-        )?;
-        check(
-            "phased.scan_points",
-            p.scan_points as f64,
-            (3..=200).contains(&p.scan_points),
-            "must be in 3..=200",
-        )?;
-        check(
-            "phased.bend_tol_deg",
-            p.bend_tol_deg,
-            p.bend_tol_deg > 0.0,
-            "must be > 0 degrees",
-        )?;
-        let fr = &self.free;
-        check(
-            "free.nodes",
-            fr.nodes as f64,
-            (4..=400).contains(&fr.nodes),
-            "must be in 4..=400",
-        )?;
-        check(
-            "free.max_iterations",
-            fr.max_iterations as f64,
-            fr.max_iterations >= 1,
-            "must be >= 1",
-        )?;
-        check(
-            "free.tolerance",
-            fr.tolerance,
-            fr.tolerance > 0.0 && fr.tolerance < 1.0,
-            "must be in (0, 1)",
-        )?;
-        check(
-            "free.attitude_tolerance",
-            fr.attitude_tolerance,
-            fr.attitude_tolerance > 0.0,
-            "must be > 0 rad",
-        )?;
+        self.simulate.validate()?;
+        self.phased.validate()?;
+        self.free.validate()?;
         self.start.validate()?;
         self.land.validate()?;
         self.control.validate()?;
@@ -619,16 +354,14 @@ impl Config {
         }
     }
 
-    /// `sqrt(2 h / g)`, s. A height near `f64::MAX` makes it infinite, which
-    /// the fall-time range check refuses (kept in this form: the designs of
-    /// the bundled configs depend on its last bit).
+    /// `sqrt(2 h / g)`, s (see [`Fall::fall_time`]).
     pub fn fall_time(&self) -> f64 {
-        (2.0 * self.fall.height / self.fall.gravity).sqrt()
+        self.fall.fall_time()
     }
 
     /// Time for the manoeuvre: fall time minus margin, s.
     pub fn available_time(&self) -> f64 {
-        self.fall_time() - self.fall.margin
+        self.fall.available_time()
     }
 
     pub fn norm(&self) -> TorqueNorm {
@@ -637,13 +370,30 @@ impl Config {
             .unwrap_or(TorqueNorm::default_for(self.cat.joint))
     }
 
-    /// Whether the design needs the motor-envelope program (a speed limit, a
-    /// torque-speed line or an objective other than the peak torque) rather
-    /// than the unit-time peak program with F3 scaling.
+    /// Whether the design needs the motor-envelope program (see
+    /// [`DesignSpec::uses_envelope`]).
     pub fn uses_envelope(&self) -> bool {
         self.design.objective != crate::design::objective::Objective::PeakTorque
             || self.limits.max_speed.is_some()
             || self.limits.no_load_speed.is_some()
+    }
+
+    /// What the design code takes: the body, motors, fall, start, objective
+    /// and the optimisers' settings.
+    pub fn design_spec(&self) -> DesignSpec {
+        DesignSpec {
+            cat: self.cat(),
+            motor: self.motor(),
+            fall: self.fall,
+            start: (!self.start.is_default()).then(|| self.start.start()),
+            objective: self.design.objective,
+            max_bend_deg: self.limits.max_bend_deg,
+            max_tilt_deg: self.land.max_tilt_deg,
+            analytic: self.analytic.clone(),
+            simulate: self.simulate.clone(),
+            phased: self.phased.clone(),
+            free: self.free.clone(),
+        }
     }
 
     /// The joint's motors as the limits describe them.

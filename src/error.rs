@@ -86,3 +86,26 @@ impl Error {
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// A number as the user would read it: `1e308`, not 309 digits.
+pub fn show(x: f64) -> String {
+    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
+/// `Ok` when `ok` holds and `value` is finite, else the [`Error::Invalid`]
+/// that names `key`, the value and what was `expected`.
+pub fn check(key: &str, value: f64, ok: bool, expected: &str) -> Result<()> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(Error::Invalid {
+            key: key.into(),
+            value: show(value),
+            expected: expected.into(),
+        })
+    }
+}

@@ -29,5 +29,8 @@ pub mod table;
 pub mod verdict;
 pub mod verify;
 
+#[cfg(test)]
+mod test_support;
+
 pub use config::Config;
 pub use error::{Error, Result};

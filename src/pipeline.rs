@@ -15,7 +15,7 @@ use crate::report::MethodTrace;
 use crate::report::animation::Track;
 use crate::verdict::{DesignNumbers, Grade, Miss, Simulated, Status, Targets, Verdict, verdict};
 use crate::verify::analyze::Analysis;
-use crate::verify::simulate::{SimReport, dynamic_cfg};
+use crate::verify::simulate::{SimReport, dynamic_spec};
 use serde::Serialize;
 
 /// The design methods, in the order every table lists them.
@@ -186,7 +186,7 @@ pub fn judge(
 ) -> Verdict {
     let motor = schedule.map(|s| usage(cfg, s));
     verdict(
-        &Targets::of(cfg),
+        &Targets::of(&cfg.design_spec()),
         &DesignNumbers {
             status,
             peak_torque_nm,
@@ -201,7 +201,7 @@ pub fn judge(
 /// The seed's analytic schedule as written, and its verdict (closed form;
 /// the flip from the analysis's kinematic simulation).
 pub fn judge_analysis(cfg: &Config, a: &Analysis) -> (Schedule, Verdict) {
-    let schedule = crate::verify::analyze::analytic_schedule(cfg, &a.plan);
+    let schedule = crate::verify::analyze::analytic_schedule(&cfg.design_spec(), &a.plan);
     let v = judge(
         cfg,
         Status::ClosedForm,
@@ -242,7 +242,7 @@ pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
     };
     let sim = match design.simulation() {
         Some(s) => Ok(s.clone()),
-        None => dynamic_cfg(cfg, design.plan()),
+        None => dynamic_spec(&cfg.design_spec(), design.plan()),
     };
     let method = design.method();
     let (bend, twist, durations) = design.path_numbers();
@@ -374,7 +374,7 @@ pub fn trace(
         qd,
         tau_xy,
         peak_nm: peak,
-        over_limit: Targets::of(cfg).over_torque(peak),
+        over_limit: Targets::of(&cfg.design_spec()).over_torque(peak),
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),

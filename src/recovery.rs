@@ -348,7 +348,7 @@ impl Origin {
         grid.validate()?;
         let mut at_rest = cfg.clone();
         at_rest.start = Default::default();
-        let design = FreeDesign::new(&at_rest).solve()?;
+        let design = FreeDesign::new(&at_rest.design_spec()).solve()?;
         Ok(Origin {
             cfg: at_rest,
             grid: grid.clone(),
@@ -405,7 +405,9 @@ impl Origin {
         let fr = if magnitude == 0.0 {
             Ok(self.design.clone())
         } else {
-            FreeDesign::new(&cfg).warm(warm, before).solve()
+            FreeDesign::new(&cfg.design_spec())
+                .warm(warm, before)
+                .solve()
         };
         let kept = match fr {
             Ok(fr) => {
@@ -480,7 +482,10 @@ impl Origin {
             let mid = 0.5 * (lo + hi);
             let cfg = line.config(&self.cfg, mid, self.grid.max_iterations);
             b.iterations += 1;
-            match FreeDesign::new(&cfg).warm(&warm, None).solve() {
+            match FreeDesign::new(&cfg.design_spec())
+                .warm(&warm, None)
+                .solve()
+            {
                 Ok(fr) if lands(&cfg, &fr) => {
                     lo = mid;
                     warm = fr;
@@ -498,14 +503,15 @@ impl Origin {
 /// one (constraints met, inside the motor envelope, landing within the
 /// tolerance under the motor model).
 fn lands(cfg: &Config, fr: &FreeResult) -> bool {
-    fr.landing_error_deg <= tolerance_deg(cfg) && crate::design::least_height::verified(cfg, fr)
+    fr.landing_error_deg <= tolerance_deg(cfg)
+        && crate::design::least_height::verified(&cfg.design_spec(), fr)
 }
 
 /// The least drop height from `cfg`'s start, m: the shortest verified
 /// free-form `time` design inside the motor envelope (from the start at
 /// rest the phased one counts too); `None` when none verifies.
 fn least_height(cfg: &Config) -> Option<f64> {
-    match crate::design::least_height::heights(cfg, true, |_| {}) {
+    match crate::design::least_height::heights(&cfg.design_spec(), true, |_| {}) {
         Ok(Some(h)) if h.free.is_some() || cfg.start.is_default() => Some(h.answer.least_height_m),
         _ => None,
     }

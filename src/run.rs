@@ -175,7 +175,8 @@ impl Methods {
 /// others: its status and reason go into the summary, table and report. Only
 /// when every method fails is the run an error.
 pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
-    let limited = cfg.motor().is_limited();
+    let spec = cfg.design_spec();
+    let limited = spec.motor.is_limited();
     let cat = cfg.cat();
     let mut stages = Stages {
         index: 0,
@@ -188,7 +189,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     let clock = stages.begin("analytic schedule (seed closed forms, errata corrected)");
     // the kinematic check is part of the analysis; a failed dynamic
     // simulation (e.g. under a saturating torque limit) only flags the schedule
-    let analytic = analyze(cfg);
+    let analytic = analyze(&spec, &cfg.name);
     let seconds = clock.elapsed().as_secs_f64();
     match analytic {
         Ok(a) => {
@@ -212,11 +213,11 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         let clock =
             stages.begin("least drop height (shortest manoeuvre inside the motor envelope)");
         let progress = &mut stages.progress;
-        let a = crate::design::least_height::heights(cfg, true, |it| progress(Progress::Scp(it)))
+        let a = crate::design::least_height::heights(&spec, true, |it| progress(Progress::Scp(it)))
             .map(|h| {
                 h.map(|h| {
-                    phased_short =
-                        (!crate::design::least_height::fits(cfg, h.phased_m)).then_some(h.phased_m);
+                    phased_short = (!crate::design::least_height::fits(&spec, h.phased_m))
+                        .then_some(h.phased_m);
                     fastest_free = h.free;
                     h.answer
                 })
@@ -252,7 +253,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         None => {
             let mut evaluations = 0;
             let progress = &mut stages.progress;
-            let phased = crate::design::phased::optimize(cfg, |e| {
+            let phased = crate::design::phased::optimize(&spec, |e| {
                 evaluations += 1;
                 progress(Progress::Bend {
                     evaluations,
@@ -283,7 +284,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             (Some(ph), _) => (ph.plan(), "phased"),
             (None, Some(fr)) => (&fr.plan, "free least-time"),
             (None, None) => {
-                analytic_seed = crate::design::analytic::analytic_plan(cfg);
+                analytic_seed = crate::design::analytic::analytic_plan(&spec);
                 (&analytic_seed, "analytic")
             }
         };
@@ -294,7 +295,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         }
         None => {
             let progress = &mut stages.progress;
-            let free = crate::design::free::FreeDesign::new(cfg)
+            let free = crate::design::free::FreeDesign::new(&spec)
                 .from_plan(seed_plan, seed_name)
                 .on_iteration(&mut |it| progress(Progress::Scp(it)))
                 .solve();
@@ -417,7 +418,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         scp_iterations,
         nodes,
         mesh_levels,
-        analytic: crate::design::analytic::closed_forms(cfg),
+        analytic: crate::design::analytic::closed_forms(&spec),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
         answer,
     };

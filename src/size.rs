@@ -34,7 +34,9 @@ use crate::config::Config;
 use crate::design::free::FreeDesign;
 use crate::design::least_height::heights;
 use crate::design::objective::Objective;
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
+use crate::model::motor::Motor;
 use crate::verdict::Status;
 use serde::Serialize;
 use std::time::Instant;
@@ -254,12 +256,18 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
 /// The configured motor with `torque` and `no_load` in place of its line;
 /// a hard speed limit keeps its ratio to the no-load speed (a gear or a
 /// scaled motor scales it alike).
-fn with_motor(q: &Config, torque: Option<f64>, no_load: Option<f64>, speed: Option<f64>) -> Config {
-    let mut c = q.clone();
-    c.limits.max_torque = torque;
-    c.limits.no_load_speed = no_load;
-    c.limits.max_speed = speed;
-    c
+fn with_motor(
+    q: &Config,
+    torque: Option<f64>,
+    no_load: Option<f64>,
+    speed: Option<f64>,
+) -> DesignSpec {
+    q.design_spec().with_motor(Motor {
+        max_torque: torque,
+        no_load_speed: no_load,
+        max_speed: speed,
+        norm: q.norm(),
+    })
 }
 
 /// The hard speed limit over the no-load speed of the configured motor.
@@ -274,8 +282,8 @@ fn speed_ratio(q: &Config) -> Option<f64> {
 /// question's fall: the least-height answer of [`heights`].
 pub fn design_motor(q: &Config, torque: f64, no_load: f64) -> Result<MotorDesign> {
     let speed = speed_ratio(q).map(|r| r * no_load);
-    let cfg = with_motor(q, Some(torque), Some(no_load), speed);
-    let h = heights(&cfg, true, |_| {})?.expect("a limited motor has an answer");
+    let spec = with_motor(q, Some(torque), Some(no_load), speed);
+    let h = heights(&spec, true, |_| {})?.expect("a limited motor has an answer");
     let a = &h.answer;
     if !a.from_start {
         // a tilted release: only a free-form design from the start answers
@@ -298,8 +306,7 @@ pub fn design_motor(q: &Config, torque: f64, no_load: f64) -> Result<MotorDesign
 /// The two ends of the curve: `(T_inf, w_min)`.
 fn asymptotes(q: &Config) -> Result<(f64, f64)> {
     // unlimited speed: the least peak torque within the manoeuvre time
-    let mut peak = with_motor(q, None, None, None);
-    peak.design.objective = Objective::PeakTorque;
+    let peak = with_motor(q, None, None, None).with_objective(Objective::PeakTorque);
     let phased = crate::design::phased::optimize(&peak, |_| {})?.peak_torque_nm;
     let torque = match FreeDesign::new(&peak).solve() {
         Ok(fr) if Status::from(fr.status).is_proven() => fr.peak_torque_nm.min(phased),
@@ -310,8 +317,8 @@ fn asymptotes(q: &Config) -> Result<(f64, f64)> {
     // configured no-load speed and scaled (F3)
     let w0 = q.limits.no_load_speed.expect("checked by question");
     let w = w0 * speed_ratio(q).unwrap_or(1.0).min(1.0);
-    let speed_cfg = with_motor(q, None, None, Some(w));
-    let h = heights(&speed_cfg, true, |_| {})?.expect("a speed limit has an answer");
+    let speed = with_motor(q, None, None, Some(w));
+    let h = heights(&speed, true, |_| {})?.expect("a speed limit has an answer");
     let speed = w0 * h.answer.least_time_s / q.available_time();
     Ok((torque, speed))
 }
@@ -425,7 +432,7 @@ fn gear_search(
         .map(|&(ln_n, t)| GearPrediction {
             gear_ratio: ln_n.exp(),
             least_time_s: t,
-            least_height_m: crate::design::envelope::height_for(q, t),
+            least_height_m: crate::design::envelope::height_for(&q.design_spec(), t),
         })
         .collect();
     predictions.sort_by(|a, b| a.gear_ratio.total_cmp(&b.gear_ratio));
@@ -491,7 +498,8 @@ fn gear_search(
         .iter()
         .min_by(|a, b| a.design.least_time_s.total_cmp(&b.design.least_time_s))
         .expect("the configured ratio at least");
-    let fits = |h: f64| crate::design::least_height::fits(q, h);
+    let spec = q.design_spec();
+    let fits = |h: f64| crate::design::least_height::fits(&spec, h);
     Ok((
         GearAnswer {
             best_ratio: top.gear_ratio,

@@ -277,13 +277,14 @@ fn point(
     let limited_cfg = cfg;
     let mut cfg = cfg.clone();
     cfg.limits.max_torque = None;
+    let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);
     if methods.analytic {
         p.analytic_peak_nm = Some(
             peak_along(
-                &cfg,
-                &analytic_plan(&cfg),
-                crate::verify::analyze::dense_samples(&cfg),
+                &spec,
+                &analytic_plan(&spec),
+                crate::verify::analyze::dense_samples(&spec),
             )
             .0,
         );
@@ -316,7 +317,7 @@ fn point(
                     bends.len().checked_sub(2).map(|i| bends[i]),
                 )
             });
-            let r = crate::design::phased::optimize_near(&cfg, hint, |_| {});
+            let r = crate::design::phased::optimize_near(&spec, hint, |_| {});
             // only a solved design at the point just before predicts this
             // one: after a failure the next point scans afresh
             match &r {
@@ -350,7 +351,7 @@ fn point(
                 p.phased_bend_deg = Some(ph.bend_deg);
                 p.least_height_phased_m = limit
                     .filter(|_| !envelope)
-                    .map(|l| least_height(&cfg, ph.peak_torque_nm * t2, l));
+                    .map(|l| least_height(&spec, ph.peak_torque_nm * t2, l));
             }
             Err(e) if methods.phased => errors.push(format!("phased: {e}")),
             _ => {}
@@ -358,14 +359,14 @@ fn point(
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
             let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::FreeDesign::new(&cfg)
+                (_, Some(w)) => crate::design::free::FreeDesign::new(&spec)
                     .warm(w, before)
                     .solve(),
-                (Ok(ph), None) => crate::design::free::FreeDesign::new(&cfg)
+                (Ok(ph), None) => crate::design::free::FreeDesign::new(&spec)
                     .from_plan(&ph.plan, "phased")
                     .solve(),
-                (Err(_), None) => crate::design::free::FreeDesign::new(&cfg)
-                    .from_plan(&analytic_plan(&cfg), "analytic")
+                (Err(_), None) => crate::design::free::FreeDesign::new(&spec)
+                    .from_plan(&analytic_plan(&spec), "analytic")
                     .solve(),
             };
             match fr {
@@ -382,7 +383,7 @@ fn point(
                     p.free_bend_deg = Some(fr.bend_deg);
                     p.least_height_free_m = limit
                         .filter(|_| !envelope)
-                        .map(|l| least_height(&cfg, fr.peak_torque_nm * t2, l));
+                        .map(|l| least_height(&spec, fr.peak_torque_nm * t2, l));
                     p.free_status = Some(fr.status.into());
                     kept = Some(fr);
                 }
@@ -391,15 +392,17 @@ fn point(
         }
     }
     if envelope && (methods.phased || methods.free) {
-        match crate::design::least_height::heights(limited_cfg, methods.free, |_| {}) {
+        let limited = limited_cfg.design_spec();
+        match crate::design::least_height::heights(&limited, methods.free, |_| {}) {
             Ok(Some(h)) => {
                 if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);
                 }
                 if methods.free {
-                    p.least_height_free_m = h.free.as_ref().map(|f| {
-                        crate::design::envelope::height_for(limited_cfg, f.manoeuvre_time_s)
-                    });
+                    p.least_height_free_m = h
+                        .free
+                        .as_ref()
+                        .map(|f| crate::design::envelope::height_for(&limited, f.manoeuvre_time_s));
                     if h.free.is_none() {
                         errors.push("free least height: no free-form time design verified".into());
                     }

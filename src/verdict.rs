@@ -3,9 +3,9 @@
 //! targets it misses ([`Miss`]), judged by [`verdict`] against one table of
 //! tolerances ([`tolerance`]). Statuses become strings only when serialised.
 
-use crate::config::Config;
 use crate::design::conic::SolveStatus;
 use crate::design::scp::ScpStatus;
+use crate::design::spec::DesignSpec;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -139,23 +139,23 @@ pub struct Targets {
 }
 
 impl Targets {
-    pub fn of(cfg: &Config) -> Targets {
+    pub fn of(spec: &DesignSpec) -> Targets {
         Targets {
-            max_torque: cfg.limits.max_torque,
-            no_load_speed: cfg.limits.no_load_speed,
-            max_speed: cfg.limits.max_speed,
-            max_bend_deg: cfg.limits.max_bend_deg,
-            flip_tolerance: cfg.simulate.flip_tolerance,
-            landing_tolerance: match cfg.land.max_tilt_deg {
+            max_torque: spec.motor.max_torque,
+            no_load_speed: spec.motor.no_load_speed,
+            max_speed: spec.motor.max_speed,
+            max_bend_deg: spec.max_bend_deg,
+            flip_tolerance: spec.simulate.flip_tolerance,
+            landing_tolerance: match spec.max_tilt_deg {
                 Some(t) => Some((t, "land.max_tilt_deg")),
-                None if !cfg.start.is_default() => Some((
-                    cfg.simulate.flip_tolerance.to_degrees(),
+                None if !spec.is_default_start() => Some((
+                    spec.simulate.flip_tolerance.to_degrees(),
                     "land.max_tilt_deg, by default simulate.flip_tolerance",
                 )),
                 None => None,
             },
-            judge_flip: cfg.start.is_default(),
-            envelope_keys: cfg.envelope_keys(),
+            judge_flip: spec.is_default_start(),
+            envelope_keys: spec.envelope_keys(),
         }
     }
 

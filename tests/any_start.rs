@@ -20,7 +20,7 @@ fn tight() -> OdeSettings {
 
 fn design(sets: &[&str]) -> (catflip::Config, FreeResult) {
     let cfg = util::seed(sets);
-    let r = FreeDesign::new(&cfg)
+    let r = FreeDesign::new(&cfg.design_spec())
         .solve()
         .expect("a design from this start");
     (cfg, r)
@@ -46,7 +46,7 @@ fn lands(sets: &[&str]) {
         "{sets:?}: kinematic replay lands {} deg off",
         kin.landing_error_deg
     );
-    let mut ff = Controller::from_config(&cfg);
+    let mut ff = Controller::from_spec(&cfg.design_spec());
     (ff.kp, ff.kd) = (0.0, 0.0);
     let dyn_ff = dynamic_landing(&cat, &r.plan, &ff, &tight(), &start, cfg.fall.margin).unwrap();
     assert!(
@@ -55,7 +55,9 @@ fn lands(sets: &[&str]) {
         dyn_ff.landing_error_deg
     );
     // and today's schedule, made for the start at rest, does not
-    let today = FreeDesign::new(&util::seed(&[])).solve().unwrap();
+    let today = FreeDesign::new(&util::seed(&[]).design_spec())
+        .solve()
+        .unwrap();
     let mut off = kinematic_from(&cat, &today.plan, &start, &tight()).unwrap();
     off.land(&cat, cfg.fall.margin);
     assert!(
@@ -90,7 +92,7 @@ fn a_design_from_a_spin_and_a_roll_tilt_together_lands_belly_down() {
 #[test]
 fn a_pitched_start_is_answered_as_unlandable() {
     let cfg = util::seed(&["start.rotation_deg=[0, 5, 0]"]);
-    let e = FreeDesign::new(&cfg)
+    let e = FreeDesign::new(&cfg.design_spec())
         .solve()
         .expect_err("a pitched no-twist cat")
         .to_string();
@@ -101,8 +103,10 @@ fn a_pitched_start_is_answered_as_unlandable() {
 /// The default start keeps today's problem (full attitude `Rz(pi)`), bit for bit.
 #[test]
 fn the_default_start_is_todays_problem() {
-    let a = FreeDesign::new(&util::seed(&[])).solve().unwrap();
-    let b = FreeDesign::new(&util::seed(&["start.rotation_deg=[0, 0, 0]"]))
+    let a = FreeDesign::new(&util::seed(&[]).design_spec())
+        .solve()
+        .unwrap();
+    let b = FreeDesign::new(&util::seed(&["start.rotation_deg=[0, 0, 0]"]).design_spec())
         .solve()
         .unwrap();
     assert_eq!(a.plan.z, b.plan.z);

@@ -96,8 +96,8 @@ fn identical_front_table_reproduces_the_symmetric_cat() {
     let same = seed(&["cat.front.mass=1.0", "cat.front.length=1.0"]);
     assert_eq!(plain.cat(), same.cat());
     let (a, b) = (
-        optimize(&plain, |_| {}).unwrap(),
-        optimize(&same, |_| {}).unwrap(),
+        optimize(&plain.design_spec(), |_| {}).unwrap(),
+        optimize(&same.design_spec(), |_| {}).unwrap(),
     );
     assert!((a.peak_torque_nm - b.peak_torque_nm).abs() <= 1e-12 * a.peak_torque_nm);
 }
@@ -115,8 +115,8 @@ fn no_twist_swapping_the_halves_keeps_the_optimal_peak() {
         "cat.front.length=1.0",
     ]);
     let (a, b) = (
-        optimize(&heavy_rear, |_| {}).unwrap(),
-        optimize(&heavy_front, |_| {}).unwrap(),
+        optimize(&heavy_rear.design_spec(), |_| {}).unwrap(),
+        optimize(&heavy_front.design_spec(), |_| {}).unwrap(),
     );
     let rel = (a.peak_torque_nm - b.peak_torque_nm).abs() / a.peak_torque_nm;
     assert!(
@@ -126,7 +126,9 @@ fn no_twist_swapping_the_halves_keeps_the_optimal_peak() {
         b.peak_torque_nm
     );
     // the designs really are for different bodies: the unequal cat differs from the seed
-    let seed_peak = optimize(&seed(&[]), |_| {}).unwrap().peak_torque_nm;
+    let seed_peak = optimize(&seed(&[]).design_spec(), |_| {})
+        .unwrap()
+        .peak_torque_nm;
     assert!((a.peak_torque_nm - seed_peak).abs() > 1e-3 * seed_peak);
     // and both flip by pi in the dynamic simulation (the twist is root-found)
     for r in [&a, &b] {

@@ -12,13 +12,14 @@ use util::seed;
 fn time_with_a_torque_limit_alone_is_f7() {
     // F7: T_min = sqrt(P / tau_max) with P the unit-time optimum of the peak design
     let tau_max = 0.8;
-    let peak = optimize(&seed(&[]), |_| {}).unwrap();
+    let peak = optimize(&seed(&[]).design_spec(), |_| {}).unwrap();
     let t_f7 = (peak.unit_peak_nm_s2 / tau_max).sqrt();
     let timed = optimize(
         &seed(&[
             "design.objective=time",
             &format!("limits.max_torque={tau_max}"),
-        ]),
+        ])
+        .design_spec(),
         |_| {},
     )
     .unwrap();
@@ -26,7 +27,7 @@ fn time_with_a_torque_limit_alone_is_f7() {
     assert!(rel < 5e-3, "time {} vs F7 {t_f7}", timed.manoeuvre_time_s);
     let cfg = seed(&[]);
     let (h, h_f7) = (
-        height_for(&cfg, timed.manoeuvre_time_s),
+        height_for(&cfg.design_spec(), timed.manoeuvre_time_s),
         0.5 * cfg.fall.gravity * t_f7 * t_f7,
     );
     assert!((h - h_f7).abs() < 1e-2 * h_f7, "{h} vs {h_f7}");
@@ -37,7 +38,7 @@ fn time_with_a_torque_limit_alone_is_f7() {
 fn time_with_a_speed_limit_alone_scales_as_one_over_the_limit() {
     let t = |w: f64| {
         optimize(
-            &seed(&["design.objective=time", &format!("limits.max_speed={w}")]),
+            &seed(&["design.objective=time", &format!("limits.max_speed={w}")]).design_spec(),
             |_| {},
         )
         .unwrap()
@@ -52,8 +53,8 @@ fn envelope_path_with_no_binding_limit_matches_the_unit_time_peak_program() {
     // a speed limit far above anything the design reaches sends the design
     // through the three-phase envelope program; its optimum must be the
     // unit-time program's (two formulations of the same optimum)
-    let plain = optimize(&seed(&[]), |_| {}).unwrap();
-    let env = optimize(&seed(&["limits.max_speed=1000"]), |_| {}).unwrap();
+    let plain = optimize(&seed(&[]).design_spec(), |_| {}).unwrap();
+    let env = optimize(&seed(&["limits.max_speed=1000"]).design_spec(), |_| {}).unwrap();
     let rel = (env.peak_torque_nm - plain.peak_torque_nm).abs() / plain.peak_torque_nm;
     assert!(
         rel < 3e-3,
@@ -86,8 +87,8 @@ fn every_row_inside_the_envelope_and_the_motor_model_flips() {
         ov.push(&o);
         ov.push(&n);
         let cfg = seed(&ov);
-        let r = optimize(&cfg, |_| {}).unwrap();
-        let u = usage_of(&cfg, &r.plan);
+        let r = optimize(&cfg.design_spec(), |_| {}).unwrap();
+        let u = usage_of(&cfg.design_spec(), &r.plan);
         assert!(
             u.min_margin.unwrap() >= -1e-6,
             "{objective} {norm}: margin {:?}",
@@ -115,7 +116,7 @@ fn every_row_inside_the_envelope_and_the_motor_model_flips() {
     let (_, _, cfg_e, energy) = &results[3];
     let mut ov = limits.to_vec();
     ov.push("limits.norm=per-motor");
-    let peak = optimize(&seed(&ov), |_| {}).unwrap();
+    let peak = optimize(&seed(&ov).design_spec(), |_| {}).unwrap();
     let cat = cfg_e.cat();
     let (e_of_energy, e_of_peak) = (
         torque_squared_integral(&cat, &energy.plan, 2000),

@@ -293,7 +293,7 @@ fn held_torques_carry_the_schedules_impulse() {
 #[test]
 fn ball_controls_are_quaternions_and_child_frame_rates() {
     let cfg = config("seed", &[]);
-    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
     let mj = Controls::sample(&cfg, &plan, Simulator::Mujoco);
     let n = mj.rows.len();
     let mut worst: f64 = 0.0;

@@ -27,7 +27,7 @@ fn f1_seed_schedule_flips_by_pi_at_several_bends() {
     let one_turn = turns_theta(cat.i_t(), cat.i_a(), 1.0).to_degrees();
     for theta in [30.0, 45.0, 90.0, 120.0, one_turn] {
         let cfg = seed(&[&format!("analytic.theta_deg={theta}")]);
-        let r = kinematic(&cfg.cat(), &analytic_plan(&cfg), &tight()).unwrap();
+        let r = kinematic(&cfg.cat(), &analytic_plan(&cfg.design_spec()), &tight()).unwrap();
         assert!(
             r.flip_error_rad.abs() < 1e-8,
             "theta {theta}: flip error {}",
@@ -69,7 +69,10 @@ fn f2_flip_depends_on_the_path_not_its_timing() {
         "analytic.split=[0.5, 0.3, 0.2]",
         "fall.height=3",
     ]);
-    let (pa, pb) = (analytic_plan(&a), analytic_plan(&b));
+    let (pa, pb) = (
+        analytic_plan(&a.design_spec()),
+        analytic_plan(&b.design_spec()),
+    );
     assert_eq!(pa.paths, pb.paths);
     let ra = kinematic(&a.cat(), &pa, &tight()).unwrap();
     let rb = kinematic(&b.cat(), &pb, &tight()).unwrap();
@@ -124,7 +127,7 @@ fn power_balance_dt_dt_equals_tau_dot_qdot() {
         let j = format!("cat.joint={joint}");
         let cfg = seed(&[&[j.as_str()][..], front].concat());
         let cat = cfg.cat();
-        let p = analytic_plan(&cfg);
+        let p = analytic_plan(&cfg.design_spec());
         let b = p.phase_bounds();
         let h = 1e-6;
         for i in 0..3 {
@@ -149,7 +152,7 @@ fn power_balance_dt_dt_equals_tau_dot_qdot() {
 
 #[test]
 fn seed_printed_example_with_its_own_inertia() {
-    let cf = closed_forms(&seed(&["analytic.seed_inertia=true"]));
+    let cf = closed_forms(&seed(&["analytic.seed_inertia=true"]).design_spec());
     // the seed prints 1.428 for 1.42857 (truncated)
     assert!((cf.fall_time_s - 1.428).abs() < 1e-3, "{}", cf.fall_time_s);
     assert!((cf.i_yy - 0.0726).abs() < 5e-5, "{}", cf.i_yy);
@@ -161,7 +164,7 @@ fn seed_printed_example_with_its_own_inertia() {
         cf.seed_omega_rad_s
     );
     // and the design inertia differs (E1)
-    let right = closed_forms(&seed(&[]));
+    let right = closed_forms(&seed(&[]).design_spec());
     assert!((right.i_t - (3.0 * 0.01 + 1.0) / 12.0).abs() < 1e-15);
     assert!((right.i_yy - cf.i_yy).abs() > 1e-3);
 }
@@ -174,7 +177,7 @@ fn one_turn_bend_twists_once_for_the_flip() {
     let (_, c) = yy_inertia_and_c(cat.i_t(), cat.i_a(), th);
     assert!((c - 0.5).abs() < 1e-12);
     let cfg = seed(&[&format!("analytic.theta_deg={}", th.to_degrees())]);
-    assert!((closed_forms(&cfg).twist_rad - 2.0 * PI).abs() < 1e-9);
+    assert!((closed_forms(&cfg.design_spec()).twist_rad - 2.0 * PI).abs() < 1e-9);
 }
 
 #[test]
@@ -182,7 +185,7 @@ fn dynamic_simulation_of_inverse_dynamics_torque_reproduces_the_plan() {
     for joint in [Joint::NoTwist, Joint::Universal] {
         let cfg = seed(&[&format!("cat.joint={}", joint.name())]);
         let cat = cfg.cat();
-        let p = analytic_plan(&cfg);
+        let p = analytic_plan(&cfg.design_spec());
         let open_loop = Controller {
             kp: 0.0,
             kd: 0.0,
@@ -205,7 +208,11 @@ fn dynamic_simulation_of_inverse_dynamics_torque_reproduces_the_plan() {
 #[test]
 fn torque_limit_saturates_and_spoils_the_flip() {
     let cfg = seed(&["limits.max_torque=5"]);
-    let r = catflip::verify::simulate::dynamic_cfg(&cfg, &analytic_plan(&cfg)).unwrap();
+    let r = catflip::verify::simulate::dynamic_spec(
+        &cfg.design_spec(),
+        &analytic_plan(&cfg.design_spec()),
+    )
+    .unwrap();
     assert!(r.peak_torque_nm <= 5.0 + 1e-9);
     assert!(r.max_tracking_error_rad > 1e-2);
 }

@@ -14,8 +14,8 @@ use util::stall_torque_only as cfg;
 /// certified phased design, at the config's nodes.
 fn seed_from_certified_phased(norm: &str) -> (Config, catflip::design::free::FreeResult) {
     let c = cfg("seed", &[&format!("limits.norm={norm}")]);
-    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-    let r = catflip::design::free::FreeDesign::new(&c)
+    let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
+    let r = catflip::design::free::FreeDesign::new(&c.design_spec())
         .from_plan(&phased.plan, "phased")
         .solve()
         .unwrap();
@@ -36,12 +36,12 @@ fn linearisation_matches_finite_differences_of_the_nonlinear_maps() {
         let c = cfg("seed", &[&format!("cat.joint={joint}")]);
         let nodes = 6;
         let tr = Transcription::new(3, nodes);
-        let mut z = tr.sample(&analytic_plan(&c));
+        let mut z = tr.sample(&analytic_plan(&c.design_spec()));
         // move off the seed so that nothing is special
         for (i, x) in z.iter_mut().enumerate() {
             *x += 0.01 * ((i * 37 % 11) as f64 - 5.0) / 5.0;
         }
-        let p = FreeProblem::new(&c, nodes, &z);
+        let p = FreeProblem::new(&c.design_spec(), nodes, &z);
         let lin = p.linearize(&z);
         let v = p.evaluate(&z);
         let (terms, res) = (v.terms, v.residual);
@@ -323,20 +323,20 @@ fn an_unmoved_cat_is_half_a_turn_from_the_flip_and_a_hopeless_limit_fails() {
     let c = cfg("seed", &[]);
     let nodes = 6;
     let tr = Transcription::new(3, nodes);
-    let mut z = tr.sample(&analytic_plan(&c));
+    let mut z = tr.sample(&analytic_plan(&c.design_spec()));
     for p in 0..3 {
         for k in 0..nodes {
             z[tr.node(p, k)..tr.node(p, k) + Transcription::PER_NODE].fill(0.0);
         }
     }
-    let p = FreeProblem::new(&c, nodes, &z);
+    let p = FreeProblem::new(&c.design_spec(), nodes, &z);
     let r = p.evaluate(&z).residual;
     let att = &r[r.len() - 3..];
     let norm = att.iter().map(|x| x * x).sum::<f64>().sqrt();
     assert!((norm - std::f64::consts::PI).abs() < 1e-12, "{att:?}");
     // and a limit far below any flip's peak is a failure, not a design
     let c = cfg("seed", &["limits.max_torque=0.01"]);
-    let e = catflip::design::free::FreeDesign::new(&c)
+    let e = catflip::design::free::FreeDesign::new(&c.design_spec())
         .seed(catflip::design::free::Seed::Phased)
         .check_mesh()
         .solve();
@@ -348,7 +348,7 @@ fn accepted_scp_steps_never_increase_the_penalised_objective() {
     let c = cfg("seed", &[]);
     let mut seen = 0;
     let mut anchor: Option<f64> = None;
-    let r = catflip::design::free::FreeDesign::new(&c)
+    let r = catflip::design::free::FreeDesign::new(&c.design_spec())
         .seed(catflip::design::free::Seed::Analytic)
         .check_mesh()
         .on_iteration(&mut |it| {
@@ -384,8 +384,10 @@ fn a_tentative_step_stands_only_if_the_next_lowers_the_merit_below_its_start() {
         "seed",
         &["limits.norm=per-motor", "free.mesh_continuation=false"],
     );
-    let plan = catflip::design::free::Seed::Analytic.plan(&c).unwrap();
-    let r = catflip::design::free::FreeDesign::new(&c)
+    let plan = catflip::design::free::Seed::Analytic
+        .plan(&c.design_spec())
+        .unwrap();
+    let r = catflip::design::free::FreeDesign::new(&c.design_spec())
         .from_plan(plan.as_ref(), "analytic")
         .solve()
         .unwrap();
@@ -433,12 +435,12 @@ fn a_tentative_step_stands_only_if_the_next_lowers_the_merit_below_its_start() {
 #[test]
 fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
     let c = cfg("seed", &[]);
-    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+    let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
     for seed in [
         catflip::design::free::Seed::Phased,
         catflip::design::free::Seed::Analytic,
     ] {
-        let r = catflip::design::free::FreeDesign::new(&c)
+        let r = catflip::design::free::FreeDesign::new(&c.design_spec())
             .seed(seed)
             .check_mesh()
             .solve()
@@ -472,7 +474,7 @@ fn both_seeds_converge_on_the_seed_config_below_the_phased_peak() {
 fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
     for norm in ["euclidean", "per-motor"] {
         let (c, certified) = seed_from_certified_phased(norm);
-        let coarse = catflip::design::free::FreeDesign::new(&c)
+        let coarse = catflip::design::free::FreeDesign::new(&c.design_spec())
             .seed(catflip::design::free::Seed::Phased)
             .check_mesh()
             .solve()
@@ -502,8 +504,8 @@ fn the_coarse_phased_seed_reaches_the_certified_seeds_optimum() {
 #[test]
 fn per_motor_seed_design_at_120_nodes_is_within_half_a_percent_of_the_ipopt_optimum() {
     let c = cfg("seed", &["limits.norm=per-motor", "free.nodes=120"]);
-    let r = catflip::design::free::FreeDesign::new(&c)
-        .from_plan(&analytic_plan(&c), "analytic")
+    let r = catflip::design::free::FreeDesign::new(&c.design_spec())
+        .from_plan(&analytic_plan(&c.design_spec()), "analytic")
         .nodes(120)
         .solve()
         .unwrap();
@@ -548,9 +550,9 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
         let norm_key = format!("limits.norm={norm}");
         let direct_cfg = cfg("seed", &[&norm_key, "free.mesh_continuation=false"]);
         let c = cfg("seed", &[&norm_key]);
-        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+        let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
         let run = |c: &Config| {
-            catflip::design::free::FreeDesign::new(c)
+            catflip::design::free::FreeDesign::new(&c.design_spec())
                 .from_plan(&phased.plan, "phased")
                 .nodes(40)
                 .solve()
@@ -573,7 +575,7 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
         // what the observer was shown is what the result records, each
         // mesh announced before its iterations
         let mut seen = Seen::default();
-        let again = catflip::design::free::FreeDesign::new(&c)
+        let again = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&phased.plan, "phased")
             .nodes(40)
             .observe(&mut seen)
@@ -612,13 +614,13 @@ fn mesh_continuation_reaches_the_direct_optimum_with_fewer_fine_iterations() {
 fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
     for name in ["seed", "domestic-cat"] {
         let c = cfg(name, &[]);
-        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let a = catflip::design::free::FreeDesign::new(&c)
+        let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
+        let a = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&phased.plan, "phased")
             .nodes(40)
             .solve()
             .unwrap();
-        let b = catflip::design::free::FreeDesign::new(&c)
+        let b = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&phased.plan, "phased")
             .nodes(80)
             .solve()
@@ -638,8 +640,8 @@ fn mesh_check_n_and_2n_nodes_agree_within_one_percent() {
 fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
     for name in ["seed", "domestic-cat", "robot-universal"] {
         let c = cfg(name, &[]);
-        let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let free = catflip::design::free::FreeDesign::new(&c)
+        let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
+        let free = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&phased.plan, "phased")
             .solve()
             .unwrap();
@@ -656,9 +658,9 @@ fn free_form_is_no_worse_than_phased_on_every_bundled_config() {
 #[test]
 fn bend_limit_holds_in_both_optimisers() {
     let c = cfg("seed", &["limits.max_bend_deg=30"]);
-    let phased = catflip::design::phased::optimize(&c, |_| {}).unwrap();
+    let phased = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
     assert!(phased.bend_deg <= 30.0 + 1e-9, "{}", phased.bend_deg);
-    let free = catflip::design::free::FreeDesign::new(&c)
+    let free = catflip::design::free::FreeDesign::new(&c.design_spec())
         .from_plan(&phased.plan, "phased")
         .nodes(20)
         .solve()
@@ -670,7 +672,7 @@ fn bend_limit_holds_in_both_optimisers() {
     assert!(free.bend_deg <= 30.0 + 1e-5, "{}", free.bend_deg);
     assert!(free.flip_error_rad.abs() < 1e-3);
     // the limit costs torque against the unconstrained design (optimum bend ~ 42 deg)
-    let open = catflip::design::free::FreeDesign::new(&cfg("seed", &[]))
+    let open = catflip::design::free::FreeDesign::new(&cfg("seed", &[]).design_spec())
         .from_plan(&phased.plan, "phased")
         .nodes(20)
         .solve()
@@ -683,15 +685,15 @@ fn a_torque_limit_that_cannot_bind_changes_nothing() {
     // a limit of 1e9 / 1e12 N m once entered the conic data and broke Clarabel;
     // 1e9 N m is now the largest limit the config accepts
     let open = cfg("seed", &[]);
-    let phased = catflip::design::phased::optimize(&open, |_| {}).unwrap();
-    let a = catflip::design::free::FreeDesign::new(&open)
+    let phased = catflip::design::phased::optimize(&open.design_spec(), |_| {}).unwrap();
+    let a = catflip::design::free::FreeDesign::new(&open.design_spec())
         .from_plan(&phased.plan, "phased")
         .nodes(40)
         .solve()
         .unwrap();
     for lim in ["1e6", "1e9"] {
         let c = cfg("seed", &[&format!("limits.max_torque={lim}")]);
-        let b = catflip::design::free::FreeDesign::new(&c)
+        let b = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&phased.plan, "phased")
             .nodes(40)
             .solve()
@@ -716,9 +718,9 @@ fn extreme_drop_heights_solve_the_same_dimensionless_problem() {
     // 1 ms to 30 s, so the ends of that range. F3: peak * T^2 does not depend
     // on the time available, so the designs agree after scaling.
     let c10 = cfg("seed", &[]);
-    let phased = catflip::design::phased::optimize(&c10, |_| {}).unwrap();
+    let phased = catflip::design::phased::optimize(&c10.design_spec(), |_| {}).unwrap();
     let nodes = 40;
-    let base = catflip::design::free::FreeDesign::new(&c10)
+    let base = catflip::design::free::FreeDesign::new(&c10.design_spec())
         .from_plan(&phased.plan, "phased")
         .nodes(nodes)
         .solve()
@@ -726,8 +728,8 @@ fn extreme_drop_heights_solve_the_same_dimensionless_problem() {
     let unit = |c: &catflip::Config, peak: f64| peak * c.available_time().powi(2);
     for h in ["4.9e-6", "4410"] {
         let c = cfg("seed", &[&format!("fall.height={h}")]);
-        let ph = catflip::design::phased::optimize(&c, |_| {}).unwrap();
-        let r = catflip::design::free::FreeDesign::new(&c)
+        let ph = catflip::design::phased::optimize(&c.design_spec(), |_| {}).unwrap();
+        let r = catflip::design::free::FreeDesign::new(&c.design_spec())
             .from_plan(&ph.plan, "phased")
             .nodes(nodes)
             .solve()
@@ -747,7 +749,7 @@ fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
         &["limits.max_bend_deg=1", "phased.bend_min_deg=0.5"],
     );
     let t = std::time::Instant::now();
-    let e = catflip::design::free::FreeDesign::new(&c)
+    let e = catflip::design::free::FreeDesign::new(&c.design_spec())
         .seed(catflip::design::free::Seed::Analytic)
         .check_mesh()
         .solve()
@@ -775,7 +777,7 @@ fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
             "phased.bend_min_deg=0.5",
         ],
     );
-    catflip::design::free::check_resolvable(&ok, ok.free.nodes).unwrap();
+    catflip::design::free::check_resolvable(&ok.design_spec(), ok.free.nodes).unwrap();
     let worse = cfg(
         "seed",
         &[
@@ -783,7 +785,9 @@ fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
             "phased.bend_min_deg=0.5",
         ],
     );
-    assert!(catflip::design::free::check_resolvable(&worse, worse.free.nodes).is_err());
+    assert!(
+        catflip::design::free::check_resolvable(&worse.design_spec(), worse.free.nodes).is_err()
+    );
 }
 
 #[test]
@@ -829,7 +833,7 @@ fn the_certificate_backs_the_status() {
 fn the_per_motor_designs_from_both_seeds_agree_and_hold_between_check_points() {
     let c = cfg("seed", &["limits.norm=per-motor"]);
     let solve = |seed| {
-        catflip::design::free::FreeDesign::new(&c)
+        catflip::design::free::FreeDesign::new(&c.design_spec())
             .seed(seed)
             .check_mesh()
             .solve()

@@ -11,8 +11,8 @@ use util::seed;
 /// The free-form design seeded by the phased design of the same objective
 /// (the mesh check left out).
 fn free(cfg: &Config) -> FreeResult {
-    let phased = catflip::design::phased::optimize(cfg, |_| {}).unwrap();
-    let r = FreeDesign::new(cfg)
+    let phased = catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).unwrap();
+    let r = FreeDesign::new(&cfg.design_spec())
         .from_plan(&phased.plan, "phased")
         .solve()
         .unwrap();
@@ -42,14 +42,14 @@ fn free_time_with_a_torque_limit_alone_is_f7() {
         timed.manoeuvre_time_s
     );
     let (h, h_f7) = (
-        height_for(&open, timed.manoeuvre_time_s),
+        height_for(&open.design_spec(), timed.manoeuvre_time_s),
         0.5 * open.fall.gravity * t_f7 * t_f7,
     );
     assert!((h - h_f7).abs() < 1e-2 * h_f7, "{h} vs {h_f7}");
     assert!(timed.peak_torque_nm <= tau_max * (1.0 + 1e-6));
     // the mesh check compares the objective, here the time (the peak sits
     // at the limit, 1 N m, about 10 % from this time in s)
-    let m = catflip::design::free::mesh_check(&timed_cfg, &timed).unwrap();
+    let m = catflip::design::free::mesh_check(&timed_cfg.design_spec(), &timed).unwrap();
     assert!(
         (m.objective_value - timed.manoeuvre_time_s).abs() < 2e-2 * timed.manoeuvre_time_s,
         "{m:?}"
@@ -84,13 +84,13 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
             "limits.max_torque=1",
             "limits.no_load_speed=8",
         ]);
-        let phased = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let r = FreeDesign::new(&cfg)
+        let phased = catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).unwrap();
+        let r = FreeDesign::new(&cfg.design_spec())
             .from_plan(&phased.plan, "phased")
             .solve()
             .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
-        let margin = usage_of(&cfg, &r.plan).min_margin.unwrap();
+        let margin = usage_of(&cfg.design_spec(), &r.plan).min_margin.unwrap();
         assert!(margin >= -1e-6, "{objective}: margin {margin}");
         // the dynamic simulation applies the motor model (clipped torque)
         assert!(
@@ -123,9 +123,12 @@ fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
         catflip::design::free::Seed::Phased,
         catflip::design::free::Seed::Analytic,
     ] {
-        let r = FreeDesign::new(&cfg).seed(seed).solve().unwrap();
+        let r = FreeDesign::new(&cfg.design_spec())
+            .seed(seed)
+            .solve()
+            .unwrap();
         assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
-        let dense = catflip::verify::analyze::dense_samples(&cfg);
+        let dense = catflip::verify::analyze::dense_samples(&cfg.design_spec());
         let sched = catflip::design::plan::Schedule::sample(&cfg.cat(), &r.plan, dense);
         let margin = cfg
             .motor()

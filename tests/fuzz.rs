@@ -231,7 +231,7 @@ fn config_file_and_set_parsers_never_panic() {
                     .contains(&t),
                 "{input:?}: fall time {t}"
             );
-            let cf = catflip::design::analytic::closed_forms(&cfg);
+            let cf = catflip::design::analytic::closed_forms(&cfg.design_spec());
             assert!(
                 cf.twist_rad.is_finite() && cf.seed_torque_estimate_nm.is_finite(),
                 "{input:?}: {cf:?}"
@@ -275,11 +275,17 @@ fn schedule_reader_never_panics() {
     let mut rng = Rng(0xFEED_FACE_CAFE_BEEF);
     let cfg = Config::from_toml(&config_text("seed"), "seed", &[]).unwrap();
     // a short valid schedule of the seed's fall
-    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
     let base = Schedule::sample(&cfg.cat(), &plan, 4).to_csv();
-    assert!(catflip::verify::simulate::read_schedule(&cfg, &base, "base").is_ok());
+    assert!(
+        catflip::verify::simulate::read_schedule(&cfg.design_spec(), &cfg.name, &base, "base")
+            .is_ok()
+    );
     let base_json = Schedule::sample(&cfg.cat(), &plan, 4).to_json();
-    assert!(catflip::verify::simulate::read_schedule(&cfg, &base_json, "base").is_ok());
+    assert!(
+        catflip::verify::simulate::read_schedule(&cfg.design_spec(), &cfg.name, &base_json, "base")
+            .is_ok()
+    );
     for i in 0..10_000 {
         let text = if i % 7 == 0 {
             random_text(&mut rng)
@@ -299,7 +305,12 @@ fn schedule_reader_never_panics() {
             Schedule::from_json(&json, "fuzz.schedule.json")
         });
         no_panic("read_schedule", &text, || {
-            let s = catflip::verify::simulate::read_schedule(&cfg, &text, "fuzz.csv")?;
+            let s = catflip::verify::simulate::read_schedule(
+                &cfg.design_spec(),
+                &cfg.name,
+                &text,
+                "fuzz.csv",
+            )?;
             // what is accepted is usable as a plan over the whole fall
             let b = catflip::design::plan::ShapePlan::phase_bounds(&s);
             assert!(b.windows(2).all(|w| w[0] <= w[1]), "{b:?}");

@@ -300,7 +300,7 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
     assert_eq!(cfg.limits.max_speed, Some(5.969));
     assert_eq!(cfg.limits.no_load_speed, Some(5.969));
     // the robot question: from its 2 m it cannot; the least height says from where
-    let a = catflip::design::least_height::answer(&cfg)
+    let a = catflip::design::least_height::answer(&cfg.design_spec())
         .unwrap()
         .unwrap();
     assert!(
@@ -313,7 +313,7 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
         "box-robot",
         &[&format!("fall.height={}", 1.01 * a.least_height_m)],
     );
-    let b = catflip::design::least_height::answer(&again)
+    let b = catflip::design::least_height::answer(&again.design_spec())
         .unwrap()
         .unwrap();
     assert!(b.possible, "from 1.01 x its least height it can");

@@ -11,7 +11,7 @@ fn robot(set: &[String]) -> Config {
 }
 
 fn least(cfg: &Config) -> Heights {
-    heights(cfg, true, |_| {})
+    heights(&cfg.design_spec(), true, |_| {})
         .unwrap()
         .expect("the robot has motor limits")
 }
@@ -25,8 +25,8 @@ fn the_least_height_is_the_same_from_any_question_height() {
     let at = |h: f64| robot(&[format!("fall.height={h}")]);
     for h in [1.0, 6.0, 10.0] {
         assert_eq!(
-            reference(&at(h)).fall.height,
-            reference(&at(2.0)).fall.height,
+            reference(&at(h).design_spec()).fall.height,
+            reference(&at(2.0).design_spec()).fall.height,
             "reference drop from {h} m"
         );
     }
@@ -91,26 +91,26 @@ fn a_weaker_motor_never_needs_less_height() {
 #[test]
 fn the_least_stretch_is_inside_and_no_less_would_do() {
     let cfg = robot(&[]);
-    let plan = catflip::design::analytic::analytic_plan(&cfg);
+    let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
     let margin = |k: f64| {
         let mut p = plan.clone();
         p.durations = p.durations.map(|d| d * k);
         // on the dense samples the verdict reads (the written rows among them)
-        let dense = catflip::verify::analyze::dense_samples(&cfg);
+        let dense = catflip::verify::analyze::dense_samples(&cfg.design_spec());
         let rows = catflip::design::plan::Schedule::sample(&cfg.cat(), &p, dense).rows;
         let dense_margin = cfg
             .motor()
             .usage(rows.iter().map(|r| (r.tau, r.qd)))
             .min_margin
             .unwrap();
-        assert!(dense_margin <= usage_of(&cfg, &p).min_margin.unwrap());
+        assert!(dense_margin <= usage_of(&cfg.design_spec(), &p).min_margin.unwrap());
         dense_margin
     };
     assert!(
         margin(1.0) < 0.0,
         "the seed's schedule breaks the robot's limits"
     );
-    let k = least_stretch(&cfg, &plan);
+    let k = least_stretch(&cfg.design_spec(), &plan);
     assert!(k > 1.0);
     assert!(margin(k) >= -1e-12, "{}", margin(k));
     assert!(
@@ -121,5 +121,5 @@ fn the_least_stretch_is_inside_and_no_less_would_do() {
     // a plan inside already is not slowed
     let mut slow = plan.clone();
     slow.durations = slow.durations.map(|d| d * 1.01 * k);
-    assert_eq!(least_stretch(&cfg, &slow), 1.0);
+    assert_eq!(least_stretch(&cfg.design_spec(), &slow), 1.0);
 }

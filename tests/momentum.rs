@@ -201,8 +201,8 @@ fn momentum_is_conserved_from_spinning_starts() {
     for joint in ["no-twist", "universal"] {
         let cfg = seed(&[&format!("cat.joint={joint}")]);
         let cat = cfg.cat();
-        let p = analytic_plan(&cfg);
-        let ctrl = Controller::from_config(&cfg);
+        let p = analytic_plan(&cfg.design_spec());
+        let ctrl = Controller::from_spec(&cfg.design_spec());
         for s in spinning_starts() {
             let l = norm(s.momentum(&cat));
             let k = kinematic_from(&cat, &p, &s, &tight()).unwrap();
@@ -361,7 +361,7 @@ fn zero_momentum_runs_are_today_and_rotate_with_the_release() {
     for joint in ["no-twist", "universal"] {
         let cfg = seed(&[&format!("cat.joint={joint}")]);
         let cat = cfg.cat();
-        let p = analytic_plan(&cfg);
+        let p = analytic_plan(&cfg.design_spec());
         let today = kinematic(&cat, &p, &tight()).unwrap();
         let same = kinematic_from(&cat, &p, &Start::default(), &tight()).unwrap();
         assert_eq!(today.flip_deg, same.flip_deg);
@@ -379,7 +379,7 @@ fn zero_momentum_runs_are_today_and_rotate_with_the_release() {
         let rotated = kinematic_from(&cat, &p, &s, &tight()).unwrap();
         let r0 = *s.rotation().to_rotation_matrix().matrix();
         assert!((rot(&rotated) - r0 * rot(&today)).norm() < 1e-12);
-        let ctrl = Controller::from_config(&cfg);
+        let ctrl = Controller::from_spec(&cfg.design_spec());
         let d0 = dynamic(&cat, &p, &ctrl, &tight()).unwrap();
         let d1 = dynamic_from(&cat, &p, &ctrl, &tight(), &s).unwrap();
         assert!((rot(&d1) - r0 * rot(&d0)).norm() < 1e-12);
@@ -392,7 +392,13 @@ fn zero_momentum_runs_are_today_and_rotate_with_the_release() {
 fn tilted_release_lands_tilted_with_todays_schedule() {
     let cfg = seed(&["start.rotation_deg=[0, 30, 0]"]);
     let cat = cfg.cat();
-    let r = kinematic_from(&cat, &analytic_plan(&cfg), &cfg.start.start(), &tight()).unwrap();
+    let r = kinematic_from(
+        &cat,
+        &analytic_plan(&cfg.design_spec()),
+        &cfg.start.start(),
+        &tight(),
+    )
+    .unwrap();
     // the belly is turned by the flip about the (tilted) spine: still 30 deg from down
     assert!(
         (r.landing_error_deg - 30.0).abs() < 1e-6,

@@ -28,7 +28,7 @@ fn socp_peak_matches_inverse_dynamics_along_the_reconstruction_and_converges_in_
             let t = c.available_time();
             let dur = d.durations(t);
             let plan = d.plan(dur);
-            let (_, per_phase) = peak_along(&c, &plan, 20 * k);
+            let (_, per_phase) = peak_along(&c.design_spec(), &plan, 20 * k);
             for i in 0..3 {
                 let socp = d.phases[i].unit_peak / dur[i].powi(2);
                 let rel = (per_phase[i] - socp).abs() / socp;
@@ -59,7 +59,7 @@ fn per_motor_gap_between_socp_and_reconstruction_closes_at_second_order() {
         let mut prob = TimingProblem::new(k, c.norm());
         let d = design_at(&cat, &mut prob, 1.0).unwrap();
         let dur = d.durations(1.0);
-        let (dense, _) = peak_along(&c, &d.plan(dur), 20 * k);
+        let (dense, _) = peak_along(&c.design_spec(), &d.plan(dur), 20 * k);
         let socp = d.unit_peak();
         assert!(
             dense >= socp * (1.0 - 1e-6),
@@ -89,8 +89,8 @@ fn no_twist_unfold_equals_the_reversed_fold() {
 #[test]
 fn f3_halving_the_time_multiplies_the_optimum_by_four() {
     // height / 4 halves the fall time; compare the reconstructed schedules' dense peaks
-    let a = optimize(&cfg("seed", &[]), |_| {}).unwrap();
-    let b = optimize(&cfg("seed", &["fall.height=2.5"]), |_| {}).unwrap();
+    let a = optimize(&cfg("seed", &[]).design_spec(), |_| {}).unwrap();
+    let b = optimize(&cfg("seed", &["fall.height=2.5"]).design_spec(), |_| {}).unwrap();
     let ratio = b.peak_torque_nm / a.peak_torque_nm;
     assert!((ratio - 4.0).abs() < 4e-6, "ratio {ratio}");
     assert!((a.bend_deg - b.bend_deg).abs() < 1e-9);
@@ -107,13 +107,13 @@ fn optimum_never_exceeds_the_cosine_schedule_at_the_same_bend_and_split() {
         for bend in [0.4, 1.2, 2.4] {
             let d = design_at(&cat, &mut prob, bend).unwrap();
             let opt = d.peak_with(split);
-            let (cos, _) = peak_along(&c, &cosine_plan(bend, d.twist, split), 2000);
+            let (cos, _) = peak_along(&c.design_spec(), &cosine_plan(bend, d.twist, split), 2000);
             assert!(
                 opt <= cos,
                 "{name} bend {bend}: optimum {opt} > cosine {cos}"
             );
         }
-        let r = optimize(&c, |_| {}).unwrap();
+        let r = optimize(&c.design_spec(), |_| {}).unwrap();
         assert!(
             r.improvement_factor > 1.0,
             "{name}: {}",
@@ -158,7 +158,7 @@ fn universal_twist_is_found_from_the_integrated_attitude() {
     // the free-form design's phased seed root-finds its twist more loosely
     // (to 1e-8 rad) and still flips, to its 20-interval timing's own error
     // (2.3e-6 rad with either tolerance)
-    let seed = catflip::design::phased::seed_plan(&c).unwrap();
+    let seed = catflip::design::phased::seed_plan(&c.design_spec()).unwrap();
     let r = kinematic(&cat, &seed, &Default::default()).unwrap();
     assert!(r.flip_error_rad.abs() < 1e-5, "{}", r.flip_error_rad);
 }
@@ -166,7 +166,7 @@ fn universal_twist_is_found_from_the_integrated_attitude() {
 #[test]
 fn torque_limit_below_the_optimum_names_the_least_drop_height() {
     let c = cfg("seed", &["limits.max_torque=0.3"]);
-    let e = optimize(&c, |_| {}).unwrap_err();
+    let e = optimize(&c.design_spec(), |_| {}).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::Unreachable { .. }), "{msg}");
     let h: f64 = msg
@@ -187,7 +187,8 @@ fn torque_limit_below_the_optimum_names_the_least_drop_height() {
                 "limits.max_torque=0.3",
                 &format!("fall.height={}", h * 1.01),
             ],
-        ),
+        )
+        .design_spec(),
         |_| {},
     )
     .unwrap();

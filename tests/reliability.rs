@@ -363,7 +363,8 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
             &seed_toml(),
             &["limits.max_torque=0.5".into(), "fall.height=12".into()],
         )
-        .unwrap(),
+        .unwrap()
+        .design_spec(),
     );
     let at_reference = format!("fall.height={}", reference.fall.height);
     let (code, out, err) = run(

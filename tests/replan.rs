@@ -37,11 +37,19 @@ fn fly(cfg: &catflip::Config, plan: &dyn ShapePlan, y: Y) -> f64 {
 #[test]
 fn a_replan_from_the_nominal_state_continues_the_design_and_lands() {
     let cfg = util::seed(&["design.objective=\"energy\""]);
-    let d = FreeDesign::new(&cfg).solve().unwrap();
+    let d = FreeDesign::new(&cfg.design_spec()).solve().unwrap();
     let r = Reference::new(&cfg, &d.plan);
     let j = (0.4 * d.plan.duration() / r.h) as usize;
     let t = j as f64 * r.h;
-    let re = replan(&cfg, &d.plan, t, &r.nominal[j], cfg.free.nodes, 40).unwrap();
+    let re = replan(
+        &cfg.design_spec(),
+        &d.plan,
+        t,
+        &r.nominal[j],
+        cfg.free.nodes,
+        40,
+    )
+    .unwrap();
     assert_eq!(re.status, ScpStatus::Converged);
     // the rest of an energy optimum is the optimum of the rest (Bellman)
     let peak = r.peak_torque;
@@ -71,7 +79,7 @@ fn phase_of(plan: &dyn ShapePlan, t: f64) -> usize {
 #[test]
 fn a_replan_from_a_perturbed_state_lands_where_the_plan_would_not() {
     let cfg = util::seed(&[]);
-    let d = FreeDesign::new(&cfg).solve().unwrap();
+    let d = FreeDesign::new(&cfg.design_spec()).solve().unwrap();
     let r = Reference::new(&cfg, &d.plan);
     let j = (0.3 * d.plan.duration() / r.h) as usize;
     let t = j as f64 * r.h;
@@ -87,7 +95,7 @@ fn a_replan_from_a_perturbed_state_lands_where_the_plan_would_not() {
     }
     let plain = fly(&cfg, &Shifted(&d.plan, t), y);
     assert!(plain > 2.0, "the old plan would land {plain} deg off");
-    let re = replan(&cfg, &d.plan, t, &y, cfg.free.nodes, 40).unwrap();
+    let re = replan(&cfg.design_spec(), &d.plan, t, &y, cfg.free.nodes, 40).unwrap();
     let e = fly(&cfg, &re.plan, y);
     assert!(
         e < 1e-2,
@@ -157,7 +165,7 @@ fn one_iteration_replans_every_control_period_land_a_knocked_flight() {
     // under the latest plan with one SCP iteration on a coarse mesh, each
     // replan started from the last one's plan and end state
     let cfg = util::seed(&[]);
-    let d = FreeDesign::new(&cfg).solve().unwrap();
+    let d = FreeDesign::new(&cfg.design_spec()).solve().unwrap();
     let end = d.plan.duration();
     let period = 1.0 / cfg.control.rate_hz;
     let knock = (0.3 * end / period).round() * period;
@@ -172,7 +180,7 @@ fn one_iteration_replans_every_control_period_land_a_knocked_flight() {
     let old = fly_span(&cfg, &d.plan, 0.0, y, knock, cfg.fall_time());
     let old = landing_error(attitude(&old).to_rotation_matrix().matrix()).to_degrees();
     assert!(old > 2.0, "the old plan would land {old} deg off");
-    let mut replanner = Replanner::new(&cfg, 10).unwrap().real_time();
+    let mut replanner = Replanner::new(&cfg.design_spec(), 10).unwrap().real_time();
     let (mut plan, mut origin, mut t) = (d.plan.clone(), 0.0, knock);
     let mut replans = 0;
     // replans up to two periods before the manoeuvre's end; the last plan is flown out

@@ -143,12 +143,12 @@ fn sweep_agrees_with_single_runs() {
     for p in &points {
         let cfg = catflip::Config::load(&cfg_path, &[format!("fall.height={}", p.value)]).unwrap();
         let (a, _) = catflip::verify::analyze::peak_along(
-            &cfg,
-            &catflip::design::analytic::analytic_plan(&cfg),
-            catflip::verify::analyze::dense_samples(&cfg),
+            &cfg.design_spec(),
+            &catflip::design::analytic::analytic_plan(&cfg.design_spec()),
+            catflip::verify::analyze::dense_samples(&cfg.design_spec()),
         );
-        let ph = catflip::design::phased::optimize(&cfg, |_| {}).unwrap();
-        let fr = catflip::design::free::FreeDesign::new(&cfg)
+        let ph = catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).unwrap();
+        let fr = catflip::design::free::FreeDesign::new(&cfg.design_spec())
             .from_plan(&ph.plan, "phased")
             .solve()
             .unwrap();
@@ -296,8 +296,8 @@ fn animation_frames_follow_the_simulation() {
     use nalgebra::{Quaternion, UnitQuaternion, Vector3};
     let cfg = catflip::Config::load(&configs().join("seed.toml"), &[]).unwrap();
     let cat = cfg.cat();
-    let plan = catflip::design::analytic::analytic_plan(&cfg);
-    let sim = catflip::verify::simulate::dynamic_cfg(&cfg, &plan).unwrap();
+    let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
+    let sim = catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &plan).unwrap();
     let tr = track(&cat, cfg.norm(), "analytic", &sim, FRAMES);
     let f = &tr.frames;
     assert!(f.len() > FRAMES / 2 && f.len() <= FRAMES, "{}", f.len());

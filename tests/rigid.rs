@@ -80,8 +80,8 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
         close(a.straight_inertia(), b.straight_inertia(), name);
         // the phased design and its simulation
         let (pa, pb) = (
-            optimize(&cfg, |_| {}).unwrap(),
-            optimize(&general, |_| {}).unwrap(),
+            optimize(&cfg.design_spec(), |_| {}).unwrap(),
+            optimize(&general.design_spec(), |_| {}).unwrap(),
         );
         close(pa.peak_torque_nm, pb.peak_torque_nm, name);
         close(pa.unit_peak_nm_s2, pb.unit_peak_nm_s2, name);
@@ -92,8 +92,8 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
         close(pa.tilt_deg + 1.0, pb.tilt_deg + 1.0, name);
         // the least height (motors limited)
         if let (Some(ha), Some(hb)) = (
-            least_height::answer(&cfg).unwrap(),
-            least_height::answer(&general).unwrap(),
+            least_height::answer(&cfg.design_spec()).unwrap(),
+            least_height::answer(&general.design_spec()).unwrap(),
         ) {
             close(ha.least_height_m, hb.least_height_m, name);
             close(ha.least_time_s, hb.least_time_s, name);
@@ -102,8 +102,11 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
     // the free-form design of the seed
     let cfg = seed(&["free.nodes=24"]);
     let (fa, fb) = (
-        FreeDesign::new(&cfg).seed(Seed::Phased).solve().unwrap(),
-        FreeDesign::new(&as_tensors(&cfg))
+        FreeDesign::new(&cfg.design_spec())
+            .seed(Seed::Phased)
+            .solve()
+            .unwrap(),
+        FreeDesign::new(&as_tensors(&cfg).design_spec())
             .seed(Seed::Phased)
             .solve()
             .unwrap(),

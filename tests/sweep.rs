@@ -139,7 +139,8 @@ fn phased_sweep_against_fresh_designs(key: &str, range: &str) -> Vec<(f64, f64, 
             let value = cells[0];
             let fresh = catflip::design::phased::optimize(
                 &catflip::Config::load(&cfg, &["phased.nodes=12".into(), format!("{key}={value}")])
-                    .unwrap(),
+                    .unwrap()
+                    .design_spec(),
                 |_| {},
             )
             .unwrap()

@@ -430,7 +430,7 @@ fn run_design(
                         )));
                     }
                 };
-                let r = catflip::design::free::FreeDesign::new(&cfg)
+                let r = catflip::design::free::FreeDesign::new(&cfg.design_spec())
                     .seed(seed)
                     .check_mesh()
                     .solve()
@@ -460,7 +460,8 @@ fn run_design(
                 if seed.is_some() {
                     return Err(no_seed("the phased design"));
                 }
-                let r = catflip::design::phased::optimize(&cfg, |_| {}).map_err(err)?;
+                let r =
+                    catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).map_err(err)?;
                 let sched = sample(&r.plan);
                 let status = Status::from(r.status);
                 let reason = judged(
@@ -487,8 +488,10 @@ fn run_design(
                     return Err(no_seed("the analytic schedule"));
                 }
                 // the CLI's `analyze`: a miss is flagged in the analysis
-                let a = catflip::verify::analyze::analyze(&cfg).map_err(err)?;
-                let sched = catflip::verify::analyze::analytic_schedule(&cfg, &a.plan);
+                let a = catflip::verify::analyze::analyze(&cfg.design_spec(), &cfg.name)
+                    .map_err(err)?;
+                let sched =
+                    catflip::verify::analyze::analytic_schedule(&cfg.design_spec(), &a.plan);
                 let status = Status::ClosedForm;
                 let reason = judged(
                     &cfg,
@@ -778,20 +781,28 @@ fn simulate(
                 let d = d.get();
                 (
                     format!("{} design", d.method),
-                    catflip::verify::analyze::verify(&cfg, d.plan.as_ref()),
+                    catflip::verify::analyze::verify(&cfg.design_spec(), d.plan.as_ref()),
                 )
             }
             Subject::File(p, text) => {
                 let origin = p.display().to_string();
-                let s =
-                    catflip::verify::simulate::read_schedule(&cfg, text, &origin).map_err(err)?;
-                (origin, catflip::verify::analyze::verify(&cfg, &s))
+                let s = catflip::verify::simulate::read_schedule(
+                    &cfg.design_spec(),
+                    &cfg.name,
+                    text,
+                    &origin,
+                )
+                .map_err(err)?;
+                (
+                    origin,
+                    catflip::verify::analyze::verify(&cfg.design_spec(), &s),
+                )
             }
             Subject::Analytic => {
-                let plan = catflip::design::analytic::analytic_plan(&cfg);
+                let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
                 (
                     "analytic schedule".into(),
-                    catflip::verify::analyze::verify(&cfg, &plan),
+                    catflip::verify::analyze::verify(&cfg.design_spec(), &plan),
                 )
             }
         };
@@ -1042,7 +1053,8 @@ impl LeastHeight {
 fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>> {
     let (_, cfg) = config.snapshot();
     py.detach(move || {
-        let h = catflip::design::least_height::heights(&cfg, true, |_| {}).map_err(err)?;
+        let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
+            .map_err(err)?;
         Ok(h.map(|h| LeastHeight {
             answer: h.answer,
             phased_m: h.phased_m,
@@ -1304,12 +1316,12 @@ impl Controls {
     /// catflip's PD stiffness, N m/rad.
     #[getter]
     fn kp(&self) -> f64 {
-        catflip::verify::simulate::Controller::from_config(&self.cfg).kp
+        catflip::verify::simulate::Controller::from_spec(&self.cfg.design_spec()).kp
     }
     /// catflip's PD damping, N m s/rad.
     #[getter]
     fn kd(&self) -> f64 {
-        catflip::verify::simulate::Controller::from_config(&self.cfg).kd
+        catflip::verify::simulate::Controller::from_spec(&self.cfg.design_spec()).kd
     }
     /// `limits.max_torque`, N m, or None.
     #[getter]

@@ -185,14 +185,7 @@ impl KeyRange {
     }
 }
 
-/// A number as the user would read it: `1e308`, not 309 digits.
-pub fn show(x: f64) -> String {
-    if x != 0.0 && x.is_finite() && !(1e-4..1e7).contains(&x.abs()) {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
-    }
-}
+pub use crate::error::show;
 
 fn invalid(key: &str, value: f64, expected: String) -> Error {
     Error::Invalid {

@@ -36,7 +36,7 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
     );
     // what a controller run from this file needs, one `# key = value` a line
     let motor = cfg.motor();
-    let pd = crate::verify::simulate::Controller::from_config(cfg);
+    let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
     let nominal = |fb| fly(&r, fb, &motor, Flight::nominal(&r)).error_deg;
     let keys = [
         ("step_s", r.h),

@@ -68,7 +68,7 @@ impl Online {
             reference,
             tvlqr,
             motor: cfg.motor(),
-            pd: Controller::from_config(cfg),
+            pd: Controller::from_spec(&cfg.design_spec()),
             in_flight: InFlight::new(plan.clone()),
             replanning: Replanning::new(cfg, plan),
             issued: Vec::new(),

@@ -191,7 +191,8 @@ impl InFlight {
         let y = predict(r, tv, motor, issued, s - 1, s, &before);
         let solved = match &mut self.replanner {
             Some(p) => Ok(p),
-            None => Replanner::new(&rp.cfg, rp.nodes).map(|p| self.replanner.insert(p.real_time())),
+            None => Replanner::new(&rp.cfg.design_spec(), rp.nodes)
+                .map(|p| self.replanner.insert(p.real_time())),
         }
         .and_then(|p| p.replan(base.as_ref(), offset, t, &y, rp.iterations));
         let solve_seconds = solved.as_ref().map_or(0.0, |re| re.seconds);

@@ -25,9 +25,10 @@ pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 /// `run` makes it, or from the analytic seed where the phased family cannot fit.
 pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
     use crate::design::free::{FreeDesign, Seed};
-    FreeDesign::new(cfg)
+    let spec = cfg.design_spec();
+    FreeDesign::new(&spec)
         .solve()
-        .or_else(|_| FreeDesign::new(cfg).seed(Seed::Analytic).solve())
+        .or_else(|_| FreeDesign::new(&spec).seed(Seed::Analytic).solve())
 }
 
 /// One trial's draws.
@@ -177,7 +178,7 @@ impl<'a> Study<'a> {
             seed,
             reference,
             tvlqr,
-            pd: Controller::from_config(cfg),
+            pd: Controller::from_spec(&cfg.design_spec()),
             replanning: Replanning::new(cfg, plan),
         }
     }

@@ -1,8 +1,8 @@
 //! The seed's closed forms and its cosine schedule, errata corrected
 //! (docs/model.md section 7), evaluated with the true dynamics elsewhere.
 
-use crate::config::Config;
 use crate::design::path::{Path, PhasedPlan, Timing};
+use crate::design::spec::DesignSpec;
 use serde::Serialize;
 use std::f64::consts::PI;
 
@@ -43,14 +43,14 @@ pub struct ClosedForms {
     pub phase_durations_s: [f64; 3],
 }
 
-pub fn closed_forms(cfg: &Config) -> ClosedForms {
-    let cat = cfg.cat();
+pub fn closed_forms(spec: &DesignSpec) -> ClosedForms {
+    let cat = spec.cat;
     let (i_t, i_a) = (cat.i_t(), cat.i_a());
-    let theta = cfg.analytic.theta_deg.to_radians();
+    let theta = spec.analytic.theta_deg.to_radians();
     let (i_yy, c) = yy_inertia_and_c(i_t, i_a, theta);
-    let fall = cfg.fall_time();
-    let avail = cfg.available_time();
-    let d = cfg.analytic.split.map(|f| f * avail);
+    let fall = spec.fall_time();
+    let avail = spec.available_time();
+    let d = spec.analytic.split.map(|f| f * avail);
     let twist = PI / c;
     let omega0 = twist / d[1];
     // the seed swings the front half about the joint
@@ -64,8 +64,8 @@ pub fn closed_forms(cfg: &Config) -> ClosedForms {
     ClosedForms {
         fall_time_s: fall,
         available_time_s: avail,
-        theta_deg: cfg.analytic.theta_deg,
-        bend_deg: 180.0 - cfg.analytic.theta_deg,
+        theta_deg: spec.analytic.theta_deg,
+        bend_deg: 180.0 - spec.analytic.theta_deg,
         i_t,
         i_a,
         i_yy,
@@ -94,8 +94,8 @@ pub fn plan(bend: f64, twist: f64, durations: [f64; 3]) -> PhasedPlan {
 }
 
 /// The analytic plan of a config.
-pub fn analytic_plan(cfg: &Config) -> PhasedPlan {
-    let cf = closed_forms(cfg);
+pub fn analytic_plan(spec: &DesignSpec) -> PhasedPlan {
+    let cf = closed_forms(spec);
     plan(cf.bend_deg.to_radians(), cf.twist_rad, cf.phase_durations_s)
 }
 

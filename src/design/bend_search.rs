@@ -5,8 +5,8 @@
 //! objective has kinks (a phase taking over the peak); it assumes
 //! unimodality inside the bracket.
 
-use crate::config::Config;
 use crate::design::analytic::turns_theta;
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 use serde::Serialize;
 use std::f64::consts::PI;
@@ -29,14 +29,14 @@ pub struct BendEvaluation {
 
 /// The coarse bend scan over `[lo, hi]` rad: `phased.scan_points` even
 /// points plus the one-turn bend (F6) and the config's bend where inside.
-pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
-    let cat = cfg.cat();
-    let n = cfg.phased.scan_points;
+pub fn bend_scan(spec: &DesignSpec, lo: f64, hi: f64) -> Vec<f64> {
+    let cat = spec.cat;
+    let n = spec.phased.scan_points;
     let mut xs: Vec<f64> = (0..n)
         .map(|i| lo + (hi - lo) * i as f64 / (n - 1) as f64)
         .collect();
     let one_turn = PI - turns_theta(cat.i_t(), cat.i_a(), 1.0);
-    let seed_bend = PI - cfg.analytic.theta_deg.to_radians();
+    let seed_bend = PI - spec.analytic.theta_deg.to_radians();
     for b in [one_turn, seed_bend] {
         if b > lo && b < hi {
             xs.push(b);
@@ -46,16 +46,16 @@ pub fn bend_scan(cfg: &Config, lo: f64, hi: f64) -> Vec<f64> {
 }
 
 /// The bend range the config allows, rad.
-pub fn bend_range(cfg: &Config) -> Result<(f64, f64)> {
-    let lo = cfg.phased.bend_min_deg.to_radians();
-    let hi = cfg.phased.bend_max_deg.to_radians().min(cfg.max_bend());
+pub fn bend_range(spec: &DesignSpec) -> Result<(f64, f64)> {
+    let lo = spec.phased.bend_min_deg.to_radians();
+    let hi = spec.phased.bend_max_deg.to_radians().min(spec.max_bend());
     if hi <= lo {
         return Err(Error::Invalid {
             key: "limits.max_bend_deg".into(),
-            value: format!("{}", cfg.max_bend().to_degrees()),
+            value: format!("{}", spec.max_bend().to_degrees()),
             expected: format!(
                 "must exceed phased.bend_min_deg = {}",
-                cfg.phased.bend_min_deg
+                spec.phased.bend_min_deg
             ),
         });
     }

@@ -59,13 +59,13 @@
 //! whatever the size of the cat; each bend gets a fresh Clarabel solver so
 //! that its equilibration matches the bend's data.
 
-use crate::config::Config;
 use crate::design::bend_search::{BendEvaluation, bend_range, bend_scan};
 use crate::design::bend_search::{Scored, scan_then_brent};
 use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::design::objective::Objective;
 use crate::design::path::{GridTiming, Path, PhasedPlan, Timing};
 use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::spec::DesignSpec;
 use crate::design::timing::path_coefficients;
 use crate::design::twist::twist_for;
 use crate::error::{Error, Result};
@@ -701,9 +701,9 @@ pub fn search(
 }
 
 /// The motor usage of a plan at the rows a schedule would carry.
-pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
-    let sched = Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
-    cfg.motor().usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
+pub fn usage_of(spec: &DesignSpec, plan: &dyn ShapePlan) -> MotorUse {
+    let sched = Schedule::sample(&spec.cat, plan, spec.simulate.samples_per_phase);
+    spec.motor.usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
 /// The least factor `k >= 1` by which a plan's durations must grow for
@@ -713,13 +713,13 @@ pub fn usage_of(cfg: &Config, plan: &dyn ShapePlan) -> MotorUse {
 /// found by bisection on the rows themselves to a relative `1e-9` (1 when
 /// they are inside already). The returned factor is always inside; a first
 /// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
-pub fn least_stretch(cfg: &Config, plan: &dyn ShapePlan) -> f64 {
+pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
     // on the dense samples the verdict reads the peak from (a multiple of
     // the written rows): inside at the rows alone, the peak could still be
     // a rounding above the stall torque
-    let dense = crate::verify::analyze::dense_samples(cfg);
-    let sched = Schedule::sample(&cfg.cat(), plan, dense);
-    let motor = cfg.motor();
+    let dense = crate::verify::analyze::dense_samples(spec);
+    let sched = Schedule::sample(&spec.cat, plan, dense);
+    let motor = spec.motor;
     let margin = |k: f64| {
         let k2 = k * k;
         motor
@@ -757,8 +757,8 @@ pub fn torque_squared_integral(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize
 }
 
 /// Least drop height for a manoeuvre of `time` seconds, m.
-pub fn height_for(cfg: &Config, time: f64) -> f64 {
-    0.5 * cfg.fall.gravity * (time + cfg.fall.margin).powi(2)
+pub fn height_for(spec: &DesignSpec, time: f64) -> f64 {
+    0.5 * spec.fall.gravity * (time + spec.fall.margin).powi(2)
 }
 
 /// How far (relative) the program's time model may be from the integrated
@@ -774,11 +774,11 @@ const ON_TIME: f64 = 1e-3;
 /// time is within [`ON_TIME`] of the fall's (then rescaled to it), and the limits are backed off until every
 /// schedule row is inside the envelope. `None` when nothing fits.
 fn verified_design(
-    cfg: &Config,
+    spec: &DesignSpec,
     problem: &mut EnvelopeProblem,
     bend: f64,
 ) -> Result<Option<(EnvelopeDesign, PhasedPlan)>> {
-    let cat = cfg.cat();
+    let cat = spec.cat;
     let budget = problem.budget;
     let mut shrink = 1.0;
     for _ in 0..12 {
@@ -795,7 +795,7 @@ fn verified_design(
             problem.budget = Some(given * ratio);
             plan.durations = plan.durations.map(|x| x * ratio);
         }
-        let margin = usage_of(cfg, &plan).min_margin.unwrap_or(1.0);
+        let margin = usage_of(spec, &plan).min_margin.unwrap_or(1.0);
         if margin < -1e-7 {
             shrink *= 1.0 + 1.2 * margin;
         } else if on_time {
@@ -827,23 +827,26 @@ pub struct EnvelopeResult {
 }
 
 /// The phased optimiser inside the motor envelope, for `design.objective`.
-pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Result<EnvelopeResult> {
+pub fn optimize(
+    spec: &DesignSpec,
+    mut observe: impl FnMut(&BendEvaluation),
+) -> Result<EnvelopeResult> {
     let start = Instant::now();
-    let cat = cfg.cat();
-    let objective = cfg.design.objective;
-    let budget = (objective != Objective::Time).then(|| cfg.available_time());
-    let (lo, hi) = bend_range(cfg)?;
+    let cat = spec.cat;
+    let objective = spec.objective;
+    let budget = (objective != Objective::Time).then(|| spec.available_time());
+    let (lo, hi) = bend_range(spec)?;
     let mut evals = Vec::new();
     // the bend is searched on a half-resolution grid (the optimum moves at
     // second order with the grid), the final design at full resolution
     let mut coarse = EnvelopeProblem::new(
-        (cfg.phased.nodes / 2).max(8),
-        cfg.motor(),
+        (spec.phased.nodes / 2).max(8),
+        spec.motor,
         objective,
         budget,
     );
     coarse.tangent_tol = COARSE_TANGENT_TOL;
-    let mut problem = EnvelopeProblem::new(cfg.phased.nodes, cfg.motor(), objective, budget);
+    let mut problem = EnvelopeProblem::new(spec.phased.nodes, spec.motor, objective, budget);
     let mut record = |d: &EnvelopeDesign| {
         let e = BendEvaluation {
             bend_deg: d.bend.to_degrees(),
@@ -854,17 +857,17 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
         observe(&e);
         evals.push(e);
     };
-    let scan = bend_scan(cfg, lo, hi);
+    let scan = bend_scan(spec, lo, hi);
     let spacing = (hi - lo) / (scan.len().max(2) - 1) as f64;
-    let tol = cfg.phased.bend_tol_deg.to_radians();
+    let tol = spec.phased.bend_tol_deg.to_radians();
     let mut best = search(&cat, &mut coarse, scan, tol, &mut record)?;
     let mut fastest_bend = None;
     if !best.value.is_finite() && budget.is_some() {
         // a budget close to the least time leaves a narrow band of feasible
         // bends that the scan can miss: look around the time-optimal bend
-        let mut timed = EnvelopeProblem::new(coarse.k, cfg.motor(), Objective::Time, None);
+        let mut timed = EnvelopeProblem::new(coarse.k, spec.motor, Objective::Time, None);
         timed.tangent_tol = COARSE_TANGENT_TOL;
-        let fastest = search(&cat, &mut timed, bend_scan(cfg, lo, hi), tol, |_| {})?;
+        let fastest = search(&cat, &mut timed, bend_scan(spec, lo, hi), tol, |_| {})?;
         fastest_bend = fastest.value.is_finite().then_some(fastest.bend);
         let around: Vec<f64> = (-3..=3)
             .map(|i| (fastest.bend + spacing * i as f64 / 6.0).clamp(lo, hi))
@@ -872,12 +875,12 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
         best = search(&cat, &mut coarse, around, tol, &mut record)?;
     }
     let found = if best.value.is_finite() {
-        verified_design(cfg, &mut problem, best.bend)?
+        verified_design(spec, &mut problem, best.bend)?
     } else {
         None
     };
     let Some((design, plan)) = found else {
-        return Err(unreachable_here(cfg, fastest_bend));
+        return Err(unreachable_here(spec, fastest_bend));
     };
     Ok(EnvelopeResult {
         status: design.status,
@@ -896,14 +899,13 @@ pub fn optimize(cfg: &Config, mut observe: impl FnMut(&BendEvaluation)) -> Resul
 /// `fastest_bend`: the `time` design's bend when the search already found it
 /// (the same search `optimize` would run for `time`, so only its verified
 /// design at that bend is left to do).
-fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
-    let mut timed = cfg.clone();
-    timed.design.objective = Objective::Time;
-    let least_time = if cfg.design.objective == Objective::Time {
+fn unreachable_here(spec: &DesignSpec, fastest_bend: Option<f64>) -> Error {
+    let timed = spec.with_objective(Objective::Time);
+    let least_time = if spec.objective == Objective::Time {
         None
     } else if let Some(bend) = fastest_bend {
         let mut problem =
-            EnvelopeProblem::new(cfg.phased.nodes, cfg.motor(), Objective::Time, None);
+            EnvelopeProblem::new(spec.phased.nodes, spec.motor, Objective::Time, None);
         verified_design(&timed, &mut problem, bend)
             .ok()
             .flatten()
@@ -913,15 +915,15 @@ fn unreachable_here(cfg: &Config, fastest_bend: Option<f64>) -> Error {
             .ok()
             .map(|r| r.plan.durations.iter().sum::<f64>())
     };
-    let least = least_time.map(|t| height_for(cfg, t));
+    let least = least_time.map(|t| height_for(spec, t));
     Error::Unreachable {
         reason: match least {
             Some(h) => format!(
                 "no phased {} schedule fits the motor envelope ({}) in the {:.4} s the fall from {} m leaves for the manoeuvre; the phased design needs a drop of at least {h:.3} m (fall.height) or stronger or faster motors; `catflip run` also tries the free-form design, which may need less",
-                cfg.design.objective.name(),
-                cfg.envelope_keys(),
-                cfg.available_time(),
-                cfg.fall.height
+                spec.objective.name(),
+                spec.envelope_keys(),
+                spec.available_time(),
+                spec.fall.height
             ),
             None => "no phased schedule fits the motor envelope at any bend; widen phased.bend_min_deg / bend_max_deg or relax the limits".into(),
         },
@@ -969,8 +971,8 @@ mod tests {
             "/configs/robot-universal.toml"
         ))
         .unwrap();
-        let cfg = Config::from_toml(&text, "robot-universal.toml", &[]).unwrap();
-        let (cat, motor) = (cfg.cat(), cfg.motor());
+        let spec = crate::test_support::spec_of(&text, "robot-universal.toml", &[]);
+        let (cat, motor) = (spec.cat, spec.motor);
         assert!(motor.slope() > 0.0 && motor.norm == TorqueNorm::PerMotor);
         let bend = 0.7;
         let twist = twist_for(&cat, bend).unwrap();

@@ -32,7 +32,6 @@
 //! solved from the analytic schedule ([`other_starts`]) and the lower
 //! design continued.
 
-use crate::config::Config;
 use crate::design::collocation::{CollocationPlan, Transcription};
 use crate::design::conic::{Cone, ConicData, ConicSettings};
 use crate::design::objective::Objective;
@@ -42,6 +41,7 @@ use crate::design::scp::{
     Certificate, Cost, Executor, Linearization, ScpIteration, ScpProblem, ScpSettings, ScpStatus,
     Triplets, Values, WarmStart,
 };
+use crate::design::spec::DesignSpec;
 use crate::error::Result;
 use crate::model::dynamics::{christoffel, linearize_torque, torque_from};
 use crate::model::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
@@ -140,10 +140,10 @@ struct TorqueRow {
 impl FreeProblem {
     /// The problem at `nodes` per phase; `z0` (any units of duration) sets
     /// the trust-region scales of the shape variables.
-    pub fn new(cfg: &Config, nodes: usize, z0: &[f64]) -> Self {
+    pub fn new(spec: &DesignSpec, nodes: usize, z0: &[f64]) -> Self {
         let tr = Transcription::new(3, nodes);
-        let time_unit = cfg.available_time();
-        let cat = cfg.cat();
+        let time_unit = spec.available_time();
+        let cat = spec.cat;
         let torque_unit = cat.i_t() / (time_unit * time_unit);
         let mut sq = 0.1f64;
         let mut sv = 0.1f64;
@@ -175,24 +175,24 @@ impl FreeProblem {
         Self {
             cat,
             tr,
-            norm: cfg.norm(),
+            norm: spec.norm(),
             time_unit,
             torque_unit,
             min_phase: 0.02 * manoeuvre,
-            max_bend: cfg.limits.max_bend_deg.map(f64::to_radians),
+            max_bend: spec.max_bend_deg.map(f64::to_radians),
             // without a torque-speed line, a limit above the cap can never bind
-            max_torque: cfg
-                .limits
+            max_torque: spec
+                .motor
                 .max_torque
                 .map(|l| l / torque_unit)
-                .filter(|&l| l < LIMIT_CAP || cfg.motor().slope() > 0.0)
+                .filter(|&l| l < LIMIT_CAP || spec.motor.slope() > 0.0)
                 .map(|l| l.min(LIMIT_CAP)),
-            slope: cfg.motor().slope() / (torque_unit * time_unit),
-            max_speed: cfg.limits.max_speed.map(|w| w * time_unit),
-            objective: cfg.design.objective,
+            slope: spec.motor.slope() / (torque_unit * time_unit),
+            max_speed: spec.motor.max_speed.map(|w| w * time_unit),
+            objective: spec.objective,
             scales,
             second_terms: Default::default(),
-            release: Release::of(cfg, time_unit),
+            release: Release::of(spec, time_unit),
             initial: None,
             checks: CHECKS_PER_INTERVAL,
             extra: Default::default(),
@@ -1231,10 +1231,10 @@ impl Seed {
 
     /// The seed's schedule: the phased design's ([`crate::design::phased::seed_plan`])
     /// or the analytic cosine schedule (which costs nothing).
-    pub fn plan(self, cfg: &Config) -> Result<Box<dyn crate::design::plan::ShapePlan>> {
+    pub fn plan(self, spec: &DesignSpec) -> Result<Box<dyn crate::design::plan::ShapePlan>> {
         Ok(match self {
-            Seed::Phased => Box::new(crate::design::phased::seed_plan(cfg)?),
-            Seed::Analytic => Box::new(crate::design::analytic::analytic_plan(cfg)),
+            Seed::Phased => Box::new(crate::design::phased::seed_plan(spec)?),
+            Seed::Analytic => Box::new(crate::design::analytic::analytic_plan(spec)),
         })
     }
 }
@@ -1250,7 +1250,7 @@ pub use crate::design::scp::Observer;
 /// observer sees them. A fine design the coarse one cannot start is solved
 /// from the seed. The observer is also told where each mesh begins.
 fn from_plan(
-    cfg: &Config,
+    spec: &DesignSpec,
     seed_plan: &dyn crate::design::plan::ShapePlan,
     seed: &str,
     nodes: usize,
@@ -1259,9 +1259,9 @@ fn from_plan(
     let clock = std::time::Instant::now();
     let seed_start = || Transcription::new(3, nodes).sample(seed_plan);
     let mut levels = Vec::new();
-    let z0 = if cfg.free.mesh_continuation && !cfg.uses_envelope() {
+    let z0 = if spec.free.mesh_continuation && !spec.uses_envelope() {
         coarse_start(
-            cfg,
+            spec,
             seed_plan,
             seed == "analytic",
             nodes,
@@ -1279,7 +1279,7 @@ fn from_plan(
     let from_coarse = levels.last().is_some_and(|l: &Coarse| l.0.converged);
     // the fine mesh's iterations are numbered on from the coarse meshes'
     let first = recorded(&levels);
-    let mut r = match optimize_start(cfg, &z0, None, seed, nodes, first, |it| {
+    let mut r = match optimize_start(spec, &z0, None, seed, nodes, first, |it| {
         observe.iteration(it)
     }) {
         // a fine design the coarse one could not start: from the seed (the
@@ -1289,7 +1289,7 @@ fn from_plan(
             before = clock.elapsed().as_secs_f64();
             // the failed attempt is not on the record: its numbers are reused
             observe.mesh(nodes);
-            optimize_start(cfg, &seed_start(), None, seed, nodes, first, |it| {
+            optimize_start(spec, &seed_start(), None, seed, nodes, first, |it| {
                 observe.iteration(it)
             })?
         }
@@ -1440,7 +1440,7 @@ fn recorded(levels: &[Coarse]) -> usize {
 /// 54.5 G, 0.317201 N m instead of 0.317395). A coarse design that fails
 /// or does not converge leaves the seed itself as the start.
 fn coarse_start(
-    cfg: &Config,
+    spec: &DesignSpec,
     seed_plan: &dyn crate::design::plan::ShapePlan,
     seed_is_analytic: bool,
     nodes: usize,
@@ -1451,13 +1451,13 @@ fn coarse_start(
     let Some(coarse) = coarser(nodes) else {
         return tr.sample(seed_plan);
     };
-    let z0 = coarse_start(cfg, seed_plan, seed_is_analytic, coarse, observe, levels);
+    let z0 = coarse_start(spec, seed_plan, seed_is_analytic, coarse, observe, levels);
     let mut its = Vec::new();
     observe.mesh(coarse);
     let first = recorded(levels);
     // the coarsest mesh also solves the other starts, beside the seed's
     let others = if coarser(coarse).is_none() {
-        other_starts(cfg, !seed_is_analytic)
+        other_starts(spec, !seed_is_analytic)
     } else {
         Vec::new()
     };
@@ -1469,12 +1469,12 @@ fn coarse_start(
                     let z = Transcription::new(3, coarse)
                         .sample(&crate::design::analytic::analytic_plan(c));
                     let mut n = 0;
-                    let s = design(cfg, &z, None, coarse, Mesh::Coarse, 0, |_| n += 1).ok()?;
+                    let s = design(spec, &z, None, coarse, Mesh::Coarse, 0, |_| n += 1).ok()?;
                     (s.res.status == ScpStatus::Converged).then_some((s, n))
                 })
                 .min_by(|a, b| a.0.res.objective.total_cmp(&b.0.res.objective))
         });
-        let solved = design(cfg, &z0, None, coarse, Mesh::Coarse, first, |it| {
+        let solved = design(spec, &z0, None, coarse, Mesh::Coarse, first, |it| {
             observe.iteration(it);
             its.push(*it);
         });
@@ -1525,9 +1525,9 @@ fn coarse_start(
 /// 1.0 s on a loaded machine); from twelve analytic schedules (bends of 30
 /// to 90 degrees, three splits) the 40-node design ended between 0.31883
 /// and 0.32372 N m.
-fn other_starts(cfg: &Config, configured: bool) -> Vec<Config> {
+fn other_starts(spec: &DesignSpec, configured: bool) -> Vec<DesignSpec> {
     if configured {
-        vec![cfg.clone()]
+        vec![spec.clone()]
     } else {
         Vec::new()
     }
@@ -1568,7 +1568,7 @@ impl FreeProblem {
 /// rest, continuity, defects, bend and speed limits), so that every
 /// subproblem is feasible at `dz = 0`.
 fn design(
-    cfg: &Config,
+    spec: &DesignSpec,
     z0: &[f64],
     warm: Option<&WarmStart>,
     nodes: usize,
@@ -1576,10 +1576,10 @@ fn design(
     first: usize,
     observe: impl FnMut(&ScpIteration),
 ) -> Result<Solved> {
-    check_resolvable(cfg, nodes)?;
+    check_resolvable(spec, nodes)?;
     design_problem(
-        cfg,
-        FreeProblem::new(cfg, nodes, z0),
+        spec,
+        FreeProblem::new(spec, nodes, z0),
         z0,
         warm,
         mesh,
@@ -1588,9 +1588,9 @@ fn design(
     )
 }
 
-/// [`design`] of a given problem (its start may be another than `cfg`'s: a replan).
+/// [`design`] of a given problem (its start may be another than `spec`'s: a replan).
 fn design_problem(
-    cfg: &Config,
+    spec: &DesignSpec,
     problem: FreeProblem,
     z0: &[f64],
     warm: Option<&WarmStart>,
@@ -1603,14 +1603,14 @@ fn design_problem(
     let (problem, max_iterations, tolerance, conic) = match mesh {
         Mesh::Coarse => (
             problem.at_nodes_only(),
-            COARSE_MAX_ITERATIONS.min(cfg.free.max_iterations),
-            COARSE_TOLERANCE.max(cfg.free.tolerance),
+            COARSE_MAX_ITERATIONS.min(spec.free.max_iterations),
+            COARSE_TOLERANCE.max(spec.free.tolerance),
             ConicSettings::COARSE,
         ),
         Mesh::Final => (
             problem,
-            cfg.free.max_iterations,
-            cfg.free.tolerance,
+            spec.free.max_iterations,
+            spec.free.tolerance,
             ConicSettings::MODEL,
         ),
     };
@@ -1636,7 +1636,7 @@ fn design_problem(
     let settings = ScpSettings {
         max_iterations,
         tolerance,
-        feasibility: cfg.free.attitude_tolerance,
+        feasibility: spec.free.attitude_tolerance,
         conic,
         ..Default::default()
     };
@@ -1686,21 +1686,21 @@ fn design_problem(
 /// when the fall leaves room (always for `time`), or else the problem is
 /// solved again with the limit tightened by the excess.
 fn inside_envelope(
-    cfg: &Config,
+    spec: &DesignSpec,
     mut solved: Solved,
     nodes: usize,
     first: usize,
     observe: &mut dyn FnMut(&ScpIteration),
 ) -> Result<Solved> {
-    let motor = cfg.motor();
+    let motor = spec.motor;
     if motor.max_torque.is_none() {
         // the speed limit holds exactly (Bernstein bound)
         return Ok(solved);
     }
     let tr = solved.plan.tr;
-    let mut tight = cfg.clone();
+    let mut tight = spec.clone();
     for _ in 0..8 {
-        let margin = crate::design::envelope::usage_of(cfg, &solved.plan)
+        let margin = crate::design::envelope::usage_of(spec, &solved.plan)
             .min_margin
             .unwrap_or(1.0);
         if margin >= -1e-7 {
@@ -1708,13 +1708,13 @@ fn inside_envelope(
         }
         // the least slow-down that brings every row inside (one guess of
         // 1 - 1.5 margin overshot the robot's least time by 0.9 %)
-        let stretch = crate::design::envelope::least_stretch(cfg, &solved.plan);
+        let stretch = crate::design::envelope::least_stretch(spec, &solved.plan);
         let total: f64 = solved.plan.phase_bounds()[3];
         // slowing the same path down keeps its attitude only at zero
         // momentum (F2; F10): from another start the problem is solved again
-        let room = (cfg.design.objective == Objective::Time
-            || total * stretch <= cfg.available_time() * (1.0 + 1e-12))
-            && cfg.start.is_default();
+        let room = (spec.objective == Objective::Time
+            || total * stretch <= spec.available_time() * (1.0 + 1e-12))
+            && spec.is_default_start();
         if room {
             for p in 0..3 {
                 let i = tr.duration(p);
@@ -1727,8 +1727,11 @@ fn inside_envelope(
             // |tau + k qd| <= T tightened as a whole: T and the no-load
             // speed shrink together, k = T / w0 stays
             let f = 1.0 + 1.5 * margin;
-            tight.limits.max_torque = tight.limits.max_torque.map(|t| t * f);
-            tight.limits.no_load_speed = tight.limits.no_load_speed.map(|w| w * f);
+            tight = tight.with_motor(crate::model::motor::Motor {
+                max_torque: tight.motor.max_torque.map(|t| t * f),
+                no_load_speed: tight.motor.no_load_speed.map(|w| w * f),
+                ..tight.motor
+            });
             let mut iterations = std::mem::take(&mut solved.res.iterations);
             let n0 = iterations.len();
             let again = design(
@@ -1766,7 +1769,7 @@ const BETWEEN_TOLERANCE: f64 = 1e-4;
 /// that cut the seed's per-motor peak by 0.1 % for 3 to 4 more SCP
 /// iterations, and the reported peak is the dense one either way.
 fn refine_checks(
-    cfg: &Config,
+    spec: &DesignSpec,
     mut solved: Solved,
     nodes: usize,
     first: usize,
@@ -1777,7 +1780,7 @@ fn refine_checks(
         if solved.res.status != ScpStatus::Converged {
             break;
         }
-        let from = FreeProblem::new(cfg, nodes, &solved.res.z).with_extra_checks(extra.clone());
+        let from = FreeProblem::new(spec, nodes, &solved.res.z).with_extra_checks(extra.clone());
         let found = from.between_checks(&solved.z_scaled, BETWEEN_TOLERANCE);
         if found.iter().all(Vec::is_empty) {
             break;
@@ -1785,7 +1788,7 @@ fn refine_checks(
         for (e, f) in extra.iter_mut().zip(found) {
             e.extend(f);
         }
-        let problem = FreeProblem::new(cfg, nodes, &solved.res.z).with_extra_checks(extra.clone());
+        let problem = FreeProblem::new(spec, nodes, &solved.res.z).with_extra_checks(extra.clone());
         let old = &solved.res.warm;
         let warm = WarmStart {
             multipliers: crate::design::scp::Multipliers {
@@ -1798,7 +1801,7 @@ fn refine_checks(
         let n0 = solved.res.iterations.len();
         let z0 = solved.res.z.clone();
         let again = design_problem(
-            cfg,
+            spec,
             problem,
             &z0,
             Some(&warm),
@@ -1824,7 +1827,7 @@ fn refine_checks(
 /// the schedule inside the motor envelope (see [`inside_envelope`]) and
 /// verifies it by simulation.
 fn optimize_start(
-    cfg: &Config,
+    spec: &DesignSpec,
     z0: &[f64],
     warm: Option<&WarmStart>,
     seed: &str,
@@ -1833,14 +1836,14 @@ fn optimize_start(
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let start = std::time::Instant::now();
-    let solved = design(cfg, z0, warm, nodes, Mesh::Final, first, &mut observe)?;
+    let solved = design(spec, z0, warm, nodes, Mesh::Final, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
-        return Err(infeasible(cfg, &solved));
+        return Err(infeasible(spec, &solved));
     }
-    let solved = refine_checks(cfg, solved, nodes, first, &mut observe)?;
-    let solved = inside_envelope(cfg, solved, nodes, first, &mut observe)?;
+    let solved = refine_checks(spec, solved, nodes, first, &mut observe)?;
+    let solved = inside_envelope(spec, solved, nodes, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
-        return Err(infeasible(cfg, &solved));
+        return Err(infeasible(spec, &solved));
     }
     let Solved {
         res,
@@ -1851,10 +1854,10 @@ fn optimize_start(
     } = solved;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
-    let objective = cfg.design.objective;
-    let (peak, objective_value) = dense_objective(cfg, &plan);
-    let sim = crate::verify::simulate::dynamic_cfg(cfg, &plan)?;
-    let kin = crate::verify::simulate::kinematic_cfg(cfg, &plan)?;
+    let objective = spec.objective;
+    let (peak, objective_value) = dense_objective(spec, &plan);
+    let sim = crate::verify::simulate::dynamic_spec(spec, &plan)?;
+    let kin = crate::verify::simulate::kinematic_spec(spec, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
     for p in 0..3 {
         for k in 0..nodes {
@@ -1915,16 +1918,16 @@ fn optimize_start(
 /// The error when the SCP cannot meet the motor limits in the fall: with a
 /// torque limit alone, F7's least height for the design's peak; otherwise
 /// the pointer to the `time` objective.
-fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
+fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
     let node_peak = solved.node_peak;
-    if !cfg.start.is_default() && solved.attitude_error > cfg.free.attitude_tolerance.max(1e-6) {
+    if !spec.is_default_start() && solved.attitude_error > spec.free.attitude_tolerance.max(1e-6) {
         // the landing, not the motors: what the optimiser could not undo
         return crate::error::Error::Unreachable {
             reason: format!(
                 "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height",
-                cfg.fall.height,
+                spec.fall.height,
                 solved.attitude_error.to_degrees(),
-                if cfg.cat.joint == crate::model::Joint::NoTwist {
+                if spec.cat.joint == crate::model::Joint::NoTwist {
                     "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine). "
                 } else {
                     ""
@@ -1932,12 +1935,12 @@ fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
             ),
         };
     }
-    let motor = cfg.motor();
+    let motor = spec.motor;
     if motor.no_load_speed.is_none()
         && motor.max_speed.is_none()
         && let Err(e) = crate::design::phased::check_limit(
-            cfg,
-            node_peak * cfg.available_time().powi(2),
+            spec,
+            node_peak * spec.available_time().powi(2),
             node_peak,
             "free-form design",
         )
@@ -1947,12 +1950,12 @@ fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
     crate::error::Error::Unreachable {
         reason: format!(
             "the free-form design cannot keep inside the motor limits in the fall from {} m; `catflip run` (or design.objective = \"time\") gives the least drop height",
-            cfg.fall.height
+            spec.fall.height
         ),
     }
 }
 
-/// Continuation: the free-form design for `cfg` started from a neighbouring
+/// Continuation: the free-form design for `spec` started from a neighbouring
 /// design `prev` (another point of a sweep). The start is `prev`'s solution
 /// in dimensionless units, so a change of drop height, margin or gravity
 /// (F3) starts exactly at the optimum, and a change of the cat or limits
@@ -1960,12 +1963,12 @@ fn infeasible(cfg: &Config, solved: &Solved) -> crate::error::Error {
 /// further back) the start is the secant predictor `2 prev - before`,
 /// which moves it along the solution path as well.
 fn continue_from(
-    cfg: &Config,
+    spec: &DesignSpec,
     prev: &FreeResult,
     before: Option<&FreeResult>,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
-    let nodes = cfg.free.nodes;
+    let nodes = spec.free.nodes;
     let tr = Transcription::new(3, nodes);
     // the secant from two converged designs on this mesh, its durations
     // kept to at least half the last's; the plain start if it fails
@@ -1979,10 +1982,10 @@ fn continue_from(
             .collect();
         for p in 0..3 {
             let i = tr.duration(p);
-            z[i] = z[i].max(0.5 * prev.z_scaled[i]) * cfg.available_time();
+            z[i] = z[i].max(0.5 * prev.z_scaled[i]) * spec.available_time();
         }
         if let Ok(r) = optimize_start(
-            cfg,
+            spec,
             &z,
             Some(&prev.warm),
             "continuation",
@@ -2004,10 +2007,10 @@ fn continue_from(
         z
     };
     for p in 0..3 {
-        z0[tr.duration(p)] *= cfg.available_time();
+        z0[tr.duration(p)] *= spec.available_time();
     }
     optimize_start(
-        cfg,
+        spec,
         &z0,
         Some(&prev.warm),
         "continuation",
@@ -2031,9 +2034,9 @@ fn twist_coefficient(cat: &Cat, b: f64) -> f64 {
 /// Fails fast when the bend limit is so small that the flip needs more
 /// turns of the bend direction (F1, F6: `n = 1 / (2 C)`) than `nodes` per
 /// phase can resolve, naming the bend (and the nodes) that would do.
-pub fn check_resolvable(cfg: &Config, nodes: usize) -> Result<()> {
-    let cat = cfg.cat();
-    let b = cfg.max_bend();
+pub fn check_resolvable(spec: &DesignSpec, nodes: usize) -> Result<()> {
+    let cat = spec.cat;
+    let b = spec.max_bend();
     let turns = 1.0 / (2.0 * twist_coefficient(&cat, b));
     let most = 3.0 * nodes as f64 / NODES_PER_TURN;
     if turns <= most {
@@ -2062,14 +2065,14 @@ pub fn check_resolvable(cfg: &Config, nodes: usize) -> Result<()> {
 /// The dense inverse-dynamics peak of a schedule, N m, and the objective's
 /// value for it (in [`Objective::unit`]): the peak, the manoeuvre time, or
 /// `integral |tau|^2 dt`.
-fn dense_objective(cfg: &Config, plan: &dyn ShapePlan) -> (f64, f64) {
-    let dense = crate::verify::analyze::dense_samples(cfg);
-    let (peak, _) = crate::verify::analyze::peak_along(cfg, plan, dense);
-    let value = match cfg.design.objective {
+fn dense_objective(spec: &DesignSpec, plan: &dyn ShapePlan) -> (f64, f64) {
+    let dense = crate::verify::analyze::dense_samples(spec);
+    let (peak, _) = crate::verify::analyze::peak_along(spec, plan, dense);
+    let value = match spec.objective {
         Objective::PeakTorque => peak,
         Objective::Time => plan.phase_bounds()[3],
         Objective::Energy => {
-            crate::design::envelope::torque_squared_integral(&cfg.cat(), plan, dense)
+            crate::design::envelope::torque_squared_integral(&spec.cat, plan, dense)
         }
     };
     (peak, value)
@@ -2093,11 +2096,11 @@ pub struct MeshCheck {
 
 /// Re-optimises `r` at twice its nodes per phase (warm start: the coarse
 /// schedule sampled on the fine mesh).
-pub fn mesh_check(cfg: &Config, r: &FreeResult) -> Result<MeshCheck> {
+pub fn mesh_check(spec: &DesignSpec, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = Transcription::new(3, nodes).sample(&r.plan);
-    let fine = design(cfg, &z0, None, nodes, Mesh::Final, 0, |_| {})?;
-    let (peak, value) = dense_objective(cfg, &fine.plan);
+    let fine = design(spec, &z0, None, nodes, Mesh::Final, 0, |_| {})?;
+    let (peak, value) = dense_objective(spec, &fine.plan);
     Ok(MeshCheck {
         nodes,
         status: fine.res.status,
@@ -2122,11 +2125,11 @@ pub enum Start<'a> {
 }
 
 /// The free-form optimiser, configured step by step:
-/// `FreeDesign::new(&cfg).seed(Seed::Analytic).observe(&mut table).solve()`.
+/// `FreeDesign::new(&spec).seed(Seed::Analytic).observe(&mut table).solve()`.
 /// By default it starts from the phased seed at `free.nodes` per phase,
 /// without the mesh check.
 pub struct FreeDesign<'a> {
-    cfg: &'a Config,
+    spec: &'a DesignSpec,
     start: Start<'a>,
     nodes: usize,
     mesh_check: bool,
@@ -2134,11 +2137,11 @@ pub struct FreeDesign<'a> {
 }
 
 impl<'a> FreeDesign<'a> {
-    pub fn new(cfg: &'a Config) -> Self {
+    pub fn new(spec: &'a DesignSpec) -> Self {
         FreeDesign {
-            cfg,
+            spec,
             start: Start::Seed(Seed::Phased),
-            nodes: cfg.free.nodes,
+            nodes: spec.free.nodes,
             mesh_check: false,
             observer: None,
         }
@@ -2187,7 +2190,7 @@ impl<'a> FreeDesign<'a> {
     }
 
     pub fn solve(self) -> Result<FreeResult> {
-        let cfg = self.cfg;
+        let spec = self.spec;
         let mut quiet = |_: &ScpIteration| {};
         let observe: &mut dyn Observer = match self.observer {
             Some(o) => o,
@@ -2195,8 +2198,8 @@ impl<'a> FreeDesign<'a> {
         };
         let mut r = match self.start {
             Start::Seed(seed) => {
-                check_resolvable(cfg, self.nodes)?;
-                let plan = match seed.plan(cfg) {
+                check_resolvable(spec, self.nodes)?;
+                let plan = match seed.plan(spec) {
                     // the phased family's least height is not the free-form
                     // design's: say so rather than pass it on as the answer
                     Err(crate::error::Error::Unreachable { reason }) => {
@@ -2204,15 +2207,15 @@ impl<'a> FreeDesign<'a> {
                     }
                     r => r?,
                 };
-                from_plan(cfg, plan.as_ref(), seed.name(), self.nodes, observe)?
+                from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?
             }
-            Start::Plan(plan, name) => from_plan(cfg, plan, name, self.nodes, observe)?,
+            Start::Plan(plan, name) => from_plan(spec, plan, name, self.nodes, observe)?,
             Start::Warm(prev, before) => {
-                continue_from(cfg, prev, before, |it| observe.iteration(it))?
+                continue_from(spec, prev, before, |it| observe.iteration(it))?
             }
         };
         if self.mesh_check {
-            r.mesh_check = Some(mesh_check(cfg, &r)?);
+            r.mesh_check = Some(mesh_check(spec, &r)?);
         }
         Ok(r)
     }
@@ -2251,12 +2254,8 @@ mod tests {
     fn torque_hessian_matches_second_differences_of_the_inverse_dynamics() {
         for joint in [crate::model::Joint::NoTwist, crate::model::Joint::Universal] {
             let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
-            let cfg = Config::load(
-                std::path::Path::new(path),
-                &[format!("cat.joint={}", joint.name())],
-            )
-            .unwrap();
-            let cat = cfg.cat();
+            let spec = crate::test_support::spec_at(path, &[format!("cat.joint={}", joint.name())]);
+            let cat = spec.cat;
             let x = [0.4, -0.3, 1.2, 0.7, -2.0, 3.0];
             let y = [0.8, -1.3];
             let base = ShapeTerms::second(&cat, [x[0], x[1]]);
@@ -2294,16 +2293,12 @@ mod tests {
     #[test]
     fn checking_at_the_nodes_only_drops_the_midpoints_and_nothing_else() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
-        let cfg = Config::load(
-            std::path::Path::new(path),
-            &["limits.norm=per-motor".into()],
-        )
-        .unwrap();
+        let spec = crate::test_support::spec_at(path, &["limits.norm=per-motor".into()]);
         let n = 8;
         let tr = Transcription::new(3, n);
-        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
-        let full = FreeProblem::new(&cfg, n, &z0).with_checks(2);
-        let nodes = FreeProblem::new(&cfg, n, &z0).at_nodes_only();
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&spec));
+        let full = FreeProblem::new(&spec, n, &z0).with_checks(2);
+        let nodes = FreeProblem::new(&spec, n, &z0).at_nodes_only();
         let z = full.to_scaled(&z0);
         assert_eq!(nodes.torques_len(), 3 * 2 * n);
         assert_eq!(full.torques_len(), 3 * 2 * (2 * n - 1));
@@ -2379,23 +2374,19 @@ mod tests {
     #[test]
     fn an_added_check_point_is_a_finer_patterns_point_and_nothing_else() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
-        let cfg = Config::load(
-            std::path::Path::new(path),
-            &["limits.norm=per-motor".into()],
-        )
-        .unwrap();
+        let spec = crate::test_support::spec_at(path, &["limits.norm=per-motor".into()]);
         let n = 8;
         let tr = Transcription::new(3, n);
-        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
-        let plain = FreeProblem::new(&cfg, n, &z0);
-        let fine = FreeProblem::new(&cfg, n, &z0).with_checks(8);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&spec));
+        let plain = FreeProblem::new(&spec, n, &z0);
+        let fine = FreeProblem::new(&spec, n, &z0).with_checks(8);
         // (phase, interval, eighths)
         let added = [(1, 2, 1), (1, 4, 5), (2, 0, 3)];
         let mut extra: [Vec<(usize, f64)>; 3] = Default::default();
         for (p, k, j) in added {
             extra[p].push((k, j as f64 / 8.0));
         }
-        let more = FreeProblem::new(&cfg, n, &z0).with_extra_checks(extra);
+        let more = FreeProblem::new(&spec, n, &z0).with_extra_checks(extra);
         assert_eq!(more.torques_len(), plain.torques_len() + 2 * added.len());
         let z = plain.to_scaled(&z0);
         let (lm, lf) = (more.linearize(&z), fine.linearize(&z));
@@ -2463,21 +2454,20 @@ mod tests {
         assert!(plain.between_checks(&z, 1e-4).iter().all(Vec::is_empty));
         let peak = crate::design::scp::peak_of(&plain.torques(&z), 2, plain.norm);
         let limit = 0.9 * peak * plain.torque_unit;
-        let limited = Config::load(
-            std::path::Path::new(path),
+        let limited = crate::test_support::spec_at(
+            path,
             &[
                 "limits.norm=per-motor".into(),
                 format!("limits.max_torque={limit}"),
             ],
-        )
-        .unwrap();
+        );
         let found = FreeProblem::new(&limited, n, &z0)
             .at_nodes_only()
             .between_checks(&z, 1e-4);
         assert!(found.iter().any(|f| !f.is_empty()));
         for (p, f) in found.iter().enumerate() {
             for &(k, c) in f {
-                let pt = FreeProblem::new(&cfg, n, &z0).with_extra_checks({
+                let pt = FreeProblem::new(&spec, n, &z0).with_extra_checks({
                     let mut e: [Vec<(usize, f64)>; 3] = Default::default();
                     e[p].push((k, c));
                     e
@@ -2492,10 +2482,10 @@ mod tests {
     #[test]
     fn the_hessian_reads_the_linearisations_shape_terms_only_at_the_same_point() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
-        let cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
+        let spec = crate::test_support::spec_at(path, &[]);
         let tr = Transcription::new(3, 8);
-        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
-        let fresh = || FreeProblem::new(&cfg, 8, &z0);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&spec));
+        let fresh = || FreeProblem::new(&spec, 8, &z0);
         let p = fresh();
         let z = p.to_scaled(&z0);
         let mut moved = z.clone();
@@ -2525,11 +2515,11 @@ mod tests {
     #[test]
     fn the_check_points_quarter_each_interval_and_integrate_cubics_exactly() {
         let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml");
-        let cfg = Config::load(std::path::Path::new(path), &[]).unwrap();
+        let spec = crate::test_support::spec_at(path, &[]);
         let n = 6;
         let tr = Transcription::new(3, n);
-        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&cfg));
-        let p = FreeProblem::new(&cfg, n, &z0);
+        let z0 = tr.sample(&crate::design::analytic::analytic_plan(&spec));
+        let p = FreeProblem::new(&spec, n, &z0);
         assert_eq!(p.points_per_phase(), CHECKS_PER_INTERVAL * (n - 1) + 1);
         let w = p.quadrature();
         let s_at = |i: usize| i as f64 / (p.points_per_phase() - 1) as f64;
@@ -2564,13 +2554,15 @@ mod tests {
         let load = |extra: &[String]| {
             let mut o = vec!["limits.norm=per-motor".to_string()];
             o.extend_from_slice(extra);
-            Config::load(std::path::Path::new(path), &o).unwrap()
+            crate::test_support::spec_at(path, &o)
         };
-        let cfg = load(&[]);
+        let spec = load(&[]);
         let tr = Transcription::new(3, 12);
-        let plan =
-            CollocationPlan::new(tr, tr.sample(&crate::design::analytic::analytic_plan(&cfg)));
-        let rows = crate::design::plan::Schedule::sample(&cfg.cat(), &plan, 50).rows;
+        let plan = CollocationPlan::new(
+            tr,
+            tr.sample(&crate::design::analytic::analytic_plan(&spec)),
+        );
+        let rows = crate::design::plan::Schedule::sample(&spec.cat, &plan, 50).rows;
         let peak = rows
             .iter()
             .map(|r| r.tau[0].abs().max(r.tau[1].abs()))
@@ -2580,21 +2572,21 @@ mod tests {
             .map(|r| r.qd[0].abs().max(r.qd[1].abs()))
             .fold(0.0, f64::max);
         // a torque-speed line 20 % short of the schedule's peak
-        let cfg = load(&[
+        let spec = load(&[
             format!("limits.max_torque={}", 0.8 * peak),
             format!("limits.no_load_speed={}", 4.0 * top),
             "simulate.samples_per_phase=50".into(),
         ]);
-        let s = crate::design::envelope::least_stretch(&cfg, &plan);
+        let s = crate::design::envelope::least_stretch(&spec, &plan);
         assert!(s > 1.05 && s < 3.0, "{s}");
         let slowed = |f: f64| {
             let mut p = plan.clone();
             for ph in 0..3 {
                 p.z[tr.duration(ph)] *= f;
             }
-            let dense = crate::verify::analyze::dense_samples(&cfg);
-            let rows = crate::design::plan::Schedule::sample(&cfg.cat(), &p, dense).rows;
-            cfg.motor()
+            let dense = crate::verify::analyze::dense_samples(&spec);
+            let rows = crate::design::plan::Schedule::sample(&spec.cat, &p, dense).rows;
+            spec.motor
                 .usage(rows.iter().map(|r| (r.tau, r.qd)))
                 .min_margin
                 .unwrap()

@@ -4,12 +4,13 @@
 //! The least drop height is the `time` design inside the motor envelope:
 //! `h_min = g (T_min + margin)^2 / 2` (F7 when only the torque is limited).
 
-use crate::config::Config;
 use crate::design::free::{self, FreeResult};
 use crate::design::objective::Objective;
 use crate::design::plan::Schedule;
 use crate::design::scp::ScpIteration;
+use crate::design::spec::DesignSpec;
 use crate::error::Result;
+use crate::model::motor::Motor;
 use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
 use serde::Serialize;
 
@@ -53,34 +54,34 @@ pub struct HeightAnswer {
 /// Answers the question when the motors are limited (`None` otherwise: an
 /// unlimited motor flips the cat from any height), with the phased `time`
 /// design made for the [`reference`] drop.
-pub fn answer(cfg: &Config) -> Result<Option<HeightAnswer>> {
-    if !cfg.motor().is_limited() {
+pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
+    if !spec.motor.is_limited() {
         return Ok(None);
     }
-    answer_for(cfg, &reference(cfg)).map(Some)
+    answer_for(spec, &reference(spec)).map(Some)
 }
 
 /// [`answer`] with the phased `time` design made for `reference`.
-fn answer_for(cfg: &Config, reference: &Config) -> Result<HeightAnswer> {
+fn answer_for(spec: &DesignSpec, reference: &DesignSpec) -> Result<HeightAnswer> {
     let r = crate::design::phased::optimize(reference, |_| {})?;
-    let least = crate::design::envelope::height_for(cfg, r.manoeuvre_time_s);
+    let least = crate::design::envelope::height_for(spec, r.manoeuvre_time_s);
     Ok(HeightAnswer {
-        possible: fits(cfg, least),
-        height_m: cfg.fall.height,
+        possible: fits(spec, least),
+        height_m: spec.fall.height,
         least_height_m: least,
         least_time_s: r.manoeuvre_time_s,
         method: "phased",
         status: r.status.into(),
         least_height_lower_bound_m: None,
         flip_error_rad: r.flip_error_rad,
-        from_start: cfg.start.is_default(),
-        schedule: Schedule::sample(&cfg.cat(), &r.plan, cfg.simulate.samples_per_phase),
+        from_start: spec.is_default_start(),
+        schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
     })
 }
 
 /// Whether a drop from `height` is within the configured one (to rounding).
-pub fn fits(cfg: &Config, height: f64) -> bool {
-    height <= cfg.fall.height * (1.0 + crate::verdict::tolerance::HEIGHT)
+pub fn fits(spec: &DesignSpec, height: f64) -> bool {
+    height <= spec.fall.height * (1.0 + crate::verdict::tolerance::HEIGHT)
 }
 
 /// The least drop heights of both design families, each from its `time`
@@ -104,33 +105,29 @@ pub struct Heights {
 /// From a start with angular momentum the body turns all through the fall,
 /// so the fall itself is part of the question: there the reference is the
 /// config's own drop.
-pub fn reference(cfg: &Config) -> Config {
-    if !cfg.start.is_default() {
-        let mut r = cfg.clone();
-        r.design.objective = Objective::Time;
-        return r;
+pub fn reference(spec: &DesignSpec) -> DesignSpec {
+    if !spec.is_default_start() {
+        return spec.with_objective(Objective::Time);
     }
-    let plan = crate::design::analytic::analytic_plan(cfg);
-    let t0 = cfg.available_time();
-    let motor = cfg.motor();
+    let plan = crate::design::analytic::analytic_plan(spec);
+    let t0 = spec.available_time();
+    let motor = spec.motor;
     // the torque alone when there is one: a start that is too fast for the
     // line (the SCP slows it down) found the shorter manoeuvres; the
     // no-load speed in the reference (0.94 s for the robot against 0.15 s)
     // took every start to 1.26 s instead of 0.75 s
     let least = match (motor.max_torque, motor.max_speed) {
         (Some(t), _) => {
-            let dense = crate::verify::analyze::dense_samples(cfg);
-            let (peak, _) = crate::verify::analyze::peak_along(cfg, &plan, dense);
+            let dense = crate::verify::analyze::dense_samples(spec);
+            let (peak, _) = crate::verify::analyze::peak_along(spec, &plan, dense);
             t0 * (peak / t).sqrt()
         }
-        (None, Some(w)) => t0 * crate::design::envelope::usage_of(cfg, &plan).max_speed_rad_s / w,
+        (None, Some(w)) => t0 * crate::design::envelope::usage_of(spec, &plan).max_speed_rad_s / w,
         (None, None) => t0,
     };
     let least = round_to_digits(least.max(1e-3), 3);
-    let mut r = cfg.clone();
-    r.fall.height = 0.5 * cfg.fall.gravity * (least + cfg.fall.margin).powi(2);
-    r.design.objective = Objective::Time;
-    r
+    spec.with_height(0.5 * spec.fall.gravity * (least + spec.fall.margin).powi(2))
+        .with_objective(Objective::Time)
 }
 
 /// `x` rounded to `digits` significant digits.
@@ -146,15 +143,13 @@ fn round_to_digits(x: f64, digits: i32) -> f64 {
 /// from a motor that is speeding up, so this bounds the least time under
 /// the line from below (the design is a local optimum: the bound is the
 /// best one found).
-pub fn stall_only(reference: &Config) -> Result<Option<(f64, FreeResult)>> {
-    let Some(stall) = reference.limits.max_torque else {
+pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
+    let Some(stall) = reference.motor.max_torque else {
         return Ok(None);
     };
-    let mut peak = reference.clone();
-    peak.design.objective = Objective::PeakTorque;
-    peak.limits.max_torque = None;
-    peak.limits.no_load_speed = None;
-    peak.limits.max_speed = None;
+    let peak = reference
+        .with_objective(Objective::PeakTorque)
+        .with_motor(Motor::unlimited(reference.motor.norm));
     let plan = crate::design::analytic::analytic_plan(&peak);
     let r = free::FreeDesign::new(&peak)
         .from_plan(&plan, "analytic")
@@ -188,16 +183,16 @@ fn stretched(
 /// the one from the stall-only design. The stall-only least time is the
 /// answer's lower bound. Without `with_free`, the phased answer alone.
 pub fn heights(
-    cfg: &Config,
+    spec: &DesignSpec,
     with_free: bool,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Option<Heights>> {
-    if !cfg.motor().is_limited() {
+    if !spec.motor.is_limited() {
         return Ok(None);
     }
-    let reference = reference(cfg);
+    let reference = reference(spec);
     if !with_free {
-        let answer = answer_for(cfg, &reference)?;
+        let answer = answer_for(spec, &reference)?;
         return Ok(Some(Heights {
             phased_m: answer.least_height_m,
             answer,
@@ -207,7 +202,7 @@ pub fn heights(
     let analytic_plan = crate::design::analytic::analytic_plan(&reference);
     let ((phased, from_analytic), (bound, from_stall)) = std::thread::scope(|s| {
         let others = s.spawn(|| {
-            let phased = answer_for(cfg, &reference);
+            let phased = answer_for(spec, &reference);
             let analytic = free::FreeDesign::new(&reference)
                 .from_plan(&analytic_plan, "analytic")
                 .solve();
@@ -231,7 +226,7 @@ pub fn heights(
         (others, (bound, from_stall))
     });
     let mut answer = phased?;
-    answer.least_height_lower_bound_m = bound.map(|t| crate::design::envelope::height_for(cfg, t));
+    answer.least_height_lower_bound_m = bound.map(|t| crate::design::envelope::height_for(spec, t));
     let phased_m = answer.least_height_m;
     let mut fastest: Option<FreeResult> = None;
     for fr in from_stall.into_iter().chain([from_analytic]).flatten() {
@@ -244,13 +239,13 @@ pub fn heights(
         }
     }
     if let Some(fr) = &fastest {
-        if !cfg.start.is_default() {
+        if !spec.is_default_start() {
             // the phased design is made for the start at rest: from another
             // start it only seeds the free-form one, which answers
             answer.least_time_s = f64::INFINITY;
         }
-        answer.improve_with(cfg, fr);
-    } else if !cfg.start.is_default() {
+        answer.improve_with(spec, fr);
+    } else if !spec.is_default_start() {
         answer.possible = false;
     }
     Ok(Some(Heights {
@@ -267,10 +262,10 @@ pub fn heights(
 /// any schedule that does this shows the flip possible from its height (the
 /// least height found is an upper bound either way), so a design that ran
 /// out of iterations still counts, and says so in its status.
-pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
-    let usage = crate::design::envelope::usage_of(cfg, &fr.plan);
+pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> bool {
+    let usage = crate::design::envelope::usage_of(spec, &fr.plan);
     let v = verdict(
-        &Targets::of(cfg),
+        &Targets::of(spec),
         &DesignNumbers {
             status: fr.status.into(),
             peak_torque_nm: fr.peak_torque_nm,
@@ -278,7 +273,7 @@ pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
             max_speed_rad_s: Some(usage.max_speed_rad_s),
             envelope_margin: usage.min_margin,
         },
-        &if cfg.start.is_default() {
+        &if spec.is_default_start() {
             Simulated::Flip {
                 flip_error_rad: fr.flip_error_rad,
                 tilt_deg: fr.tilt_deg,
@@ -291,7 +286,7 @@ pub fn verified(cfg: &Config, fr: &FreeResult) -> bool {
             }
         },
     );
-    fr.certificate.constraint_violation <= cfg.free.attitude_tolerance
+    fr.certificate.constraint_violation <= spec.free.attitude_tolerance
         && v.within_envelope()
         && v.flips()
 }
@@ -300,18 +295,18 @@ impl HeightAnswer {
     /// Takes a verified free-form `time` design (`fr`: inside the envelope
     /// and flipping; `run` also passes designs that stopped at the
     /// iteration limit) when it is shorter than the answer's.
-    pub fn improve_with(&mut self, cfg: &Config, fr: &FreeResult) {
+    pub fn improve_with(&mut self, spec: &DesignSpec, fr: &FreeResult) {
         if fr.manoeuvre_time_s >= self.least_time_s {
             return;
         }
         self.least_time_s = fr.manoeuvre_time_s;
-        self.least_height_m = crate::design::envelope::height_for(cfg, fr.manoeuvre_time_s);
-        self.possible = fits(cfg, self.least_height_m);
+        self.least_height_m = crate::design::envelope::height_for(spec, fr.manoeuvre_time_s);
+        self.possible = fits(spec, self.least_height_m);
         self.method = "free";
         self.status = fr.status.into();
         self.flip_error_rad = fr.flip_error_rad;
         self.from_start = true;
-        self.schedule = Schedule::sample(&cfg.cat(), &fr.plan, cfg.simulate.samples_per_phase);
+        self.schedule = Schedule::sample(&spec.cat, &fr.plan, spec.simulate.samples_per_phase);
     }
 
     /// One plain sentence for the terminal and the report.

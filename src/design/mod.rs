@@ -15,5 +15,6 @@ pub mod phased;
 pub mod plan;
 pub mod release;
 pub mod scp;
+pub mod spec;
 pub mod timing;
 pub mod twist;

@@ -10,20 +10,20 @@
 //! falls back to golden steps there). In a sweep a neighbour's bend predicts
 //! this point's ([`BendHint`]), and a local bracket replaces the scan.
 
-use crate::config::Config;
 use crate::design::analytic::plan as cosine_plan;
 pub use crate::design::bend_search::{BendEvaluation, BendHint, bend_range, bend_scan};
 use crate::design::bend_search::{Scored, bracket_then_brent, scan_then_brent};
 use crate::design::conic::SolveStatus;
 use crate::design::objective::Objective;
 use crate::design::path::{Path, PhasedPlan, Timing};
+use crate::design::spec::DesignSpec;
 use crate::design::timing::{PhaseTiming, TimingProblem};
 pub use crate::design::twist::twist_for;
 use crate::design::twist::{TWIST_TOL, twist_to};
 use crate::error::{Error, Result};
 use crate::model::{Cat, Joint};
 use crate::verify::analyze::peak_along;
-use crate::verify::simulate::{SimReport, dynamic_cfg};
+use crate::verify::simulate::{SimReport, dynamic_spec};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -186,30 +186,30 @@ impl Scored for BendDesign {
 /// instead of the scan (the scan when no bend of the bracket is possible,
 /// one fails, or the one-turn or the config's bend is better).
 pub fn search_bend(
-    cfg: &Config,
+    spec: &DesignSpec,
     problem: &mut TimingProblem,
     hint: Option<BendHint>,
     observe: impl FnMut(&BendEvaluation),
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
-    let tol = cfg.phased.bend_tol_deg.to_radians();
-    let (found, evals) = search_bend_to(cfg, problem, hint, tol, TWIST_TOL, observe)?;
-    Ok((certified(&cfg.cat(), problem, found), evals))
+    let tol = spec.phased.bend_tol_deg.to_radians();
+    let (found, evals) = search_bend_to(spec, problem, hint, tol, TWIST_TOL, observe)?;
+    Ok((certified(&spec.cat, problem, found), evals))
 }
 
 /// [`search_bend`] to the bend tolerance `tol` (rad), with every twist to
 /// the flip error `twist_tol` (rad) and the winner at the search's
 /// accuracy (not certified).
 fn search_bend_to(
-    cfg: &Config,
+    spec: &DesignSpec,
     problem: &TimingProblem,
     hint: Option<BendHint>,
     tol: f64,
     twist_tol: f64,
     mut observe: impl FnMut(&BendEvaluation),
 ) -> Result<(BendDesign, Vec<BendEvaluation>)> {
-    let cat = cfg.cat();
-    let t = cfg.available_time();
-    let (lo, hi) = bend_range(cfg)?;
+    let cat = spec.cat;
+    let t = spec.available_time();
+    let (lo, hi) = bend_range(spec)?;
     let mut evals = Vec::new();
     let mut search = problem.for_search();
     let mut eval = |b: f64, evals: &mut Vec<BendEvaluation>| -> Result<BendDesign> {
@@ -224,7 +224,7 @@ fn search_bend_to(
         evals.push(e);
         Ok(d)
     };
-    let xs = bend_scan(cfg, lo, hi);
+    let xs = bend_scan(spec, lo, hi);
     // the bracket's best, unless a bend of it fails, none is possible, or
     // one of the bends the scan always tries (one turn, F6, and the
     // config's) beats it: another basin, so the scan
@@ -233,7 +233,7 @@ fn search_bend_to(
             bracket_then_brent(h.bend, h.step, (lo, hi), tol, |b| eval(b, &mut evals))
     {
         let mut beaten = false;
-        for &b in &xs[cfg.phased.scan_points..] {
+        for &b in &xs[spec.phased.scan_points..] {
             if let Ok(other) = eval(b, &mut evals) {
                 beaten |= other.unit_peak() < d.unit_peak();
             }
@@ -253,20 +253,20 @@ fn certified(cat: &Cat, problem: &mut TimingProblem, found: BendDesign) -> BendD
 }
 
 /// F7: least drop height at which `unit_peak / T^2 <= tau_max`, m.
-pub fn least_height(cfg: &Config, unit_peak: f64, tau_max: f64) -> f64 {
-    let t_min = (unit_peak / tau_max).sqrt() + cfg.fall.margin;
-    0.5 * cfg.fall.gravity * t_min * t_min
+pub fn least_height(spec: &DesignSpec, unit_peak: f64, tau_max: f64) -> f64 {
+    let t_min = (unit_peak / tau_max).sqrt() + spec.fall.margin;
+    0.5 * spec.fall.gravity * t_min * t_min
 }
 
 /// Checks a design's peak against `limits.max_torque`.
-pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Result<()> {
-    if let Some(lim) = cfg.limits.max_torque
+pub fn check_limit(spec: &DesignSpec, unit_peak: f64, peak: f64, what: &str) -> Result<()> {
+    if let Some(lim) = spec.motor.max_torque
         && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
         return Err(Error::Unreachable {
             reason: format!(
                 "the {what} needs {peak:.4} N m but limits.max_torque = {lim} N m; drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
-                least_height(cfg, unit_peak, lim)
+                least_height(spec, unit_peak, lim)
             ),
         });
     }
@@ -274,26 +274,26 @@ pub fn check_limit(cfg: &Config, unit_peak: f64, peak: f64, what: &str) -> Resul
 }
 
 /// The phased optimiser: bend search, optimal split, reconstruction, verification.
-pub fn optimize(cfg: &Config, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
-    optimize_near(cfg, None, observe)
+pub fn optimize(spec: &DesignSpec, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
+    optimize_near(spec, None, observe)
 }
 
 /// [`optimize`] with the bend search started at a neighbour's bend (a
 /// sweep's continuation; see [`search_bend`]). The motor-envelope design
 /// ignores the hint.
 pub fn optimize_near(
-    cfg: &Config,
+    spec: &DesignSpec,
     hint: Option<BendHint>,
     observe: impl FnMut(&BendEvaluation),
 ) -> Result<PhasedResult> {
-    if cfg.uses_envelope() {
-        return finish_envelope(cfg, crate::design::envelope::optimize(cfg, observe)?);
+    if spec.uses_envelope() {
+        return finish_envelope(spec, crate::design::envelope::optimize(spec, observe)?);
     }
     let start = Instant::now();
-    let mut problem = TimingProblem::new(cfg.phased.nodes, cfg.norm());
-    let (design, evals) = search_bend(cfg, &mut problem, hint, observe)?;
+    let mut problem = TimingProblem::new(spec.phased.nodes, spec.norm());
+    let (design, evals) = search_bend(spec, &mut problem, hint, observe)?;
     let solve_time = start.elapsed().as_secs_f64();
-    finish(cfg, design, evals, solve_time)
+    finish(spec, design, evals, solve_time)
 }
 
 /// Grid intervals per phase of the free-form design's phased seed: the free-form
@@ -327,36 +327,36 @@ pub const SEED_BEND_TOL_DEG: f64 = 0.5;
 /// [`SEED_BEND_TOL_DEG`], the twist to [`SEED_TWIST_TOL`], and the search's accuracy (a config with a motor
 /// envelope gets the whole envelope design, whose torque-speed line needs
 /// its own iteration).
-pub fn seed_plan(cfg: &Config) -> Result<PhasedPlan> {
-    if cfg.uses_envelope() {
-        return Ok(crate::design::envelope::optimize(cfg, |_| {})?.plan);
+pub fn seed_plan(spec: &DesignSpec) -> Result<PhasedPlan> {
+    if spec.uses_envelope() {
+        return Ok(crate::design::envelope::optimize(spec, |_| {})?.plan);
     }
-    let problem = TimingProblem::new(cfg.phased.nodes.min(SEED_NODES), cfg.norm());
-    let tol = cfg.phased.bend_tol_deg.max(SEED_BEND_TOL_DEG).to_radians();
-    let (design, _) = search_bend_to(cfg, &problem, None, tol, SEED_TWIST_TOL, |_| {})?;
-    Ok(design.plan(design.durations(cfg.available_time())))
+    let problem = TimingProblem::new(spec.phased.nodes.min(SEED_NODES), spec.norm());
+    let tol = spec.phased.bend_tol_deg.max(SEED_BEND_TOL_DEG).to_radians();
+    let (design, _) = search_bend_to(spec, &problem, None, tol, SEED_TWIST_TOL, |_| {})?;
+    Ok(design.plan(design.durations(spec.available_time())))
 }
 
 /// Reconstruction, comparison and verification of a design inside the
 /// motor envelope.
 fn finish_envelope(
-    cfg: &Config,
+    spec: &DesignSpec,
     r: crate::design::envelope::EnvelopeResult,
 ) -> Result<PhasedResult> {
     let plan = r.plan;
     let time: f64 = plan.durations.iter().sum();
-    let dense = crate::verify::analyze::dense_samples(cfg);
-    let (peak, _) = peak_along(cfg, &plan, dense);
+    let dense = crate::verify::analyze::dense_samples(spec);
+    let (peak, _) = peak_along(spec, &plan, dense);
     let value = match r.objective {
         Objective::PeakTorque => peak,
         Objective::Time => time,
         Objective::Energy => {
-            crate::design::envelope::torque_squared_integral(&cfg.cat(), &plan, dense)
+            crate::design::envelope::torque_squared_integral(&spec.cat, &plan, dense)
         }
     };
-    let split = cfg.analytic.split.map(|f| f * time);
-    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(r.bend, r.twist, split), 2000);
-    let sim = dynamic_cfg(cfg, &plan)?;
+    let split = spec.analytic.split.map(|f| f * time);
+    let (analytic_peak, _) = peak_along(spec, &cosine_plan(r.bend, r.twist, split), 2000);
+    let sim = dynamic_spec(spec, &plan)?;
     Ok(PhasedResult {
         mode: "phased",
         status: r.status,
@@ -379,7 +379,7 @@ fn finish_envelope(
         tilt_deg: sim.tilt_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
-        nodes: cfg.phased.nodes,
+        nodes: spec.phased.nodes,
         evaluations: r.evaluations,
         solve_time_s: r.solve_time_s,
         plan,
@@ -390,20 +390,20 @@ fn finish_envelope(
 
 /// Reconstruction, comparison and verification of a chosen design.
 pub fn finish(
-    cfg: &Config,
+    spec: &DesignSpec,
     design: BendDesign,
     evals: Vec<BendEvaluation>,
     solve_time: f64,
 ) -> Result<PhasedResult> {
-    let t = cfg.available_time();
+    let t = spec.available_time();
     let durations = design.durations(t);
     let socp_peak = design.unit_peak() / (t * t);
     let plan = design.plan(durations);
-    let (peak, _) = peak_along(cfg, &plan, crate::verify::analyze::dense_samples(cfg));
-    check_limit(cfg, peak * t * t, peak, "phased design")?;
-    let split = cfg.analytic.split.map(|f| f * t);
-    let (analytic_peak, _) = peak_along(cfg, &cosine_plan(design.bend, design.twist, split), 2000);
-    let sim = dynamic_cfg(cfg, &plan)?;
+    let (peak, _) = peak_along(spec, &plan, crate::verify::analyze::dense_samples(spec));
+    check_limit(spec, peak * t * t, peak, "phased design")?;
+    let split = spec.analytic.split.map(|f| f * t);
+    let (analytic_peak, _) = peak_along(spec, &cosine_plan(design.bend, design.twist, split), 2000);
+    let sim = dynamic_spec(spec, &plan)?;
     let status = design
         .phases
         .iter()
@@ -432,7 +432,7 @@ pub fn finish(
         tilt_deg: sim.tilt_deg,
         sim_peak_torque_nm: sim.peak_torque_nm,
         momentum_drift_nms: sim.momentum_drift_nms,
-        nodes: cfg.phased.nodes,
+        nodes: spec.phased.nodes,
         evaluations: evals,
         solve_time_s: solve_time,
         plan,

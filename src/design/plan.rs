@@ -431,15 +431,14 @@ mod tests {
 
     /// The seed's analytic schedule as catflip writes it.
     fn written() -> String {
-        let cfg = crate::config::Config::from_toml(
+        let spec = crate::test_support::spec_of(
             &std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml"))
                 .unwrap(),
             "seed.toml",
             &[],
-        )
-        .unwrap();
-        let plan = crate::design::analytic::analytic_plan(&cfg);
-        Schedule::sample(&cfg.cat(), &plan, 20).to_csv()
+        );
+        let plan = crate::design::analytic::analytic_plan(&spec);
+        Schedule::sample(&spec.cat, &plan, 20).to_csv()
     }
 
     fn message(text: &str) -> (usize, String) {

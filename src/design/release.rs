@@ -17,6 +17,7 @@
 //! exact in the local shape and duration and lagged in the attitude.
 
 use crate::design::collocation::Transcription;
+use crate::design::spec::DesignSpec;
 use crate::model::Cat;
 use crate::model::momentum::{body_rate_with, momentum_torque, straight_inertias};
 use crate::model::small::Real;
@@ -407,19 +408,19 @@ impl Release {
         }
     }
 
-    /// The release of `cfg`'s start in the units of a problem whose time
+    /// The release of `spec`'s start in the units of a problem whose time
     /// unit is `time_unit`; `None` for today's start (upside down at rest).
-    pub fn of(cfg: &crate::config::Config, time_unit: f64) -> Option<Release> {
-        if cfg.start.is_default() {
+    pub fn of(spec: &DesignSpec, time_unit: f64) -> Option<Release> {
+        if spec.is_default_start() {
             return None;
         }
-        let cat = cfg.cat();
-        let start = cfg.start.start();
+        let cat = spec.cat;
+        let start = spec.release();
         let l = start.momentum(&cat);
         Some(Release {
             attitude: start.attitude,
             momentum: l.map(|c| c * time_unit),
-            tail: cfg.fall.margin / time_unit,
+            tail: spec.fall.margin / time_unit,
             inertias: straight_inertias(&cat),
         })
     }
@@ -428,15 +429,14 @@ impl Release {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::Config;
     use crate::design::free::FreeProblem;
     use crate::design::scp::ScpProblem;
 
     const SEED: &str = include_str!("../../configs/seed.toml");
 
-    fn config(sets: &[&str]) -> Config {
+    fn config(sets: &[&str]) -> DesignSpec {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-        Config::from_toml(SEED, "seed", &sets).unwrap()
+        crate::test_support::spec_of(SEED, "seed", &sets)
     }
 
     /// A smooth, bent, moving path on `nodes` per phase (not a flip: the
@@ -465,10 +465,10 @@ mod tests {
 
     #[test]
     fn the_landing_residual_has_the_derivative_of_its_own_map() {
-        let cfg = config(&SPUN);
+        let spec = config(&SPUN);
         let tr = Transcription::new(3, 8);
         let z = wavy(&tr);
-        let problem = FreeProblem::new(&cfg, 8, &z);
+        let problem = FreeProblem::new(&spec, 8, &z);
         assert!(problem.release.is_some());
         let lin = problem.linearize(&z);
         let m = lin.residual.len();
@@ -496,7 +496,7 @@ mod tests {
 
     #[test]
     fn the_momentum_torque_gradients_match_differences() {
-        let cat = config(&[]).cat();
+        let cat = config(&[]).cat;
         let (q, v, mu) = ([0.4, -0.7], [1.3, 0.6], [0.02, -0.05, 0.03]);
         let (g, dg) = Release::torque(&cat, q, v, mu);
         let dmu = Release::torque_dmu(&cat, q, v, mu);

@@ -274,7 +274,7 @@ impl Controls {
     /// and the motor envelope catflip's own simulation clips to
     /// (`|tau + k qd| <= T` per motor or as a disc, `k` = `motor_slope_nm_s`).
     pub fn to_csv(&self, cfg: &Config, method: &str) -> String {
-        let ctrl = crate::verify::simulate::Controller::from_config(cfg);
+        let ctrl = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
         let n = self.rows.len() - 1;
         let mut s = format!(
             "# catflip controls for {sim}: config {name}, method {method}, {joint} joint\n\

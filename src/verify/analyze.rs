@@ -1,26 +1,26 @@
 //! `catflip analyze`: the seed's closed forms beside the true dynamics of its
 //! schedule.
 
-use crate::config::Config;
 use crate::design::analytic::{ClosedForms, analytic_plan, closed_forms};
 use crate::design::path::PhasedPlan;
 use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::spec::DesignSpec;
 use crate::error::Result;
-use crate::verify::simulate::{SimReport, dynamic_cfg, kinematic_cfg};
+use crate::verify::simulate::{SimReport, dynamic_spec, kinematic_spec};
 use serde::Serialize;
 
 /// Samples per phase of the reported ("dense") peaks: at least 2000 and a
 /// multiple of the written schedules' rows, so every written row is among them.
-pub fn dense_samples(cfg: &Config) -> usize {
-    let n = cfg.simulate.samples_per_phase;
+pub fn dense_samples(spec: &DesignSpec) -> usize {
+    let n = spec.simulate.samples_per_phase;
     n * 2000usize.div_ceil(n)
 }
 
 /// Peak joint torque along a plan, sampled densely in every phase, N m.
-pub fn peak_along(cfg: &Config, plan: &dyn ShapePlan, per_phase: usize) -> (f64, [f64; 3]) {
-    let cat = cfg.cat();
+pub fn peak_along(spec: &DesignSpec, plan: &dyn ShapePlan, per_phase: usize) -> (f64, [f64; 3]) {
+    let cat = spec.cat;
     let b = plan.phase_bounds();
-    let norm = cfg.norm();
+    let norm = spec.norm();
     let mut per = [0.0f64; 3];
     for i in 0..3 {
         for k in 0..=per_phase {
@@ -53,14 +53,15 @@ pub struct Analysis {
     pub kinematic: SimReport,
 }
 
-pub fn analyze(cfg: &Config) -> Result<Analysis> {
-    let closed = closed_forms(cfg);
-    let plan = analytic_plan(cfg);
-    let (peak, per) = peak_along(cfg, &plan, dense_samples(cfg));
-    let kin = kinematic_cfg(cfg, &plan)?;
+/// The analytic schedule of `spec` (the config `name`) and its closed forms.
+pub fn analyze(spec: &DesignSpec, name: &str) -> Result<Analysis> {
+    let closed = closed_forms(spec);
+    let plan = analytic_plan(spec);
+    let (peak, per) = peak_along(spec, &plan, dense_samples(spec));
+    let kin = kinematic_spec(spec, &plan)?;
     Ok(Analysis {
-        name: cfg.name.clone(),
-        joint: cfg.cat.joint.name(),
+        name: name.to_string(),
+        joint: spec.cat.joint.name(),
         peak_over_seed_estimate: peak / closed.seed_torque_estimate_nm,
         closed,
         peak_torque_nm: peak,
@@ -75,11 +76,11 @@ pub fn analyze(cfg: &Config) -> Result<Analysis> {
 }
 
 /// Schedule of the analytic plan, sampled for output.
-pub fn analytic_schedule(cfg: &Config, plan: &PhasedPlan) -> Schedule {
-    Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase)
+pub fn analytic_schedule(spec: &DesignSpec, plan: &PhasedPlan) -> Schedule {
+    Schedule::sample(&spec.cat, plan, spec.simulate.samples_per_phase)
 }
 
 /// Dynamic verification of any plan.
-pub fn verify(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    dynamic_cfg(cfg, plan)
+pub fn verify(spec: &DesignSpec, plan: &dyn ShapePlan) -> Result<SimReport> {
+    dynamic_spec(spec, plan)
 }

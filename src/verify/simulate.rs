@@ -7,8 +7,8 @@
 //! pair, restarted at phase boundaries, with the attitude quaternion
 //! renormalised after each step.
 
-use crate::config::Config;
 use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 use crate::model::dynamics::angular_momentum;
 use crate::model::momentum::{
@@ -114,10 +114,10 @@ impl SimReport {
     }
 }
 
-fn settings(cfg: &Config) -> OdeSettings {
+fn settings(spec: &DesignSpec) -> OdeSettings {
     OdeSettings {
-        rtol: cfg.simulate.rtol,
-        atol: cfg.simulate.atol,
+        rtol: spec.simulate.rtol,
+        atol: spec.simulate.atol,
         ..Default::default()
     }
 }
@@ -370,18 +370,18 @@ pub struct Controller {
 
 impl Controller {
     /// Gains from the config: natural frequency `2 pi f` about `M(0) = I_t / 2`.
-    pub fn from_config(cfg: &Config) -> Controller {
-        let m0 = cfg.cat().straight_inertia();
-        let wn = 2.0 * std::f64::consts::PI * cfg.simulate.pd_bandwidth_hz;
-        let (kp, kd) = if cfg.simulate.pd {
-            (m0 * wn * wn, 2.0 * cfg.simulate.pd_damping * m0 * wn)
+    pub fn from_spec(spec: &DesignSpec) -> Controller {
+        let m0 = spec.cat.straight_inertia();
+        let wn = 2.0 * std::f64::consts::PI * spec.simulate.pd_bandwidth_hz;
+        let (kp, kd) = if spec.simulate.pd {
+            (m0 * wn * wn, 2.0 * spec.simulate.pd_damping * m0 * wn)
         } else {
             (0.0, 0.0)
         };
         Controller {
             kp,
             kd,
-            motor: cfg.motor(),
+            motor: spec.motor,
         }
     }
 
@@ -528,24 +528,24 @@ pub fn dynamic_landing(
 
 /// Kinematic run from the config's start with its tolerances; the landing
 /// error after its `fall.margin`.
-pub fn kinematic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
-    let cat = cfg.cat();
-    let mut r = kinematic_from(&cat, plan, &cfg.start.start(), &settings(cfg))?;
-    r.land(&cat, cfg.fall.margin);
+pub fn kinematic_spec(spec: &DesignSpec, plan: &dyn ShapePlan) -> Result<SimReport> {
+    let cat = spec.cat;
+    let mut r = kinematic_from(&cat, plan, &spec.release(), &settings(spec))?;
+    r.land(&cat, spec.fall.margin);
     Ok(r)
 }
 
 /// Dynamic run from the config's start with its tolerances, gains and
 /// limits; the landing error after its `fall.margin`, the motors holding the
 /// shape straight meanwhile ([`dynamic_landing`]).
-pub fn dynamic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
+pub fn dynamic_spec(spec: &DesignSpec, plan: &dyn ShapePlan) -> Result<SimReport> {
     dynamic_landing(
-        &cfg.cat(),
+        &spec.cat,
         plan,
-        &Controller::from_config(cfg),
-        &settings(cfg),
-        &cfg.start.start(),
-        cfg.fall.margin,
+        &Controller::from_spec(spec),
+        &settings(spec),
+        &spec.release(),
+        spec.fall.margin,
     )
 }
 
@@ -555,9 +555,10 @@ pub fn dynamic_cfg(cfg: &Config, plan: &dyn ShapePlan) -> Result<SimReport> {
 /// `3 * (30000 + 1)` rows (`simulate.samples_per_phase` <= 30000).
 pub const MAX_SCHEDULE_ROWS: usize = 100_000;
 
-/// Reads a schedule CSV for replay on `cfg`'s fall: bounded in size, and
-/// lasting as long as the manoeuvre the config leaves (fall time minus margin).
-pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule> {
+/// Reads a schedule CSV for replay on `spec`'s fall (the config `name`, for
+/// messages): bounded in size, and lasting as long as the manoeuvre the fall
+/// leaves (fall time minus margin).
+pub fn read_schedule(spec: &DesignSpec, name: &str, text: &str, origin: &str) -> Result<Schedule> {
     let rows = text.lines().filter(|l| !l.trim().is_empty()).count();
     if rows > MAX_SCHEDULE_ROWS + 1 {
         return Err(Error::Schedule {
@@ -582,14 +583,14 @@ pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule>
     }
     let b = s.phase_bounds();
     let (start, end) = (b[0], b[3]);
-    let want = cfg.available_time();
+    let want = spec.available_time();
     let tol = 1e-6 * (1.0 + want);
     if start.abs() > tol || (end - want).abs() > tol {
         // a schedule from 0 fits one height; one that starts later, none
         let fits = if start.abs() <= tol {
             format!(
                 "this one fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
-                0.5 * cfg.fall.gravity * (end + cfg.fall.margin).powi(2)
+                0.5 * spec.fall.gravity * (end + spec.fall.margin).powi(2)
             )
         } else {
             "this one does not start at 0, so no height fits it".into()
@@ -599,9 +600,9 @@ pub fn read_schedule(cfg: &Config, text: &str, origin: &str) -> Result<Schedule>
             line: s.rows.len() + 1,
             message: format!(
                 "the schedule runs from t = {start} s to {end} s, but config `{}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then; replay it with the config it was designed for ({fits}), or design one for this fall with `catflip optimize`",
-                cfg.name,
-                cfg.fall_time(),
-                cfg.fall.margin,
+                name,
+                spec.fall_time(),
+                spec.fall.margin,
             ),
         });
     }

@@ -12,11 +12,11 @@
 //! one's plan, moved to the newly measured state.
 
 use super::{FreeProblem, Objective, Release, Transcription};
-use crate::config::Config;
 use crate::design::collocation::CollocationPlan;
 use crate::design::conic::{Cone, ConicData, ConicSettings, ConicSolver, solve_reusing};
 use crate::design::plan::ShapePlan;
 use crate::design::scp::{Executor, ScpSettings, ScpStatus, Solvers, WarmStart};
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 
 /// The rest of a plan from `t0`, as a plan of three phases starting at 0:
@@ -72,7 +72,7 @@ pub struct Replan {
 
 /// The replans of one flight at a fixed mesh (see the module doc).
 pub struct Replanner {
-    cfg: Config,
+    spec: DesignSpec,
     nodes: usize,
     settings: ScpSettings,
     solvers: Solvers,
@@ -81,9 +81,9 @@ pub struct Replanner {
 }
 
 impl Replanner {
-    /// Replans of `cfg`'s flight at `nodes` per phase, each SCP to the
+    /// Replans of `spec`'s flight at `nodes` per phase, each SCP to the
     /// design's own tolerances (`free.tolerance`, `free.attitude_tolerance`).
-    pub fn new(cfg: &Config, nodes: usize) -> Result<Self> {
+    pub fn new(spec: &DesignSpec, nodes: usize) -> Result<Self> {
         if nodes < 3 {
             return Err(Error::Invalid {
                 key: "replan nodes".into(),
@@ -91,9 +91,9 @@ impl Replanner {
                 expected: "at least 3 nodes per phase".into(),
             });
         }
-        if cfg.design.objective == Objective::Time
-            && cfg.limits.max_torque.is_none()
-            && cfg.limits.max_speed.is_none()
+        if spec.objective == Objective::Time
+            && spec.motor.max_torque.is_none()
+            && spec.motor.max_speed.is_none()
         {
             return Err(Error::Invalid {
                 key: "design.objective".into(),
@@ -104,11 +104,11 @@ impl Replanner {
             });
         }
         Ok(Self {
-            cfg: cfg.clone(),
+            spec: spec.clone(),
             nodes,
             settings: ScpSettings {
-                tolerance: cfg.free.tolerance,
-                feasibility: cfg.free.attitude_tolerance,
+                tolerance: spec.free.tolerance,
+                feasibility: spec.free.attitude_tolerance,
                 conic: ConicSettings::MODEL,
                 ..Default::default()
             },
@@ -147,9 +147,9 @@ impl Replanner {
         max_iterations: usize,
     ) -> Result<Replan> {
         let clock = std::time::Instant::now();
-        let cfg = &self.cfg;
+        let spec = &self.spec;
         let end = origin + previous.duration();
-        let remaining = cfg.available_time() - t;
+        let remaining = spec.available_time() - t;
         if !(t >= origin && t < end && remaining > 0.0) {
             return Err(Error::Invalid {
                 key: "replan time".into(),
@@ -157,9 +157,8 @@ impl Replanner {
                 expected: format!("within the manoeuvre, [{origin}, {end})"),
             });
         }
-        let mut rc = cfg.clone();
-        let g = rc.fall.gravity;
-        rc.fall.height = 0.5 * g * (remaining + rc.fall.margin).powi(2);
+        let g = spec.fall.gravity;
+        let rc = spec.with_height(0.5 * g * (remaining + spec.fall.margin).powi(2));
         let tr = Transcription::new(3, self.nodes);
         let z0 = tr.sample(&Remainder::new(previous, t - origin));
         let mut problem = FreeProblem::new(&rc, self.nodes, &z0);
@@ -349,7 +348,7 @@ fn least_step(d: &ConicData) -> Option<Vec<f64>> {
     None
 }
 
-/// Re-solves the free-form design of `cfg` from the state `y` measured at
+/// Re-solves the free-form design of `spec` from the state `y` measured at
 /// time `t` of the flight (`[quaternion, q, q_dot, lambda]`, the closed
 /// loop's: attitude, shape, shape rate, body-frame momentum) over the time
 /// the fall still leaves, to the landing set, seeded by the rest of
@@ -357,14 +356,14 @@ fn least_step(d: &ConicData) -> Option<Vec<f64>> {
 /// `max_iterations` SCP iterations on `nodes` per phase. The new plan's time
 /// 0 is `t`. One replan alone; a flight's replans share a [`Replanner`].
 pub fn replan(
-    cfg: &Config,
+    spec: &DesignSpec,
     previous: &dyn ShapePlan,
     t: f64,
     y: &[f64; 11],
     nodes: usize,
     max_iterations: usize,
 ) -> Result<Replan> {
-    Replanner::new(cfg, nodes)?.replan(previous, 0.0, t, y, max_iterations)
+    Replanner::new(spec, nodes)?.replan(previous, 0.0, t, y, max_iterations)
 }
 
 #[cfg(test)]
@@ -412,12 +411,12 @@ mod tests {
 
     #[test]
     fn a_replans_projection_is_solved_directly_and_agrees_with_clarabel() {
-        let cfg =
-            Config::from_toml(include_str!("../../../configs/seed.toml"), "seed", &[]).unwrap();
+        let spec =
+            crate::test_support::spec_of(include_str!("../../../configs/seed.toml"), "seed", &[]);
         let nodes = 8;
-        let seed = crate::design::free::Seed::Analytic.plan(&cfg).unwrap();
+        let seed = crate::design::free::Seed::Analytic.plan(&spec).unwrap();
         let z0 = Transcription::new(3, nodes).sample(seed.as_ref());
-        let mut problem = FreeProblem::new(&cfg, nodes, &z0);
+        let mut problem = FreeProblem::new(&spec, nodes, &z0);
         problem.initial = Some(([0.2, -0.1], [0.4, -0.3]));
         let z = problem.to_scaled(&z0);
         let d = problem.projection_data(&z);
