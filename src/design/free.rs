@@ -1638,6 +1638,7 @@ fn design_problem(
         tolerance,
         feasibility: cfg.free.attitude_tolerance,
         conic,
+        screen: cfg.free.screen_limits,
         ..Default::default()
     };
     let unit = problem.objective_unit();
