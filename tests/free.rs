@@ -866,3 +866,41 @@ fn the_per_motor_designs_from_both_seeds_agree_and_hold_between_check_points() {
         );
     }
 }
+
+/// The least-time designs inside the robots' servo envelopes from 6 m
+/// (analytic seed): screening the subproblems' torque-speed rows
+/// (`free.screen_limits`, the default) leaves the optimum where holding
+/// every row puts it, to the optimiser's tolerance (the two SCP runs part
+/// by rounding, so not to the bit), and the screened design keeps every
+/// check point and the samples between them inside the line.
+#[test]
+fn screening_the_torque_speed_rows_keeps_the_least_time_and_every_row() {
+    use catflip::design::envelope::usage_of;
+    for name in ["robot-universal", "box-robot"] {
+        let solve = |screen: &str| {
+            let c = util::config(
+                name,
+                &[
+                    "fall.height=6",
+                    "design.objective=time",
+                    &format!("free.screen_limits={screen}"),
+                ],
+            );
+            let spec = c.design_spec();
+            let plan = analytic_plan(&spec);
+            let r = catflip::design::free::FreeDesign::new(&spec)
+                .from_plan(&plan, "analytic")
+                .solve()
+                .unwrap();
+            assert_eq!(r.status, ScpStatus::Converged, "{name}, screen {screen}");
+            let margin = usage_of(&spec, &r.plan).min_margin.unwrap();
+            assert!(margin >= -1e-6, "{name}, screen {screen}: margin {margin}");
+            r.manoeuvre_time_s
+        };
+        let (screened, whole) = (solve("true"), solve("false"));
+        assert!(
+            (screened - whole).abs() <= 5e-4 * whole,
+            "{name}: least time {screened} s screened, {whole} s whole"
+        );
+    }
+}

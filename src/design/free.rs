@@ -1638,6 +1638,7 @@ fn design_problem(
         tolerance,
         feasibility: spec.free.attitude_tolerance,
         conic,
+        screen: spec.free.screen_limits,
         ..Default::default()
     };
     let unit = problem.objective_unit();

@@ -11,7 +11,9 @@
 //! (`|g + G dz| / L <= 1 + sigma`, penalised by `w sigma`), which keep every
 //! subproblem feasible, bounds the step by a scaled trust region, and solves
 //! one conic program with Clarabel; the data pattern is the same every
-//! iteration, so the solver is updated in place.
+//! iteration, so the solver is updated in place, except that limit rows that
+//! cannot bind inside the trust region are left out ([`ScpSettings::screen`]),
+//! a set that is kept while it still holds every row that can.
 //!
 //! Steps are judged on the exact penalty
 //! `phi(z) = cost(z) + w (|r(z)|_1 + max(0, max_k |g_k(z)| / L - 1))`:
@@ -196,6 +198,17 @@ settings! {
         pub curvature: Curvature = Curvature::default(),
         /// How exactly the subproblems and corrections are solved.
         pub conic: ConicSettings = ConicSettings::MODEL,
+        /// Leave out of each subproblem the limit rows that cannot bind
+        /// inside its trust region ([`screen`]): the same solution from a
+        /// smaller conic program.
+        pub screen: bool = true,
+        /// With `screen`, a row is also left out when it stays this far
+        /// (relative to the limit) inside it, whatever the trust region;
+        /// the solution is checked against the rows left out and solved
+        /// again with any it breaks. Infinite: only the rows that cannot
+        /// bind (1.0, the far side of every line, was no faster:
+        /// docs/benchmarks.md).
+        pub screen_band: f64 = f64::INFINITY,
     }
 }
 
@@ -362,7 +375,7 @@ impl ScpSettings {
         );
         let positive = |x: f64| x.is_finite() && x > 0.0;
         let share = |x: f64| x.is_finite() && x > 0.0 && x < 1.0;
-        let checks: [(&str, f64, bool, &str); 26] = [
+        let checks: [(&str, f64, bool, &str); 27] = [
             (
                 "max_iterations",
                 self.max_iterations as f64,
@@ -408,6 +421,12 @@ impl ScpSettings {
                 "at least trust.initial_radius",
             ),
             ("trust.cut", t.cut, share(t.cut), "in (0, 1)"),
+            (
+                "screen_band",
+                self.screen_band,
+                self.screen_band > 0.0,
+                "positive (infinite: only rows that cannot bind are left out)",
+            ),
             (
                 "trust.least_cut",
                 t.least_cut,
@@ -765,6 +784,137 @@ fn norm_rows(
     norm: TorqueNorm,
     bound: (&[(usize, f64)], f64),
 ) -> TermRows {
+    norm_rows_kept(d, values, jac, dim, norm, bound, None)
+}
+
+/// Which rows of each flattened limited term a subproblem holds: bit
+/// [`UPPER`] the row `g <= 1 + sigma`, bit [`LOWER`] the row
+/// `-g <= 1 + sigma` (per motor); a Euclidean term's cone is held when any
+/// of its components has a bit.
+pub type Screen = Vec<u8>;
+
+/// [`Screen`]'s bit of the upper row.
+const UPPER: u8 = 1;
+/// [`Screen`]'s bit of the lower row.
+const LOWER: u8 = 2;
+
+/// The limit rows that can bind anywhere inside the trust region
+/// `|dz_i| <= radius scale_i`: a row whose value plus the most its
+/// linearisation can move there (`sum_i |G_ri| radius scale_i`) stays
+/// within the limit holds with `sigma = 0` at every step the subproblem
+/// can take, so leaving it out changes neither the subproblem's solution
+/// nor its value (its multiplier is zero). At the small radii of a design
+/// near its optimum about half the rows of a torque-speed line are such
+/// (its far side, 2 away, and the near side where the motor is well
+/// inside). The reach is capped at `band`: a row left out by the cap may
+/// bind, so the solution is checked against it ([`broken_rows`]).
+fn screen(
+    lin: &Linearization,
+    scales: &[f64],
+    radius: f64,
+    band: f64,
+    dim: usize,
+    norm: TorqueNorm,
+) -> Screen {
+    let g = &lin.limited;
+    let mut reach = vec![0.0; g.len()];
+    for &(r, c, v) in &lin.limited_jac {
+        reach[r] += v.abs() * radius * scales[c];
+    }
+    match norm {
+        TorqueNorm::PerMotor => g
+            .iter()
+            .zip(&reach)
+            .map(|(&v, &h)| {
+                let h = h.min(band);
+                (u8::from(v + h > 1.0) * UPPER) | (u8::from(-v + h > 1.0) * LOWER)
+            })
+            .collect(),
+        TorqueNorm::Euclidean => {
+            let norm2 = |x: &[f64]| x.iter().map(|v| v * v).sum::<f64>().sqrt();
+            g.chunks(dim)
+                .zip(reach.chunks(dim))
+                .flat_map(|(v, h)| {
+                    let keep = norm2(v) + norm2(h).min(band) > 1.0;
+                    std::iter::repeat_n(if keep { UPPER | LOWER } else { 0 }, v.len())
+                })
+                .collect()
+        }
+    }
+}
+
+/// Whether a subproblem may keep the rows of `held` when `need` are the
+/// rows that can bind: all of them are held, and not many more (a held
+/// set keeps the conic pattern, so the solver is updated in place rather
+/// than set up again; a few idle rows cost less than a new set-up).
+fn holds(held: &Screen, need: &Screen) -> bool {
+    let count = |s: &Screen| s.iter().map(|b| b.count_ones() as usize).sum::<usize>();
+    held.len() == need.len()
+        && held.iter().zip(need).all(|(h, n)| n & !h == 0)
+        && count(held) <= count(need) + count(need) / SCREEN_SLACK
+}
+
+/// The rows `held` leaves out that the subproblem's solution `x` breaks
+/// (beyond rounding), as `(flattened term, bit)`.
+fn broken_rows(
+    lin: &Linearization,
+    held: &Screen,
+    x: &[f64],
+    v: &Layout,
+    norm: TorqueNorm,
+    dim: usize,
+) -> Vec<(usize, u8)> {
+    let mut s = lin.limited.clone();
+    for &(r, c, g) in &lin.limited_jac {
+        s[r] += g * x[c];
+    }
+    let bound = 1.0 + v.slack(x) + SCREEN_CHECK;
+    match norm {
+        TorqueNorm::PerMotor => s
+            .iter()
+            .enumerate()
+            .flat_map(|(r, &sr)| {
+                [(UPPER, sr), (LOWER, -sr)]
+                    .into_iter()
+                    .filter(move |&(bit, x)| held[r] & bit == 0 && x > bound)
+                    .map(move |(bit, _)| (r, bit))
+            })
+            .collect(),
+        TorqueNorm::Euclidean => s
+            .chunks(dim)
+            .enumerate()
+            .filter(|&(k, t)| {
+                held[k * dim] == 0 && t.iter().map(|x| x * x).sum::<f64>().sqrt() > bound
+            })
+            .flat_map(|(k, _)| (k * dim..(k + 1) * dim).map(|r| (r, UPPER | LOWER)))
+            .collect(),
+    }
+}
+
+/// How far past its limit a left-out row may be at a subproblem's solution
+/// (the solver's own feasibility tolerance is 1e-8).
+const SCREEN_CHECK: f64 = 1e-7;
+
+/// A held [`Screen`] is kept while it holds at most `1 / SCREEN_SLACK` more
+/// rows than can bind.
+const SCREEN_SLACK: usize = 4;
+
+/// A new [`Screen`] holds the rows that can bind within this many trust
+/// radii.
+const SCREEN_MARGIN: f64 = 1.25;
+
+/// [`norm_rows`] with only the rows `keep` names (all without it); a term
+/// without rows gets no entry in the returned rows.
+fn norm_rows_kept(
+    d: &mut ConicData,
+    values: &[f64],
+    jac: &Triplets,
+    dim: usize,
+    norm: TorqueNorm,
+    bound: (&[(usize, f64)], f64),
+    keep: Option<&Screen>,
+) -> TermRows {
+    let kept = |r: usize, bit: u8| keep.is_none_or(|k| k[r] & bit != 0);
     let mut rows_of: TermRows = vec![Vec::new(); values.len()];
     let mut jr: Vec<Vec<(usize, f64)>> = vec![Vec::new(); values.len()];
     for &(r, c, v) in jac {
@@ -776,6 +926,9 @@ fn norm_rows(
     match norm {
         TorqueNorm::Euclidean => {
             for k in 0..values.len() / dim {
+                if !(k * dim..(k + 1) * dim).any(|r| kept(r, UPPER | LOWER)) {
+                    continue;
+                }
                 d.row(&neg(bvars), bconst);
                 for j in 0..dim {
                     let r = k * dim + j;
@@ -786,15 +939,24 @@ fn norm_rows(
             }
         }
         TorqueNorm::PerMotor => {
+            let mut count = 0;
             for r in 0..values.len() {
-                let mut up = jr[r].clone();
-                up.extend(neg(bvars));
-                rows_of[r].push((d.row(&up, bconst - values[r]), 1.0));
-                let mut down = neg(&jr[r]);
-                down.extend(neg(bvars));
-                rows_of[r].push((d.row(&down, bconst + values[r]), -1.0));
+                if kept(r, UPPER) {
+                    let mut up = jr[r].clone();
+                    up.extend(neg(bvars));
+                    rows_of[r].push((d.row(&up, bconst - values[r]), 1.0));
+                    count += 1;
+                }
+                if kept(r, LOWER) {
+                    let mut down = neg(&jr[r]);
+                    down.extend(neg(bvars));
+                    rows_of[r].push((d.row(&down, bconst + values[r]), -1.0));
+                    count += 1;
+                }
             }
-            d.cone(Cone::Nonneg(2 * values.len()));
+            if count > 0 {
+                d.cone(Cone::Nonneg(count));
+            }
         }
     }
     rows_of
@@ -900,6 +1062,7 @@ fn subproblem(
     radius: f64,
     w: f64,
     hessian: &Triplets,
+    keep: Option<&Screen>,
 ) -> (ConicData, f64, TermRows, TermRows) {
     let v = Layout::of(p, lin);
     let (n, m, t) = (v.n, v.m, v.t());
@@ -988,13 +1151,14 @@ fn subproblem(
         }
         Some(_) => {
             d.q[v.sigma()] = w;
-            norm_rows(
+            norm_rows_kept(
                 &mut d,
                 &lin.limited,
                 &lin.limited_jac,
                 dim,
                 p.norm(),
                 (&[(v.sigma(), 1.0)], 1.0),
+                keep,
             )
         }
         None => Vec::new(),
@@ -1190,6 +1354,10 @@ fn scaled_max(d: impl Iterator<Item = f64>, scales: &[f64]) -> f64 {
 #[derive(Default)]
 pub struct Solvers {
     subproblem: Option<ConicSolver>,
+    /// The limit rows the subproblem solver's pattern holds.
+    screen: Option<Screen>,
+    /// Rows left out that a subproblem's solution broke: held from then on.
+    added: Screen,
     correction: Option<ConicSolver>,
     bounded_correction: Option<ConicSolver>,
 }
@@ -1198,6 +1366,7 @@ pub struct Solvers {
 /// data, constant and rows ([`subproblem`]'s) and its variables.
 struct Subproblem {
     lin: Linearization,
+    hessian: Triplets,
     data: ConicData,
     constant: f64,
     term_rows: TermRows,
@@ -1463,18 +1632,51 @@ impl<'a> Scp<'a> {
             .collect();
         let mut hessian = p.hessian(z, &mult.terms, &u_abs);
         hessian.iter_mut().for_each(|e| e.2 *= mult.curvature);
+        if self.screens() {
+            let (dim, norm, sv) = (p.term_dim(), p.norm(), &mut state.solvers);
+            let band = self.s.screen_band;
+            let mut need = screen(&lin, &self.scales, state.radius, band, dim, norm);
+            if sv.added.len() == need.len() {
+                need.iter_mut().zip(&sv.added).for_each(|(n, a)| *n |= a);
+            } else {
+                sv.added = vec![0; need.len()];
+            }
+            if !sv.screen.as_ref().is_some_and(|h| holds(h, &need)) {
+                // a little wider than needed, so that the next iterations'
+                // rows fit in the same pattern
+                let r = SCREEN_MARGIN * state.radius;
+                let mut wide = screen(&lin, &self.scales, r, SCREEN_MARGIN * band, dim, norm);
+                wide.iter_mut().zip(&need).for_each(|(w, n)| *w |= n);
+                sv.screen = Some(wide);
+            }
+        }
+        self.assemble(state, lin, hessian)
+    }
+
+    /// Whether the subproblems leave out limit rows ([`ScpSettings::screen`]).
+    fn screens(&self) -> bool {
+        self.s.screen && self.p.limit().is_some() && !held_by_epigraph(self.p)
+    }
+
+    /// The subproblem at the state's point from its linearisation and
+    /// Hessian, with the limit rows of the held [`Screen`].
+    fn assemble(&self, state: &State, lin: Linearization, hessian: Triplets) -> Subproblem {
+        let p = self.p;
+        let keep = state.solvers.screen.as_ref().filter(|_| self.screens());
         let (data, constant, term_rows, limit_rows) = subproblem(
             p,
-            z,
+            &state.z,
             &lin,
             &self.scales,
             state.radius,
             state.weight,
             &hessian,
+            keep,
         );
         let layout = Layout::of(p, &lin);
         Subproblem {
             lin,
+            hessian,
             data,
             constant,
             term_rows,
@@ -1529,8 +1731,23 @@ impl<'a> Scp<'a> {
     /// it). Returns the record, the trial point and its merit.
     fn step(&self, state: &mut State, iteration: usize) -> Result<(ScpIteration, Vec<f64>, Merit)> {
         let (p, s) = (self.p, self.s);
-        let sub = self.model(state);
-        let (x, obj, solve_ms) = self.solve_model(state, &sub, iteration)?;
+        let mut sub = self.model(state);
+        let (mut x, mut obj, mut solve_ms) = self.solve_model(state, &sub, iteration)?;
+        // rows left out that the solution breaks: held, and solved again,
+        // so the solution is the whole subproblem's
+        while let Some(held) = state.solvers.screen.as_mut().filter(|_| self.screens()) {
+            let broken = broken_rows(&sub.lin, held, &x, &sub.layout, p.norm(), p.term_dim());
+            if broken.is_empty() {
+                break;
+            }
+            for &(r, bit) in &broken {
+                held[r] |= bit;
+                state.solvers.added[r] |= bit;
+            }
+            sub = self.assemble(state, sub.lin, sub.hessian);
+            let (x2, obj2, ms) = self.solve_model(state, &sub, iteration)?;
+            (x, obj, solve_ms) = (x2, obj2, solve_ms + ms);
+        }
         let (phi, cost, inf) = state.here;
         let v = sub.layout;
         // model value: the cost's constant plus the solver's objective
@@ -2089,6 +2306,83 @@ pub struct WarmStart {
 mod tests {
     use super::*;
 
+    /// The robot's subproblem at its analytic start inside the servo's
+    /// torque-speed line (which the start breaks), per motor and
+    /// Euclidean, at a wide and a narrow trust region: the screened one,
+    /// with the rows its solution broke added back, holds fewer rows, has
+    /// the whole one's optimal value, and its solution keeps every row of
+    /// the whole one.
+    #[test]
+    fn a_screened_subproblem_has_the_whole_ones_optimum_and_keeps_every_row() {
+        use crate::design::free::{FreeProblem, Seed};
+        for norm in ["per-motor", "euclidean"] {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/robot-universal.toml");
+            let set = [
+                "fall.height=6".to_string(),
+                "design.objective=time".to_string(),
+                format!("limits.norm={norm}"),
+            ];
+            let cfg = crate::test_support::spec_at(path, &set);
+            let nodes = cfg.free.nodes;
+            let plan = Seed::Analytic.plan(&cfg).unwrap();
+            let z0 = crate::design::collocation::Transcription::new(3, nodes).sample(plan.as_ref());
+            let p = FreeProblem::new(&cfg, nodes, &z0);
+            let z = p.project(&p.to_scaled(&z0)).unwrap();
+            let lin = linearize(&p, &z);
+            let scales = p.scales();
+            let w = 2.0 * cost_of(&p, &z, &evaluate(&p, &z)).abs();
+            let (dim, tn) = (p.term_dim(), p.norm());
+            let layout = Layout::of(&p, &lin);
+            for (radius, band) in [
+                (0.5, f64::INFINITY),
+                (0.05, f64::INFINITY),
+                (0.5, 1.0),
+                (0.05, 1.0),
+            ] {
+                let solve = |keep: Option<&Screen>| {
+                    let (d, ..) = subproblem(&p, &z, &lin, &scales, radius, w, &Vec::new(), keep);
+                    let (st, x, obj) =
+                        solve_reusing_with(&mut None, &d, ConicSettings::MODEL).unwrap();
+                    assert!(st.ok(), "{norm}, radius {radius}: {st:?}");
+                    (d.m(), x, obj)
+                };
+                let (m_all, _, obj_all) = solve(None);
+                let mut keep = screen(&lin, &scales, radius, band, dim, tn);
+                let (mut m, mut x, mut obj) = solve(Some(&keep));
+                loop {
+                    let broken = broken_rows(&lin, &keep, &x, &layout, tn, dim);
+                    if broken.is_empty() {
+                        break;
+                    }
+                    for (r, bit) in broken {
+                        keep[r] |= bit;
+                    }
+                    (m, x, obj) = solve(Some(&keep));
+                }
+                // a wide region reaches nearly every row; the band drops a
+                // line's far side, but a disc has none
+                let what = format!("{norm}, radius {radius}, band {band}");
+                eprintln!("{what}: {m} rows of {m_all}");
+                assert!(
+                    (m as f64) < 0.95 * m_all as f64
+                        || (radius > 0.1 && (band.is_infinite() || norm == "euclidean")),
+                    "{what}: {m} rows of {m_all}"
+                );
+                assert!(
+                    (obj - obj_all).abs() <= 1e-6 * obj_all.abs().max(1e-2),
+                    "{what}: optimum {obj} screened, {obj_all} whole"
+                );
+                // every row of the whole subproblem at the screened solution
+                let mut g = lin.limited.clone();
+                for &(r, c, v) in &lin.limited_jac {
+                    g[r] += v * x[c];
+                }
+                let worst = peak_of(&g, dim, tn) - 1.0 - layout.slack(&x);
+                assert!(worst <= 1e-6, "{what}: a row broken by {worst}");
+            }
+        }
+    }
+
     fn record(predicted: f64, radius: f64, bounded: bool) -> ScpIteration {
         ScpIteration {
             iteration: 0,
@@ -2431,8 +2725,9 @@ mod tests {
                     residual: plus(&lin.residual, &shift.residual),
                     ..lin.clone()
                 };
-                let build =
-                    |l: &Linearization| subproblem(&p, &z, l, &p.scales(), 0.5, 3.0, &Vec::new());
+                let build = |l: &Linearization| {
+                    subproblem(&p, &z, l, &p.scales(), 0.5, 3.0, &Vec::new(), None)
+                };
                 let (data, _, term_rows, limit_rows) = build(&lin);
                 assert_eq!(limit_rows.is_empty(), on_epigraph);
                 let rebuilt: Vec<f64> = build(&moved)
@@ -2477,7 +2772,7 @@ mod tests {
         let (w, radius) = (2.0, 0.3);
         let hessian = Triplets::new();
         let (data, _, term_rows, limit_rows) =
-            subproblem(&p, &z, &lin, &scales, radius, w, &hessian);
+            subproblem(&p, &z, &lin, &scales, radius, w, &hessian, None);
         let mut solver = ConicSolver::with_settings(&data, ConicSettings::MODEL).unwrap();
         let (st, x, _) = solver.solve();
         assert!(st.ok(), "{st:?}");
@@ -2623,7 +2918,7 @@ mod tests {
         let lin = p.linearize(&z);
         let v = Layout::of(&p, &lin);
         assert_eq!((v.n, v.m, v.limited), (2, 1, true));
-        let (data, ..) = subproblem(&p, &z, &lin, &p.scales(), 0.5, 3.0, &Vec::new());
+        let (data, ..) = subproblem(&p, &z, &lin, &p.scales(), 0.5, 3.0, &Vec::new(), None);
         assert_eq!(data.n, v.len());
         assert_eq!(data.q[v.nu_plus(0)], 3.0);
         assert_eq!(data.q[v.nu_minus(0)], 3.0);

@@ -188,6 +188,10 @@ pub struct FreeSettings {
     /// leaves at least 20 per phase), loosely, and refine; see
     /// `design::free::coarse_start`.
     pub mesh_continuation: bool,
+    /// Leave out of each SCP subproblem the torque-speed rows that cannot
+    /// bind there (default true): the same designs from smaller conic
+    /// programs; see `design::scp::screen`.
+    pub screen_limits: bool,
 }
 
 impl Default for FreeSettings {
@@ -198,6 +202,7 @@ impl Default for FreeSettings {
             tolerance: 1e-4,
             attitude_tolerance: 1e-6,
             mesh_continuation: true,
+            screen_limits: true,
         }
     }
 }

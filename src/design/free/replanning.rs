@@ -110,6 +110,10 @@ impl Replanner {
                 tolerance: spec.free.tolerance,
                 feasibility: spec.free.attitude_tolerance,
                 conic: ConicSettings::MODEL,
+                // a replan's subproblems keep the last one's pattern, so its
+                // solver is updated in place, not set up again (not measured
+                // with the screen)
+                screen: false,
                 ..Default::default()
             },
             solvers: Solvers::default(),
