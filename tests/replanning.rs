@@ -120,3 +120,91 @@ fn inside_the_robots_motor_envelope_replanning_corrects_nothing_on_the_nominal()
     );
     assert!(re.error_deg < 0.05, "lands {} deg off", re.error_deg);
 }
+
+/// The take-or-keep comparison on long steps (one a control period, the
+/// plans' torque jumps on the simulator's steps) lands as the simulator's
+/// steps do, and decides alike, from knocked states along the seed's design.
+#[test]
+fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
+    use catflip::control::replanning::{Comparison, breaks, landing_on, torque_of};
+    use catflip::design::free::Replanner;
+    let (cfg, r, tv, plan) = spin_only();
+    let motor = cfg.motor();
+    let p = tv.period_steps;
+    let mut replanner = Replanner::new(&cfg, 10).unwrap().real_time();
+    for (frac, knock) in [(0.1, 0.3), (0.3, -0.4), (0.5, 0.2)] {
+        let k = (frac * tv.starts.len() as f64) as usize;
+        let s = tv.starts[k];
+        let mut y = r.nominal[s];
+        y[6] += knock;
+        y[7] -= 0.5 * knock;
+        y[8] += 0.05 * knock;
+        let t = s as f64 * r.h;
+        let re = replanner.replan(plan.as_ref(), 0.0, t, &y, 1).unwrap();
+        let new: SharedPlan = Arc::new(re.plan);
+        let cmp = Comparison {
+            from: s,
+            y,
+            motor: &motor,
+            tv: &tv,
+            in_use: breaks(&r, plan.as_ref(), 0.0),
+            new: breaks(&r, new.as_ref(), t),
+        };
+        let (cat, h) = (r.cat, r.h);
+        let ff = |j: usize| torque_of(new.as_ref(), &cat, 0.5 * h * (j as f64 - 2.0 * s as f64));
+        let (now, next) = (cmp.in_use(&r, 1).0, cmp.new_plan(&r, &ff, 1).0);
+        let (now_long, next_long) = (cmp.in_use(&r, p).0, cmp.new_plan(&r, &ff, p).0);
+        assert!(
+            (now_long - now).abs() < 1e-4 && (next_long - next).abs() < 1e-4,
+            "at {frac}: in use {now_long} vs {now}, new {next_long} vs {next} rad"
+        );
+        // the jumps are what the long steps must not straddle: the new plan's
+        // flight over them is off by more than the tolerance of the decision
+        let straddled = landing_on(&r, s, &y, ff, None, &motor, p, &[], None).0;
+        assert!(
+            (straddled - next).abs() > 5.0 * (next_long - next).abs(),
+            "at {frac}: straddling the jumps {straddled}, not {next_long}, vs {next} rad"
+        );
+        let mut a = r.clone();
+        let mut b = r.clone();
+        let decided = cmp.decide(&mut a, &ff, cmp.new_plan(&r, &ff, p));
+        assert_eq!(decided.0, cmp.exact(&mut b, &ff).0, "at {frac}");
+        assert_eq!(decided.0, next <= now);
+    }
+}
+
+/// A taken plan's nominal flown a few periods at a time is the one flown at
+/// once, to the bit (feed-forward, shape and states).
+#[test]
+fn a_nominal_flown_lazily_is_the_one_flown_at_once() {
+    let cfg = util::config("robot-universal", &["fall.height=4.25"]);
+    let plan: SharedPlan = Arc::new(catflip::control::robustness::design(&cfg).unwrap().plan);
+    let r = Reference::new(&cfg, plan.as_ref());
+    let motor = cfg.motor();
+    let s = r.steps / 3;
+    let mut y = r.nominal[s];
+    y[6] += 0.3;
+    // the rest of the design from s, as a new plan starting there
+    let rest: SharedPlan = plan.clone();
+    let mut eager = r.clone();
+    eager.replace_plan(s, rest.as_ref());
+    eager.fly_from(s, y, Some(&motor));
+    let mut lazy = r.clone();
+    lazy.replace_plan_lazily(s, rest);
+    lazy.fill_ff(2 * s);
+    lazy.fly_lazily(s, y, Some(&motor));
+    let mut to = s;
+    while lazy.flown < lazy.steps {
+        to += 37;
+        lazy.extend_nominal(to);
+        assert!(lazy.flown == to.min(lazy.steps));
+    }
+    let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+    for j in 0..=r.steps {
+        assert_eq!(bits(&lazy.nominal[j]), bits(&eager.nominal[j]), "step {j}");
+        assert_eq!(lazy.shape[j], eager.shape[j], "shape at {j}");
+    }
+    for j in 0..=2 * r.steps {
+        assert_eq!(bits(&lazy.ff[j]), bits(&eager.ff[j]), "half step {j}");
+    }
+}

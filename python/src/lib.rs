@@ -1633,7 +1633,7 @@ impl Controller {
     /// changes it from the instant its plan acts on): float64, shape (2 steps + 1, 2).
     #[getter]
     fn feedforward<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        matrix(py, &self.lock().reference.ff)
+        matrix(py, &self.lock().reference.completed().ff)
     }
     /// The planned shape `(q1, q2, qd1, qd2)` at every step (the PD's reference): shape (steps + 1, 4).
     #[getter]
@@ -1641,6 +1641,7 @@ impl Controller {
         let rows: Vec<[f64; 4]> = self
             .lock()
             .reference
+            .completed()
             .shape
             .iter()
             .map(|(q, qd)| [q[0], q[1], qd[0], qd[1]])
@@ -1651,7 +1652,14 @@ impl Controller {
     /// convention: float64, shape (steps + 1, 11).
     #[getter]
     fn nominal<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
-        let rows: Vec<SimState> = self.lock().reference.nominal.iter().map(to_sim).collect();
+        let rows: Vec<SimState> = self
+            .lock()
+            .reference
+            .completed()
+            .nominal
+            .iter()
+            .map(to_sim)
+            .collect();
         matrix(py, &rows)
     }
     /// The TVLQR gains `K_k` (u = -K x): float64, shape (control steps, 2, 10).

@@ -8,7 +8,7 @@
 //! linearisation of one control period is then the derivative of exactly
 //! the map the simulation applies.
 
-use crate::model::momentum::{body_rate_from, forward_dynamics_from};
+use crate::model::momentum::{body_rate_from, forward_dynamics_with, shape_and_momentum_torque};
 use crate::model::small::cross;
 use crate::model::so3::{normalize_quat, quat_from, quat_rate};
 use crate::model::{Cat, ShapeTerms};
@@ -27,8 +27,8 @@ pub const NX: usize = 10;
 /// `dy/dt` under joint torque `tau`.
 pub fn rhs(cat: &Cat, y: &Y, tau: [f64; 2]) -> Y {
     let (q, qd, lam) = ([y[4], y[5]], [y[6], y[7]], [y[8], y[9], y[10]]);
-    let terms = ShapeTerms::first(cat, q);
-    let qdd = forward_dynamics_from(cat, &terms, q, qd, tau, lam);
+    let (terms, g) = shape_and_momentum_torque(cat, q, qd, lam);
+    let qdd = forward_dynamics_with(&terms, qd, tau, g, lam);
     let w = body_rate_from(cat, &terms, q, qd, lam);
     let dq = quat_rate(y, w);
     let dl = cross(lam, w);

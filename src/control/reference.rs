@@ -9,6 +9,7 @@ use crate::design::plan::ShapePlan;
 use crate::model::Cat;
 use crate::model::momentum::Start;
 use crate::model::motor::Motor;
+use std::sync::Arc;
 
 /// A design sampled for the closed loop.
 #[derive(Debug, Clone)]
@@ -26,6 +27,34 @@ pub struct Reference {
     pub nominal: Vec<Y>,
     /// Largest feed-forward torque (in the config's norm), N m: the torque scale.
     pub peak_torque: f64,
+    /// `nominal` holds from `flown` on only once [`Reference::extend_nominal`]
+    /// has flown it there (a replan's plan is flown a few periods at a time).
+    pub flown: usize,
+    /// The envelope the rest of the nominal is flown inside.
+    pending_motor: Option<Motor>,
+    /// `ff` holds up to this half step (and `shape` up to half of it); the
+    /// rest is `pending`'s, sampled by [`Reference::ff_value`] and filled
+    /// by [`Reference::extend_nominal`] as the nominal is flown.
+    pub ff_filled: usize,
+    pending: Option<Pending>,
+    /// Where `nominal` is not flown yet: the model's state on the control
+    /// steps as a flight on long steps estimates it (a comparison's nominal).
+    pub rough: Vec<Option<Y>>,
+}
+
+/// A plan whose samples are taken as they are needed: its time 0 at step `from`.
+#[derive(Clone)]
+struct Pending {
+    plan: Arc<dyn ShapePlan + Send + Sync>,
+    from: usize,
+}
+
+impl std::fmt::Debug for Pending {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pending")
+            .field("from", &self.from)
+            .finish_non_exhaustive()
+    }
 }
 
 /// The integrator state of a straight, rigid release.
@@ -48,6 +77,11 @@ impl Reference {
             shape: vec![([0.0; 2], [0.0; 2]); steps + 1],
             nominal: vec![[0.0; 11]; steps + 1],
             peak_torque: 0.0,
+            flown: steps,
+            pending_motor: None,
+            ff_filled: 2 * steps,
+            pending: None,
+            rough: Vec::new(),
         };
         r.splice(0, release(&cat, &cfg.start.start()), plan);
         let norm = cfg.norm();
@@ -68,6 +102,8 @@ impl Reference {
     /// The feed-forward and the planned shape from step `from` on: `plan`'s,
     /// its time 0 at that step.
     pub fn replace_plan(&mut self, from: usize, plan: &dyn ShapePlan) {
+        self.pending = None;
+        self.ff_filled = 2 * self.steps;
         let (cat, h, steps) = (self.cat, self.h, self.steps);
         let t0 = h * from as f64;
         let b = plan.phase_bounds();
@@ -87,17 +123,102 @@ impl Reference {
         }
     }
 
+    /// [`Reference::replace_plan`] deferred: the samples from step `from`
+    /// on are `plan`'s, taken as they are needed, the same numbers to the bit.
+    pub fn replace_plan_lazily(&mut self, from: usize, plan: Arc<dyn ShapePlan + Send + Sync>) {
+        self.pending = Some(Pending { plan, from });
+        self.ff_filled = (2 * from).saturating_sub(1);
+    }
+
+    /// The pending plan's sample at half step `j` and its shape at step `j / 2`.
+    fn sample(&self, p: &Pending, j: usize) -> [f64; 2] {
+        let t0 = self.h * p.from as f64;
+        let end = p.plan.duration();
+        let t = 0.5 * self.h * j as f64 - t0;
+        if t >= end {
+            [0.0; 2]
+        } else {
+            let b = p.plan.phase_bounds();
+            let phase = (0..3).find(|&i| t < b[i + 1]).unwrap_or(2);
+            p.plan.torque_in(&self.cat, phase, t)
+        }
+    }
+
+    /// The feed-forward at half step `j`, filled or not.
+    pub fn ff_value(&self, j: usize) -> [f64; 2] {
+        match &self.pending {
+            Some(p) if j > self.ff_filled => self.sample(p, j),
+            _ => self.ff[j],
+        }
+    }
+
+    /// Fills the feed-forward up to half step `to` (and the shape to `to / 2`).
+    pub fn fill_ff(&mut self, to: usize) {
+        let Some(p) = self.pending.clone() else {
+            return;
+        };
+        let to = to.min(2 * self.steps);
+        let (h, end) = (self.h, p.plan.duration());
+        let t0 = h * p.from as f64;
+        for j in self.ff_filled + 1..=to {
+            self.ff[j] = self.sample(&p, j);
+            if j % 2 == 0 && j / 2 >= p.from {
+                let s = p.plan.state((h * (j / 2) as f64 - t0).min(end));
+                self.shape[j / 2] = (s.q, s.qd);
+            }
+        }
+        self.ff_filled = self.ff_filled.max(to);
+        if self.ff_filled == 2 * self.steps {
+            self.pending = None;
+        }
+    }
+
     /// The nominal from step `from` on: the model flown from `y` there under
     /// the feed-forward, inside `motor`'s envelope when given (a replan's plan
     /// may leave it by what one SCP iteration leaves unmet; a design does not).
     pub fn fly_from(&mut self, from: usize, y: Y, motor: Option<&Motor>) {
-        let (cat, h, steps) = (self.cat, self.h, self.steps);
+        self.fly_lazily(from, y, motor);
+        self.extend_nominal(self.steps);
+    }
+
+    /// [`Reference::fly_from`] deferred: the nominal from `from` on is flown
+    /// by [`Reference::extend_nominal`] as far as it is asked for, the same
+    /// numbers to the bit.
+    pub fn fly_lazily(&mut self, from: usize, y: Y, motor: Option<&Motor>) {
         self.nominal[from] = y;
-        for j in from..steps {
+        self.flown = from;
+        self.pending_motor = motor.copied();
+        self.rough.clear();
+    }
+
+    /// Flies the nominal on to step `to` (at most touchdown).
+    pub fn extend_nominal(&mut self, to: usize) {
+        self.fill_ff(2 * to.min(self.steps));
+        let (cat, h) = (self.cat, self.h);
+        let motor = self.pending_motor;
+        for j in self.flown..to.min(self.steps) {
             let ff = &self.ff;
             self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, ys| {
                 motor.map_or(ff[2 * j + s], |m| m.clip(ff[2 * j + s], [ys[6], ys[7]]))
             });
+            self.flown = j + 1;
+        }
+    }
+
+    /// A copy with the feed-forward, the shape and the nominal all filled in
+    /// (this one's later flight unchanged: its comparisons read its rough estimate).
+    pub fn completed(&self) -> Reference {
+        let mut r = self.clone();
+        r.extend_nominal(r.steps);
+        r
+    }
+
+    /// The nominal at step `j` if flown, else its rough estimate (if any).
+    pub fn nominal_or_rough(&self, j: usize) -> Option<&Y> {
+        if j <= self.flown {
+            Some(&self.nominal[j])
+        } else {
+            self.rough.get(j).and_then(|y| y.as_ref())
         }
     }
 

@@ -137,11 +137,9 @@ impl Clone for InFlight {
 /// Replans in a row after which an untaken chain restarts from the plan in use.
 const CHAIN_RESTART: usize = 8;
 
-/// The screen's steps (simulator steps), how many control steps its
-/// reference landing holds, and its slack, rad: a plan whose landing on the
-/// screen's long steps is over twice the reference plus the slack is
-/// dropped without the full comparison.
-const SCREEN: usize = 4;
+/// How many control steps the screen's reference landing holds, and its
+/// slack, rad: a plan whose landing on long steps is over twice the
+/// reference plus the slack is dropped without the comparison.
 const REFRESH: usize = 5;
 const SCREEN_SLACK: f64 = 0.02;
 
@@ -172,6 +170,12 @@ impl InFlight {
         k: usize,
         m: &Y,
     ) {
+        let clock = std::time::Instant::now();
+        // a taken plan's nominal is flown a little ahead of the commands each
+        // period (two periods' steps), not to touchdown at once
+        let p = tv.period_steps;
+        let need = tv.starts.get(k + 1).copied().unwrap_or(r.steps) + p;
+        r.extend_nominal(need.max(r.flown + 2 * p));
         if !k.is_multiple_of(rp.every.max(1)) || k + 1 >= tv.starts.len() {
             return;
         }
@@ -185,7 +189,6 @@ impl InFlight {
         if t >= offset + base.duration() || s >= r.steps {
             return;
         }
-        let clock = std::time::Instant::now();
         // (the step before `s` ends on the sample at `s`, which a plan taken replaces)
         let before = predict(r, tv, motor, issued, k * tv.period_steps, s - 1, m);
         let y = predict(r, tv, motor, issued, s - 1, s, &before);
@@ -205,38 +208,60 @@ impl InFlight {
             Ok(re) => {
                 let own = re.landing_error_rad;
                 let new: SharedPlan = Arc::new(re.plan);
-                let ff = |j: usize| {
-                    torque_of(
-                        new.as_ref(),
-                        &r.cat,
-                        0.5 * r.h * (j as f64 - 2.0 * s as f64),
-                    )
+                let cmp = Comparison {
+                    from: s,
+                    y,
+                    motor,
+                    tv,
+                    in_use: breaks(r, self.plan.as_ref(), self.offset),
+                    new: breaks(r, new.as_ref(), t),
                 };
-                // screened first on long steps against the last comparison's
-                // landing of the plan in use: most one-iteration plans land far worse
-                // (the solve's own landing error is a free first screen: its
+                let (cat, h) = (r.cat, r.h);
+                let ff =
+                    |j: usize| torque_of(new.as_ref(), &cat, 0.5 * h * (j as f64 - 2.0 * s as f64));
+                // screened first against the last comparison's landing of the
+                // plan in use: most one-iteration plans land far worse (the
+                // solve's own landing error is a free first screen: its
                 // one-iteration plans landed worse in the simulator than on
                 // their own map in every case measured)
-                let hopeless = self.in_use.is_some_and(|(at, est)| {
-                    let bar = 2.0 * est + SCREEN_SLACK;
-                    k < at + REFRESH
-                        && (own > bar || landing_under(r, s, &y, ff, None, motor, SCREEN) > bar)
-                });
-                let (now, next) = if hopeless {
-                    (0.0, f64::INFINITY)
+                let fresh = self.in_use.filter(|&(at, _)| k < at + REFRESH);
+                let bar = fresh.map(|(_, est)| 2.0 * est + SCREEN_SLACK);
+                let next_long = if bar.is_some_and(|b| own > b) {
+                    (f64::INFINITY, false)
                 } else {
-                    // the plan in use as the TVLQR flies it; the new one's nominal
-                    // starts at the predicted state, so the TVLQR adds nothing to it
-                    let now = landing_under(r, s, &y, |j| r.ff[j], Some(tv), motor, 1);
+                    cmp.new_plan(r, &ff, p)
+                };
+                let better = if bar.is_some_and(|b| next_long.0 > b) {
+                    None
+                } else {
+                    let (better, now) = cmp.decide(r, &ff, next_long);
                     self.in_use = Some((k, now));
-                    (now, landing_under(r, s, &y, ff, None, motor, 1))
+                    Some(better)
                 };
                 if late(&clock) {
                     Outcome::Late
-                } else if next <= now {
-                    r.replace_plan(s, new.as_ref());
+                } else if better == Some(true) {
+                    r.replace_plan_lazily(s, new.clone());
+                    r.fill_ff(2 * s);
                     let y = predict(r, tv, motor, issued, s - 1, s, &before);
-                    r.fly_from(s, y, Some(motor));
+                    // its nominal: flown ahead of the commands period by period,
+                    // estimated on long steps meanwhile for the comparisons
+                    r.fly_lazily(s, y, Some(motor));
+                    let mut rough = vec![None; r.steps + 1];
+                    let fine = breaks(r, new.as_ref(), t);
+                    landing_on(
+                        r,
+                        s,
+                        &y,
+                        |j| r.ff_value(j),
+                        None,
+                        motor,
+                        p,
+                        &fine,
+                        Some(&mut rough),
+                    );
+                    r.rough = rough;
+                    r.extend_nominal(need.max(s + 2 * p));
                     self.plan = new;
                     self.offset = t;
                     self.candidate = None;
@@ -262,8 +287,129 @@ impl InFlight {
     }
 }
 
+/// The take-or-keep comparison of one replan: the model flown from the
+/// predicted state `y` at step `from` to touchdown under the new plan's
+/// feed-forward and under the plan in use with the TVLQR correcting about
+/// its nominal.
+///
+/// Both are flown first on long steps (one a control period), each long
+/// step ending at the plans' torque jumps (phase junctions, nodes, the end),
+/// which are taken on the simulator's own steps: there RK4 converges at its
+/// order and lands within about 1e-5 rad of the flight on the simulator's
+/// steps (docs/benchmarks.md). The landings decide when they differ by more
+/// than a tolerance; else they are flown again on shorter steps, and at
+/// last on the simulator's, as before (a near tie).
+pub struct Comparison<'a> {
+    pub from: usize,
+    pub y: Y,
+    pub motor: &'a Motor,
+    pub tv: &'a Tvlqr,
+    /// Steps at the torque jumps of the plan in use and of the new plan.
+    pub in_use: Vec<usize>,
+    pub new: Vec<usize>,
+}
+
+/// The decision tolerance `(absolute rad, relative)` of each level but the
+/// last, and the levels' strides as fractions of the control period.
+/// Where the motor envelope binds on either flight (a kink in the torque,
+/// where RK4 converges more slowly) the relative tolerances are `CLIPPED`'s.
+const TOLERANCE: [(f64, f64); 4] = [(1e-3, 5e-3), (3e-4, 1e-3), (1e-4, 2e-4), (2e-5, 5e-5)];
+const CLIPPED: [f64; 4] = [0.15, 0.05, 0.01, 2e-3];
+const LEVELS: [usize; 4] = [1, 2, 4, 10];
+
+impl Comparison<'_> {
+    /// The new plan's landing error, rad, on steps of `stride`, and whether
+    /// the motor envelope bound on the way.
+    pub fn new_plan(
+        &self,
+        r: &Reference,
+        ff: &impl Fn(usize) -> [f64; 2],
+        stride: usize,
+    ) -> (f64, bool) {
+        landing_on(
+            r, self.from, &self.y, ff, None, self.motor, stride, &self.new, None,
+        )
+    }
+
+    /// The plan in use's landing error under the TVLQR, rad, on steps of
+    /// `stride`, and whether the motor envelope bound on the way.
+    pub fn in_use(&self, r: &Reference, stride: usize) -> (f64, bool) {
+        let tv = Some(self.tv);
+        landing_on(
+            r,
+            self.from,
+            &self.y,
+            |j| r.ff_value(j),
+            tv,
+            self.motor,
+            stride,
+            &self.in_use,
+            None,
+        )
+    }
+
+    /// Whether the new plan lands the model at least as well as the plan in
+    /// use, and the plan in use's landing error: on the long steps when
+    /// they tell (`next_long`: the new plan's there), else on shorter ones.
+    pub fn decide(
+        &self,
+        r: &mut Reference,
+        ff: &impl Fn(usize) -> [f64; 2],
+        next_long: (f64, bool),
+    ) -> (bool, f64) {
+        let p = self.tv.period_steps;
+        // a nominal neither flown nor estimated: fly it
+        if r.rough.is_empty() {
+            r.extend_nominal(r.steps);
+        }
+        for (i, &(abs, rel)) in TOLERANCE.iter().enumerate() {
+            let stride = divisor_at_most(p, p / LEVELS[i]);
+            let (next, a) = if i == 0 {
+                next_long
+            } else {
+                self.new_plan(r, ff, stride)
+            };
+            let (now, b) = self.in_use(r, stride);
+            let rel = if a || b { CLIPPED[i] } else { rel };
+            if now.is_finite() && next.is_finite() && (next - now).abs() > abs + rel * now.max(next)
+            {
+                return (next <= now, now);
+            }
+        }
+        self.exact(r, ff)
+    }
+
+    /// The decision on the simulator's steps.
+    pub fn exact(&self, r: &mut Reference, ff: &impl Fn(usize) -> [f64; 2]) -> (bool, f64) {
+        r.extend_nominal(r.steps);
+        let now = self.in_use(r, 1).0;
+        (self.new_plan(r, ff, 1).0 <= now, now)
+    }
+}
+
+/// The largest divisor of `p` not above `m` (at least 1).
+fn divisor_at_most(p: usize, m: usize) -> usize {
+    (1..=m.max(1))
+        .rev()
+        .find(|d| p.is_multiple_of(*d))
+        .unwrap_or(1)
+}
+
+/// The steps around the torque jumps of `plan` (time 0 at flight time
+/// `offset`): the simulator's step in which each [`ShapePlan::breaks`] falls, sorted.
+pub fn breaks(r: &Reference, plan: &dyn ShapePlan, offset: f64) -> Vec<usize> {
+    let mut out: Vec<usize> = plan
+        .breaks()
+        .iter()
+        .map(|b| ((offset + b) / r.h).floor() as usize)
+        .collect();
+    out.sort_unstable();
+    out.dedup();
+    out
+}
+
 /// The feed-forward of `plan` at its time `t` (none after its end).
-fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
+pub fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
     let b = plan.phase_bounds();
     if t >= b[3] {
         return [0.0; 2];
@@ -274,14 +420,13 @@ fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
 
 /// The landing error, rad, of the model flown from `y` at step `from` to
 /// touchdown under the feed-forward `ff(half step)` (inside `motor`'s
-/// envelope) and, with `tvlqr`, its
-/// gains about the nominal of `r` (each correction from the state at its
-/// start, no delay), on steps of `stride` simulator steps (the last ones
-/// single): two plans are compared on the simulator's own steps (on steps
-/// four times as long the comparison misjudged spinning flights, whose
-/// landing is sensitive, and took plans that landed worse), the long steps
-/// only screen.
-fn landing_under(
+/// envelope) and, with `tvlqr`, its gains about the nominal of `r` (each
+/// correction from the state at its start, no delay; beyond the nominal
+/// flown, about its rough estimate), on steps of `stride` simulator steps
+/// aligned with the control steps, the steps in `fine` (sorted) single, the
+/// last one what remains; `rough` takes the state at each step's end.
+#[allow(clippy::too_many_arguments)]
+pub fn landing_on(
     r: &Reference,
     from: usize,
     y: &Y,
@@ -289,17 +434,33 @@ fn landing_under(
     tvlqr: Option<&Tvlqr>,
     motor: &Motor,
     stride: usize,
-) -> f64 {
+    fine: &[usize],
+    mut rough: Option<&mut Vec<Option<Y>>>,
+) -> (f64, bool) {
+    let mut clipped = false;
     let mut y = *y;
     let mut j = from;
     let mut u = [0.0; 2];
+    let mut f = fine.partition_point(|&b| b < j);
     while j < r.steps {
-        let n = if j + stride <= r.steps { stride } else { 1 };
+        while f < fine.len() && fine[f] < j {
+            f += 1;
+        }
+        let next_fine = fine.get(f).copied().unwrap_or(usize::MAX);
+        let aligned = from + ((j - from) / stride + 1) * stride;
+        let n = if next_fine == j {
+            1
+        } else {
+            (aligned - j).min(next_fine - j).min(r.steps - j)
+        };
         if let Some(tv) = tvlqr
             && let Some(k) = tv.interval_at(j)
             && tv.starts[k] == j
         {
-            let x = super::plant::error(&y, &r.nominal[j]);
+            let Some(nom) = r.nominal_or_rough(j) else {
+                return (f64::NAN, clipped);
+            };
+            let x = super::plant::error(&y, nom);
             let mut c = -(tv.gains[k] * x);
             let size = motor.norm.of([c[0], c[1]]);
             if size > tv.max_correction {
@@ -309,12 +470,28 @@ fn landing_under(
         }
         y = super::plant::rk4(&r.cat, &y, r.h * n as f64, |st, ys| {
             let f = ff(2 * j + n * st);
-            motor.clip([f[0] + u[0], f[1] + u[1]], [ys[6], ys[7]])
+            let want = [f[0] + u[0], f[1] + u[1]];
+            // (a long step may blow a wild plan's flight up: no envelope for NaN)
+            if !(ys[6].is_finite() && ys[7].is_finite()) {
+                return want;
+            }
+            let got = motor.clip(want, [ys[6], ys[7]]);
+            clipped |= got != want;
+            got
         });
         j += n;
+        if !y.iter().all(|v| v.is_finite()) {
+            return (f64::INFINITY, clipped);
+        }
+        if let Some(rough) = rough.as_deref_mut() {
+            rough[j] = Some(y);
+        }
     }
     if !y.iter().all(|v| v.is_finite()) {
-        return f64::INFINITY;
+        return (f64::INFINITY, clipped);
     }
-    landing_error(attitude(&y).to_rotation_matrix().matrix())
+    (
+        landing_error(attitude(&y).to_rotation_matrix().matrix()),
+        clipped,
+    )
 }

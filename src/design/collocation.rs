@@ -223,6 +223,20 @@ impl ShapePlan for CollocationPlan {
         b
     }
 
+    /// The nodes too: a plan one SCP iteration from its start leaves its
+    /// accelerations, so its torques, jumping a little at the nodes.
+    fn breaks(&self) -> Vec<f64> {
+        let b = self.phase_bounds();
+        let h = self.tr.h();
+        let mut out = Vec::new();
+        for i in 0..self.tr.phases {
+            let dur = b[i + 1] - b[i];
+            out.extend((1..self.tr.nodes - 1).map(|k| b[i] + k as f64 * h * dur));
+            out.push(b[i + 1]);
+        }
+        out
+    }
+
     fn state_in(&self, i: usize, t: f64) -> ShapeState {
         let b = self.phase_bounds();
         let dur = b[i + 1] - b[i];

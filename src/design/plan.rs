@@ -54,6 +54,11 @@ pub trait ShapePlan {
     fn duration(&self) -> f64 {
         *self.phase_bounds().last().unwrap()
     }
+    /// The instants in `(0, T]` where the torque may jump (a long integrator
+    /// step must not straddle them): by default the phase junctions and the end.
+    fn breaks(&self) -> Vec<f64> {
+        self.phase_bounds()[1..].to_vec()
+    }
     /// Feed-forward torque at `t` in phase `i`: by default the inverse dynamics along the plan.
     fn torque_in(&self, cat: &Cat, i: usize, t: f64) -> [f64; 2] {
         let s = self.state_in(i, t);

@@ -296,6 +296,21 @@ impl Cat {
         rel: &M3<T>,
         sj: [V3<T>; N],
     ) -> ([[T; N]; N], [V3<T>; N]) {
+        let (m, a, _) = self.locked_terms_and_inertia_of(rel, sj);
+        (m, a)
+    }
+
+    /// [`Cat::locked_terms`] and the locked inertia `J(q)` of the same pass
+    /// (the momentum terms need both: one pass instead of two).
+    pub fn locked_terms_and_inertia<T: Real>(&self, q: [T; 2]) -> ([[T; 2]; 2], [V3<T>; 2], M3<T>) {
+        self.locked_terms_and_inertia_of(&self.rel_rotation(q), self.rel_rate_jacobian(q))
+    }
+
+    fn locked_terms_and_inertia_of<T: Real, const N: usize>(
+        &self,
+        rel: &M3<T>,
+        sj: [V3<T>; N],
+    ) -> ([[T; N]; N], [V3<T>; N], M3<T>) {
         let (j, kt, nt) = self.locked_parts_of(rel);
         let k: [V3<T>; N] = std::array::from_fn(|i| mat_vec(&kt, sj[i]));
         let a: [V3<T>; N] = std::array::from_fn(|i| solve3(&j, k[i]));
@@ -305,7 +320,7 @@ impl Cat {
                 m[r][cidx] = dot(sj[r], mat_vec(&nt, sj[cidx])) - dot(k[r], a[cidx]);
             }
         }
-        (m, a)
+        (m, a, j)
     }
 
     /// Body A's angular velocity (A frame) at zero total angular momentum.
@@ -426,7 +441,24 @@ impl ShapeTerms {
             let x = [0, 1].map(|i| Dual64::new(q[i], if i == k { 1.0 } else { 0.0 }));
             cat.locked_terms(x)
         };
-        let passes = [pass(0), pass(1)];
+        Self::of_passes(&[pass(0), pass(1)])
+    }
+
+    /// [`ShapeTerms::first`] and `J^-1 lambda` with its derivatives along
+    /// the same passes (`u[k]`: the pass along `q_k`), the same numbers as
+    /// the passes of [`crate::model::momentum::momentum_torque`].
+    pub fn first_with_momentum(cat: &Cat, q: [f64; 2], lam: [f64; 3]) -> (Self, [[Dual64; 3]; 2]) {
+        let pass = |k: usize| {
+            let x = [0, 1].map(|i| Dual64::new(q[i], if i == k { 1.0 } else { 0.0 }));
+            let (m, a, j) = cat.locked_terms_and_inertia(x);
+            ((m, a), solve3(&j, lam.map(Dual64::from_re)))
+        };
+        let (p0, p1) = (pass(0), pass(1));
+        (Self::of_passes(&[p0.0, p1.0]), [p0.1, p1.1])
+    }
+
+    #[allow(clippy::type_complexity)]
+    fn of_passes(passes: &[([[Dual64; 2]; 2], [V3<Dual64>; 2]); 2]) -> Self {
         let mut t = ShapeTerms::default();
         for i in 0..2 {
             for j in 0..2 {

@@ -101,6 +101,52 @@ pub fn momentum_torque<T: Real>(cat: &Cat, q: [T; 2], qd: [T; 2], lam: [T; 3]) -
     })
 }
 
+/// The shape terms at `q` and the momentum torque `g` of [`momentum_torque`]
+/// (zero at `lambda = 0`) from one pair of dual passes, the same numbers to
+/// the bit: the simulators evaluate both every stage.
+pub fn shape_and_momentum_torque(
+    cat: &Cat,
+    q: [f64; 2],
+    qd: [f64; 2],
+    lam: [f64; 3],
+) -> (ShapeTerms, [f64; 2]) {
+    if is_zero(lam) {
+        return (ShapeTerms::first(cat, q), [0.0; 2]);
+    }
+    let (t, u) = ShapeTerms::first_with_momentum(cat, q, lam);
+    let (a, da) = (t.a, t.da);
+    let u0 = u[0].map(|x| x.re);
+    let xi: V3<f64> = std::array::from_fn(|r| u0[r] - a[0][r] * qd[0] - a[1][r] * qd[1]);
+    let turn = cross(lam, xi);
+    let half = c::<f64>(0.5);
+    let g = std::array::from_fn(|i| {
+        let mut g = dot(a[i], turn) + half * dot(lam, u[i].map(|x| x.eps));
+        for j in 0..2 {
+            let curl: V3<f64> = std::array::from_fn(|r| da[j][i][r] - da[i][j][r]);
+            g += qd[j] * dot(lam, curl);
+        }
+        g
+    });
+    (t, g)
+}
+
+/// Shape acceleration `M^-1 (tau - h - g)` from the terms of
+/// [`shape_and_momentum_torque`]: [`forward_dynamics_from`]'s numbers.
+pub fn forward_dynamics_with(
+    t: &ShapeTerms,
+    qd: [f64; 2],
+    tau: [f64; 2],
+    g: [f64; 2],
+    lam: [f64; 3],
+) -> [f64; 2] {
+    let h = bias(t, qd);
+    let mut f = [tau[0] - h[0], tau[1] - h[1]];
+    if !is_zero(lam) {
+        f = [f[0] - g[0], f[1] - g[1]];
+    }
+    solve2(&t.m, f)
+}
+
 /// Body A's rate `w_A = J^-1 lambda - A q_dot` (A frame), generic.
 pub fn body_rate_with<T: Real>(cat: &Cat, q: [T; 2], qd: [T; 2], lam: [T; 3]) -> [T; 3] {
     let (j, k) = cat.locked_inertia(q);
@@ -295,6 +341,38 @@ mod tests {
                 m[i] -= h;
                 let want = (v(p) - v(m)) / (2.0 * h) + dot(a[i], turn);
                 assert!((g[i] - want).abs() < 1e-8, "{} vs {want}", g[i]);
+            }
+        }
+    }
+
+    /// The fused passes give [`ShapeTerms::first`] and [`momentum_torque`] to the bit.
+    #[test]
+    fn fused_shape_and_momentum_terms_are_the_separate_ones_bit_for_bit() {
+        let states = [
+            ([0.7, -0.4], [1.3, -2.1], [0.2, -0.35, 0.5]),
+            ([0.01, 0.02], [-0.3, 0.8], [1e-3, 0.0, -2e-3]),
+            ([-1.9, 1.2], [4.0, 0.1], [-3.0, 1.5, 0.7]),
+            ([0.3, 1.1], [-0.7, 0.4], [0.0; 3]),
+        ];
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        for cat in cats() {
+            for (q, qd, lam) in states {
+                let (t, g) = shape_and_momentum_torque(&cat, q, qd, lam);
+                let t0 = ShapeTerms::first(&cat, q);
+                let flat = |t: &ShapeTerms| {
+                    let mut v: Vec<f64> = t.m.iter().flatten().copied().collect();
+                    v.extend(t.dm.iter().flatten().flatten());
+                    v.extend(t.a.iter().flatten());
+                    v.extend(t.da.iter().flatten().flatten());
+                    v
+                };
+                assert_eq!(bits(&flat(&t)), bits(&flat(&t0)), "{cat:?} {q:?}");
+                assert_eq!(bits(&g), bits(&momentum_torque(&cat, q, qd, lam)));
+                let tau = [0.3, -0.2];
+                assert_eq!(
+                    bits(&forward_dynamics_with(&t, qd, tau, g, lam)),
+                    bits(&forward_dynamics_from(&cat, &t0, q, qd, tau, lam))
+                );
             }
         }
     }
