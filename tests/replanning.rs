@@ -131,7 +131,7 @@ fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
     let (cfg, r, tv, plan) = spin_only();
     let motor = cfg.motor();
     let p = tv.period_steps;
-    let mut replanner = Replanner::new(&cfg, 10).unwrap().real_time();
+    let mut replanner = Replanner::new(&cfg.design_spec(), 10).unwrap().real_time();
     for (frac, knock) in [(0.1, 0.3), (0.3, -0.4), (0.5, 0.2)] {
         let k = (frac * tv.starts.len() as f64) as usize;
         let s = tv.starts[k];
