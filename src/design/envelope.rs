@@ -585,15 +585,8 @@ impl EnvelopeProblem {
             slope: self.motor.slope() / (ts * nu),
             budget: self.budget.map(|b| b / ts),
         };
-        if self.objective == Objective::Time && lim.torque.is_none() && lim.speed.is_none() {
-            return Err(Error::Invalid {
-                key: "design.objective".into(),
-                value: "\"time\"".into(),
-                expected:
-                    "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
-                        .into(),
-            });
-        }
+        self.objective
+            .check_bounded(lim.torque.is_some() || lim.speed.is_some())?;
         let tangents = lim.torque.is_some() && lim.slope > 0.0;
         // first tangent of sqrt(beta) where the path runs at the no-load
         // speed: beyond it a motor can only brake, so this is where the line

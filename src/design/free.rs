@@ -1614,17 +1614,9 @@ fn design_problem(
             ConicSettings::MODEL,
         ),
     };
-    if problem.objective == Objective::Time
-        && problem.max_torque.is_none()
-        && problem.max_speed.is_none()
-    {
-        return Err(crate::error::Error::Invalid {
-            key: "design.objective".into(),
-            value: "\"time\"".into(),
-            expected: "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
-                .into(),
-        });
-    }
+    problem
+        .objective
+        .check_bounded(problem.max_torque.is_some() || problem.max_speed.is_some())?;
     let mut z0 = problem.to_scaled(z0);
     let total: f64 = (0..3).map(|p| z0[tr.duration(p)]).sum();
     if total > 1.0 && problem.objective != Objective::Time {

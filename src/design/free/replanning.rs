@@ -91,18 +91,8 @@ impl Replanner {
                 expected: "at least 3 nodes per phase".into(),
             });
         }
-        if spec.objective == Objective::Time
-            && spec.motor.max_torque.is_none()
-            && spec.motor.max_speed.is_none()
-        {
-            return Err(Error::Invalid {
-                key: "design.objective".into(),
-                value: "\"time\"".into(),
-                expected:
-                    "needs a limit to be finite: set limits.max_torque and/or limits.max_speed"
-                        .into(),
-            });
-        }
+        spec.objective
+            .check_bounded(spec.motor.max_torque.is_some() || spec.motor.max_speed.is_some())?;
         Ok(Self {
             spec: spec.clone(),
             nodes,
