@@ -158,7 +158,7 @@ const LAST: f64 = 2.0;
 /// period by one [`Replanner`] (see the module doc).
 fn flight(
     cfg: &Config,
-    design: &catflip::design::collocation::CollocationPlan,
+    design: &catflip::design::collocation_plan::CollocationPlan,
     at: f64,
     nodes: usize,
     iterations: usize,

@@ -5,10 +5,10 @@
 use crate::common::{Common, Progress, Status, flag, load, publisher, say, say_lines};
 use anyhow::Result;
 use catflip::console;
-use catflip::output::{Output, with_verdict};
+use catflip::output::Output;
 use catflip::pipeline::{Design, Method};
 use catflip::sweep::{Methods, Shard, SweepSpec};
-use catflip::verdict::{self, Grade};
+use catflip::verdict::{self, Grade, with_verdict};
 use catflip::verify::analyze::{analyze, verify};
 use clap::{Parser, Subcommand};
 use std::path::{Path, PathBuf};

@@ -74,19 +74,6 @@ pub fn ensure_finite(v: &serde_json::Value, fields: &[&str]) -> Result<()> {
     }
 }
 
-/// A result's JSON with its verdict (`"verdict": "ok" | "flagged" | ...`)
-/// and, when it misses a target, `"reason"`.
-pub fn with_verdict(
-    v: &mut serde_json::Value,
-    grade: crate::verdict::Grade,
-    reason: Option<String>,
-) {
-    v["verdict"] = serde_json::to_value(grade).expect("a grade serialises");
-    if let Some(r) = reason {
-        v["reason"] = r.into();
-    }
-}
-
 /// The set a command publishes with `--set` overrides: `<base>@<overrides>`
 /// (e.g. `run@cat.joint=no-twist`), so that runs of one config with other
 /// overrides keep their own reports side by side; `<base>` without any.

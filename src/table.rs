@@ -1,5 +1,5 @@
 //! The comparison table of the methods, shared by the terminal
-//! ([`crate::console::run`]) and the report (index.html, the animation's
+//! (`catflip run`'s table) and the report (index.html, the animation's
 //! captions): its columns, one line per method, and a verdict in words.
 
 use crate::pipeline::MethodSummary;

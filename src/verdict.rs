@@ -541,6 +541,15 @@ pub fn verdict(targets: &Targets, design: &DesignNumbers, simulation: &Simulated
     }
 }
 
+/// A result's JSON with its verdict (`"verdict": "ok" | "flagged" | ...`)
+/// and, when it misses a target, `"reason"`.
+pub fn with_verdict(v: &mut serde_json::Value, grade: Grade, reason: Option<String>) {
+    v["verdict"] = serde_json::to_value(grade).expect("a grade serialises");
+    if let Some(r) = reason {
+        v["reason"] = r.into();
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -7,12 +7,13 @@
 //! so the controller remembers them: a command at control step `k` drops
 //! the history from `k` on (a command at step 0 starts a new flight).
 
+use super::closed_loop::pd_command;
 pub use super::closed_loop::{SimState, from_sim, to_sim};
-use super::closed_loop::{pd_command, tvlqr_command};
 use super::plant::{Y, momentum_from_rates};
 use super::reference::Reference;
 use super::replanning::{InFlight, Record, Replanning, SharedPlan};
 use super::tvlqr::Tvlqr;
+use super::tvlqr::tvlqr_command;
 use crate::config::Config;
 use crate::model::motor::Motor;
 use crate::verify::simulate::Controller;

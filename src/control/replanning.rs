@@ -13,10 +13,9 @@
 //! when the model flown from the predicted state under the new plan would
 //! land worse than under the plan in use (a single SCP iteration may).
 
-use super::closed_loop::predict;
 use super::plant::{Y, attitude};
 use super::reference::Reference;
-use super::tvlqr::Tvlqr;
+use super::tvlqr::{Tvlqr, predict};
 use crate::config::Config;
 use crate::design::free::Replanner;
 use crate::design::plan::ShapePlan;

@@ -15,10 +15,11 @@
 //! belly's direction (the heading is free), at touchdown with
 //! `control.landing_weight`.
 
-use super::plant::{NX, X, error, perturb, rk4};
+use super::plant::{NX, X, Y, error, perturb, rk4};
 use super::reference::Reference;
 use crate::config::ControlConfig;
 use crate::model::momentum::straight_inertias;
+use crate::model::motor::Motor;
 use crate::model::so3::hat;
 use nalgebra::{SMatrix, SVector, Vector3};
 
@@ -213,4 +214,57 @@ impl Tvlqr {
     pub fn closed_loop(&self, k: usize) -> A {
         self.a[k] - self.b[k] * self.gains[k]
     }
+}
+
+/// The model's state at step `to` from the measurement `m` at step `from`,
+/// under the feed-forward of `r` and the corrections `issued` acting as the
+/// TVLQR `tv` sends them (in the motor envelope at the predicted speed).
+pub fn predict(
+    r: &Reference,
+    tv: &Tvlqr,
+    motor: &Motor,
+    issued: &[[f64; 2]],
+    from: usize,
+    to: usize,
+    m: &Y,
+) -> Y {
+    let mut yp = *m;
+    for i in from..to {
+        let u = tv
+            .interval_at(i)
+            .and_then(|c| issued.get(c))
+            .copied()
+            .unwrap_or([0.0; 2]);
+        yp = rk4(&r.cat, &yp, r.h, |st, ys| {
+            let ff = r.ff_at(i, st);
+            motor.clip([ff[0] + u[0], ff[1] + u[1]], [ys[6], ys[7]])
+        });
+    }
+    yp
+}
+
+/// The TVLQR's correction `k` from the measurement `m` taken `delay` steps
+/// before it acts: the model predicts the state over the delay under the
+/// corrections already sent, the gain acts on the predicted error, and the
+/// sum with the feed-forward is held inside the motor envelope at the
+/// predicted joint speed.
+pub fn tvlqr_command(
+    r: &Reference,
+    tv: &Tvlqr,
+    motor: &Motor,
+    issued: &[[f64; 2]],
+    k: usize,
+    m: &Y,
+) -> [f64; 2] {
+    let s = tv.starts[k];
+    let yp = predict(r, tv, motor, issued, s - tv.delay_steps, s, m);
+    let x = error(&yp, &r.nominal[s]);
+    let mut u = -(tv.gains[k] * x);
+    let size = motor.norm.of([u[0], u[1]]);
+    if size > tv.max_correction {
+        u *= tv.max_correction / size;
+    }
+    let ff = r.ff_at(s, 0);
+    let total = motor.clip([ff[0] + u[0], ff[1] + u[1]], [yp[6], yp[7]]);
+    [total[0] - ff[0], total[1] - ff[1]]
 }

@@ -17,7 +17,7 @@
 //! the interpolation is the matching cubic in `q`, and the same interpolation
 //! reconstructs the schedule.
 
-use crate::design::plan::{Phase, ShapePlan, ShapeState};
+use crate::design::plan::ShapePlan;
 
 /// Grid and variable layout.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -197,81 +197,10 @@ impl Transcription {
     }
 }
 
-/// A transcribed solution as a plan, with the scheme's interpolation.
-#[derive(Debug, Clone)]
-pub struct CollocationPlan {
-    pub tr: Transcription,
-    pub z: Vec<f64>,
-    /// From a start with angular momentum: the attitude along the plan, whose
-    /// momentum enters the feed-forward torque (docs/model.md section 8).
-    pub track: Option<crate::design::release::Track>,
-}
-
-impl CollocationPlan {
-    /// A plan at zero momentum.
-    pub fn new(tr: Transcription, z: Vec<f64>) -> Self {
-        CollocationPlan { tr, z, track: None }
-    }
-}
-
-impl ShapePlan for CollocationPlan {
-    fn phase_bounds(&self) -> Vec<f64> {
-        let mut b = vec![0.0];
-        for p in 0..self.tr.phases {
-            b.push(b[p] + self.z[self.tr.duration(p)]);
-        }
-        b
-    }
-
-    /// The nodes too: a plan one SCP iteration from its start leaves its
-    /// accelerations, so its torques, jumping a little at the nodes.
-    fn breaks(&self) -> Vec<f64> {
-        let b = self.phase_bounds();
-        let h = self.tr.h();
-        let mut out = Vec::new();
-        for i in 0..self.tr.phases {
-            let dur = b[i + 1] - b[i];
-            out.extend((1..self.tr.nodes - 1).map(|k| b[i] + k as f64 * h * dur));
-            out.push(b[i + 1]);
-        }
-        out
-    }
-
-    fn state_in(&self, i: usize, t: f64) -> ShapeState {
-        let b = self.phase_bounds();
-        let dur = b[i + 1] - b[i];
-        let s = ((t - b[i]) / dur).clamp(0.0, 1.0);
-        let h = self.tr.h();
-        let k = ((s / h).floor() as usize).min(self.tr.nodes - 2);
-        let c = ((s - k as f64 * h) / h).clamp(0.0, 1.0);
-        let it = self.tr.interval(&self.z, i, k).at(c);
-        ShapeState {
-            q: it.q,
-            qd: it.v.map(|x| x / dur),
-            qdd: it.a.map(|x| x / (dur * dur)),
-            phase: Phase::ALL[i.min(2)],
-        }
-    }
-
-    /// The inverse dynamics along the plan, with the momentum's part
-    /// `g(q, q_dot, lambda)` when the plan starts with angular momentum.
-    fn torque_in(&self, cat: &crate::model::Cat, i: usize, t: f64) -> [f64; 2] {
-        let st = self.state_in(i, t);
-        let tau = crate::model::dynamics::inverse_dynamics(cat, st.q, st.qd, st.qdd);
-        let Some(track) = &self.track else {
-            return tau;
-        };
-        let b = self.phase_bounds();
-        let s = ((t - b[i]) / (b[i + 1] - b[i])).clamp(0.0, 1.0);
-        let lam = track.body_momentum(cat, &self.tr, &self.z, i, s);
-        let g = crate::model::momentum::momentum_torque(cat, st.q, st.qd, lam);
-        [tau[0] + g[0], tau[1] + g[1]]
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::collocation_plan::CollocationPlan;
 
     #[test]
     fn interpolant_satisfies_the_defects_exactly_and_has_consistent_derivatives() {

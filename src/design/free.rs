@@ -32,7 +32,8 @@
 //! solved from the analytic schedule ([`other_starts`]) and the lower
 //! design continued.
 
-use crate::design::collocation::{CollocationPlan, Transcription};
+use crate::design::collocation::Transcription;
+use crate::design::collocation_plan::CollocationPlan;
 use crate::design::conic::{Cone, ConicData, ConicSettings};
 use crate::design::objective::Objective;
 use crate::design::plan::ShapePlan;

@@ -160,9 +160,9 @@ pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
 
 /// A plan's durations multiplied by `k` (the same path, F3).
 fn stretched(
-    plan: &crate::design::collocation::CollocationPlan,
+    plan: &crate::design::collocation_plan::CollocationPlan,
     k: f64,
-) -> crate::design::collocation::CollocationPlan {
+) -> crate::design::collocation_plan::CollocationPlan {
     let mut p = plan.clone();
     for i in 0..p.tr.phases {
         let d = p.tr.duration(i);

@@ -5,6 +5,7 @@
 pub mod analytic;
 pub mod bend_search;
 pub mod collocation;
+pub mod collocation_plan;
 pub mod conic;
 pub mod envelope;
 pub mod free;

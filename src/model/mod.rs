@@ -446,7 +446,7 @@ impl ShapeTerms {
 
     /// [`ShapeTerms::first`] and `J^-1 lambda` with its derivatives along
     /// the same passes (`u[k]`: the pass along `q_k`), the same numbers as
-    /// the passes of [`crate::model::momentum::momentum_torque`].
+    /// the passes of the momentum module's `momentum_torque`.
     pub fn first_with_momentum(cat: &Cat, q: [f64; 2], lam: [f64; 3]) -> (Self, [[Dual64; 3]; 2]) {
         let pass = |k: usize| {
             let x = [0, 1].map(|i| Dual64::new(q[i], if i == k { 1.0 } else { 0.0 }));

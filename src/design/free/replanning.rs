@@ -12,7 +12,7 @@
 //! one's plan, moved to the newly measured state.
 
 use super::{FreeProblem, Objective, Release, Transcription};
-use crate::design::collocation::CollocationPlan;
+use crate::design::collocation_plan::CollocationPlan;
 use crate::design::conic::{Cone, ConicData, ConicSettings, ConicSolver, solve_reusing};
 use crate::design::plan::ShapePlan;
 use crate::design::scp::{Executor, ScpSettings, ScpStatus, Solvers, WarmStart};
