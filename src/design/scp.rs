@@ -201,7 +201,7 @@ settings! {
         /// Leave out of each subproblem the limit rows that cannot bind
         /// inside its trust region ([`screen`]): the same solution from a
         /// smaller conic program.
-        pub screen: bool = true,
+        pub screen: bool = false,
         /// With `screen`, a row is also left out when it stays this far
         /// (relative to the limit) inside it, whatever the trust region;
         /// the solution is checked against the rows left out and solved
