@@ -344,8 +344,9 @@ pub fn run() -> Result<Status> {
 fn cmd_analyze(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "analyze")?;
-    let a = analyze(&cfg.design_spec(), &cfg.name)?;
-    let (sched, verdict) = catflip::pipeline::judge_analysis(&cfg, &a);
+    let spec = cfg.design_spec();
+    let a = analyze(&spec, &cfg.name)?;
+    let (sched, verdict) = catflip::pipeline::judge_analysis(&spec, &a);
     let reason = verdict.reason();
     let mut v = serde_json::to_value(&a)?;
     catflip::output::ensure_finite(&v, &[])?;
@@ -465,7 +466,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         }
     };
     // the same stage as `run`: schedule, verdict, files
-    let judged = catflip::pipeline::stage(&cfg, design, 0.0);
+    let judged = catflip::pipeline::stage(&spec, design, 0.0);
     let method = judged.design.method();
     let reason = judged.verdict.reason();
     let what = match method {

@@ -5,10 +5,10 @@
 //! `run` passes each method through [`stage`]; `optimize` passes its one
 //! design; `sweep` judges its points with [`judge`] (peaks only, no files).
 
-use crate::config::Config;
 use crate::design::free::FreeResult;
 use crate::design::phased::PhasedResult;
 use crate::design::plan::{Schedule, ShapePlan};
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 use crate::output::Output;
 use crate::report::MethodTrace;
@@ -69,8 +69,11 @@ pub struct LeastHeightDesign {
 
 impl LeastHeightDesign {
     /// The answer's schedule, its numbers read off its rows.
-    pub fn of(cfg: &Config, a: &crate::design::least_height::HeightAnswer) -> LeastHeightDesign {
-        let norm = cfg.norm();
+    pub fn of(
+        spec: &DesignSpec,
+        a: &crate::design::least_height::HeightAnswer,
+    ) -> LeastHeightDesign {
+        let norm = spec.norm();
         let rows = &a.schedule.rows;
         let peak = rows.iter().map(|r| norm.of(r.tau)).fold(0.0, f64::max);
         let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
@@ -178,15 +181,15 @@ impl Design {
 /// (deg), written as `schedule` (the motor usage of its rows; `None`: not
 /// judged on speed and envelope) and simulated as `simulated`.
 pub fn judge(
-    cfg: &Config,
+    spec: &DesignSpec,
     status: Status,
     (peak_torque_nm, bend_deg): (f64, f64),
     schedule: Option<&Schedule>,
     simulated: &Simulated,
 ) -> Verdict {
-    let motor = schedule.map(|s| usage(cfg, s));
+    let motor = schedule.map(|s| usage(spec, s));
     verdict(
-        &Targets::of(&cfg.design_spec()),
+        &Targets::of(spec),
         &DesignNumbers {
             status,
             peak_torque_nm,
@@ -200,10 +203,10 @@ pub fn judge(
 
 /// The seed's analytic schedule as written, and its verdict (closed form;
 /// the flip from the analysis's kinematic simulation).
-pub fn judge_analysis(cfg: &Config, a: &Analysis) -> (Schedule, Verdict) {
-    let schedule = crate::verify::analyze::analytic_schedule(&cfg.design_spec(), &a.plan);
+pub fn judge_analysis(spec: &DesignSpec, a: &Analysis) -> (Schedule, Verdict) {
+    let schedule = crate::verify::analyze::analytic_schedule(spec, &a.plan);
     let v = judge(
-        cfg,
+        spec,
         Status::ClosedForm,
         (a.peak_torque_nm, a.closed.bend_deg),
         Some(&schedule),
@@ -216,8 +219,8 @@ pub fn judge_analysis(cfg: &Config, a: &Analysis) -> (Schedule, Verdict) {
 }
 
 /// How the motors are used by a written schedule's rows.
-fn usage(cfg: &Config, schedule: &Schedule) -> crate::model::motor::MotorUse {
-    cfg.motor()
+fn usage(spec: &DesignSpec, schedule: &Schedule) -> crate::model::motor::MotorUse {
+    spec.motor
         .usage(schedule.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
@@ -234,22 +237,22 @@ pub struct Judged {
 
 /// The stage: sample, simulate, judge, summarise. `solve_time_s` is the
 /// method's time (the analytic design's includes its simulation).
-pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
+pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
     let schedule = match &design {
         // already rows: written as they are
         Design::LeastHeight(l) => l.schedule.clone(),
-        _ => Schedule::sample(&cfg.cat(), design.plan(), cfg.simulate.samples_per_phase),
+        _ => Schedule::sample(&spec.cat, design.plan(), spec.simulate.samples_per_phase),
     };
     let sim = match design.simulation() {
         Some(s) => Ok(s.clone()),
-        None => dynamic_spec(&cfg.design_spec(), design.plan()),
+        None => dynamic_spec(spec, design.plan()),
     };
     let method = design.method();
     let (bend, twist, durations) = design.path_numbers();
     let peak = design.peak_torque_nm();
     let failed_sim = SimReport::failed();
     let s = sim.as_ref().unwrap_or(&failed_sim);
-    let motor = usage(cfg, &schedule);
+    let motor = usage(spec, &schedule);
     let n = MethodNumbers {
         peak_torque_nm: peak,
         bend_deg: bend,
@@ -271,7 +274,7 @@ pub fn stage(cfg: &Config, design: Design, solve_time_s: f64) -> Judged {
         schedule_json: format!("{}.schedule.json", method.name()),
     };
     let verdict = judge(
-        cfg,
+        spec,
         design.status(),
         (peak, bend),
         Some(&schedule),
@@ -316,9 +319,9 @@ impl Judged {
     }
 
     /// Curves for the figures, `per_phase` samples a phase.
-    pub fn trace(&self, cfg: &Config, per_phase: usize) -> MethodTrace {
+    pub fn trace(&self, spec: &DesignSpec, per_phase: usize) -> MethodTrace {
         trace(
-            cfg,
+            spec,
             self.design.method().name(),
             self.design.plan(),
             self.design.peak_torque_nm(),
@@ -328,10 +331,10 @@ impl Judged {
     }
 
     /// The animation's track.
-    pub fn track(&self, cfg: &Config) -> Track {
+    pub fn track(&self, spec: &DesignSpec) -> Track {
         crate::report::animation::track(
-            &cfg.cat(),
-            cfg.norm(),
+            &spec.cat,
+            spec.norm(),
             self.design.method().name(),
             &self.sim_or_failed(),
             crate::report::animation::FRAMES,
@@ -342,15 +345,15 @@ impl Judged {
 /// Curves of one method for the figures; `peak` is its dense peak torque,
 /// the table's (the curve's samples may fall just short of it).
 pub fn trace(
-    cfg: &Config,
+    spec: &DesignSpec,
     name: &str,
     plan: &dyn ShapePlan,
     peak: f64,
     sim: &SimReport,
     per_phase: usize,
 ) -> MethodTrace {
-    let cat = cfg.cat();
-    let norm = cfg.norm();
+    let cat = &spec.cat;
+    let norm = spec.norm();
     let b = plan.phase_bounds();
     let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
     let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
@@ -361,7 +364,7 @@ pub fn trace(
             let s = plan.state_in(i, tt);
             q.push(s.q);
             qd.push(s.qd);
-            let v = plan.torque_in(&cat, i, tt);
+            let v = plan.torque_in(cat, i, tt);
             tau.push(norm.of(v));
             tau_xy.push(v);
         }
@@ -374,7 +377,7 @@ pub fn trace(
         qd,
         tau_xy,
         peak_nm: peak,
-        over_limit: Targets::of(&cfg.design_spec()).over_torque(peak),
+        over_limit: Targets::of(spec).over_torque(peak),
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),

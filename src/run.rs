@@ -6,6 +6,7 @@ use crate::design::analytic::ClosedForms;
 use crate::design::least_height::HeightAnswer;
 use crate::design::plan::ShapePlan;
 use crate::design::scp::ScpIteration;
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 use crate::output::Output;
 use crate::pipeline::{self, Design, Judged, Method};
@@ -146,10 +147,10 @@ struct Methods {
 impl Methods {
     /// A method's design, `seconds` to make, through the pipeline stage;
     /// or why it failed.
-    fn add(&mut self, cfg: &Config, method: Method, design: Result<(Design, f64)>) {
+    fn add(&mut self, spec: &DesignSpec, method: Method, design: Result<(Design, f64)>) {
         match design {
             Ok((d, seconds)) => {
-                let j = pipeline::stage(cfg, d, seconds);
+                let j = pipeline::stage(spec, d, seconds);
                 j.add_files(&mut self.output);
                 self.lines.push(j.summary.clone());
                 self.judged.push(j);
@@ -193,12 +194,12 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     let seconds = clock.elapsed().as_secs_f64();
     match analytic {
         Ok(a) => {
-            done.add(cfg, Method::Analytic, Ok((Design::Analytic(a), seconds)));
+            done.add(&spec, Method::Analytic, Ok((Design::Analytic(a), seconds)));
             stages.end(clock, None);
         }
         Err(e) => {
             stages.end(clock, Some(&e));
-            done.add(cfg, Method::Analytic, Err(e));
+            done.add(&spec, Method::Analytic, Err(e));
         }
     }
 
@@ -263,7 +264,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             });
             stages.end(clock, phased.as_ref().err());
             done.add(
-                cfg,
+                &spec,
                 Method::Phased,
                 phased.map(|ph| {
                     let t = ph.solve_time_s;
@@ -301,7 +302,7 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
                 .solve();
             stages.end(clock, free.as_ref().err());
             done.add(
-                cfg,
+                &spec,
                 Method::Free,
                 free.map(|fr| {
                     let t = fr.solve_time_s;
@@ -325,10 +326,10 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     // drawn, animated and exported (it needs its own, longer fall)
     if let Some(a) = &answer {
         done.add(
-            cfg,
+            &spec,
             Method::LeastHeight,
             Ok((
-                Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(cfg, a)),
+                Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(&spec, a)),
                 least_seconds,
             )),
         );
@@ -355,8 +356,8 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         .map(|j| (j.design.method().name(), j.design.plan()))
         .collect();
     crate::export::add_simulator_files(cfg, &mut output, &plans);
-    let traces: Vec<MethodTrace> = judged.iter().map(|j| j.trace(cfg, 300)).collect();
-    let mut tracks: Vec<_> = judged.iter().map(|j| j.track(cfg)).collect();
+    let traces: Vec<MethodTrace> = judged.iter().map(|j| j.trace(&spec, 300)).collect();
+    let mut tracks: Vec<_> = judged.iter().map(|j| j.track(&spec)).collect();
     let free = judged.iter().find_map(|j| match &j.design {
         Design::Free(fr) => Some(fr),
         _ => None,

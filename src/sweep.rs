@@ -14,6 +14,7 @@ use crate::config::Config;
 use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
 use crate::design::phased::least_height;
+use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
 use crate::verdict::{Simulated, Status};
 use crate::verify::analyze::peak_along;
@@ -341,7 +342,7 @@ fn point(
             Ok(ph) if methods.phased => {
                 errors.extend(flagged(
                     "phased",
-                    &cfg,
+                    &spec,
                     ph.status.into(),
                     ph.peak_torque_nm,
                     ph.bend_deg,
@@ -373,7 +374,7 @@ fn point(
                 Ok(fr) => {
                     errors.extend(flagged(
                         "free",
-                        &cfg,
+                        &spec,
                         fr.status.into(),
                         fr.peak_torque_nm,
                         fr.bend_deg,
@@ -424,14 +425,14 @@ fn point(
 /// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
-    cfg: &Config,
+    spec: &DesignSpec,
     status: Status,
     peak_torque_nm: f64,
     bend_deg: f64,
     (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
     let v = crate::pipeline::judge(
-        cfg,
+        spec,
         status,
         (peak_torque_nm, bend_deg),
         None,

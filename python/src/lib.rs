@@ -345,14 +345,14 @@ impl Config {
 /// The verdict on a design, as the CLI's `optimize` and `analyze` give it
 /// (`catflip::pipeline::judge`): solver status, the flip, the limits.
 fn judged(
-    cfg: &Cfg,
+    spec: &catflip::design::spec::DesignSpec,
     status: catflip::verdict::Status,
     (peak, bend): (f64, f64),
     schedule: &Schedule,
     (flip_error_rad, tilt_deg): (f64, f64),
 ) -> Option<String> {
     catflip::pipeline::judge(
-        cfg,
+        spec,
         status,
         (peak, bend),
         Some(schedule),
@@ -416,8 +416,9 @@ fn run_design(
             "seed applies to method=\"free\" ({what} has no seed); leave seed out or use method=\"free\""
         ))
     };
+    let spec = cfg.design_spec();
     let sample =
-        |plan: &dyn ShapePlan| Schedule::sample(&cfg.cat(), plan, cfg.simulate.samples_per_phase);
+        |plan: &dyn ShapePlan| Schedule::sample(&spec.cat, plan, spec.simulate.samples_per_phase);
     let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
         match method {
             "free" => {
@@ -430,7 +431,7 @@ fn run_design(
                         )));
                     }
                 };
-                let r = catflip::design::free::FreeDesign::new(&cfg.design_spec())
+                let r = catflip::design::free::FreeDesign::new(&spec)
                     .seed(seed)
                     .check_mesh()
                     .solve()
@@ -438,7 +439,7 @@ fn run_design(
                 let sched = sample(&r.plan);
                 let status = Status::from(r.status);
                 let reason = judged(
-                    &cfg,
+                    &spec,
                     status,
                     (r.peak_torque_nm, r.bend_deg),
                     &sched,
@@ -461,11 +462,11 @@ fn run_design(
                     return Err(no_seed("the phased design"));
                 }
                 let r =
-                    catflip::design::phased::optimize(&cfg.design_spec(), |_| {}).map_err(err)?;
+                    catflip::design::phased::optimize(&spec, |_| {}).map_err(err)?;
                 let sched = sample(&r.plan);
                 let status = Status::from(r.status);
                 let reason = judged(
-                    &cfg,
+                    &spec,
                     status,
                     (r.peak_torque_nm, r.bend_deg),
                     &sched,
@@ -488,13 +489,13 @@ fn run_design(
                     return Err(no_seed("the analytic schedule"));
                 }
                 // the CLI's `analyze`: a miss is flagged in the analysis
-                let a = catflip::verify::analyze::analyze(&cfg.design_spec(), &cfg.name)
+                let a = catflip::verify::analyze::analyze(&spec, &cfg.name)
                     .map_err(err)?;
                 let sched =
-                    catflip::verify::analyze::analytic_schedule(&cfg.design_spec(), &a.plan);
+                    catflip::verify::analyze::analytic_schedule(&spec, &a.plan);
                 let status = Status::ClosedForm;
                 let reason = judged(
-                    &cfg,
+                    &spec,
                     status,
                     (a.peak_torque_nm, a.closed.bend_deg),
                     &sched,
