@@ -4,8 +4,9 @@
 //! a shared machine; run under `valgrind --tool=callgrind` for instruction
 //! counts).
 //!
-//! `cargo run --release --example bench_robot [-- RUNS [CASE...]]` (default
-//! 3 runs, every case). Cases:
+//! `cargo run --release --example bench_robot [-- RUNS [CASE...] [KEY=VALUE...]]`
+//! (default 3 runs, every case; the overrides as `--set` takes them, for
+//! every case, e.g. `free.screen_limits=true`). Cases:
 //! - `run:CONFIG`: `catflip run`'s pipeline (analytic, least height, phased,
 //!   free-form, report; files not written), e.g. `run:robot-universal`;
 //! - `height:CONFIG`: the least-height stage alone, with its answer;
@@ -34,18 +35,19 @@ fn cpu_s() -> f64 {
     tv(u.ru_utime) + tv(u.ru_stime)
 }
 
-fn config(name: &str, set: &[String]) -> anyhow::Result<Config> {
+fn config(name: &str, set: &[String], extra: &[String]) -> anyhow::Result<Config> {
     let path = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
-    Ok(Config::load(std::path::Path::new(&path), set)?)
+    let all: Vec<String> = set.iter().chain(extra).cloned().collect();
+    Ok(Config::load(std::path::Path::new(&path), &all)?)
 }
 
 /// One case, timed once: what it printed and the work's wall and CPU seconds.
-fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
+fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
     let parts: Vec<&str> = case.split(':').collect();
     let (t, c) = (Instant::now(), cpu_s());
     let text = match parts.as_slice() {
         ["run", name] => {
-            let cfg = config(name, &[])?;
+            let cfg = config(name, &[], extra)?;
             let r = catflip::run::run(&cfg, |_| {})?;
             let a = r.summary.answer.as_ref();
             format!(
@@ -55,7 +57,7 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
             )
         }
         ["height", name] => {
-            let cfg = config(name, &[])?;
+            let cfg = config(name, &[], extra)?;
             let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})?
                 .ok_or_else(|| anyhow::anyhow!("{name}: no motor limits"))?;
             format!(
@@ -65,7 +67,7 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
         }
         ["parts", name] => {
             // the least-height stage's designs one by one, in one thread
-            let cfg = config(name, &[])?;
+            let cfg = config(name, &[], extra)?;
             let reference = catflip::design::least_height::reference(&cfg.design_spec());
             let mut out = Vec::new();
             let mut lap = |what: &str, text: String, t: &mut (Instant, f64)| {
@@ -121,6 +123,7 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
                     "fall.height=6".into(),
                     format!("design.objective={objective}"),
                 ],
+                extra,
             )?;
             let seed = match *seed {
                 "phased" => Seed::Phased,
@@ -156,7 +159,8 @@ fn once(case: &str) -> anyhow::Result<(String, f64, f64)> {
 fn main() -> anyhow::Result<()> {
     let mut args = std::env::args().skip(1);
     let runs: usize = args.next().map(|s| s.parse()).transpose()?.unwrap_or(3);
-    let mut cases: Vec<String> = args.collect();
+    // KEY=VALUE arguments are overrides for every case (as `--set` takes them)
+    let (extra, mut cases): (Vec<String>, Vec<String>) = args.partition(|a| a.contains('='));
     if cases.is_empty() {
         for c in ["robot-universal", "box-robot"] {
             cases.push(format!("run:{c}"));
@@ -172,7 +176,7 @@ fn main() -> anyhow::Result<()> {
     for case in cases {
         let (mut wall, mut cpu, mut text) = (Vec::new(), Vec::new(), String::new());
         for _ in 0..runs {
-            let (t, w, c) = once(&case)?;
+            let (t, w, c) = once(&case, &extra)?;
             wall.push(w);
             cpu.push(c);
             text = t;
