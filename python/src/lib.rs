@@ -461,8 +461,7 @@ fn run_design(
                 if seed.is_some() {
                     return Err(no_seed("the phased design"));
                 }
-                let r =
-                    catflip::design::phased::optimize(&spec, |_| {}).map_err(err)?;
+                let r = catflip::design::phased::optimize(&spec, |_| {}).map_err(err)?;
                 let sched = sample(&r.plan);
                 let status = Status::from(r.status);
                 let reason = judged(
@@ -489,10 +488,8 @@ fn run_design(
                     return Err(no_seed("the analytic schedule"));
                 }
                 // the CLI's `analyze`: a miss is flagged in the analysis
-                let a = catflip::verify::analyze::analyze(&spec, &cfg.name)
-                    .map_err(err)?;
-                let sched =
-                    catflip::verify::analyze::analytic_schedule(&spec, &a.plan);
+                let a = catflip::verify::analyze::analyze(&spec, &cfg.name).map_err(err)?;
+                let sched = catflip::verify::analyze::analytic_schedule(&spec, &a.plan);
                 let status = Status::ClosedForm;
                 let reason = judged(
                     &spec,
