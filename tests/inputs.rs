@@ -756,13 +756,13 @@ fn the_largest_accepted_inputs_hold_the_memory_and_output_caps() {
     assert!(written < 100_000_000, "a run wrote {written} bytes");
 }
 
-/// `catflip robustness` on the seed cat, `trials` trials on 2 threads, into `out`.
 /// The override of [`robustness_args`] (its set's folder carries it).
 const REPLAN_EVERY: &str = "control.replan_every=10";
 
-/// A robustness study of the seed, replanning every 10th control period (what
-/// is checked here is the stop and the resume, not the controllers: a study
-/// of 40 trials then takes 5 s, not 25).
+/// `catflip robustness` on the seed cat, `trials` trials on 2 threads, into
+/// `out`, replanning every 10th control period (what is checked here is the
+/// stop and the resume, not the controllers: a study of 40 trials then takes
+/// 5 s, not 25).
 fn robustness_args(out: &str, trials: usize) -> Vec<String> {
     [
         "robustness",

@@ -27,7 +27,7 @@ fn spin_only() -> (catflip::Config, Reference, Tvlqr, SharedPlan) {
 }
 
 /// The robot's study design from 1.2 times its least height, where its
-/// servo's torque-speed line binds (made once: 150 SCP iterations).
+/// servo's torque-speed line binds (made once: over 100 SCP iterations).
 fn robot() -> &'static (catflip::Config, SharedPlan) {
     static D: OnceLock<(catflip::Config, SharedPlan)> = OnceLock::new();
     D.get_or_init(|| {
