@@ -699,17 +699,12 @@ pub fn usage_of(spec: &DesignSpec, plan: &dyn ShapePlan) -> MotorUse {
     spec.motor.usage(sched.rows.iter().map(|r| (r.tau, r.qd)))
 }
 
-/// The smallest motor-envelope margin of a plan ([`crate::model::motor::Motor::margin`];
-/// 1 without limits) on the dense samples the verdict reads the peak from (a
-/// multiple of the written rows): inside at the rows alone, the torque
-/// between them can still be outside.
-pub fn dense_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
-    stretched_margin(spec, plan)(1.0)
-}
-
-/// [`dense_margin`] of the plan slowed down by `k` (F3: torque as `1 / k^2`,
-/// speed as `1 / k`), without sampling it again.
-fn stretched_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> impl Fn(f64) -> f64 {
+/// The smallest motor-envelope margin ([`crate::model::motor::Motor::margin`];
+/// 1 without limits) of a plan slowed down by `k` (F3: torque as `1 / k^2`,
+/// speed as `1 / k`), on the dense samples the verdict reads the peak from
+/// (a multiple of the written rows: inside at the rows alone, the torque
+/// between them can still be outside); sampled once for every `k`.
+pub fn dense_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> impl Fn(f64) -> f64 + use<> {
     let dense = crate::verify::analyze::dense_samples(spec);
     let sched = Schedule::sample(&spec.cat, plan, dense);
     let motor = spec.motor;
@@ -735,7 +730,11 @@ fn stretched_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> impl Fn(f64) -> 
 /// they are inside already). The returned factor is always inside; a first
 /// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
 pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
-    let margin = stretched_margin(spec, plan);
+    least_stretch_of(&dense_margin(spec, plan))
+}
+
+/// [`least_stretch`] from a plan's [`dense_margin`].
+pub fn least_stretch_of(margin: &impl Fn(f64) -> f64) -> f64 {
     let first = margin(1.0);
     if first >= 0.0 {
         return 1.0;

@@ -1697,13 +1697,14 @@ fn inside_envelope(
         // on the dense samples, not the written rows alone: a design solved
         // again with a tightened limit is not searched between its check
         // points, and the simulators' steps fall between the rows
-        let margin = crate::design::envelope::dense_margin(spec, &solved.plan);
+        let margins = crate::design::envelope::dense_margin(spec, &solved.plan);
+        let margin = margins(1.0);
         if margin >= -1e-7 {
             break;
         }
-        // the least slow-down that brings every row inside (one guess of
+        // the least slow-down that brings every sample inside (one guess of
         // 1 - 1.5 margin overshot the robot's least time by 0.9 %)
-        let stretch = crate::design::envelope::least_stretch(spec, &solved.plan);
+        let stretch = crate::design::envelope::least_stretch_of(&margins);
         let total: f64 = solved.plan.phase_bounds()[3];
         // slowing the same path down keeps its attitude only at zero
         // momentum (F2; F10): from another start the problem is solved again
