@@ -4,13 +4,13 @@
 //! and `<name>.csv` with `t, q1, q2, qd1, qd2, qdd1, qdd2, tau1, tau2`.
 //! The bodies: the bundled box robot (configs/box-robot.urdf, whose own file
 //! the check also loads) and a lopsided body with products of inertia, off-axis
-//! centres of mass and tilted motor axes (tests/import.rs). Universal joints.
+//! centres of mass and tilted motor axes (tests/it/import.rs). Universal joints.
 //! `cargo run --release --example inverse_dynamics -- OUT_DIR`
 use catflip::Config;
 use catflip::model::dynamics::inverse_dynamics;
 use std::path::Path;
 
-/// The lopsided body's config: the `[body]` keys tests/import.rs uses.
+/// The lopsided body's config: the `[body]` keys tests/it/import.rs uses.
 fn lopsided() -> String {
     format!(
         "name = \"lopsided\"\n[cat]\njoint = \"universal\"\n[fall]\nheight = 10.0\n{}",

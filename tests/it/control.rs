@@ -10,7 +10,7 @@ use nalgebra::SMatrix;
 use std::sync::OnceLock;
 
 fn seed_cfg() -> Config {
-    Config::load(std::path::Path::new("configs/seed.toml"), &[]).unwrap()
+    crate::util::seed(&[])
 }
 
 /// The seed's free-form design and its gains, made once for all tests.
@@ -214,7 +214,8 @@ fn the_study_is_deterministic_and_its_shards_concatenate() {
 /// Bad input is refused with the key, the value and the range; nothing is written.
 #[test]
 fn bad_input_is_refused_before_anything_is_written() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = crate::util::temp_dir();
+    let seed = crate::util::config_arg("seed");
     for (args, key) in [
         (vec!["--set", "control.delay_ms=-1"], "control.delay_ms"),
         (
@@ -228,13 +229,10 @@ fn bad_input_is_refused_before_anything_is_written() {
         ),
         (vec!["--trials", "1000001"], "--trials"),
     ] {
-        let out = std::process::Command::new(env!("CARGO_BIN_EXE_catflip"))
-            .args(["robustness", "configs/seed.toml", "--out"])
-            .arg(dir.path())
-            .args(&args)
-            .output()
-            .unwrap();
-        let err = String::from_utf8_lossy(&out.stderr);
+        let mut argv = vec!["robustness", &seed, "--out", "."];
+        argv.extend(&args);
+        let out = crate::util::output(&argv, dir.path());
+        let err = crate::util::stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(key), "{args:?}: {err}");
         assert!(err.contains("must be in"), "{args:?}: {err}");

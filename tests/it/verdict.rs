@@ -1,16 +1,16 @@
 //! One verdict: `catflip optimize` and `catflip run` judge the same method on
 //! the same config alike, on every bundled config.
 
+use crate::util;
 use std::path::Path;
-use std::process::Command;
 
 /// The command's JSON, or its stderr when it printed none.
 fn json_or_error(args: &[&str], out: &Path) -> Result<serde_json::Value, String> {
-    let o = Command::new(env!("CARGO_BIN_EXE_catflip"))
+    let o = util::bin()
         .args(args)
         .args(["--json", "--out"])
         .arg(out)
-        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .current_dir(util::repo())
         .output()
         .unwrap();
     serde_json::from_slice(&o.stdout).map_err(|_| String::from_utf8_lossy(&o.stderr).into_owned())
@@ -22,8 +22,8 @@ fn json(args: &[&str], out: &Path) -> Option<serde_json::Value> {
 
 #[test]
 fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
-    let dir = tempfile::tempdir().unwrap();
-    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let dir = util::temp_dir();
+    let configs = util::configs();
     let mut checked = 0;
     for entry in std::fs::read_dir(configs).unwrap() {
         let path = entry.unwrap().path();

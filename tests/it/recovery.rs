@@ -2,7 +2,7 @@
 //! about the spine the design handles is recoverable, the map is symmetric
 //! where the body is, shards concatenate to the whole map, the figures are SVG.
 
-mod util;
+use crate::util;
 
 use catflip::recovery::{Family, Grid, LineResult, Outcome, map};
 use catflip::sweep::Shard;

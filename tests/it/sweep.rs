@@ -1,6 +1,6 @@
 //! Sweeps: continuation chunks, shards through the real binary, progress.
 
-mod util;
+use crate::util;
 
 use catflip::sweep::{CHUNK, Shard, progress_line};
 use util::{bin, configs, run_written, temp_dir};

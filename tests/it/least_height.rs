@@ -5,9 +5,8 @@ use catflip::Config;
 use catflip::design::envelope::{least_stretch, usage_of};
 use catflip::design::least_height::{Heights, heights, reference};
 
-fn robot(set: &[String]) -> Config {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/configs/robot-universal.toml");
-    Config::load(std::path::Path::new(path), set).unwrap()
+fn robot(set: &[&str]) -> Config {
+    crate::util::config("robot-universal", set)
 }
 
 fn least(cfg: &Config) -> Heights {
@@ -22,7 +21,7 @@ fn least(cfg: &Config) -> Heights {
 /// same to the bit). The question's height only decides `possible`.
 #[test]
 fn the_least_height_is_the_same_from_any_question_height() {
-    let at = |h: f64| robot(&[format!("fall.height={h}")]);
+    let at = |h: f64| robot(&[&format!("fall.height={h}")]);
     for h in [1.0, 6.0, 10.0] {
         assert_eq!(
             reference(&at(h).design_spec()).fall.height,
@@ -75,7 +74,7 @@ fn the_least_height_is_the_same_from_any_question_height() {
 fn a_weaker_motor_never_needs_less_height() {
     let base = robot(&[]);
     let w0 = base.limits.no_load_speed.unwrap();
-    let weak = robot(&[format!("limits.no_load_speed={}", 0.8 * w0)]);
+    let weak = robot(&[&format!("limits.no_load_speed={}", 0.8 * w0)]);
     let (a, b) = (least(&base).answer, least(&weak).answer);
     assert!(
         b.least_height_m >= a.least_height_m * (1.0 - 1e-3),

@@ -1,32 +1,9 @@
 //! Issue 31 through the real binary: bounded work, unit slips, interrupted
 //! sweeps, reports that copy, and the small inconsistencies.
 
+use crate::util::{self, bin, config_arg as config, output as run, stderr};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-fn bin() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_catflip"))
-}
-
-fn config(name: &str) -> String {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("configs")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn run(args: &[&str], dir: &Path) -> Output {
-    bin()
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("binary runs")
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
 
 /// Every file and folder under `dir`, hidden ones included.
 fn tree(dir: &Path) -> Vec<PathBuf> {
@@ -46,7 +23,7 @@ fn tree(dir: &Path) -> Vec<PathBuf> {
 
 /// Bad input: exit 2, a message naming `needles`, nothing written.
 fn refused(args: &[&str], needles: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let o = run(args, dir.path());
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
@@ -63,8 +40,8 @@ fn refused(args: &[&str], needles: &[&str]) {
 
 #[test]
 fn work_is_bounded_up_front_by_each_keys_range() {
-    let robot = config("robot-universal.toml");
-    let seed = config("seed.toml");
+    let robot = config("robot-universal");
+    let seed = config("seed");
     // the issue's cases: a 4 h fall (was 12.8 GB and a kill), a 10 km fall
     // (was 179 MB of output), and an overflowing fall time (was exit 0 with nulls)
     refused(
@@ -140,8 +117,8 @@ fn work_is_bounded_up_front_by_each_keys_range() {
 
 #[test]
 fn the_longest_accepted_fall_gives_finite_numbers_only() {
-    let seed = config("seed.toml");
-    let dir = tempfile::tempdir().unwrap();
+    let seed = config("seed");
+    let dir = util::temp_dir();
     // 30 s at 9.8 m/s^2 is 4410 m
     for (h, ok) in [("4409", true), ("4411", false)] {
         let set = format!("fall.height={h}");
@@ -157,7 +134,7 @@ fn the_longest_accepted_fall_gives_finite_numbers_only() {
 
 /// A warning on stderr that names the key and the slip, and the command runs.
 fn warns(args: &[&str], needles: &[&str]) {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let o = run(args, dir.path());
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
@@ -170,8 +147,8 @@ fn warns(args: &[&str], needles: &[&str]) {
 
 #[test]
 fn unit_slips_are_warned_about_and_impossible_cats_refused() {
-    let robot = config("robot-universal.toml");
-    let seed = config("seed.toml");
+    let robot = config("robot-universal");
+    let seed = config("seed");
     warns(
         &["analyze", &robot, "--set", "limits.no_load_speed=46"],
         &["limits.no_load_speed", "rev/min", "4.8171 rad/s"],
@@ -201,8 +178,8 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["fall.gravity", "ft/s^2"],
     );
     // the shipped configs are plausible: no slip warnings
-    for c in ["seed.toml", "robot-universal.toml", "domestic-cat.toml"] {
-        let dir = tempfile::tempdir().unwrap();
+    for c in ["seed", "robot-universal", "domestic-cat"] {
+        let dir = util::temp_dir();
         let o = run(&["analyze", &config(c)], dir.path());
         let err = stderr(&o);
         assert!(
@@ -220,7 +197,7 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["analyze", &seed, "--set", "limits.max_bend_deg=175"],
         &["limits.max_bend_deg", "into each other", "168.46"],
     );
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let o = run(
         &["analyze", &seed, "--set", "limits.max_bend_deg=168"],
         dir.path(),
@@ -233,7 +210,7 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
 fn sweep_args(out: &str) -> Vec<String> {
     [
         "sweep",
-        &config("seed.toml"),
+        &config("seed"),
         "--set-range",
         "cat.mass=0.5:2.4:20",
         "--methods",
@@ -299,7 +276,7 @@ fn read(p: PathBuf) -> String {
 
 #[test]
 fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_results() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let set = |out: &str| {
         dir.path()
             .join(out)
@@ -375,7 +352,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
     assert!(stderr(&o).contains("no sweep to resume"), "{}", stderr(&o));
     // an edited config file is refused by the state's record of the config
     let edited = dir.path().join("seed.toml");
-    let text = read(PathBuf::from(config("seed.toml")));
+    let text = read(PathBuf::from(config("seed")));
     std::fs::write(&edited, text.replace("radius = 0.1 ", "radius = 0.11 ")).unwrap();
     let mut changed = args.clone();
     changed[1] = edited.display().to_string();
@@ -411,7 +388,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
 
 #[test]
 fn sigterm_stops_a_sweep_too() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM");
     assert_eq!(code, Some(130), "{err}");
     assert!(
@@ -443,8 +420,8 @@ fn contents(dir: &Path) -> Vec<(PathBuf, Vec<u8>)> {
 
 #[test]
 fn a_report_is_an_ordinary_folder_that_copies_and_runs_keep_their_own() {
-    let dir = tempfile::tempdir().unwrap();
-    let seed = config("seed.toml");
+    let dir = util::temp_dir();
+    let seed = config("seed");
     let plain = ["run", &seed, "--set", "free.nodes=12"];
     let o = run(&plain, dir.path());
     assert!(o.status.success(), "{}", stderr(&o));
@@ -559,8 +536,8 @@ fn a_report_is_an_ordinary_folder_that_copies_and_runs_keep_their_own() {
 
 #[test]
 fn the_small_inconsistencies_are_fixed() {
-    let dir = tempfile::tempdir().unwrap();
-    let seed = config("seed.toml");
+    let dir = util::temp_dir();
+    let seed = config("seed");
     // a JSON schedule replays as its CSV does
     let o = run(&["analyze", &seed], dir.path());
     assert!(o.status.success());
@@ -646,7 +623,7 @@ fn the_small_inconsistencies_are_fixed() {
         &["2 of 3 points", "fall.height", "30 s"],
     );
     // venv/ is ignored
-    let ignore = read(Path::new(env!("CARGO_MANIFEST_DIR")).join(".gitignore"));
+    let ignore = read(util::repo().join(".gitignore"));
     assert!(
         ignore
             .lines()
@@ -685,8 +662,8 @@ fn size(dir: &Path) -> u64 {
 /// amounts and report only finite numbers.
 #[test]
 fn the_largest_accepted_inputs_hold_the_memory_and_output_caps() {
-    let dir = tempfile::tempdir().unwrap();
-    let robot = config("robot-universal.toml");
+    let dir = util::temp_dir();
+    let robot = config("robot-universal");
     // 30 s at 9.81 m/s^2: 4414.5 m
     let longest = "fall.height=4414";
     let o = run_capped(
@@ -766,7 +743,7 @@ const REPLAN_EVERY: &str = "control.replan_every=10";
 fn robustness_args(out: &str, trials: usize) -> Vec<String> {
     [
         "robustness",
-        &config("seed.toml"),
+        &config("seed"),
         "--trials",
         &trials.to_string(),
         "--threads",
@@ -783,7 +760,7 @@ fn robustness_args(out: &str, trials: usize) -> Vec<String> {
 
 #[test]
 fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_the_same_results() {
-    let dir = tempfile::tempdir().unwrap();
+    let dir = util::temp_dir();
     let set = |out: &str| {
         dir.path()
             .join(out)

@@ -1,6 +1,6 @@
 //! Physics facts of docs/model.md section 6 checked on the library.
 
-mod util;
+use crate::util;
 
 use catflip::design::analytic::{analytic_plan, closed_forms, plan, turns_theta, yy_inertia_and_c};
 use catflip::design::plan::ShapePlan;

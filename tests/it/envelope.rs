@@ -1,7 +1,7 @@
 //! Phased designs inside the motor envelope (design/envelope.rs) against
 //! F7, time scaling, the unit-time peak program, and the motor model.
 
-mod util;
+use crate::util;
 
 use catflip::design::envelope::{height_for, torque_squared_integral, usage_of};
 use catflip::design::phased::optimize;

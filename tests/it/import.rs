@@ -2,7 +2,7 @@
 //! the same model to round-off; what catflip cannot model is refused with
 //! the element and its line, exit status 2, nothing written.
 
-mod util;
+use crate::util;
 
 use catflip::Config;
 use catflip::export::{mjcf, urdf};
@@ -12,7 +12,7 @@ use util::{config, run, seed, temp_dir};
 
 /// A body with products of inertia, off-axis centres of mass, an
 /// off-centre joint and (universal) tilted motor axes, as `[body]` keys.
-pub const LOPSIDED: &str = include_str!("data/lopsided-body.toml");
+pub const LOPSIDED: &str = include_str!("../data/lopsided-body.toml");
 
 pub fn lopsided(joint: &str, extra: &str) -> Config {
     let text = format!(

@@ -2,7 +2,7 @@
 //! the schedule in the simulator's coordinates. The engines themselves
 //! (MuJoCo, pyBullet) check the replays in `.ci/run` (examples/replay_*.py).
 
-mod util;
+use crate::util;
 
 use catflip::export::controls::{Controls, Simulator, time_step};
 use catflip::model::Joint;

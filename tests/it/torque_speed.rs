@@ -3,7 +3,7 @@
 //! no-load speed, and a schedule the JSON calls inside the envelope is drawn
 //! inside it (one that leaves it is drawn outside: the check can fail).
 
-mod util;
+use crate::util;
 
 use util::{bin, config_path, temp_dir};
 

@@ -1,6 +1,6 @@
 //! The phased optimiser against independent code paths.
 
-mod util;
+use crate::util;
 
 use catflip::design::analytic::plan as cosine_plan;
 use catflip::design::path::Path;

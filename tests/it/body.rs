@@ -1,7 +1,7 @@
 //! Unequal halves (`[cat.front]`): the reduced model against the bodies'
 //! own velocities, the relabelling symmetry, and identical halves as before.
 
-mod util;
+use crate::util;
 
 use catflip::design::phased::optimize;
 use catflip::model::dynamics::kinetic_energy;
@@ -88,7 +88,7 @@ fn unequal_halves_zero_momentum_and_kinetic_energy_from_the_bodies() {
     }
 }
 
-// power balance with unequal halves: tests/foundation.rs, power_balance_dt_dt_equals_tau_dot_qdot
+// power balance with unequal halves: tests/it/foundation.rs, power_balance_dt_dt_equals_tau_dot_qdot
 
 #[test]
 fn identical_front_table_reproduces_the_symmetric_cat() {

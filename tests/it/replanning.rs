@@ -1,7 +1,7 @@
 //! The replanning controller of issue 27: the free-form design solved again
 //! in flight from the predicted state, about which the design's TVLQR gains act.
 
-mod util;
+use crate::util;
 
 use catflip::control::closed_loop::{Feedback, Flight, fly};
 use catflip::control::reference::Reference;

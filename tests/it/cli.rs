@@ -1,6 +1,6 @@
 //! The real binary on a temporary directory.
 
-mod util;
+use crate::util;
 
 use std::path::Path;
 use util::{bin, configs, output, temp_dir, text};

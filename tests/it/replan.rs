@@ -2,7 +2,7 @@
 //! state measured mid-manoeuvre, checked by flying the new plan from that
 //! state in the closed-loop simulator's fixed-step model.
 
-mod util;
+use crate::util;
 
 use catflip::control::plant::{Y, attitude, rk4};
 use catflip::control::reference::Reference;

@@ -2,7 +2,7 @@
 //! without errors, and the animation advances. Ignored by default because it
 //! needs `chromium`; `.ci/run` installs it and runs `cargo test --release --test browser -- --ignored`.
 
-mod util;
+use crate::util;
 
 use std::process::Command;
 use util::{bin, seed_toml, temp_dir};

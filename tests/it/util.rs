@@ -1,7 +1,5 @@
-//! Helpers shared by the integration tests: each file in `tests/` says
-//! `mod util;` and takes what it needs, so a helper is written once.
-//! (A folder module, so cargo does not build it as a test binary of its own.)
-#![allow(dead_code)] // each test binary uses a part of it
+//! Helpers shared by the integration tests: each module says
+//! `use crate::util;` and takes what it needs, so a helper is written once.
 
 use catflip::Config;
 use std::path::{Path, PathBuf};
@@ -21,6 +19,11 @@ pub fn configs() -> PathBuf {
 /// The path of a bundled config: `config_path("seed")` is `configs/seed.toml`.
 pub fn config_path(name: &str) -> PathBuf {
     configs().join(format!("{name}.toml"))
+}
+
+/// A bundled config's path as a command-line argument.
+pub fn config_arg(name: &str) -> String {
+    config_path(name).display().to_string()
 }
 
 /// `configs/seed.toml`, the seed document's example.
@@ -49,7 +52,7 @@ pub fn seed(overrides: &[&str]) -> Config {
 
 /// A bundled config as a peak-torque problem: the robot's servo also has a
 /// torque-speed line, which only the envelope designs handle
-/// (tests/envelope.rs), so here it is the same body under its stall torque
+/// (tests/it/envelope.rs), so here it is the same body under its stall torque
 /// alone. The other configs have no line and come as they are.
 pub fn stall_torque_only(name: &str, overrides: &[&str]) -> Config {
     let path = config_path(name);
@@ -83,6 +86,11 @@ pub fn text(o: &Output) -> (String, String) {
         String::from_utf8_lossy(&o.stdout).into_owned(),
         String::from_utf8_lossy(&o.stderr).into_owned(),
     )
+}
+
+/// A finished run's stderr as text.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
 }
 
 /// Runs the binary: its exit code (`None` when a signal ended it), stdout, stderr.

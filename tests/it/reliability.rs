@@ -1,7 +1,7 @@
 //! Every failure named, nothing half-written, no result thrown away.
 //! Each test runs the real binary on a temporary folder.
 
-mod util;
+use crate::util;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};

@@ -4,7 +4,7 @@
 //! each then designs a few motors itself with the library's least-height
 //! designs, independently of the curve's own arithmetic.
 
-mod util;
+use crate::util;
 
 use catflip::size::{HEIGHT_TOLERANCE, SizeAnswer, SizeSettings, design_motor, question, size};
 use std::sync::OnceLock;

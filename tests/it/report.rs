@@ -1,6 +1,6 @@
 //! The main job, sweeps and exports, through the real binary and the library.
 
-mod util;
+use crate::util;
 
 use util::{configs, run_ok, schedule_peak, temp_dir};
 

@@ -2,7 +2,7 @@
 //! a row, every row names a key the config accepts, and every documented
 //! default is the code's default. Either side changing alone fails here.
 
-mod util;
+use crate::util;
 
 use catflip::Config;
 use std::collections::BTreeMap;

@@ -3,7 +3,7 @@
 //! of mass keeps zero momentum and conserves energy in free fall; the
 //! relabelling symmetry where it holds and where it does not.
 
-mod util;
+use crate::util;
 
 use catflip::Config;
 use catflip::design::free::{FreeDesign, Seed};

@@ -1,7 +1,7 @@
 //! Free-form designs for every objective inside the motor envelope, against
 //! F7, time scaling, the motor model and the phased designs.
 
-mod util;
+use crate::util;
 
 use catflip::Config;
 use catflip::design::envelope::{height_for, usage_of};

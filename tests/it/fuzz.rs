@@ -5,7 +5,7 @@
 //! line) and random strings from the characters the formats use. A fixed
 //! seed keeps failures reproducible; the failing input is printed.
 
-mod util;
+use crate::util;
 
 use catflip::Config;
 use catflip::design::plan::Schedule;

@@ -1,7 +1,7 @@
 //! The model with angular momentum (MODEL.md section 6, F8-F10) checked on
 //! the library: conservation, power balance, the locked rigid body, time scaling.
 
-use catflip::Config;
+use crate::util::seed;
 use catflip::design::analytic::{analytic_plan, plan};
 use catflip::design::plan::{Phase, ShapePlan, ShapeState};
 use catflip::model::Cat;
@@ -25,13 +25,6 @@ fn tight() -> OdeSettings {
         atol: 1e-14,
         ..Default::default()
     }
-}
-
-fn seed(overrides: &[&str]) -> Config {
-    let text =
-        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml")).unwrap();
-    let ov: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
-    Config::from_toml(&text, "seed.toml", &ov).unwrap()
 }
 
 /// The seed's cat and an unequal one, both joints.

@@ -2,7 +2,7 @@
 //! section 6): checked against catflip's independent simulators, which
 //! integrate the attitude and momentum with their own adaptive method.
 
-mod util;
+use crate::util;
 
 use catflip::design::free::{FreeDesign, FreeResult};
 use catflip::design::plan::ShapePlan;
