@@ -851,9 +851,12 @@ pub fn index_html(page: &Page) -> String {
     h.push_str(&esc(title));
     h.push_str(concat!(
         "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px}",
-        "table{border-collapse:collapse}td,th{border:1px solid #bbb;padding:4px 8px;text-align:right;white-space:nowrap}",
-        "th{background:#eee}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}",
-        // the verdict (a sentence when flagged) wraps inside the page width
+        // the comparison fits the page: headers and the verdict (a sentence
+        // when flagged) wrap, numbers do not; a narrow window scrolls the
+        // table alone
+        ".wide{overflow-x:auto}table{border-collapse:collapse;font-size:14px}",
+        "td,th{border:1px solid #bbb;padding:3px 6px;text-align:right;white-space:nowrap}",
+        "th{background:#eee;white-space:normal}td:first-child{text-align:left}img{max-width:100%;margin:1em 0}",
         "td:last-child,th:last-child{white-space:normal;text-align:left;min-width:12em}",
         ".warn{border-left:4px solid #b00;padding:2px 8px;background:#fee}",
         "#views{display:flex;flex-wrap:wrap;gap:12px}.view h3{margin:4px 0}",
@@ -871,7 +874,7 @@ pub fn index_html(page: &Page) -> String {
     if let Some(lead) = lead {
         h.push_str(lead);
     }
-    h.push_str("<table>\n<tr>");
+    h.push_str("<div class=\"wide\"><table>\n<tr>");
     for c in header {
         h.push_str(&format!("<th>{}</th>", esc(c)));
     }
@@ -883,7 +886,7 @@ pub fn index_html(page: &Page) -> String {
         }
         h.push_str("</tr>\n");
     }
-    h.push_str("</table>\n");
+    h.push_str("</table></div>\n");
     for w in warnings {
         h.push_str(&format!("<p class=\"warn\">{}</p>\n", esc(w)));
     }

@@ -247,6 +247,10 @@
     // world x of body A's belly at the end: cos(flip) for a straight, untilted cat
     out.belly_x_end = tracks.map(tr => rot(tr.frames[tr.frames.length - 1].a, [1, 0, 0])[0]);
     out.flip_end_deg = tracks.map(tr => tr.frames[tr.frames.length - 1].flip_deg);
+    // the page's layout: what overflows the window sideways, px
+    out.window_width_px = window.innerWidth;
+    out.page_width_px = document.documentElement.scrollWidth;
+    out.table_right_px = document.querySelector('table').getBoundingClientRect().right;
     setTime(0);
     play(true);
     setTimeout(() => {
