@@ -68,7 +68,8 @@ fn main() -> anyhow::Result<()> {
                         r.scp_iterations,
                         format!("{:?}", r.status),
                         r.objective_value,
-                        r.landing_error_deg
+                        catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &r.plan)
+                            .map_or(f64::NAN, |s| s.landing_error_deg)
                     ),
                     Err(e) => println!("{norm:<10} {objective:<12} {label:<22} failed: {e}"),
                 }

@@ -28,7 +28,7 @@ fn main() -> anyhow::Result<()> {
         "free-form: peak {:.4} N m ({:.1} % of phased), simulated flip error {:.1e} rad",
         free.peak_torque_nm,
         100.0 * free.peak_torque_nm / phased.peak_torque_nm,
-        free.flip_error_rad
+        catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &free.plan)?.flip_error_rad
     );
     // inside the project, published like the commands' sets: output/<name>/example-design/
     let mut out = catflip::output::Output::default();

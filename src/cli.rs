@@ -474,12 +474,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         _ => "the phased design",
     };
     let partial = flag(what, reason.clone());
-    let mut json = match &judged.design {
-        Design::Phased(r) => serde_json::to_value(r)?,
-        Design::Free(r) => serde_json::to_value(r)?,
-        Design::Analytic(a) => serde_json::to_value(a)?,
-        Design::LeastHeight(l) => serde_json::to_value(l)?,
-    };
+    let mut json = judged.design_json(&spec)?;
     // a number that is not finite is refused, not written as null
     catflip::output::ensure_finite(
         &json,
@@ -503,8 +498,12 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         return Ok(Status::of(partial));
     }
     match &judged.design {
-        Design::Phased(r) => say_lines(console::design::phased(&cfg, r, &written).lines()),
-        Design::Free(r) => say_lines(console::design::free(&cfg, r, &written).lines()),
+        Design::Phased(r) => {
+            say_lines(console::design::phased(&cfg, r, judged.sim.as_ref().ok(), &written).lines())
+        }
+        Design::Free(r) => {
+            say_lines(console::design::free(&cfg, r, judged.sim.as_ref().ok(), &written).lines())
+        }
         Design::Analytic(_) | Design::LeastHeight(_) => {}
     }
     Ok(Status::of(partial))

@@ -1,7 +1,7 @@
 //! The per-method stage every command shares: a method's design is sampled
-//! as the schedule that is written, simulated (unless the design brought
-//! its verifying simulation), judged by [`crate::verdict`], and turned into
-//! its summary line, its files, its figure curves and its animation track.
+//! as the schedule that is written, simulated (designs do not fly
+//! themselves), judged by [`crate::verdict`], and turned into its summary
+//! line, its files, its figure curves and its animation track.
 //! `run` passes each method through [`stage`]; `optimize` passes its one
 //! design; `sweep` judges its points with [`judge`] (peaks only, no files).
 
@@ -15,7 +15,7 @@ use crate::report::MethodTrace;
 use crate::report::animation::Track;
 use crate::verdict::{DesignNumbers, Grade, Miss, Simulated, Status, Targets, Verdict, verdict};
 use crate::verify::analyze::Analysis;
-use crate::verify::simulate::{SimReport, dynamic_spec};
+use crate::verify::simulate::{SimReport, dynamic_spec, kinematic_spec};
 use serde::Serialize;
 
 /// The design methods, in the order every table lists them.
@@ -165,16 +165,6 @@ impl Design {
             }
         }
     }
-
-    /// The dynamic simulation the design was verified with, if it brought one.
-    fn simulation(&self) -> Option<&SimReport> {
-        match self {
-            Design::Analytic(_) => None,
-            Design::Phased(p) => p.sim.as_ref(),
-            Design::Free(f) => Some(&f.sim),
-            Design::LeastHeight(_) => None,
-        }
-    }
 }
 
 /// The verdict on a design with this status, dense peak and largest bend
@@ -243,10 +233,7 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
         Design::LeastHeight(l) => l.schedule.clone(),
         _ => Schedule::sample(&spec.cat, design.plan(), spec.simulate.samples_per_phase),
     };
-    let sim = match design.simulation() {
-        Some(s) => Ok(s.clone()),
-        None => dynamic_spec(spec, design.plan()),
-    };
+    let sim = dynamic_spec(spec, design.plan());
     let method = design.method();
     let (bend, twist, durations) = design.path_numbers();
     let peak = design.peak_torque_nm();
@@ -311,6 +298,33 @@ impl Judged {
             Ok(s) => std::borrow::Cow::Borrowed(s),
             Err(_) => std::borrow::Cow::Owned(SimReport::failed()),
         }
+    }
+
+    /// The design's JSON (`optimize`'s `<method>.json`, the Python
+    /// `Design.json`): its own numbers, and for an optimised design how it
+    /// flew ([`Flown`]). A failed simulation is the error.
+    pub fn design_json(&self, spec: &DesignSpec) -> Result<serde_json::Value> {
+        let mut json = match &self.design {
+            Design::Phased(r) => serde_json::to_value(r),
+            Design::Free(r) => serde_json::to_value(r),
+            Design::Analytic(a) => serde_json::to_value(a),
+            Design::LeastHeight(l) => serde_json::to_value(l),
+        }
+        .map_err(|e| Error::Report(e.to_string()))?;
+        if let Design::Phased(_) | Design::Free(_) = self.design {
+            let sim = self.sim.as_ref().map_err(|e| match e {
+                Error::Simulation(m) => Error::Simulation(m.clone()),
+                other => Error::Simulation(other.to_string()),
+            })?;
+            let kin = kinematic_spec(spec, self.design.plan())?;
+            let flown = serde_json::to_value(Flown::of(sim, &kin))
+                .map_err(|e| Error::Report(e.to_string()))?;
+            if let (serde_json::Value::Object(j), serde_json::Value::Object(f)) = (&mut json, flown)
+            {
+                j.extend(f);
+            }
+        }
+        Ok(json)
     }
 
     /// `<method>.csv` and `<method>.schedule.json`.
@@ -381,6 +395,39 @@ pub fn trace(
         phase_bounds: b,
         flip_t: sim.trace.iter().map(|p| p.t).collect(),
         flip_deg: sim.trace.iter().map(|p| p.flip.to_degrees()).collect(),
+    }
+}
+
+/// How an optimised design flew, as its `<method>.json` gives it beside
+/// the design's own numbers.
+#[derive(Debug, Clone, Serialize)]
+pub struct Flown {
+    /// From the dynamic simulation (feed-forward + PD) of the schedule.
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown, deg.
+    pub landing_error_deg: f64,
+    pub sim_peak_torque_nm: f64,
+    pub momentum_drift_nms: f64,
+    /// From the kinematic simulation of the planned shape.
+    pub kinematic_flip_error_rad: f64,
+    pub kinematic_tilt_deg: f64,
+}
+
+impl Flown {
+    /// The numbers of the dynamic `sim` and the kinematic `kin` simulations.
+    pub fn of(sim: &SimReport, kin: &SimReport) -> Flown {
+        Flown {
+            flip_deg: sim.flip_deg,
+            flip_error_rad: sim.flip_error_rad,
+            tilt_deg: sim.tilt_deg,
+            landing_error_deg: sim.landing_error_deg,
+            sim_peak_torque_nm: sim.peak_torque_nm,
+            momentum_drift_nms: sim.momentum_drift_nms,
+            kinematic_flip_error_rad: kin.flip_error_rad,
+            kinematic_tilt_deg: kin.tilt_deg,
+        }
     }
 }
 

@@ -26,6 +26,7 @@ use crate::design::plan::ShapePlan;
 use crate::error::{Error, Result};
 use crate::verdict::Status;
 use crate::verify::ode::OdeSettings;
+use crate::verify::simulate::SimReport;
 use serde::{Deserialize, Serialize};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -409,14 +410,17 @@ impl Origin {
                 .warm(warm, before)
                 .solve()
         };
-        let kept = match fr {
-            Ok(fr) => {
-                p.outcome = if lands(&cfg, &fr) {
+        let flown = fr.and_then(|fr| {
+            crate::verify::simulate::dynamic_spec(&cfg.design_spec(), &fr.plan).map(|s| (fr, s))
+        });
+        let kept = match flown {
+            Ok((fr, sim)) => {
+                p.outcome = if lands(&cfg, &fr, &sim) {
                     Outcome::Lands
                 } else {
                     Outcome::Misses
                 };
-                p.landing_error_deg = fr.landing_error_deg;
+                p.landing_error_deg = sim.landing_error_deg;
                 p.error_source = Source::Design;
                 p.design_status = Some(fr.status.into());
                 p.peak_torque_nm = Some(fr.peak_torque_nm);
@@ -486,7 +490,10 @@ impl Origin {
                 .warm(&warm, None)
                 .solve()
             {
-                Ok(fr) if lands(&cfg, &fr) => {
+                Ok(fr)
+                    if crate::verify::simulate::dynamic_spec(&cfg.design_spec(), &fr.plan)
+                        .is_ok_and(|sim| lands(&cfg, &fr, &sim)) =>
+                {
                     lo = mid;
                     warm = fr;
                 }
@@ -502,9 +509,9 @@ impl Origin {
 /// Whether a design lands: verified as the least-height answer verifies
 /// one (constraints met, inside the motor envelope, landing within the
 /// tolerance under the motor model).
-fn lands(cfg: &Config, fr: &FreeResult) -> bool {
-    fr.landing_error_deg <= tolerance_deg(cfg)
-        && crate::design::least_height::verified(&cfg.design_spec(), fr)
+fn lands(cfg: &Config, fr: &FreeResult, sim: &SimReport) -> bool {
+    sim.landing_error_deg <= tolerance_deg(cfg)
+        && crate::design::least_height::verifies(&cfg.design_spec(), fr, sim)
 }
 
 /// The least drop height from `cfg`'s start, m: the shortest verified

@@ -346,7 +346,7 @@ fn point(
                     ph.status.into(),
                     ph.peak_torque_nm,
                     ph.bend_deg,
-                    (ph.flip_error_rad, ph.tilt_deg),
+                    &ph.plan,
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
@@ -378,7 +378,7 @@ fn point(
                         fr.status.into(),
                         fr.peak_torque_nm,
                         fr.bend_deg,
-                        (fr.flip_error_rad, fr.tilt_deg),
+                        &fr.plan,
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
@@ -421,7 +421,8 @@ fn point(
 
 /// A kept design that misses a target (unconverged, flip missed, bend
 /// limit broken) is named in the point's `error` column beside its numbers
-/// ([`crate::pipeline::judge`]; a sweep's peaks are computed without the torque limit and
+/// ([`crate::pipeline::judge`], the flip from `plan` flown under the motor
+/// model; a sweep's peaks are computed without the torque limit and
 /// samples no schedule, so speed and envelope are not judged here).
 fn flagged(
     method: &str,
@@ -429,18 +430,16 @@ fn flagged(
     status: Status,
     peak_torque_nm: f64,
     bend_deg: f64,
-    (flip_error_rad, tilt_deg): (f64, f64),
+    plan: &dyn crate::design::plan::ShapePlan,
 ) -> Option<String> {
-    let v = crate::pipeline::judge(
-        spec,
-        status,
-        (peak_torque_nm, bend_deg),
-        None,
-        &Simulated::Flip {
-            flip_error_rad,
-            tilt_deg,
+    let simulated = match crate::verify::simulate::dynamic_spec(spec, plan) {
+        Ok(sim) => Simulated::Flip {
+            flip_error_rad: sim.flip_error_rad,
+            tilt_deg: sim.tilt_deg,
         },
-    );
+        Err(e) => Simulated::Failed(e.to_string()),
+    };
+    let v = crate::pipeline::judge(spec, status, (peak_torque_nm, bend_deg), None, &simulated);
     let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }

@@ -115,7 +115,7 @@ class Design:
         ``criticality``, ``radius``, ``weight``, ``rule``); None for the other methods."""
     @property
     def flip_deg(self) -> float:
-        """Flip of the design's own simulation, deg (dynamic for free and phased, kinematic for analytic)."""
+        """Flip of the design's flight, deg (dynamic for free and phased, as ``optimize`` flies it; kinematic for analytic)."""
     @property
     def config(self) -> Config:
         """The config the design was made with (with ``objective`` applied)."""

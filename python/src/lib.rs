@@ -403,6 +403,41 @@ struct Design {
     durations: [f64; 3],
 }
 
+/// An optimised design as the CLI's `optimize` makes it: through its stage
+/// (`catflip::pipeline::stage`: sampled, flown, judged), with its JSON.
+type Staged = (
+    Plan,
+    Schedule,
+    serde_json::Value,
+    catflip::verdict::Status,
+    Option<String>,
+    f64,
+    [f64; 3],
+);
+
+fn staged(
+    spec: &catflip::design::spec::DesignSpec,
+    design: catflip::pipeline::Design,
+) -> PyResult<Staged> {
+    use catflip::pipeline::Design as D;
+    let j = catflip::pipeline::stage(spec, design, 0.0);
+    let json = j.design_json(spec).map_err(err)?;
+    catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
+    let (status, reason, peak) = (
+        j.design.status(),
+        j.verdict.reason(),
+        j.design.peak_torque_nm(),
+    );
+    let (_, _, durations) = j.design.path_numbers();
+    let plan: Plan = match j.design {
+        D::Free(r) => std::sync::Arc::new(r.plan),
+        D::Phased(r) => std::sync::Arc::new(r.plan),
+        D::Analytic(a) => std::sync::Arc::new(a.plan),
+        D::LeastHeight(l) => std::sync::Arc::new(l.schedule),
+    };
+    Ok((plan, j.schedule, json, status, reason, peak, durations))
+}
+
 /// The library's design for `method`, judged and sampled as the CLI does.
 fn run_design(
     cfg: Cfg,
@@ -417,8 +452,6 @@ fn run_design(
         ))
     };
     let spec = cfg.design_spec();
-    let sample =
-        |plan: &dyn ShapePlan| Schedule::sample(&spec.cat, plan, spec.simulate.samples_per_phase);
     let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
         match method {
             "free" => {
@@ -436,52 +469,14 @@ fn run_design(
                     .check_mesh()
                     .solve()
                     .map_err(err)?;
-                let sched = sample(&r.plan);
-                let status = Status::from(r.status);
-                let reason = judged(
-                    &spec,
-                    status,
-                    (r.peak_torque_nm, r.bend_deg),
-                    &sched,
-                    (r.flip_error_rad, r.tilt_deg),
-                );
-                let json = serde_json::to_value(&r).expect("serialises");
-                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
-                (
-                    std::sync::Arc::new(r.plan),
-                    sched,
-                    json,
-                    status,
-                    reason,
-                    r.peak_torque_nm,
-                    r.phase_durations_s,
-                )
+                staged(&spec, catflip::pipeline::Design::Free(r))?
             }
             "phased" => {
                 if seed.is_some() {
                     return Err(no_seed("the phased design"));
                 }
                 let r = catflip::design::phased::optimize(&spec, |_| {}).map_err(err)?;
-                let sched = sample(&r.plan);
-                let status = Status::from(r.status);
-                let reason = judged(
-                    &spec,
-                    status,
-                    (r.peak_torque_nm, r.bend_deg),
-                    &sched,
-                    (r.flip_error_rad, r.tilt_deg),
-                );
-                let json = serde_json::to_value(&r).expect("serialises");
-                catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
-                (
-                    std::sync::Arc::new(r.plan),
-                    sched,
-                    json,
-                    status,
-                    reason,
-                    r.peak_torque_nm,
-                    r.phase_durations_s,
-                )
+                staged(&spec, catflip::pipeline::Design::Phased(r))?
             }
             _ => {
                 if seed.is_some() {

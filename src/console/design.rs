@@ -120,37 +120,42 @@ pub fn simulation_title(cfg: &Config, source: &str) -> String {
     )
 }
 
-/// The verification numbers of a design, as both optimisers' tables show them.
-pub struct Verified {
-    pub phase_durations_s: [f64; 3],
-    pub flip_deg: f64,
-    pub flip_error_rad: f64,
-    pub tilt_deg: f64,
-    pub sim_peak_torque_nm: f64,
-}
-
-/// The rows both optimisers print: timing, verification, solve time, files.
-fn design_rows(t: &mut Rows, v: &Verified, solve: String, written: &[PathBuf]) {
-    let d = v.phase_durations_s;
+/// The rows both optimisers print: timing, the flight (`None`: the
+/// simulation failed, which the verdict says), solve time, files.
+fn design_rows(
+    t: &mut Rows,
+    durations: [f64; 3],
+    sim: Option<&SimReport>,
+    solve: String,
+    written: &[PathBuf],
+) {
+    let d = durations;
     t.row(
         "phase durations",
         format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
-    )
-    .row(
-        "flip (dynamic sim)",
-        format!("{:.6} deg (error {:.2e} rad)", v.flip_deg, v.flip_error_rad),
-    )
-    .row("tilt", format!("{:.3e} deg", v.tilt_deg))
-    .row(
-        "sim peak torque",
-        format!("{:.5} N m", v.sim_peak_torque_nm),
-    )
+    );
+    match sim {
+        Some(v) => t
+            .row(
+                "flip (dynamic sim)",
+                format!("{:.6} deg (error {:.2e} rad)", v.flip_deg, v.flip_error_rad),
+            )
+            .row("tilt", format!("{:.3e} deg", v.tilt_deg))
+            .row("sim peak torque", format!("{:.5} N m", v.peak_torque_nm)),
+        None => t.row("flip (dynamic sim)", "failed".to_string()),
+    }
     .row("solve time", solve)
     .wrote(written);
 }
 
 /// `optimize --mode phased`'s table.
-pub fn phased(cfg: &Config, r: &PhasedResult, written: &[PathBuf]) -> Rows {
+/// `sim`: the stage's flight of it.
+pub fn phased(
+    cfg: &Config,
+    r: &PhasedResult,
+    sim: Option<&SimReport>,
+    written: &[PathBuf],
+) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode phased: {} ({} joint), status {}",
         cfg.name,
@@ -179,13 +184,8 @@ pub fn phased(cfg: &Config, r: &PhasedResult, written: &[PathBuf]) -> Rows {
     );
     design_rows(
         &mut t,
-        &Verified {
-            phase_durations_s: r.phase_durations_s,
-            flip_deg: r.flip_deg,
-            flip_error_rad: r.flip_error_rad,
-            tilt_deg: r.tilt_deg,
-            sim_peak_torque_nm: r.sim_peak_torque_nm,
-        },
+        r.phase_durations_s,
+        sim,
         format!(
             "{:.3} s ({} bend evaluations)",
             r.solve_time_s,
@@ -197,7 +197,8 @@ pub fn phased(cfg: &Config, r: &PhasedResult, written: &[PathBuf]) -> Rows {
 }
 
 /// `optimize --mode free`'s table.
-pub fn free(cfg: &Config, r: &FreeResult, written: &[PathBuf]) -> Rows {
+/// `sim`: the stage's flight of it.
+pub fn free(cfg: &Config, r: &FreeResult, sim: Option<&SimReport>, written: &[PathBuf]) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
         cfg.name,
@@ -252,13 +253,8 @@ pub fn free(cfg: &Config, r: &FreeResult, written: &[PathBuf]) -> Rows {
     }
     design_rows(
         &mut t,
-        &Verified {
-            phase_durations_s: r.phase_durations_s,
-            flip_deg: r.flip_deg,
-            flip_error_rad: r.flip_error_rad,
-            tilt_deg: r.tilt_deg,
-            sim_peak_torque_nm: r.sim_peak_torque_nm,
-        },
+        r.phase_durations_s,
+        sim,
         format!(
             "{:.3} s ({})",
             r.solve_time_s,

@@ -47,7 +47,6 @@ use crate::error::Result;
 use crate::model::dynamics::{christoffel, linearize_torque, torque_from};
 use crate::model::so3::{exp, hat, log, right_jacobian, right_jacobian_inv};
 use crate::model::{Cat, ShapeTerms, TorqueNorm};
-use crate::verify::simulate::SimReport;
 use nalgebra::{Matrix3, Vector3};
 use serde::Serialize;
 
@@ -1178,17 +1177,6 @@ pub struct FreeResult {
     pub phase_durations_s: [f64; 3],
     /// Final attitude error of the optimiser's own map, rad.
     pub attitude_error_rad: f64,
-    /// From the dynamic simulation (feed-forward + PD) of the schedule.
-    pub flip_deg: f64,
-    pub flip_error_rad: f64,
-    pub tilt_deg: f64,
-    /// The belly's angle from straight down at touchdown (dynamic sim), deg.
-    pub landing_error_deg: f64,
-    pub sim_peak_torque_nm: f64,
-    pub momentum_drift_nms: f64,
-    /// From the kinematic simulation of the planned shape.
-    pub kinematic_flip_error_rad: f64,
-    pub kinematic_tilt_deg: f64,
     pub seed: String,
     pub scp_iterations: usize,
     pub nodes: usize,
@@ -1210,9 +1198,6 @@ pub struct FreeResult {
     pub warm: WarmStart,
     #[serde(skip)]
     pub plan: CollocationPlan,
-    /// The dynamic simulation the reported flip, tilt and peak come from.
-    #[serde(skip)]
-    pub sim: SimReport,
 }
 
 /// Which schedule seeds the SCP.
@@ -1819,9 +1804,9 @@ fn refine_checks(
     Ok(solved)
 }
 
-/// Runs the SCP from a start `z0` in physical units (see [`design`]), keeps
-/// the schedule inside the motor envelope (see [`inside_envelope`]) and
-/// verifies it by simulation.
+/// Runs the SCP from a start `z0` in physical units (see [`design`]) and
+/// keeps the schedule inside the motor envelope (see [`inside_envelope`]);
+/// the pipeline, not the design, flies it.
 fn optimize_start(
     spec: &DesignSpec,
     z0: &[f64],
@@ -1852,8 +1837,6 @@ fn optimize_start(
     let solve_time = start.elapsed().as_secs_f64();
     let objective = spec.objective;
     let (peak, objective_value) = dense_objective(spec, &plan);
-    let sim = crate::verify::simulate::dynamic_spec(spec, &plan)?;
-    let kin = crate::verify::simulate::kinematic_spec(spec, &plan)?;
     let (mut bend, mut twist, mut last_phi) = (0.0f64, 0.0, None::<f64>);
     for p in 0..3 {
         for k in 0..nodes {
@@ -1882,14 +1865,6 @@ fn optimize_start(
         twist_rad: twist,
         phase_durations_s: [0, 1, 2].map(|p| res.z[tr.duration(p)]),
         attitude_error_rad: att,
-        flip_deg: sim.flip_deg,
-        flip_error_rad: sim.flip_error_rad,
-        tilt_deg: sim.tilt_deg,
-        landing_error_deg: sim.landing_error_deg,
-        sim_peak_torque_nm: sim.peak_torque_nm,
-        momentum_drift_nms: sim.momentum_drift_nms,
-        kinematic_flip_error_rad: kin.flip_error_rad,
-        kinematic_tilt_deg: kin.tilt_deg,
         seed: seed.into(),
         scp_iterations: res.iterations.len(),
         nodes,
@@ -1907,7 +1882,6 @@ fn optimize_start(
         warm: res.warm.clone(),
         iterations: res.iterations,
         plan,
-        sim,
     })
 }
 

@@ -12,6 +12,7 @@ use crate::design::spec::DesignSpec;
 use crate::error::Result;
 use crate::model::motor::Motor;
 use crate::verdict::{DesignNumbers, Simulated, Status, Targets, verdict};
+use crate::verify::simulate::SimReport;
 use serde::Serialize;
 
 /// The answer, and the schedule that achieves the least height.
@@ -64,6 +65,7 @@ pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
 /// [`answer`] with the phased `time` design made for `reference`.
 fn answer_for(spec: &DesignSpec, reference: &DesignSpec) -> Result<HeightAnswer> {
     let r = crate::design::phased::optimize(reference, |_| {})?;
+    let sim = crate::verify::simulate::dynamic_spec(reference, &r.plan)?;
     let least = crate::design::envelope::height_for(spec, r.manoeuvre_time_s);
     Ok(HeightAnswer {
         possible: fits(spec, least),
@@ -73,7 +75,7 @@ fn answer_for(spec: &DesignSpec, reference: &DesignSpec) -> Result<HeightAnswer>
         method: "phased",
         status: r.status.into(),
         least_height_lower_bound_m: None,
-        flip_error_rad: r.flip_error_rad,
+        flip_error_rad: sim.flip_error_rad,
         from_start: spec.is_default_start(),
         schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
     })
@@ -228,30 +230,30 @@ pub fn heights(
     let mut answer = phased?;
     answer.least_height_lower_bound_m = bound.map(|t| crate::design::envelope::height_for(spec, t));
     let phased_m = answer.least_height_m;
-    let mut fastest: Option<FreeResult> = None;
+    let mut fastest: Option<(FreeResult, SimReport)> = None;
     for fr in from_stall.into_iter().chain([from_analytic]).flatten() {
-        if verified(&reference, &fr)
-            && fastest
-                .as_ref()
-                .is_none_or(|f| fr.manoeuvre_time_s < f.manoeuvre_time_s)
+        if fastest
+            .as_ref()
+            .is_none_or(|(f, _)| fr.manoeuvre_time_s < f.manoeuvre_time_s)
+            && let Some(sim) = verified(&reference, &fr)
         {
-            fastest = Some(fr);
+            fastest = Some((fr, sim));
         }
     }
-    if let Some(fr) = &fastest {
+    if let Some((fr, sim)) = &fastest {
         if !spec.is_default_start() {
             // the phased design is made for the start at rest: from another
             // start it only seeds the free-form one, which answers
             answer.least_time_s = f64::INFINITY;
         }
-        answer.improve_with(spec, fr);
+        answer.improve_with(spec, fr, sim);
     } else if !spec.is_default_start() {
         answer.possible = false;
     }
     Ok(Some(Heights {
         answer,
         phased_m,
-        free: fastest,
+        free: fastest.map(|(fr, _)| fr),
     }))
 }
 
@@ -261,8 +263,18 @@ pub fn heights(
 /// motor model within `simulate.flip_tolerance`. Optimality is not needed:
 /// any schedule that does this shows the flip possible from its height (the
 /// least height found is an upper bound either way), so a design that ran
-/// out of iterations still counts, and says so in its status.
-pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> bool {
+/// out of iterations still counts, and says so in its status. The
+/// simulation that verifies it, or `None`.
+pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> Option<SimReport> {
+    if fr.certificate.constraint_violation > spec.free.attitude_tolerance {
+        return None;
+    }
+    let sim = crate::verify::simulate::dynamic_spec(spec, &fr.plan).ok()?;
+    verifies(spec, fr, &sim).then_some(sim)
+}
+
+/// [`verified`] for a design already flown as `sim`.
+pub fn verifies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
     let usage = crate::design::envelope::usage_of(spec, &fr.plan);
     let v = verdict(
         &Targets::of(spec),
@@ -275,14 +287,14 @@ pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> bool {
         },
         &if spec.is_default_start() {
             Simulated::Flip {
-                flip_error_rad: fr.flip_error_rad,
-                tilt_deg: fr.tilt_deg,
+                flip_error_rad: sim.flip_error_rad,
+                tilt_deg: sim.tilt_deg,
             }
         } else {
             Simulated::Landing {
-                flip_error_rad: fr.flip_error_rad,
-                tilt_deg: fr.tilt_deg,
-                landing_error_deg: fr.landing_error_deg,
+                flip_error_rad: sim.flip_error_rad,
+                tilt_deg: sim.tilt_deg,
+                landing_error_deg: sim.landing_error_deg,
             }
         },
     );
@@ -292,10 +304,10 @@ pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> bool {
 }
 
 impl HeightAnswer {
-    /// Takes a verified free-form `time` design (`fr`: inside the envelope
-    /// and flipping; `run` also passes designs that stopped at the
-    /// iteration limit) when it is shorter than the answer's.
-    pub fn improve_with(&mut self, spec: &DesignSpec, fr: &FreeResult) {
+    /// Takes a verified free-form `time` design (`fr`, flown as `sim`:
+    /// inside the envelope and flipping; designs that stopped at the
+    /// iteration limit count too) when it is shorter than the answer's.
+    pub fn improve_with(&mut self, spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) {
         if fr.manoeuvre_time_s >= self.least_time_s {
             return;
         }
@@ -304,7 +316,7 @@ impl HeightAnswer {
         self.possible = fits(spec, self.least_height_m);
         self.method = "free";
         self.status = fr.status.into();
-        self.flip_error_rad = fr.flip_error_rad;
+        self.flip_error_rad = sim.flip_error_rad;
         self.from_start = true;
         self.schedule = Schedule::sample(&spec.cat, &fr.plan, spec.simulate.samples_per_phase);
     }

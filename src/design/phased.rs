@@ -23,7 +23,6 @@ use crate::design::twist::{TWIST_TOL, twist_to};
 use crate::error::{Error, Result};
 use crate::model::{Cat, Joint};
 use crate::verify::analyze::peak_along;
-use crate::verify::simulate::{SimReport, dynamic_spec};
 use serde::Serialize;
 use std::time::Instant;
 
@@ -158,12 +157,6 @@ pub struct PhasedResult {
     pub optimum_same_split_nm: Option<f64>,
     /// `analytic_peak_same_bend_nm / peak_torque_nm`.
     pub improvement_factor: f64,
-    /// From the dynamic simulation (feed-forward + PD).
-    pub flip_deg: f64,
-    pub flip_error_rad: f64,
-    pub tilt_deg: f64,
-    pub sim_peak_torque_nm: f64,
-    pub momentum_drift_nms: f64,
     pub nodes: usize,
     pub evaluations: Vec<BendEvaluation>,
     pub solve_time_s: f64,
@@ -171,8 +164,6 @@ pub struct PhasedResult {
     pub plan: PhasedPlan,
     #[serde(skip)]
     pub design: Option<BendDesign>,
-    #[serde(skip)]
-    pub sim: Option<SimReport>,
 }
 
 impl Scored for BendDesign {
@@ -273,7 +264,8 @@ pub fn check_limit(spec: &DesignSpec, unit_peak: f64, peak: f64, what: &str) -> 
     Ok(())
 }
 
-/// The phased optimiser: bend search, optimal split, reconstruction, verification.
+/// The phased optimiser: bend search, optimal split, reconstruction and
+/// comparison (the pipeline flies the schedule).
 pub fn optimize(spec: &DesignSpec, observe: impl FnMut(&BendEvaluation)) -> Result<PhasedResult> {
     optimize_near(spec, None, observe)
 }
@@ -317,9 +309,8 @@ pub const SEED_NODES: usize = 15;
 pub const SEED_BEND_TOL_DEG: f64 = 0.5;
 
 /// The phased design's schedule alone, as a seed for the free-form design:
-/// the bend search and the optimal split, without [`finish`]'s dense peak,
-/// comparison and verifying simulation (a third of [`optimize`]'s time on
-/// the seed config), which the free-form design does for its own result.
+/// the bend search and the optimal split, without [`finish`]'s dense peak
+/// and comparison, which the free-form design does for its own result.
 /// Nor does it check `limits.max_torque` ([`check_limit`]): a seed above the
 /// limit still starts a free-form design, which meets the limit or reports
 /// the least height itself. It is a start, not a certificate: at most
@@ -337,8 +328,7 @@ pub fn seed_plan(spec: &DesignSpec) -> Result<PhasedPlan> {
     Ok(design.plan(design.durations(spec.available_time())))
 }
 
-/// Reconstruction, comparison and verification of a design inside the
-/// motor envelope.
+/// Reconstruction and comparison of a design inside the motor envelope.
 fn finish_envelope(
     spec: &DesignSpec,
     r: crate::design::envelope::EnvelopeResult,
@@ -356,7 +346,6 @@ fn finish_envelope(
     };
     let split = spec.analytic.split.map(|f| f * time);
     let (analytic_peak, _) = peak_along(spec, &cosine_plan(r.bend, r.twist, split), 2000);
-    let sim = dynamic_spec(spec, &plan)?;
     Ok(PhasedResult {
         mode: "phased",
         status: r.status,
@@ -374,21 +363,15 @@ fn finish_envelope(
         analytic_peak_same_bend_nm: analytic_peak,
         optimum_same_split_nm: None,
         improvement_factor: analytic_peak / peak,
-        flip_deg: sim.flip_deg,
-        flip_error_rad: sim.flip_error_rad,
-        tilt_deg: sim.tilt_deg,
-        sim_peak_torque_nm: sim.peak_torque_nm,
-        momentum_drift_nms: sim.momentum_drift_nms,
         nodes: spec.phased.nodes,
         evaluations: r.evaluations,
         solve_time_s: r.solve_time_s,
         plan,
         design: None,
-        sim: Some(sim),
     })
 }
 
-/// Reconstruction, comparison and verification of a chosen design.
+/// Reconstruction and comparison of a chosen design.
 pub fn finish(
     spec: &DesignSpec,
     design: BendDesign,
@@ -403,7 +386,6 @@ pub fn finish(
     check_limit(spec, peak * t * t, peak, "phased design")?;
     let split = spec.analytic.split.map(|f| f * t);
     let (analytic_peak, _) = peak_along(spec, &cosine_plan(design.bend, design.twist, split), 2000);
-    let sim = dynamic_spec(spec, &plan)?;
     let status = design
         .phases
         .iter()
@@ -427,16 +409,10 @@ pub fn finish(
         analytic_peak_same_bend_nm: analytic_peak,
         optimum_same_split_nm: Some(design.peak_with(split)),
         improvement_factor: analytic_peak / peak,
-        flip_deg: sim.flip_deg,
-        flip_error_rad: sim.flip_error_rad,
-        tilt_deg: sim.tilt_deg,
-        sim_peak_torque_nm: sim.peak_torque_nm,
-        momentum_drift_nms: sim.momentum_drift_nms,
         nodes: spec.phased.nodes,
         evaluations: evals,
         solve_time_s: solve_time,
         plan,
         design: Some(design),
-        sim: Some(sim),
     })
 }

@@ -120,13 +120,14 @@ fn optimum_never_exceeds_the_cosine_schedule_at_the_same_bend_and_split() {
             r.improvement_factor
         );
         assert!(r.optimum_same_split_nm.unwrap() <= r.analytic_peak_same_bend_nm);
+        let sim = util::flown(&c.design_spec(), &r.plan);
         assert!(
-            r.flip_error_rad.abs() < 1e-5,
+            sim.flip_error_rad.abs() < 1e-5,
             "{name}: flip error {}",
-            r.flip_error_rad
+            sim.flip_error_rad
         );
         assert!(
-            (r.sim_peak_torque_nm - r.peak_torque_nm).abs() < 0.005 * r.peak_torque_nm,
+            (sim.peak_torque_nm - r.peak_torque_nm).abs() < 0.005 * r.peak_torque_nm,
             "{name}"
         );
     }
@@ -180,24 +181,20 @@ fn torque_limit_below_the_optimum_names_the_least_drop_height() {
         .unwrap();
     assert!(h > 10.0);
     // F7: from a little higher it works, within the limit
-    let ok = optimize(
-        &cfg(
-            "seed",
-            &[
-                "limits.max_torque=0.3",
-                &format!("fall.height={}", h * 1.01),
-            ],
-        )
-        .design_spec(),
-        |_| {},
-    )
-    .unwrap();
+    let ok_cfg = cfg(
+        "seed",
+        &[
+            "limits.max_torque=0.3",
+            &format!("fall.height={}", h * 1.01),
+        ],
+    );
+    let ok = optimize(&ok_cfg.design_spec(), |_| {}).unwrap();
     assert!(
         ok.peak_torque_nm <= 0.3 && ok.peak_torque_nm > 0.29,
         "{}",
         ok.peak_torque_nm
     );
-    assert!(ok.sim_peak_torque_nm <= 0.3 + 1e-9);
+    assert!(util::flown(&ok_cfg.design_spec(), &ok.plan).peak_torque_nm <= 0.3 + 1e-9);
 }
 
 #[test]

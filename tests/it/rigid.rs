@@ -87,9 +87,13 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
         close(pa.unit_peak_nm_s2, pb.unit_peak_nm_s2, name);
         close(pa.bend_deg, pb.bend_deg, name);
         close(pa.twist_rad, pb.twist_rad, name);
-        close(pa.flip_deg, pb.flip_deg, name);
-        close(pa.sim_peak_torque_nm, pb.sim_peak_torque_nm, name);
-        close(pa.tilt_deg + 1.0, pb.tilt_deg + 1.0, name);
+        let (sa, sb) = (
+            util::flown(&cfg.design_spec(), &pa.plan),
+            util::flown(&general.design_spec(), &pb.plan),
+        );
+        close(sa.flip_deg, sb.flip_deg, name);
+        close(sa.peak_torque_nm, sb.peak_torque_nm, name);
+        close(sa.tilt_deg + 1.0, sb.tilt_deg + 1.0, name);
         // the least height (motors limited)
         if let (Some(ha), Some(hb)) = (
             least_height::answer(&cfg.design_spec()).unwrap(),
@@ -112,8 +116,12 @@ fn cylinders_given_as_general_tensors_reproduce_todays_numbers() {
             .unwrap(),
     );
     close(fa.peak_torque_nm, fb.peak_torque_nm, "free");
-    close(fa.flip_deg, fb.flip_deg, "free");
-    close(fa.sim_peak_torque_nm, fb.sim_peak_torque_nm, "free");
+    let (sa, sb) = (
+        util::flown(&cfg.design_spec(), &fa.plan),
+        util::flown(&as_tensors(&cfg).design_spec(), &fb.plan),
+    );
+    close(sa.flip_deg, sb.flip_deg, "free");
+    close(sa.peak_torque_nm, sb.peak_torque_nm, "free");
 }
 
 /// A rear half with products of inertia and an off-axis centre of mass, the

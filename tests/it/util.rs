@@ -191,3 +191,20 @@ pub fn controls_header(csv: &str, key: &str) -> Option<String> {
                 .map(String::from)
         })
 }
+
+/// A design's schedule flown under the motor model (feed-forward + PD), as
+/// the pipeline flies every design: designs do not carry their flight.
+pub fn flown(
+    spec: &catflip::design::spec::DesignSpec,
+    plan: &dyn catflip::design::plan::ShapePlan,
+) -> catflip::verify::simulate::SimReport {
+    catflip::verify::simulate::dynamic_spec(spec, plan).expect("the design flies")
+}
+
+/// The planned shape flown exactly (kinematic simulation).
+pub fn flown_kinematic(
+    spec: &catflip::design::spec::DesignSpec,
+    plan: &dyn catflip::design::plan::ShapePlan,
+) -> catflip::verify::simulate::SimReport {
+    catflip::verify::simulate::kinematic_spec(spec, plan).expect("the shape flies")
+}
