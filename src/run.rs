@@ -174,166 +174,29 @@ impl Methods {
 
 /// Runs everything for one config. A method that fails does not stop the
 /// others: its status and reason go into the summary, table and report. Only
-/// when every method fails is the run an error.
+/// when every method fails is the run an error. The steps: the analytic
+/// schedule, the robot question (with motor limits), the phased and the
+/// free-form designs, the answer's schedule as a method, the report.
 pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     let spec = cfg.design_spec();
     let limited = spec.motor.is_limited();
-    let cat = cfg.cat();
     let mut stages = Stages {
         index: 0,
         total: if limited { 5 } else { 4 },
         progress,
     };
     let mut done = Methods::default();
-    let mut notes_early: Vec<String> = Vec::new();
-
-    let clock = stages.begin("analytic schedule (seed closed forms, errata corrected)");
-    // the kinematic check is part of the analysis; a failed dynamic
-    // simulation (e.g. under a saturating torque limit) only flags the schedule
-    let analytic = analyze(&spec, &cfg.name);
-    let seconds = clock.elapsed().as_secs_f64();
-    match analytic {
-        Ok(a) => {
-            done.add(&spec, Method::Analytic, Ok((Design::Analytic(a), seconds)));
-            stages.end(clock, None);
-        }
-        Err(e) => {
-            stages.end(clock, Some(&e));
-            done.add(&spec, Method::Analytic, Err(e));
-        }
-    }
-
+    done.analytic(&spec, &cfg.name, &mut stages);
     // the robot question first: when the motors cannot flip the cat in
     // this fall, no design at this height is attempted
-    let mut answer = None;
-    let mut fastest_free: Option<crate::design::free::FreeResult> = None;
-    // the phased least height, when no phased schedule fits this fall
-    let mut phased_short: Option<f64> = None;
-    let mut least_seconds = 0.0;
-    if limited {
-        let clock =
-            stages.begin("least drop height (shortest manoeuvre inside the motor envelope)");
-        let progress = &mut stages.progress;
-        let a = crate::design::least_height::heights(&spec, true, |it| progress(Progress::Scp(it)))
-            .map(|h| {
-                h.map(|h| {
-                    phased_short = (!crate::design::least_height::fits(&spec, h.phased_m))
-                        .then_some(h.phased_m);
-                    fastest_free = h.free;
-                    h.answer
-                })
-            });
-        least_seconds = clock.elapsed().as_secs_f64();
-        stages.end(clock, a.as_ref().err());
-        match a {
-            // its schedule becomes the least-height method below
-            Ok(Some(a)) => answer = Some(a),
-            Ok(None) => {}
-            Err(e) => notes_early.push(format!("The least drop height could not be found: {e}")),
-        }
-    }
-    let impossible = phased_short.map(|least| {
-        format!(
-            "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
-            cfg.fall.height
-        )
-    });
-    let free_impossible = answer.as_ref().filter(|a| !a.possible).map(|a| {
-        format!(
-            "no schedule found fits the motors in the fall from {} m (fall.height); the least height found is {:.3} m (the {} time design, least-height.csv)",
-            a.height_m, a.least_height_m, a.method
-        )
-    });
-
-    let clock = stages.begin("phased optimiser (path-timing SOCPs, bend search)");
-    match &impossible {
-        Some(reason) => {
-            (stages.progress)(Progress::StageSkipped { reason });
-            done.skip(Method::Phased, reason);
-        }
-        None => {
-            let mut evaluations = 0;
-            let progress = &mut stages.progress;
-            let phased = crate::design::phased::optimize(&spec, |e| {
-                evaluations += 1;
-                progress(Progress::Bend {
-                    evaluations,
-                    bend_deg: e.bend_deg,
-                    peak_nm: e.peak_nm,
-                });
-            });
-            stages.end(clock, phased.as_ref().err());
-            done.add(
-                &spec,
-                Method::Phased,
-                phased.map(|ph| {
-                    let t = ph.solve_time_s;
-                    (Design::Phased(ph), t)
-                }),
-            );
-        }
-    }
-
-    let clock = stages.begin(
-        "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
-    );
-    // seeded by the phased design, or by the free-form least-time design
-    // when no phased one fits, or by the analytic plan when that failed
-    let analytic_seed;
-    let (seed_plan, seed_name): (&dyn ShapePlan, &str) =
-        match (done.design(Method::Phased), &fastest_free) {
-            (Some(ph), _) => (ph.plan(), "phased"),
-            (None, Some(fr)) => (&fr.plan, "free least-time"),
-            (None, None) => {
-                analytic_seed = crate::design::analytic::analytic_plan(&spec);
-                (&analytic_seed, "analytic")
-            }
-        };
-    match &free_impossible {
-        Some(reason) => {
-            (stages.progress)(Progress::StageSkipped { reason });
-            done.skip(Method::Free, reason);
-        }
-        None => {
-            let progress = &mut stages.progress;
-            let free = crate::design::free::FreeDesign::new(&spec)
-                .from_plan(seed_plan, seed_name)
-                .on_iteration(&mut |it| progress(Progress::Scp(it)))
-                .solve();
-            stages.end(clock, free.as_ref().err());
-            done.add(
-                &spec,
-                Method::Free,
-                free.map(|fr| {
-                    let t = fr.solve_time_s;
-                    (Design::Free(fr), t)
-                }),
-            );
-        }
-    }
-
-    if let Some(a) = answer.as_mut().filter(|a| !a.possible)
-        && let Some(m) = done
-            .lines
-            .iter()
-            .find(|m| m.method == "free" && m.verdict == Grade::Ok)
-    {
-        // a verified free-form schedule inside the envelope settles it
-        a.possible = true;
-        a.method = m.method;
-    }
-    // the answer's schedule, a method like the others: judged, written,
-    // drawn, animated and exported (it needs its own, longer fall)
-    if let Some(a) = &answer {
-        done.add(
-            &spec,
-            Method::LeastHeight,
-            Ok((
-                Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(&spec, a)),
-                least_seconds,
-            )),
-        );
-    }
+    let mut question = if limited {
+        Question::asked(&spec, &mut stages)
+    } else {
+        Question::default()
+    };
+    done.phased(&spec, question.phased_impossible(&spec), &mut stages);
+    done.free(&spec, &question, &mut stages);
+    question.settle(&spec, &mut done);
     if done.lines.iter().all(|m| m.verdict == Grade::Failed) {
         let reasons: Vec<String> = done
             .lines
@@ -342,9 +205,201 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             .collect();
         return Err(Error::AllFailed(reasons.join("; ")));
     }
-
     stages.begin("report (figures, summary)");
     let clock = Instant::now();
+    let result = report_of(cfg, &spec, done, question);
+    stages.end(clock, None);
+    Ok(result)
+}
+
+/// The robot question's step: the answer, the shortest free-form time
+/// design (a seed when no phased design fits), the phased least height
+/// when no phased schedule fits this fall, and the notes it leaves.
+#[derive(Default)]
+struct Question {
+    answer: Option<HeightAnswer>,
+    fastest_free: Option<crate::design::free::FreeResult>,
+    phased_short: Option<f64>,
+    seconds: f64,
+    notes: Vec<String>,
+}
+
+impl Question {
+    /// The least-height stage (motors limited).
+    fn asked<F: FnMut(Progress)>(spec: &DesignSpec, stages: &mut Stages<F>) -> Question {
+        let clock =
+            stages.begin("least drop height (shortest manoeuvre inside the motor envelope)");
+        let progress = &mut stages.progress;
+        let heights =
+            crate::design::least_height::heights(spec, true, |it| progress(Progress::Scp(it)));
+        let mut q = Question {
+            seconds: clock.elapsed().as_secs_f64(),
+            ..Question::default()
+        };
+        stages.end(clock, heights.as_ref().err());
+        match heights {
+            Ok(Some(h)) => {
+                q.phased_short =
+                    (!crate::design::least_height::fits(spec, h.phased_m)).then_some(h.phased_m);
+                q.fastest_free = h.free;
+                // its schedule becomes the least-height method (`settle`)
+                q.answer = Some(h.answer);
+            }
+            Ok(None) => {}
+            Err(e) => q
+                .notes
+                .push(format!("The least drop height could not be found: {e}")),
+        }
+        q
+    }
+
+    /// Why the phased design is not attempted, if no phased schedule fits.
+    fn phased_impossible(&self, spec: &DesignSpec) -> Option<String> {
+        self.phased_short.map(|least| {
+            format!(
+                "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
+                spec.fall.height
+            )
+        })
+    }
+
+    /// Why the free-form design is not attempted, if no schedule found fits.
+    fn free_impossible(&self) -> Option<String> {
+        self.answer.as_ref().filter(|a| !a.possible).map(|a| {
+            format!(
+                "no schedule found fits the motors in the fall from {} m (fall.height); the least height found is {:.3} m (the {} time design, least-height.csv)",
+                a.height_m, a.least_height_m, a.method
+            )
+        })
+    }
+
+    /// After the designs: a verified free-form schedule inside the envelope
+    /// settles the question, and the answer's schedule becomes a method like
+    /// the others (judged, written, drawn, animated and exported; it needs
+    /// its own, longer fall).
+    fn settle(&mut self, spec: &DesignSpec, done: &mut Methods) {
+        if let Some(a) = self.answer.as_mut().filter(|a| !a.possible)
+            && let Some(m) = done
+                .lines
+                .iter()
+                .find(|m| m.method == "free" && m.verdict == Grade::Ok)
+        {
+            a.possible = true;
+            a.method = m.method;
+        }
+        if let Some(a) = &self.answer {
+            let design = Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(spec, a));
+            done.add(spec, Method::LeastHeight, Ok((design, self.seconds)));
+        }
+    }
+}
+
+impl Methods {
+    /// The analytic step: the kinematic check is part of the analysis; a
+    /// failed dynamic simulation (e.g. under a saturating torque limit)
+    /// only flags the schedule.
+    fn analytic<F: FnMut(Progress)>(
+        &mut self,
+        spec: &DesignSpec,
+        name: &str,
+        stages: &mut Stages<F>,
+    ) {
+        let clock = stages.begin("analytic schedule (seed closed forms, errata corrected)");
+        let analytic = analyze(spec, name);
+        let seconds = clock.elapsed().as_secs_f64();
+        match analytic {
+            // the stage line's time includes the schedule's simulation
+            Ok(a) => {
+                self.add(spec, Method::Analytic, Ok((Design::Analytic(a), seconds)));
+                stages.end(clock, None);
+            }
+            Err(e) => {
+                stages.end(clock, Some(&e));
+                self.add(spec, Method::Analytic, Err(e));
+            }
+        }
+    }
+
+    /// The phased step, or why it is not attempted (`impossible`).
+    fn phased<F: FnMut(Progress)>(
+        &mut self,
+        spec: &DesignSpec,
+        impossible: Option<String>,
+        stages: &mut Stages<F>,
+    ) {
+        let clock = stages.begin("phased optimiser (path-timing SOCPs, bend search)");
+        if let Some(reason) = impossible {
+            (stages.progress)(Progress::StageSkipped { reason: &reason });
+            self.skip(Method::Phased, &reason);
+            return;
+        }
+        let mut evaluations = 0;
+        let progress = &mut stages.progress;
+        let phased = crate::design::phased::optimize(spec, |e| {
+            evaluations += 1;
+            progress(Progress::Bend {
+                evaluations,
+                bend_deg: e.bend_deg,
+                peak_nm: e.peak_nm,
+            });
+        });
+        stages.end(clock, phased.as_ref().err());
+        self.add(
+            spec,
+            Method::Phased,
+            phased.map(|ph| {
+                let t = ph.solve_time_s;
+                (Design::Phased(ph), t)
+            }),
+        );
+    }
+
+    /// The free-form step: seeded by the phased design, or by the free-form
+    /// least-time design when no phased one fits, or by the analytic plan
+    /// when that failed; not attempted when no schedule found fits.
+    fn free<F: FnMut(Progress)>(
+        &mut self,
+        spec: &DesignSpec,
+        q: &Question,
+        stages: &mut Stages<F>,
+    ) {
+        let clock = stages.begin(
+            "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
+        );
+        if let Some(reason) = q.free_impossible() {
+            (stages.progress)(Progress::StageSkipped { reason: &reason });
+            self.skip(Method::Free, &reason);
+            return;
+        }
+        let analytic_seed;
+        let (seed_plan, seed_name): (&dyn ShapePlan, &str) =
+            match (self.design(Method::Phased), &q.fastest_free) {
+                (Some(ph), _) => (ph.plan(), "phased"),
+                (None, Some(fr)) => (&fr.plan, "free least-time"),
+                (None, None) => {
+                    analytic_seed = crate::design::analytic::analytic_plan(spec);
+                    (&analytic_seed, "analytic")
+                }
+            };
+        let progress = &mut stages.progress;
+        let free = crate::design::free::FreeDesign::new(spec)
+            .from_plan(seed_plan, seed_name)
+            .on_iteration(&mut |it| progress(Progress::Scp(it)))
+            .solve();
+        stages.end(clock, free.as_ref().err());
+        self.add(
+            spec,
+            Method::Free,
+            free.map(|fr| {
+                let t = fr.solve_time_s;
+                (Design::Free(fr), t)
+            }),
+        );
+    }
+}
+
+/// The report step: simulator files, figures, the summary, the page.
+fn report_of(cfg: &Config, spec: &DesignSpec, done: Methods, question: Question) -> RunResult {
     let Methods {
         mut output,
         lines: methods,
@@ -356,51 +411,22 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         .map(|j| (j.design.method().name(), j.design.plan()))
         .collect();
     crate::export::add_simulator_files(cfg, &mut output, &plans);
-    let traces: Vec<MethodTrace> = judged.iter().map(|j| j.trace(&spec, 300)).collect();
-    let mut tracks: Vec<_> = judged.iter().map(|j| j.track(&spec)).collect();
+    let traces: Vec<MethodTrace> = judged.iter().map(|j| j.trace(spec, 300)).collect();
     let free = judged.iter().find_map(|j| match &j.design {
         Design::Free(fr) => Some(fr),
         _ => None,
     });
-    let norm_name = cfg.norm().name().to_string();
     let iterations = free.map(|fr| fr.iterations.clone()).unwrap_or_default();
     // none when the free-form design failed
     let mesh_levels = free.map(|fr| fr.mesh_levels.clone()).unwrap_or_default();
-    let mut figures = vec![
-        ("angles.svg", report::angles(&traces)),
-        (
-            "torque.svg",
-            report::torque(&traces, &norm_name, &cfg.motor()),
-        ),
-        (
-            report::TORQUE_SPEED_SVG,
-            report::torque_speed(&traces, &cfg.motor()),
-        ),
-        ("flip.svg", report::flip(&traces)),
-        ("shape_path.svg", report::shape_path(&traces)),
-    ];
-    if !iterations.is_empty() {
-        figures.push((
-            "convergence.svg",
-            report::convergence(&iterations, &mesh_levels, cfg.design.objective),
-        ));
-    }
-    let mut notes = notes_early;
-    let figures: Vec<(&str, String)> = figures
-        .into_iter()
-        .filter_map(|(name, svg)| match svg {
-            Ok(svg) => Some((name, svg)),
-            Err(e) => {
-                notes.push(format!("Figure {name} is missing: {e}"));
-                None
-            }
-        })
-        .collect();
+    let mut notes = question.notes;
+    let figures = figures(cfg, &traces, &iterations, &mesh_levels, &mut notes);
     let peak = |name: &str| methods.iter().find(|m| m.method == name)?.peak();
     let ratio = |a: &str, b: &str| Some(peak(a)? / peak(b)?);
     let (scp_iterations, nodes) = free
         .map(|fr| (fr.scp_iterations, fr.nodes))
         .unwrap_or((0, cfg.free.nodes));
+    let answer = question.answer;
     let summary = RunSummary {
         name: cfg.name.clone(),
         joint: cfg.cat.joint.name(),
@@ -419,18 +445,80 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         scp_iterations,
         nodes,
         mesh_levels,
-        analytic: crate::design::analytic::closed_forms(&spec),
+        analytic: crate::design::analytic::closed_forms(spec),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
         answer,
     };
-    let header = TABLE_HEADER;
-    let rows: Vec<Vec<String>> = summary.methods.iter().map(table_row).collect();
+    page_notes(cfg, &summary, &mut notes);
+    let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
+    let tracks: Vec<_> = judged.iter().map(|j| j.track(spec)).collect();
+    let html = page(cfg, &summary, &notes, tracks, &figure_names);
+    output.add("index.html", html);
+    for (name, svg) in figures {
+        output.add(name, svg);
+    }
+    output.add(
+        "summary.json",
+        serde_json::to_string_pretty(&summary).expect("summary serialises"),
+    );
+    RunResult {
+        summary,
+        output,
+        traces,
+        iterations,
+    }
+}
+
+/// The run's figures; one that cannot be drawn is left out with a note.
+fn figures(
+    cfg: &Config,
+    traces: &[MethodTrace],
+    iterations: &[ScpIteration],
+    mesh_levels: &[crate::design::free::MeshLevel],
+    notes: &mut Vec<String>,
+) -> Vec<(&'static str, String)> {
+    let norm_name = cfg.norm().name();
+    let mut figures = vec![
+        ("angles.svg", report::angles(traces)),
+        (
+            "torque.svg",
+            report::torque(traces, norm_name, &cfg.motor()),
+        ),
+        (
+            report::TORQUE_SPEED_SVG,
+            report::torque_speed(traces, &cfg.motor()),
+        ),
+        ("flip.svg", report::flip(traces)),
+        ("shape_path.svg", report::shape_path(traces)),
+    ];
+    if !iterations.is_empty() {
+        figures.push((
+            "convergence.svg",
+            report::convergence(iterations, mesh_levels, cfg.design.objective),
+        ));
+    }
+    figures
+        .into_iter()
+        .filter_map(|(name, svg)| match svg {
+            Ok(svg) => Some((name, svg)),
+            Err(e) => {
+                notes.push(format!("Figure {name} is missing: {e}"));
+                None
+            }
+        })
+        .collect()
+}
+
+/// The page's notes above the figures: the comparison in a sentence, where
+/// the flip comes from, and the partial result first when it is one.
+fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
     let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
     notes.insert(
         0,
         format!(
-            "{} joint, peak norm {norm_name}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form design: {}.",
+            "{} joint, peak norm {}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form design: {}.",
             summary.joint,
+            cfg.norm().name(),
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,
             show(summary.free_over_phased),
@@ -455,20 +543,31 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
             "PARTIAL RESULT: some methods are flagged or failed; the verdict column says why. Their schedules, if any, are written but miss a target.".into(),
         );
     }
-    let figure_names: Vec<&str> = figures.iter().map(|f| f.0).collect();
-    // the animation: each simulated method, with its table status and verdict
+}
+
+/// `index.html`: the answer, the table, warnings, notes, the animation of
+/// each simulated method (with its table status and verdict), the figures.
+fn page(
+    cfg: &Config,
+    summary: &RunSummary,
+    notes: &[String],
+    mut tracks: Vec<report::animation::Track>,
+    figure_names: &[&str],
+) -> String {
+    let rows: Vec<Vec<String>> = summary.methods.iter().map(table_row).collect();
     for t in &mut tracks {
         if let Some(m) = summary.methods.iter().find(|m| m.method == t.name) {
             t.status = track_status(m);
         }
     }
     tracks.retain(|t| t.frames.len() > 1);
+    let cat = cfg.cat();
     let scene = report::animation::Scene {
         rear: cat.rear,
         front: cat.front,
         joint: summary.joint,
         boxes: report::animation::boxes(&cat),
-        norm: norm_name.clone(),
+        norm: cfg.norm().name().to_string(),
         max_torque_nm: cfg.limits.max_torque,
         tracks,
     };
@@ -480,32 +579,15 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
         .filter_map(crate::table::warning)
         .collect();
     let lead = summary.answer.as_ref().map(report::answer::lead);
-    output.add(
-        "index.html",
-        report::index_html(&report::Page {
-            title: &format!("catflip report: {}", cfg.name),
-            lead: lead.as_deref(),
-            header: &header,
-            rows: &rows,
-            notes: &notes,
-            warnings: &warnings,
-            animation: &report::animation::section(&scene),
-            figures: &figure_names,
-        }),
-    );
-    for (name, svg) in figures {
-        output.add(name, svg);
-    }
-    output.add(
-        "summary.json",
-        serde_json::to_string_pretty(&summary).expect("summary serialises"),
-    );
-    stages.end(clock, None);
-    Ok(RunResult {
-        summary,
-        output,
-        traces,
-        iterations,
+    report::index_html(&report::Page {
+        title: &format!("catflip report: {}", cfg.name),
+        lead: lead.as_deref(),
+        header: &TABLE_HEADER,
+        rows: &rows,
+        notes,
+        warnings: &warnings,
+        animation: &report::animation::section(&scene),
+        figures: figure_names,
     })
 }
 
