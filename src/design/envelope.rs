@@ -295,6 +295,16 @@ struct Scaled {
     budget: Option<f64>,
 }
 
+/// Joint `comp`'s torque at point `j` of phase `p`, linear in the point's
+/// `a` and `beta` (`tau = m a + c beta`).
+fn torque_at(cols: &Cols, data: &[Vec<PointData>; 3], p: usize, j: usize, comp: usize) -> Expr {
+    let pd = &data[p][j];
+    plus(
+        scaled(&cols.a_at(p, j), pd.m[comp]),
+        scaled(&cols.beta_at(p, j), pd.c[comp]),
+    )
+}
+
 impl EnvelopeProblem {
     pub fn new(k: usize, motor: Motor, objective: Objective, budget: Option<f64>) -> Self {
         Self {
@@ -307,10 +317,23 @@ impl EnvelopeProblem {
         }
     }
 
+    /// The SOCP of one linearisation: the objective, the path's kinematics,
+    /// the limit rows and the cones, in that order (the row order is part of
+    /// the problem Clarabel sees).
     fn build(&self, data: &[Vec<PointData>; 3], lim: &Scaled, beta0: &[Vec<f64>; 3]) -> ConicData {
         let cols = Cols::new(self.k, self.objective);
-        let (k, ds, np) = (self.k, cols.ds(), cols.points());
         let mut d = ConicData::new(cols.n(self.objective));
+        self.objective_costs(&cols, &mut d);
+        self.rest_to_rest(&cols, &mut d);
+        self.limit_rows(&cols, data, lim, beta0, &mut d);
+        self.cones(&cols, data, lim, beta0, &mut d);
+        d
+    }
+
+    /// The objective's costs: the peak's bound, the durations, or the
+    /// energy's quadrature weights.
+    fn objective_costs(&self, cols: &Cols, d: &mut ConicData) {
+        let (k, ds, np) = (self.k, cols.ds(), cols.points());
         match self.objective {
             Objective::PeakTorque => d.q[cols.t()] = 1.0,
             Objective::Time => {
@@ -339,14 +362,11 @@ impl EnvelopeProblem {
                 }
             }
         }
-        let torque = |p: usize, j: usize, comp: usize| -> Expr {
-            let pd = &data[p][j];
-            plus(
-                scaled(&cols.a_at(p, j), pd.m[comp]),
-                scaled(&cols.beta_at(p, j), pd.c[comp]),
-            )
-        };
-        // rest to rest, beta' = 2 a
+    }
+
+    /// Rest to rest, `beta' = 2 a` (the zero cone).
+    fn rest_to_rest(&self, cols: &Cols, d: &mut ConicData) {
+        let (k, ds) = (self.k, cols.ds());
         for p in 0..3 {
             d.row(&[(cols.beta(p, 0), 1.0)], 0.0);
             d.row(&[(cols.beta(p, k), 1.0)], 0.0);
@@ -363,7 +383,20 @@ impl EnvelopeProblem {
             }
         }
         d.cone(Cone::Zero(3 * (k + 2)));
-        // linear inequalities
+    }
+
+    /// The linear inequalities (one nonnegative cone): the time budget,
+    /// the speed limit, and per motor the peak's bound and the
+    /// torque-speed line (its speed term linearised at `beta0`).
+    fn limit_rows(
+        &self,
+        cols: &Cols,
+        data: &[Vec<PointData>; 3],
+        lim: &Scaled,
+        beta0: &[Vec<f64>; 3],
+        d: &mut ConicData,
+    ) {
+        let (k, ds, np) = (self.k, cols.ds(), cols.points());
         let mut rows = 0;
         if let Some(b) = lim.budget {
             let row: Expr = (0..3)
@@ -392,7 +425,7 @@ impl EnvelopeProblem {
                     continue;
                 }
                 for comp in 0..2 {
-                    let tau = torque(p, j, comp);
+                    let tau = torque_at(cols, data, p, j, comp);
                     for sign in [1.0, -1.0] {
                         let mut row = scaled(&tau, sign);
                         let mut rhs = 0.0;
@@ -425,12 +458,29 @@ impl EnvelopeProblem {
             }
         }
         d.cone(Cone::Nonneg(rows));
-        // cones
+    }
+
+    /// The second-order cones: in the Euclidean norm the peak's bound and
+    /// the torque-speed line, then `c <= sqrt(beta)`, the durations, and the
+    /// energy's `|tau|^2 <= e c`.
+    fn cones(
+        &self,
+        cols: &Cols,
+        data: &[Vec<PointData>; 3],
+        lim: &Scaled,
+        beta0: &[Vec<f64>; 3],
+        d: &mut ConicData,
+    ) {
+        let (k, np) = (self.k, cols.points());
+        let per_motor = self.motor.norm == TorqueNorm::PerMotor;
         for p in 0..3 {
             for j in 0..np {
                 let pd = &data[p][j];
                 if !per_motor {
-                    let tau = [torque(p, j, 0), torque(p, j, 1)];
+                    let tau = [
+                        torque_at(cols, data, p, j, 0),
+                        torque_at(cols, data, p, j, 1),
+                    ];
                     if self.objective == Objective::PeakTorque {
                         d.row(&[(cols.t(), -1.0)], 0.0);
                         for t in &tau {
@@ -479,14 +529,13 @@ impl EnvelopeProblem {
                     let (e, c) = (cols.e(p, j), cols.c(p, jc));
                     d.row(&[(e, -1.0), (c, -1.0)], 0.0);
                     for comp in 0..2 {
-                        d.row(&scaled(&torque(p, j, comp), -2.0), 0.0);
+                        d.row(&scaled(&torque_at(cols, data, p, j, comp), -2.0), 0.0);
                     }
                     d.row(&[(e, -1.0), (c, 1.0)], 0.0);
                     d.cone(Cone::Soc(4));
                 }
             }
         }
-        d
     }
 
     /// Designs the timing of the three paths of a bend; `shrink` (<= 1)
