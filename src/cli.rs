@@ -78,7 +78,7 @@ enum Command {
         #[arg(long)]
         schedule: Option<PathBuf>,
     },
-    /// Monte Carlo study of the closed loop: open loop with joint PD against TVLQR, perturbations from `[robustness]`.
+    /// Monte Carlo study of the closed loop: open loop with joint PD, TVLQR and replanning, perturbations from `[robustness]`.
     Robustness {
         #[command(flatten)]
         common: Common,
@@ -105,7 +105,7 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// The drop height to size the motors for, m (the config's fall.height is not used).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         height: f64,
         /// Points on the curve (2 to 40), each one least-time design (two when its first guess is off).
         #[arg(long, default_value_t = catflip::size::SizeSettings::default().points)]
@@ -209,12 +209,7 @@ fn trials(s: &str) -> Result<usize, String> {
     let max = catflip::config::MAX_TRIALS;
     match s.parse::<usize>() {
         Ok(n) if (1..=max).contains(&n) => Ok(n),
-        _ => Err(catflip::Error::Invalid {
-            key: "--trials".into(),
-            value: s.into(),
-            expected: format!("must be in [1, {max}]"),
-        }
-        .to_string()),
+        _ => Err(format!("{s}: must be in [1, {max}], a whole number")),
     }
 }
 
@@ -473,20 +468,9 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         Method::Free => "the free-form design",
         _ => "the phased design",
     };
-    let partial = flag(what, reason.clone());
+    // a failed flight or a number that is not finite is the error
     let mut json = judged.design_json(&spec)?;
-    // a number that is not finite is refused, not written as null
-    catflip::output::ensure_finite(
-        &json,
-        &[
-            "peak_torque_nm",
-            "bend_deg",
-            "flip_deg",
-            "tilt_deg",
-            "sim_peak_torque_nm",
-            "phase_durations_s",
-        ],
-    )?;
+    let partial = flag(what, reason.clone());
     with_verdict(&mut json, judged.verdict.grade(), reason);
     let json = serde_json::to_string_pretty(&json)?;
     let mut out = Output::default();
@@ -497,14 +481,13 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
         say!("{json}");
         return Ok(Status::of(partial));
     }
-    match &judged.design {
-        Design::Phased(r) => {
-            say_lines(console::design::phased(&cfg, r, judged.sim.as_ref().ok(), &written).lines())
+    // (flown: `design_json` returns the failed flight's error)
+    if let Ok(sim) = &judged.sim {
+        match &judged.design {
+            Design::Phased(r) => say_lines(console::design::phased(&cfg, r, sim, &written).lines()),
+            Design::Free(r) => say_lines(console::design::free(&cfg, r, sim, &written).lines()),
+            Design::Analytic(_) | Design::LeastHeight(_) => {}
         }
-        Design::Free(r) => {
-            say_lines(console::design::free(&cfg, r, judged.sim.as_ref().ok(), &written).lines())
-        }
-        Design::Analytic(_) | Design::LeastHeight(_) => {}
     }
     Ok(Status::of(partial))
 }

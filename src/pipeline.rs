@@ -302,7 +302,9 @@ impl Judged {
 
     /// The design's JSON (`optimize`'s `<method>.json`, the Python
     /// `Design.json`): its own numbers, and for an optimised design how it
-    /// flew ([`Flown`]). A failed simulation is the error.
+    /// flew ([`Flown`]). A failed simulation is the error (the flight's own:
+    /// it is flown again to return it), and so is a number of
+    /// [`DESIGN_FINITE`] that is not finite (refused, not written as null).
     pub fn design_json(&self, spec: &DesignSpec) -> Result<serde_json::Value> {
         let mut json = match &self.design {
             Design::Phased(r) => serde_json::to_value(r),
@@ -312,17 +314,23 @@ impl Judged {
         }
         .map_err(|e| Error::Report(e.to_string()))?;
         if let Design::Phased(_) | Design::Free(_) = self.design {
-            let sim = self.sim.as_ref().map_err(|e| match e {
-                Error::Simulation(m) => Error::Simulation(m.clone()),
-                other => Error::Simulation(other.to_string()),
-            })?;
-            let kin = kinematic_spec(spec, self.design.plan())?;
-            let flown = serde_json::to_value(Flown::of(sim, &kin))
+            let Ok(sim) = &self.sim else {
+                return Err(dynamic_spec(spec, self.design.plan())
+                    .err()
+                    .unwrap_or_else(|| Error::Simulation("the flight failed".into())));
+            };
+            // the planned shape flown exactly, as the free-form design reported it
+            let kin = match self.design {
+                Design::Free(_) => Some(kinematic_spec(spec, self.design.plan())?),
+                _ => None,
+            };
+            let flown = serde_json::to_value(Flown::of(sim, kin.as_ref()))
                 .map_err(|e| Error::Report(e.to_string()))?;
             if let (serde_json::Value::Object(j), serde_json::Value::Object(f)) = (&mut json, flown)
             {
                 j.extend(f);
             }
+            crate::output::ensure_finite(&json, &DESIGN_FINITE)?;
         }
         Ok(json)
     }
@@ -398,6 +406,16 @@ pub fn trace(
     }
 }
 
+/// The numbers of an optimised design's JSON that must be finite.
+pub const DESIGN_FINITE: [&str; 6] = [
+    "peak_torque_nm",
+    "bend_deg",
+    "flip_deg",
+    "tilt_deg",
+    "sim_peak_torque_nm",
+    "phase_durations_s",
+];
+
 /// How an optimised design flew, as its `<method>.json` gives it beside
 /// the design's own numbers.
 #[derive(Debug, Clone, Serialize)]
@@ -410,14 +428,17 @@ pub struct Flown {
     pub landing_error_deg: f64,
     pub sim_peak_torque_nm: f64,
     pub momentum_drift_nms: f64,
-    /// From the kinematic simulation of the planned shape.
-    pub kinematic_flip_error_rad: f64,
-    pub kinematic_tilt_deg: f64,
+    /// From the kinematic simulation of the planned shape (free-form
+    /// designs).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kinematic_flip_error_rad: Option<f64>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub kinematic_tilt_deg: Option<f64>,
 }
 
 impl Flown {
     /// The numbers of the dynamic `sim` and the kinematic `kin` simulations.
-    pub fn of(sim: &SimReport, kin: &SimReport) -> Flown {
+    pub fn of(sim: &SimReport, kin: Option<&SimReport>) -> Flown {
         Flown {
             flip_deg: sim.flip_deg,
             flip_error_rad: sim.flip_error_rad,
@@ -425,8 +446,8 @@ impl Flown {
             landing_error_deg: sim.landing_error_deg,
             sim_peak_torque_nm: sim.peak_torque_nm,
             momentum_drift_nms: sim.momentum_drift_nms,
-            kinematic_flip_error_rad: kin.flip_error_rad,
-            kinematic_tilt_deg: kin.tilt_deg,
+            kinematic_flip_error_rad: kin.map(|k| k.flip_error_rad),
+            kinematic_tilt_deg: kin.map(|k| k.tilt_deg),
         }
     }
 }

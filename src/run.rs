@@ -295,6 +295,29 @@ impl Question {
 }
 
 impl Methods {
+    /// [`Methods::add`], then the end of its stage line: the line's time
+    /// includes the stage's flight of the design (a failure ends the line
+    /// first, with its reason).
+    fn add_ending<F: FnMut(Progress)>(
+        &mut self,
+        spec: &DesignSpec,
+        method: Method,
+        design: Result<(Design, f64)>,
+        stages: &mut Stages<F>,
+        clock: Instant,
+    ) {
+        match design {
+            Ok(d) => {
+                self.add(spec, method, Ok(d));
+                stages.end(clock, None);
+            }
+            Err(e) => {
+                stages.end(clock, Some(&e));
+                self.add(spec, method, Err(e));
+            }
+        }
+    }
+
     /// The analytic step: the kinematic check is part of the analysis; a
     /// failed dynamic simulation (e.g. under a saturating torque limit)
     /// only flags the schedule.
@@ -307,17 +330,8 @@ impl Methods {
         let clock = stages.begin("analytic schedule (seed closed forms, errata corrected)");
         let analytic = analyze(spec, name);
         let seconds = clock.elapsed().as_secs_f64();
-        match analytic {
-            // the stage line's time includes the schedule's simulation
-            Ok(a) => {
-                self.add(spec, Method::Analytic, Ok((Design::Analytic(a), seconds)));
-                stages.end(clock, None);
-            }
-            Err(e) => {
-                stages.end(clock, Some(&e));
-                self.add(spec, Method::Analytic, Err(e));
-            }
-        }
+        let design = analytic.map(|a| (Design::Analytic(a), seconds));
+        self.add_ending(spec, Method::Analytic, design, stages, clock);
     }
 
     /// The phased step, or why it is not attempted (`impossible`).
@@ -343,15 +357,11 @@ impl Methods {
                 peak_nm: e.peak_nm,
             });
         });
-        stages.end(clock, phased.as_ref().err());
-        self.add(
-            spec,
-            Method::Phased,
-            phased.map(|ph| {
-                let t = ph.solve_time_s;
-                (Design::Phased(ph), t)
-            }),
-        );
+        let design = phased.map(|ph| {
+            let t = ph.solve_time_s;
+            (Design::Phased(ph), t)
+        });
+        self.add_ending(spec, Method::Phased, design, stages, clock);
     }
 
     /// The free-form step: seeded by the phased design, or by the free-form
@@ -386,15 +396,11 @@ impl Methods {
             .from_plan(seed_plan, seed_name)
             .on_iteration(&mut |it| progress(Progress::Scp(it)))
             .solve();
-        stages.end(clock, free.as_ref().err());
-        self.add(
-            spec,
-            Method::Free,
-            free.map(|fr| {
-                let t = fr.solve_time_s;
-                (Design::Free(fr), t)
-            }),
-        );
+        let design = free.map(|fr| {
+            let t = fr.solve_time_s;
+            (Design::Free(fr), t)
+        });
+        self.add_ending(spec, Method::Free, design, stages, clock);
     }
 }
 

@@ -432,13 +432,7 @@ fn flagged(
     bend_deg: f64,
     plan: &dyn crate::design::plan::ShapePlan,
 ) -> Option<String> {
-    let simulated = match crate::verify::simulate::dynamic_spec(spec, plan) {
-        Ok(sim) => Simulated::Flip {
-            flip_error_rad: sim.flip_error_rad,
-            tilt_deg: sim.tilt_deg,
-        },
-        Err(e) => Simulated::Failed(e.to_string()),
-    };
+    let simulated = Simulated::of(crate::verify::simulate::dynamic_spec(spec, plan).as_ref());
     let v = crate::pipeline::judge(spec, status, (peak_torque_nm, bend_deg), None, &simulated);
     let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))

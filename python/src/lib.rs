@@ -342,28 +342,6 @@ impl Config {
 
 // --- Design -----------------------------------------------------------------
 
-/// The verdict on a design, as the CLI's `optimize` and `analyze` give it
-/// (`catflip::pipeline::judge`): solver status, the flip, the limits.
-fn judged(
-    spec: &catflip::design::spec::DesignSpec,
-    status: catflip::verdict::Status,
-    (peak, bend): (f64, f64),
-    schedule: &Schedule,
-    (flip_error_rad, tilt_deg): (f64, f64),
-) -> Option<String> {
-    catflip::pipeline::judge(
-        spec,
-        status,
-        (peak, bend),
-        Some(schedule),
-        &catflip::verdict::Simulated::Flip {
-            flip_error_rad,
-            tilt_deg,
-        },
-    )
-    .reason()
-}
-
 fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_json::Value {
     json["verdict"] = (if reason.is_some() { "flagged" } else { "ok" }).into();
     if let Some(r) = reason {
@@ -371,16 +349,6 @@ fn with_verdict(mut json: serde_json::Value, reason: &Option<String>) -> serde_j
     }
     json
 }
-
-/// The fields an optimiser's JSON must have finite, as the CLI's `write_design`.
-const FINITE: [&str; 6] = [
-    "peak_torque_nm",
-    "bend_deg",
-    "flip_deg",
-    "tilt_deg",
-    "sim_peak_torque_nm",
-    "phase_durations_s",
-];
 
 type Plan = std::sync::Arc<dyn ShapePlan + Send + Sync>;
 
@@ -422,7 +390,6 @@ fn staged(
     use catflip::pipeline::Design as D;
     let j = catflip::pipeline::stage(spec, design, 0.0);
     let json = j.design_json(spec).map_err(err)?;
-    catflip::output::ensure_finite(&json, &FINITE).map_err(err)?;
     let (status, reason, peak) = (
         j.design.status(),
         j.verdict.reason(),
@@ -484,15 +451,8 @@ fn run_design(
                 }
                 // the CLI's `analyze`: a miss is flagged in the analysis
                 let a = catflip::verify::analyze::analyze(&spec, &cfg.name).map_err(err)?;
-                let sched = catflip::verify::analyze::analytic_schedule(&spec, &a.plan);
-                let status = Status::ClosedForm;
-                let reason = judged(
-                    &spec,
-                    status,
-                    (a.peak_torque_nm, a.closed.bend_deg),
-                    &sched,
-                    (a.flip_error_rad, a.tilt_deg),
-                );
+                let (sched, verdict) = catflip::pipeline::judge_analysis(&spec, &a);
+                let (status, reason) = (Status::ClosedForm, verdict.reason());
                 let json = serde_json::to_value(&a).expect("serialises");
                 catflip::output::ensure_finite(&json, &[]).map_err(err)?;
                 (
@@ -614,7 +574,7 @@ impl Design {
             None => Ok(None),
         }
     }
-    /// Flip of the design's own simulation, deg (dynamic for free and phased, kinematic for analytic).
+    /// Flip of the design's flight, deg (dynamic for free and phased, as `optimize` flies it; kinematic for analytic).
     #[getter]
     fn flip_deg(&self) -> f64 {
         self.json["flip_deg"].as_f64().unwrap_or(f64::NAN)

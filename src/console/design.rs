@@ -120,12 +120,11 @@ pub fn simulation_title(cfg: &Config, source: &str) -> String {
     )
 }
 
-/// The rows both optimisers print: timing, the flight (`None`: the
-/// simulation failed, which the verdict says), solve time, files.
+/// The rows both optimisers print: timing, the flight, solve time, files.
 fn design_rows(
     t: &mut Rows,
     durations: [f64; 3],
-    sim: Option<&SimReport>,
+    sim: &SimReport,
     solve: String,
     written: &[PathBuf],
 ) {
@@ -133,29 +132,23 @@ fn design_rows(
     t.row(
         "phase durations",
         format!("{:.4} / {:.4} / {:.4} s", d[0], d[1], d[2]),
-    );
-    match sim {
-        Some(v) => t
-            .row(
-                "flip (dynamic sim)",
-                format!("{:.6} deg (error {:.2e} rad)", v.flip_deg, v.flip_error_rad),
-            )
-            .row("tilt", format!("{:.3e} deg", v.tilt_deg))
-            .row("sim peak torque", format!("{:.5} N m", v.peak_torque_nm)),
-        None => t.row("flip (dynamic sim)", "failed".to_string()),
-    }
+    )
+    .row(
+        "flip (dynamic sim)",
+        format!(
+            "{:.6} deg (error {:.2e} rad)",
+            sim.flip_deg, sim.flip_error_rad
+        ),
+    )
+    .row("tilt", format!("{:.3e} deg", sim.tilt_deg))
+    .row("sim peak torque", format!("{:.5} N m", sim.peak_torque_nm))
     .row("solve time", solve)
     .wrote(written);
 }
 
 /// `optimize --mode phased`'s table.
 /// `sim`: the stage's flight of it.
-pub fn phased(
-    cfg: &Config,
-    r: &PhasedResult,
-    sim: Option<&SimReport>,
-    written: &[PathBuf],
-) -> Rows {
+pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBuf]) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode phased: {} ({} joint), status {}",
         cfg.name,
@@ -198,7 +191,7 @@ pub fn phased(
 
 /// `optimize --mode free`'s table.
 /// `sim`: the stage's flight of it.
-pub fn free(cfg: &Config, r: &FreeResult, sim: Option<&SimReport>, written: &[PathBuf]) -> Rows {
+pub fn free(cfg: &Config, r: &FreeResult, sim: &SimReport, written: &[PathBuf]) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
         cfg.name,

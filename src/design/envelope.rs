@@ -865,7 +865,7 @@ fn verified_design(
 const COARSE_TANGENT_TOL: f64 = 1e-3;
 
 /// A phased design inside the motor envelope: the chosen bend's verified
-/// design and plan (the phased optimiser reconstructs and simulates it).
+/// design and plan (the phased optimiser reconstructs it; the pipeline flies it).
 #[derive(Debug, Clone)]
 pub struct EnvelopeResult {
     pub status: SolveStatus,

@@ -266,6 +266,8 @@ pub fn heights(
 /// out of iterations still counts, and says so in its status. The
 /// simulation that verifies it, or `None`.
 pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> Option<SimReport> {
+    // (checked first, as `verifies` checks it: a design that breaks its
+    // constraints is not flown)
     if fr.certificate.constraint_violation > spec.free.attitude_tolerance {
         return None;
     }

@@ -251,6 +251,8 @@
     out.window_width_px = window.innerWidth;
     out.page_width_px = document.documentElement.scrollWidth;
     out.table_right_px = document.querySelector('table').getBoundingClientRect().right;
+    const wide = document.querySelector('.wide');
+    out.table_scrolls = !!wide && wide.scrollWidth > wide.clientWidth;
     setTime(0);
     play(true);
     setTimeout(() => {

@@ -98,7 +98,8 @@ fn report_page_renders_runs_and_animates_in_chromium() {
 /// The robot's report, whose table carries the longest verdicts (the
 /// analytic reference beyond the motors, the methods the motors cannot do
 /// from 2 m): at a 1300 px window nothing, the verdict column included,
-/// reaches past the window's right edge.
+/// reaches past the window's right edge or hides behind the table's own
+/// scroll bar.
 #[test]
 #[ignore = "needs chromium (.ci/run installs it)"]
 fn the_robots_comparison_table_fits_a_1300_px_window() {
@@ -123,4 +124,8 @@ fn the_robots_comparison_table_fits_a_1300_px_window() {
         "the page scrolls sideways: {page} px in {window}"
     );
     assert!(table <= window, "the table ends at {table} px in {window}");
+    assert_eq!(
+        st["table_scrolls"], false,
+        "the table scrolls in its frame: {st}"
+    );
 }

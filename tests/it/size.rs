@@ -210,7 +210,8 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
     let cfg = util::config_path("robot-universal");
     for (args, word) in [
         (vec!["--height", "0"], "--height"),
-        (vec!["--height", "-1"], "--height"),
+        // a negative number is the height's value, not a flag
+        (vec!["--height", "-1"], "--height -1: must be > 0 m"),
         (vec!["--height", "1e9"], "--height"),
         (vec!["--height", "nan"], "--height"),
         // a fall shorter than the 0.1 s landing margin
