@@ -255,13 +255,18 @@
     out.table_scrolls = !!wide && wide.scrollWidth > wide.clientWidth;
     setTime(0);
     play(true);
-    setTimeout(() => {
+    // the clock moves from the second animation frame on: wait for it (a
+    // loaded machine draws few frames), at most 4 s
+    const started = performance.now();
+    const report = () => {
+      if (state.t === 0 && performance.now() - started < 4000) { setTimeout(report, 100); return; }
       out.played_to_s = state.t;
       play(false);
       out.errors = window.catflipErrors || [];
       const pre = document.getElementById('selftest');
       pre.textContent = JSON.stringify(out);
       pre.hidden = false;
-    }, 500);
+    };
+    setTimeout(report, 100);
   }
 })();

@@ -18,8 +18,11 @@ fn pre<'a>(dom: &'a str, id: &str) -> Option<&'a str> {
 }
 
 /// The report page `index` opened in headless Chromium at `width` px with
-/// its `#selftest`: the dumped DOM and the self-check's result.
+/// its `#selftest`: the dumped DOM and the self-check's result. One page
+/// at a time: two browsers at once on two cores starve the animation.
 fn open_selftest(index: &std::path::Path, width: u32) -> (String, serde_json::Value) {
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let profile = temp_dir();
     let url = format!("file://{}#selftest", index.display());
     let out = Command::new("chromium")
