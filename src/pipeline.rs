@@ -246,12 +246,7 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
         theta_deg: 180.0 - bend,
         twist_rad: twist,
         phase_durations_s: durations,
-        flip_deg: s.flip_deg,
-        flip_error_rad: s.flip_error_rad,
-        tilt_deg: s.tilt_deg,
-        landing_error_deg: s.landing_error_deg,
-        sim_peak_torque_nm: s.peak_torque_nm,
-        momentum_drift_nms: s.momentum_drift_nms,
+        flight: Flight::of(s),
         final_shape_error_rad: s.final_shape_error_rad,
         max_speed_rad_s: motor.max_speed_rad_s,
         min_envelope_margin: motor.min_margin,
@@ -416,18 +411,38 @@ pub const DESIGN_FINITE: [&str; 6] = [
     "phase_durations_s",
 ];
 
+/// A schedule's flight under the motor model (the dynamic simulation:
+/// feed-forward + PD, torque limit if any), as the JSON gives it.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Flight {
+    pub flip_deg: f64,
+    pub flip_error_rad: f64,
+    pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
+    pub landing_error_deg: f64,
+    pub sim_peak_torque_nm: f64,
+    pub momentum_drift_nms: f64,
+}
+
+impl Flight {
+    pub fn of(sim: &SimReport) -> Flight {
+        Flight {
+            flip_deg: sim.flip_deg,
+            flip_error_rad: sim.flip_error_rad,
+            tilt_deg: sim.tilt_deg,
+            landing_error_deg: sim.landing_error_deg,
+            sim_peak_torque_nm: sim.peak_torque_nm,
+            momentum_drift_nms: sim.momentum_drift_nms,
+        }
+    }
+}
+
 /// How an optimised design flew, as its `<method>.json` gives it beside
 /// the design's own numbers.
 #[derive(Debug, Clone, Serialize)]
 pub struct Flown {
-    /// From the dynamic simulation (feed-forward + PD) of the schedule.
-    pub flip_deg: f64,
-    pub flip_error_rad: f64,
-    pub tilt_deg: f64,
-    /// The belly's angle from straight down at touchdown, deg.
-    pub landing_error_deg: f64,
-    pub sim_peak_torque_nm: f64,
-    pub momentum_drift_nms: f64,
+    #[serde(flatten)]
+    pub flight: Flight,
     /// From the kinematic simulation of the planned shape (free-form
     /// designs).
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -440,12 +455,7 @@ impl Flown {
     /// The numbers of the dynamic `sim` and the kinematic `kin` simulations.
     pub fn of(sim: &SimReport, kin: Option<&SimReport>) -> Flown {
         Flown {
-            flip_deg: sim.flip_deg,
-            flip_error_rad: sim.flip_error_rad,
-            tilt_deg: sim.tilt_deg,
-            landing_error_deg: sim.landing_error_deg,
-            sim_peak_torque_nm: sim.peak_torque_nm,
-            momentum_drift_nms: sim.momentum_drift_nms,
+            flight: Flight::of(sim),
             kinematic_flip_error_rad: kin.map(|k| k.flip_error_rad),
             kinematic_tilt_deg: kin.map(|k| k.tilt_deg),
         }
@@ -482,14 +492,8 @@ pub struct MethodNumbers {
     pub theta_deg: f64,
     pub twist_rad: f64,
     pub phase_durations_s: [f64; 3],
-    /// Dynamic simulation (feed-forward + PD, torque limit if any).
-    pub flip_deg: f64,
-    pub flip_error_rad: f64,
-    pub tilt_deg: f64,
-    /// The belly's angle from straight down at touchdown (docs/model.md section 8), deg.
-    pub landing_error_deg: f64,
-    pub sim_peak_torque_nm: f64,
-    pub momentum_drift_nms: f64,
+    #[serde(flatten)]
+    pub flight: Flight,
     pub final_shape_error_rad: f64,
     /// Largest joint speed of the written schedule, rad/s (motor norm).
     pub max_speed_rad_s: f64,

@@ -410,12 +410,10 @@ impl Origin {
                 .warm(warm, before)
                 .solve()
         };
-        let flown = fr.and_then(|fr| {
-            crate::verify::simulate::dynamic_spec(&cfg.design_spec(), &fr.plan).map(|s| (fr, s))
-        });
+        let flown = fr.and_then(|fr| flight(&cfg, &fr).map(|f| (fr, f)));
         let kept = match flown {
-            Ok((fr, sim)) => {
-                p.outcome = if lands(&cfg, &fr, &sim) {
+            Ok((fr, (sim, landed))) => {
+                p.outcome = if landed {
                     Outcome::Lands
                 } else {
                     Outcome::Misses
@@ -490,10 +488,7 @@ impl Origin {
                 .warm(&warm, None)
                 .solve()
             {
-                Ok(fr)
-                    if crate::verify::simulate::dynamic_spec(&cfg.design_spec(), &fr.plan)
-                        .is_ok_and(|sim| lands(&cfg, &fr, &sim)) =>
-                {
+                Ok(fr) if flight(&cfg, &fr).is_ok_and(|(_, landed)| landed) => {
                     lo = mid;
                     warm = fr;
                 }
@@ -506,12 +501,15 @@ impl Origin {
     }
 }
 
-/// Whether a design lands: verified as the least-height answer verifies
-/// one (constraints met, inside the motor envelope, landing within the
-/// tolerance under the motor model).
-fn lands(cfg: &Config, fr: &FreeResult, sim: &SimReport) -> bool {
-    sim.landing_error_deg <= tolerance_deg(cfg)
-        && crate::design::least_height::verifies(&cfg.design_spec(), fr, sim)
+/// A design flown under the motor model, and whether it lands: verified
+/// as the least-height answer verifies one (constraints met, inside the
+/// motor envelope, landing within the tolerance).
+fn flight(cfg: &Config, fr: &FreeResult) -> Result<(SimReport, bool)> {
+    let spec = cfg.design_spec();
+    let sim = crate::verify::simulate::dynamic_spec(&spec, &fr.plan)?;
+    let landed = sim.landing_error_deg <= tolerance_deg(cfg)
+        && crate::design::least_height::verifies(&spec, fr, &sim);
+    Ok((sim, landed))
 }
 
 /// The least drop height from `cfg`'s start, m: the shortest verified

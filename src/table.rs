@@ -66,10 +66,10 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.4e}", n.energy_n2m2s),
                 format!("{:.2}", n.bend_deg),
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
-                small(n.flip_error_rad),
-                small(n.tilt_deg),
-                small(n.landing_error_deg),
-                format!("{:.5}", n.sim_peak_torque_nm),
+                small(n.flight.flip_error_rad),
+                small(n.flight.tilt_deg),
+                small(n.flight.landing_error_deg),
+                format!("{:.5}", n.flight.sim_peak_torque_nm),
                 format!("{:.3}", n.solve_time_s),
             ]);
         }
