@@ -22,10 +22,18 @@ pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
 pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 
 /// The design a study flies: the free-form one from the phased seed, as
-/// `run` makes it, or from the analytic seed where the phased family cannot fit.
+/// `run` makes it, or from the analytic seed where the phased family cannot fit,
+/// with a continuous torque (`free.torque_jumps` off): the replans are
+/// solved on a grid whose acceleration is continuous, and must be able to
+/// reproduce the plan in flight (with steps at the nodes, every replan of
+/// the robot's nominal flight landed worse than the plan and none was taken).
 pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
     use crate::design::free::{FreeDesign, Seed};
     let spec = cfg.design_spec();
+    let spec = spec.with_free(crate::design::spec::FreeSettings {
+        torque_jumps: false,
+        ..spec.free.clone()
+    });
     FreeDesign::new(&spec)
         .solve()
         .or_else(|_| FreeDesign::new(&spec).seed(Seed::Analytic).solve())

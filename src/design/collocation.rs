@@ -25,6 +25,8 @@ pub struct Transcription {
     pub phases: usize,
     /// Nodes per phase (both ends included).
     pub nodes: usize,
+    /// Whether `q^^` may jump at the interior nodes ([`Transcription::with_jumps`]).
+    pub jumps: bool,
 }
 
 /// Node values bounding one interval (normalised time).
@@ -76,12 +78,40 @@ impl Transcription {
 
     pub fn new(phases: usize, nodes: usize) -> Self {
         assert!(nodes >= 2 && phases >= 1);
-        Self { phases, nodes }
+        Self {
+            phases,
+            nodes,
+            jumps: false,
+        }
     }
 
-    /// Number of decision variables: node variables plus one duration per phase.
+    /// The grid with the acceleration free to jump at each interior node:
+    /// each interval has its own `q^^` at both ends (`a` at its first node,
+    /// [`Transcription::a_in`] at its last), so the torque can switch sign
+    /// at a node instead of ramping over an interval. The shape and its
+    /// rate stay continuous.
+    pub fn with_jumps(mut self) -> Self {
+        self.jumps = true;
+        self
+    }
+
+    /// Number of decision variables: node variables, the interior nodes'
+    /// incoming accelerations (with jumps), one duration per phase.
     pub fn dim(&self) -> usize {
-        self.phases * self.nodes * Self::PER_NODE + self.phases
+        self.durations_start() + self.phases
+    }
+
+    fn node_vars(&self) -> usize {
+        self.phases * self.nodes * Self::PER_NODE
+    }
+
+    fn durations_start(&self) -> usize {
+        self.node_vars()
+            + if self.jumps {
+                self.phases * (self.nodes - 2) * 2
+            } else {
+                0
+            }
     }
 
     pub fn node(&self, p: usize, k: usize) -> usize {
@@ -93,11 +123,22 @@ impl Transcription {
     pub fn v(&self, p: usize, k: usize) -> usize {
         self.node(p, k) + 2
     }
+    /// `q^^` at node `k` as the interval starting there sees it (and at
+    /// the last node, as the interval ending there sees it).
     pub fn a(&self, p: usize, k: usize) -> usize {
         self.node(p, k) + 4
     }
+    /// `q^^` at node `k` as the interval ending there sees it: its own
+    /// variable at an interior node with jumps, else [`Transcription::a`].
+    pub fn a_in(&self, p: usize, k: usize) -> usize {
+        if self.jumps && k > 0 && k < self.nodes - 1 {
+            self.node_vars() + (p * (self.nodes - 2) + k - 1) * 2
+        } else {
+            self.a(p, k)
+        }
+    }
     pub fn duration(&self, p: usize) -> usize {
-        self.phases * self.nodes * Self::PER_NODE + p
+        self.durations_start() + p
     }
 
     /// Columns of `(q_k, q^_k, q^^_k, q^^_{k+1})`, component `j`: the variables
@@ -107,7 +148,7 @@ impl Transcription {
             self.q(p, k) + j,
             self.v(p, k) + j,
             self.a(p, k) + j,
-            self.a(p, k + 1) + j,
+            self.a_in(p, k + 1) + j,
         ]
     }
 
@@ -125,7 +166,7 @@ impl Transcription {
             q0: Self::get2(z, self.q(p, k)),
             v0: Self::get2(z, self.v(p, k)),
             a0: Self::get2(z, self.a(p, k)),
-            a1: Self::get2(z, self.a(p, k + 1)),
+            a1: Self::get2(z, self.a_in(p, k + 1)),
             h: self.h(),
         }
     }
@@ -163,14 +204,14 @@ impl Transcription {
                         (self.v(p, k + 1) + j, 1.0),
                         (self.v(p, k) + j, -1.0),
                         (self.a(p, k) + j, -h / 2.0),
-                        (self.a(p, k + 1) + j, -h / 2.0),
+                        (self.a_in(p, k + 1) + j, -h / 2.0),
                     ];
                     let q = [
                         (self.q(p, k + 1) + j, 1.0),
                         (self.q(p, k) + j, -1.0),
                         (self.v(p, k) + j, -h),
                         (self.a(p, k) + j, -h * h / 3.0),
-                        (self.a(p, k + 1) + j, -h * h / 6.0),
+                        (self.a_in(p, k + 1) + j, -h * h / 6.0),
                     ];
                     f(&v);
                     f(&q);
@@ -190,6 +231,15 @@ impl Transcription {
                 z[self.q(p, k)..self.q(p, k) + 2].copy_from_slice(&s.q);
                 z[self.v(p, k)..self.v(p, k) + 2].copy_from_slice(&s.qd.map(|x| x * t));
                 z[self.a(p, k)..self.a(p, k) + 2].copy_from_slice(&s.qdd.map(|x| x * t * t));
+                if self.a_in(p, k) != self.a(p, k) {
+                    // both one-sided limits: a plan with jumps of its own keeps them
+                    let side = |d: f64| {
+                        let st = plan.state_in(p, b[p] + t * (k as f64 * self.h() + d));
+                        st.qdd.map(|x| x * t * t)
+                    };
+                    z[self.a(p, k)..self.a(p, k) + 2].copy_from_slice(&side(1e-9));
+                    z[self.a_in(p, k)..self.a_in(p, k) + 2].copy_from_slice(&side(-1e-9));
+                }
             }
             z[self.duration(p)] = t;
         }
@@ -225,6 +275,68 @@ mod tests {
                 assert!(((p.v[j] - m.v[j]) / (2.0 * eps * d.h) - d.at(c).a[j]).abs() < 1e-6);
             }
         }
+    }
+
+    /// With jumps, each interior node has its own incoming acceleration
+    /// (nothing else shares its column), the ends keep one, and a schedule
+    /// that jumps at the nodes satisfies the defects and is sampled back
+    /// with its jumps.
+    #[test]
+    fn with_jumps_a_schedule_that_steps_at_the_nodes_reads_back_exactly() {
+        let (phases, n) = (3, 7);
+        let tr = Transcription::new(phases, n).with_jumps();
+        assert_eq!(tr.dim(), phases * n * 6 + phases * (n - 2) * 2 + phases);
+        let mut cols = Vec::new();
+        for p in 0..phases {
+            for k in 0..n {
+                cols.extend([tr.q(p, k), tr.q(p, k) + 1, tr.v(p, k), tr.v(p, k) + 1]);
+                cols.extend([tr.a(p, k), tr.a(p, k) + 1]);
+                if k > 0 && k < n - 1 {
+                    cols.extend([tr.a_in(p, k), tr.a_in(p, k) + 1]);
+                } else {
+                    assert_eq!(tr.a_in(p, k), tr.a(p, k));
+                }
+            }
+            cols.push(tr.duration(p));
+        }
+        cols.sort();
+        assert_eq!(cols, (0..tr.dim()).collect::<Vec<_>>(), "each column once");
+        // integrate arbitrary per-interval accelerations exactly
+        let mut z = vec![0.0; tr.dim()];
+        let h = tr.h();
+        for p in 0..phases {
+            z[tr.duration(p)] = 0.3 + 0.1 * p as f64;
+            for k in 0..n - 1 {
+                for j in 0..2 {
+                    let x = (p * n + k) as f64 + 0.5 * j as f64;
+                    z[tr.a(p, k) + j] = (1.3 * x).sin() * 2.0;
+                    z[tr.a_in(p, k + 1) + j] = (0.7 * x).cos() * 3.0;
+                    let d = tr.interval(&z, p, k);
+                    let (v1, q1) = (
+                        d.v0[j] + h * (d.a0[j] + d.a1[j]) / 2.0,
+                        d.q0[j] + h * d.v0[j] + h * h * (2.0 * d.a0[j] + d.a1[j]) / 6.0,
+                    );
+                    z[tr.v(p, k + 1) + j] = v1;
+                    z[tr.q(p, k + 1) + j] = q1;
+                }
+            }
+            if p + 1 < phases {
+                for j in 0..2 {
+                    z[tr.q(p + 1, 0) + j] = z[tr.q(p, n - 1) + j];
+                    z[tr.v(p + 1, 0) + j] = z[tr.v(p, n - 1) + j];
+                }
+            }
+        }
+        assert!(tr.defects(&z, 0, None).iter().all(|d| d.abs() < 1e-14));
+        let back = tr.sample(&CollocationPlan::new(tr, z.clone()));
+        for (i, (a, b)) in z.iter().zip(&back).enumerate() {
+            assert!(
+                (a - b).abs() < 1e-6 * (1.0 + a.abs()),
+                "variable {i}: {a} vs {b}"
+            );
+        }
+        let jumps = (1..n - 1).filter(|&k| (z[tr.a(1, k)] - z[tr.a_in(1, k)]).abs() > 0.1);
+        assert!(jumps.count() > n / 2, "the schedule does jump");
     }
 
     #[test]

@@ -144,7 +144,9 @@ fn round_to_digits(x: f64, digits: i32) -> f64 {
 /// exact for a torque bound alone). The torque-speed line takes torque
 /// from a motor that is speeding up, so this bounds the least time under
 /// the line from below (the design is a local optimum: the bound is the
-/// best one found).
+/// best one found). Its torque is continuous (`free.torque_jumps` off): it
+/// seeds the time design, whose grid is continuous; seeded by a design with
+/// steps, the box robot's answer was 0.4 % higher and took 1.7 times as long.
 pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
     let Some(stall) = reference.motor.max_torque else {
         return Ok(None);
@@ -152,6 +154,10 @@ pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
     let peak = reference
         .with_objective(Objective::PeakTorque)
         .with_motor(Motor::unlimited(reference.motor.norm));
+    let peak = peak.with_free(crate::design::spec::FreeSettings {
+        torque_jumps: false,
+        ..peak.free.clone()
+    });
     let plan = crate::design::analytic::analytic_plan(&peak);
     let r = free::FreeDesign::new(&peak)
         .from_plan(&plan, "analytic")

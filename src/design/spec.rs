@@ -192,6 +192,10 @@ pub struct FreeSettings {
     /// bind there (the subproblem's solution is the same, with fewer rows);
     /// see `design::scp::screen` and docs/configuration.md.
     pub screen_limits: bool,
+    /// Let the torque of a peak-torque design step at its mesh's nodes
+    /// (default true): each interval has its own acceleration at both ends;
+    /// see `design::free::grid`.
+    pub torque_jumps: bool,
 }
 
 impl Default for FreeSettings {
@@ -203,6 +207,7 @@ impl Default for FreeSettings {
             attitude_tolerance: 1e-6,
             mesh_continuation: true,
             screen_limits: true,
+            torque_jumps: true,
         }
     }
 }

@@ -146,38 +146,14 @@ fn actuator_torque(cat: &Cat, plan: &dyn ShapePlan, phase: usize, t: f64) -> Vec
     }
 }
 
-/// Average of the actuator torques over `[t0, t1]`: 4-point Gauss-Legendre on
-/// each piece between phase boundaries (a torque may jump at one).
+/// Average of the actuator torques over `[t0, t1]`, piece by piece between
+/// the plan's breaks (phase ends and nodes, where a torque may jump).
 fn step_average(cat: &Cat, plan: &dyn ShapePlan, t0: f64, t1: f64) -> Vec<f64> {
-    const X: [f64; 4] = [
-        -0.861_136_311_594_052_6,
-        -0.339_981_043_584_856_3,
-        0.339_981_043_584_856_3,
-        0.861_136_311_594_052_6,
-    ];
-    const W: [f64; 4] = [
-        0.347_854_845_137_453_9,
-        0.652_145_154_862_546_1,
-        0.652_145_154_862_546_1,
-        0.347_854_845_137_453_9,
-    ];
     let b = plan.phase_bounds();
-    let mut acc: Vec<f64> = Vec::new();
-    for i in 0..3 {
-        let (a, c) = (t0.max(b[i]), t1.min(b[i + 1]));
-        if c <= a {
-            continue;
-        }
-        for (x, w) in X.iter().zip(W) {
-            let t = 0.5 * (a + c) + 0.5 * (c - a) * x;
-            let tau = actuator_torque(cat, plan, i, t);
-            acc.resize(tau.len(), 0.0);
-            for (s, v) in acc.iter_mut().zip(tau) {
-                *s += 0.5 * (c - a) * w * v;
-            }
-        }
-    }
-    acc.iter().map(|s| s / (t1 - t0)).collect()
+    let phase = |t: f64| (0..3).find(|&i| t < b[i + 1]).unwrap_or(2);
+    crate::design::plan::mean_over(t0, t1, b.iter().copied().chain(plan.breaks()), |t| {
+        actuator_torque(cat, plan, phase(t), t)
+    })
 }
 
 /// One time step of controls.
