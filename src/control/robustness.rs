@@ -25,8 +25,8 @@ pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 /// `run` makes it, or from the analytic seed where the phased family cannot fit,
 /// with a continuous torque (`free.torque_jumps` off): the replans are
 /// solved on a grid whose acceleration is continuous, and must be able to
-/// reproduce the plan in flight (with steps at the nodes, every replan of
-/// the robot's nominal flight landed worse than the plan and none was taken).
+/// reproduce the plan in flight (with steps at the nodes, the replans of
+/// the robot's nominal flight landed worse than the plan and were not taken).
 pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
     use crate::design::free::{FreeDesign, Seed};
     let spec = cfg.design_spec();

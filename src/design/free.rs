@@ -2035,12 +2035,11 @@ fn continue_from(
 /// acceleration may jump at the nodes of its own mesh (`free.torque_jumps`):
 /// the peak optimum is bang-bang, and a continuous torque spends an
 /// interval below the peak at each sign change. Not on the continuation's
-/// coarse meshes (started from them with jumps, the fine mesh ended in
-/// worse basins after twice the iterations); not for the least time or
-/// energy (no lower, and slower); not inside a torque-speed line or speed
-/// limit (the robot's designs took 1.4 to 1.7 times as long for 0.3 to
-/// 1.9 % less peak); not from a spinning start, whose attitude map knows
-/// the momentum at the nodes and midpoints only.
+/// coarse meshes (the fine mesh then ended in worse basins); not for the
+/// least time or energy, nor inside a torque-speed line or speed limit
+/// (slower, for little or no gain: docs/optimisers.md); not from a spinning
+/// start, whose attitude map knows the momentum at the nodes and midpoints
+/// only.
 fn grid(spec: &DesignSpec, nodes: usize, mesh: Mesh) -> Transcription {
     let tr = Transcription::new(3, nodes);
     if spec.free.torque_jumps

@@ -145,8 +145,8 @@ fn round_to_digits(x: f64, digits: i32) -> f64 {
 /// from a motor that is speeding up, so this bounds the least time under
 /// the line from below (the design is a local optimum: the bound is the
 /// best one found). Its torque is continuous (`free.torque_jumps` off): it
-/// seeds the time design, whose grid is continuous; seeded by a design with
-/// steps, the box robot's answer was 0.4 % higher and took 1.7 times as long.
+/// seeds the time design, whose grid is continuous (seeded by a design with
+/// steps, the time design ended higher and slower on the box robot).
 pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
     let Some(stall) = reference.motor.max_torque else {
         return Ok(None);
