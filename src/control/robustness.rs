@@ -29,11 +29,7 @@ pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 /// the robot's nominal flight landed worse than the plan and were not taken).
 pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
     use crate::design::free::{FreeDesign, Seed};
-    let spec = cfg.design_spec();
-    let spec = spec.with_free(crate::design::spec::FreeSettings {
-        torque_jumps: false,
-        ..spec.free.clone()
-    });
+    let spec = cfg.design_spec().without_torque_jumps();
     FreeDesign::new(&spec)
         .solve()
         .or_else(|_| FreeDesign::new(&spec).seed(Seed::Analytic).solve())

@@ -1982,7 +1982,7 @@ fn continue_from(
     let tr = grid(spec, nodes, Mesh::Final);
     // the secant from two converged designs on this mesh, its durations
     // kept to at least half the last's; the plain start if it fails
-    let same_grid = |r: &FreeResult| r.nodes == nodes && r.z_scaled.len() == tr.dim();
+    let same_grid = |r: &FreeResult| r.plan.tr == tr;
     let converged = |r: &FreeResult| same_grid(r) && r.status == ScpStatus::Converged;
     if let Some(b) = before.filter(|b| converged(b) && converged(prev)) {
         let mut z: Vec<f64> = prev
@@ -2042,8 +2042,8 @@ fn continue_from(
 /// only.
 fn grid(spec: &DesignSpec, nodes: usize, mesh: Mesh) -> Transcription {
     let tr = Transcription::new(3, nodes);
+    // (`uses_envelope` holds for every objective but the peak torque)
     if spec.free.torque_jumps
-        && spec.objective == Objective::PeakTorque
         && mesh == Mesh::Final
         && !spec.uses_envelope()
         && Release::of(spec, 1.0).is_none()

@@ -153,11 +153,8 @@ pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
     };
     let peak = reference
         .with_objective(Objective::PeakTorque)
-        .with_motor(Motor::unlimited(reference.motor.norm));
-    let peak = peak.with_free(crate::design::spec::FreeSettings {
-        torque_jumps: false,
-        ..peak.free.clone()
-    });
+        .with_motor(Motor::unlimited(reference.motor.norm))
+        .without_torque_jumps();
     let plan = crate::design::analytic::analytic_plan(&peak);
     let r = free::FreeDesign::new(&peak)
         .from_plan(&plan, "analytic")

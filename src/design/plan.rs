@@ -66,48 +66,6 @@ pub trait ShapePlan {
     }
 }
 
-/// Mean of `f` over `[t0, t1]`: 4-point Gauss-Legendre on each piece
-/// between the `cuts` that fall inside (where `f` may jump), so a held
-/// value carries the exact impulse of a torque that steps within the hold.
-pub fn mean_over(
-    t0: f64,
-    t1: f64,
-    cuts: impl IntoIterator<Item = f64>,
-    mut f: impl FnMut(f64) -> Vec<f64>,
-) -> Vec<f64> {
-    const X: [f64; 4] = [
-        -0.861_136_311_594_052_6,
-        -0.339_981_043_584_856_3,
-        0.339_981_043_584_856_3,
-        0.861_136_311_594_052_6,
-    ];
-    const W: [f64; 4] = [
-        0.347_854_845_137_453_9,
-        0.652_145_154_862_546_1,
-        0.652_145_154_862_546_1,
-        0.347_854_845_137_453_9,
-    ];
-    let mut ends = vec![t0];
-    ends.extend(cuts.into_iter().filter(|&c| c > t0 && c < t1));
-    ends.push(t1);
-    ends.sort_by(f64::total_cmp);
-    let mut acc: Vec<f64> = Vec::new();
-    for w in ends.windows(2) {
-        let (a, c) = (w[0], w[1]);
-        if c <= a {
-            continue;
-        }
-        for (x, wt) in X.iter().zip(W) {
-            let v = f(0.5 * (a + c) + 0.5 * (c - a) * x);
-            acc.resize(v.len(), 0.0);
-            for (s, v) in acc.iter_mut().zip(v) {
-                *s += 0.5 * (c - a) * wt * v;
-            }
-        }
-    }
-    acc.iter().map(|s| s / (t1 - t0)).collect()
-}
-
 /// One row of a torque schedule (SI units; JSON names carry the units).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Row {

@@ -369,6 +369,14 @@ impl DesignSpec {
         s
     }
 
+    /// The same problem with a continuous torque (`free.torque_jumps` off),
+    /// for a design that seeds or is replanned on a continuous grid.
+    pub fn without_torque_jumps(&self) -> DesignSpec {
+        let mut s = self.clone();
+        s.free.torque_jumps = false;
+        s
+    }
+
     /// The same problem with another objective.
     pub fn with_objective(&self, objective: Objective) -> DesignSpec {
         let mut s = self.clone();

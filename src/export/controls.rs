@@ -146,14 +146,48 @@ fn actuator_torque(cat: &Cat, plan: &dyn ShapePlan, phase: usize, t: f64) -> Vec
     }
 }
 
-/// Average of the actuator torques over `[t0, t1]`, piece by piece between
-/// the plan's breaks (phase ends and nodes, where a torque may jump).
-fn step_average(cat: &Cat, plan: &dyn ShapePlan, t0: f64, t1: f64) -> Vec<f64> {
-    let b = plan.phase_bounds();
+/// Average of the actuator torques over `[t0, t1]`: 4-point Gauss-Legendre
+/// on each piece between the `cuts` (the plan's phase ends and breaks,
+/// sorted: a torque may jump there, at a node of a design with torque steps),
+/// so a held step carries the exact impulse. `b` are the phase bounds.
+fn step_average(
+    cat: &Cat,
+    plan: &dyn ShapePlan,
+    (b, cuts): (&[f64], &[f64]),
+    t0: f64,
+    t1: f64,
+) -> Vec<f64> {
+    const X: [f64; 4] = [
+        -0.861_136_311_594_052_6,
+        -0.339_981_043_584_856_3,
+        0.339_981_043_584_856_3,
+        0.861_136_311_594_052_6,
+    ];
+    const W: [f64; 4] = [
+        0.347_854_845_137_453_9,
+        0.652_145_154_862_546_1,
+        0.652_145_154_862_546_1,
+        0.347_854_845_137_453_9,
+    ];
+    let inside = &cuts[cuts.partition_point(|&c| c <= t0)..cuts.partition_point(|&c| c < t1)];
+    let ends: Vec<f64> = std::iter::once(t0)
+        .chain(inside.iter().copied())
+        .chain([t1])
+        .collect();
     let phase = |t: f64| (0..3).find(|&i| t < b[i + 1]).unwrap_or(2);
-    crate::design::plan::mean_over(t0, t1, b.iter().copied().chain(plan.breaks()), |t| {
-        actuator_torque(cat, plan, phase(t), t)
-    })
+    let mut acc: Vec<f64> = Vec::new();
+    for w in ends.windows(2) {
+        let (a, c) = (w[0], w[1]);
+        for (x, wt) in X.iter().zip(W) {
+            let t = 0.5 * (a + c) + 0.5 * (c - a) * x;
+            let tau = actuator_torque(cat, plan, phase(t), t);
+            acc.resize(tau.len(), 0.0);
+            for (s, v) in acc.iter_mut().zip(tau) {
+                *s += 0.5 * (c - a) * wt * v;
+            }
+        }
+    }
+    acc.iter().map(|s| s / (t1 - t0)).collect()
 }
 
 /// One time step of controls.
@@ -196,6 +230,9 @@ impl Controls {
             _ => 0.0,
         };
         let phase_of = |t: f64| (0..3).find(|&i| t <= b[i + 1]).unwrap_or(2);
+        let mut cuts: Vec<f64> = b.iter().copied().chain(plan.breaks()).collect();
+        cuts.sort_by(f64::total_cmp);
+        cuts.dedup();
         let rows = (0..=n)
             .map(|k| {
                 let t = if k == n { b[3] } else { b[0] + k as f64 * dt };
@@ -219,7 +256,7 @@ impl Controls {
                     vec![0.0; vel.len()]
                 } else {
                     let t1 = (t + dt).min(b[3]);
-                    let mut u = step_average(&cat, plan, t, t1);
+                    let mut u = step_average(&cat, plan, (&b, &cuts), t, t1);
                     if slope > 0.0 {
                         // the DC motor's command: + k times the step's mean speed
                         let (q0, q1) = (s.q, plan.state_in(phase_of(t1), t1).q);
