@@ -76,20 +76,23 @@ fn main() -> anyhow::Result<()> {
         args.len() >= 2,
         "usage: study_bound CONFIG CSV [--all] [--threads N] [KEY=VALUE ...]"
     );
-    let all = args.iter().any(|a| a == "--all");
-    let threads: usize = args
-        .iter()
-        .position(|a| a == "--threads")
-        .and_then(|i| args.get(i + 1))
-        .map(|s| s.parse())
-        .transpose()?
-        .unwrap_or(2)
-        .max(1);
-    let sets: Vec<String> = args[2..]
-        .iter()
-        .filter(|a| a.contains('='))
-        .cloned()
-        .collect();
+    // CONFIG CSV, then flags and KEY=VALUE overrides; anything else is refused
+    let (mut all, mut threads, mut sets) = (false, 2usize, Vec::new());
+    let mut rest = args[2..].iter();
+    while let Some(a) = rest.next() {
+        match a.as_str() {
+            "--all" => all = true,
+            "--threads" => {
+                let n = rest.next().and_then(|s| s.parse().ok()).filter(|&n| n >= 1);
+                threads =
+                    n.ok_or_else(|| anyhow::anyhow!("--threads needs a count of at least 1"))?;
+            }
+            kv if kv.contains('=') && !kv.starts_with('-') => sets.push(kv.to_string()),
+            other => anyhow::bail!(
+                "unknown argument {other:?}: expected --all, --threads N or KEY=VALUE"
+            ),
+        }
+    }
     let cfg = Config::load(std::path::Path::new(&args[0]), &sets)?;
     let trials = from_csv(&std::fs::read_to_string(&args[1])?).map_err(anyhow::Error::msg)?;
     let tol = cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG);
