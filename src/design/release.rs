@@ -88,6 +88,23 @@ fn rotate<T: Real>(x: [T; 4], v: [T; 3]) -> [T; 3] {
     rotate_back([x[0], -x[1], -x[2], -x[3]], v)
 }
 
+/// The rotation vector's `(y, z)` part from world `-x` to the unit vector
+/// `b`: `theta (b_y, b_z) / s` with `s = |(b_y, b_z)| = sin theta`.
+fn tilt<T: Real>(b: [T; 3]) -> [T; 2] {
+    let s2 = b[1] * b[1] + b[2] * b[2];
+    let f = if s2.re() < 1e-8 && b[0].re() < 0.0 {
+        // asin(s) / s = 1 + s^2 / 6 + 3 s^4 / 40 + ...: smooth at belly-down
+        T::one() + s2 / 6.0
+    } else if s2.re() == 0.0 {
+        // belly-up exactly: any horizontal axis
+        return [T::from(std::f64::consts::PI), T::zero()];
+    } else {
+        let s = s2.sqrt();
+        s.atan2(-b[0]) / s
+    };
+    [b[1] * f, b[2] * f]
+}
+
 fn cross<T: Real>(a: [T; 3], b: [T; 3]) -> [T; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -279,12 +296,15 @@ impl Release {
         std::array::from_fn(|i| b[i] * c + nb[i] * s + nt[i] * ndb * (T::one() - c))
     }
 
-    /// Landing residual `(b_y, b_z)` of the belly's direction `b` (zero when
-    /// it points straight down, world `-x`, whatever the heading) and its
-    /// gradient in the final quaternion.
+    /// Landing residual of the belly's direction `b` (zero when it points
+    /// straight down, world `-x`, whatever the heading) and its gradient in
+    /// the final quaternion: the tilt `theta (b_y, b_z) / |(b_y, b_z)|`, the
+    /// rotation vector from straight down to `b`, whose length is the landing
+    /// error. The horizontal components `(b_y, b_z)` alone vanish belly-up
+    /// too, where the SCP could end; the tilt is `pi` long there.
     pub fn landing(&self, end: [f64; 4]) -> ([f64; 2], [[f64; 4]; 2]) {
-        let b = self.belly(std::array::from_fn(|i| dual::<4>(end[i], i)));
-        ([b[1].re, b[2].re], [grad(&b[1]), grad(&b[2])])
+        let r = tilt(self.belly(std::array::from_fn(|i| dual::<4>(end[i], i))));
+        ([r[0].re, r[1].re], [grad(&r[0]), grad(&r[1])])
     }
 
     /// Landing error, rad: the belly's angle from straight down.
@@ -492,6 +512,63 @@ mod tests {
             }
         }
         assert!(worst < 1e-7, "worst landing-derivative error {worst:e}");
+    }
+
+    /// The residual vanishes belly-down only (not belly-up, where the
+    /// horizontal components vanish too), its length is the landing error,
+    /// and its derivative matches differences in the series near straight
+    /// down and in the closed form.
+    #[test]
+    fn the_landing_residual_is_the_tilt_from_straight_down() {
+        let rel = Release {
+            attitude: [1.0, 0.0, 0.0, 0.0],
+            momentum: [0.0; 3],
+            tail: 0.0,
+            inertias: (1.0, 2.0),
+        };
+        // belly = R e_x; about z by angle a: (cos a, sin a, 0)
+        let about = |axis: [f64; 3], a: f64| {
+            let h = 0.5 * a;
+            [
+                h.cos(),
+                axis[0] * h.sin(),
+                axis[1] * h.sin(),
+                axis[2] * h.sin(),
+            ]
+        };
+        let pi = std::f64::consts::PI;
+        for (axis, a) in [
+            ([0.0, 0.0, 1.0], pi),
+            ([0.0, 1.0, 0.0], pi - 1e-5),
+            ([0.0, 0.6, 0.8], pi - 0.3),
+            ([0.0, 0.0, 1.0], 0.0),
+            ([0.0, 1.0, 0.0], 1e-3),
+        ] {
+            let x = about(axis, a);
+            let (r, dr) = rel.landing(x);
+            let tilt = r[0].hypot(r[1]);
+            // straight down is a turn of pi from the belly's rest direction
+            let want = pi - a;
+            assert!((tilt - want).abs() < 1e-9, "{a}: tilt {tilt}, want {want}");
+            assert!((rel.landing_error(x) - want).abs() < 1e-9);
+            if a == 0.0 {
+                continue; // belly-up exactly: the direction is undefined
+            }
+            let h = 1e-7;
+            for c in 0..4 {
+                let (mut xp, mut xm) = (x, x);
+                xp[c] += h;
+                xm[c] -= h;
+                for i in 0..2 {
+                    let fd = (rel.landing(xp).0[i] - rel.landing(xm).0[i]) / (2.0 * h);
+                    let exact = dr[i][c];
+                    assert!(
+                        (fd - exact).abs() < 1e-6 * (1.0 + exact.abs()),
+                        "{a} {c} {i}: {fd} {exact}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
