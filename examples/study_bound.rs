@@ -6,8 +6,7 @@
 //! may not fit). A trial that neither this design nor any of the study's
 //! controllers lands within its tolerance is one catflip did not land. The
 //! design is a local optimum of the optimiser's own model, not an oracle:
-//! where it lands worse than a controller flew, it says nothing (its
-//! landing residual also vanishes belly-up, a root the SCP can end in).
+//! where it lands worse than a controller flew, it says nothing.
 //!
 //! `cargo run --release --example study_bound -- CONFIG CSV [--all] [--threads N] [KEY=VALUE ...]`
 //! designs the trials the replanning controller missed (`--all`: every
