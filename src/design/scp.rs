@@ -245,7 +245,8 @@ settings! {
         /// a smaller trust region is a better-conditioned subproblem.
         pub failure_cut: f64 = 0.25,
         /// Failed subproblems in a row that are taken as rejections; the
-        /// next one ends the solve with its error.
+        /// next one ends the solve at its last point
+        /// ([`Termination::Unsolvable`]).
         pub max_failures: usize = 4,
         /// The run has stalled when the radius falls below this.
         pub min_radius: f64 = 1e-10,
@@ -1429,6 +1430,9 @@ impl State {
 enum Step {
     /// The subproblem failed and counts as a rejection (no record).
     Failed,
+    /// The subproblem failed once more than the trust region's
+    /// `max_failures`: the solve ends at its point.
+    Unsolvable,
     /// A tentative step, or the step after it that undid both (see
     /// [`ScpSettings::watchdog`]): recorded, not judged by the stopping rules.
     Watchdog(ScpIteration),
@@ -1450,6 +1454,9 @@ pub enum Termination {
     Infeasible,
     /// The trust region collapsed without converging.
     Stalled,
+    /// The subproblem could not be solved however the trust region shrank
+    /// (its solver failed `max_failures + 1` times in a row).
+    Unsolvable,
     /// The iteration limit.
     IterationLimit,
 }
@@ -1464,6 +1471,9 @@ impl Termination {
                 "locally infeasible: the constraints stayed violated as the penalty grew"
             }
             Termination::Stalled => "stalled: the trust region collapsed",
+            Termination::Unsolvable => {
+                "stalled: the subproblem's solver failed however small the trust region"
+            }
             Termination::IterationLimit => "the iteration limit",
         }
     }
@@ -1473,7 +1483,7 @@ impl Termination {
         match self {
             Termination::Criticality | Termination::Progress => ScpStatus::Converged,
             Termination::Infeasible => ScpStatus::Infeasible,
-            Termination::Stalled => ScpStatus::Stalled,
+            Termination::Stalled | Termination::Unsolvable => ScpStatus::Stalled,
             Termination::IterationLimit => ScpStatus::IterationLimit,
         }
     }
@@ -1580,6 +1590,10 @@ impl<'a> Scp<'a> {
             Err(Error::Solver { .. }) if state.failures < self.s.trust.max_failures => {
                 self.failed(state);
                 return Ok(Step::Failed);
+            }
+            Err(Error::Solver { .. }) => {
+                self.failed(state);
+                return Ok(Step::Unsolvable);
             }
             Err(e) => return Err(e),
         };
@@ -2181,6 +2195,10 @@ impl<'a> Executor<'a> {
         for _ in 0..self.settings.max_iterations {
             let rec = match scp.next_iter(&mut state, self.first + iterations.len())? {
                 Step::Failed => continue,
+                Step::Unsolvable => {
+                    termination = Termination::Unsolvable;
+                    break;
+                }
                 Step::Watchdog(rec) => {
                     observer.iteration(&rec);
                     iterations.push(rec);
@@ -3088,6 +3106,27 @@ mod tests {
         assert!(nearly.raise);
     }
 
+    /// A subproblem no solver can take (a NaN in its rows), however small
+    /// the trust region: the solve ends at its start, stalled, after the
+    /// failures the settings allow, instead of throwing its point away.
+    #[test]
+    fn a_subproblem_that_always_fails_ends_the_solve_at_its_point() {
+        let broken = Toy {
+            cost: vec![(0, 1.0)],
+            r: |z| (vec![z[0] - 1.0], vec![(0, 0, f64::NAN)]),
+        };
+        let res = solve(&broken, vec![0.3, -0.2], &ScpSettings::default(), |_| {}).unwrap();
+        assert_eq!(res.termination, Termination::Unsolvable);
+        assert_eq!(res.status, ScpStatus::Stalled);
+        assert_eq!(res.z, vec![0.3, -0.2]);
+        assert!(res.iterations.is_empty());
+        assert!(
+            (res.infeasibility - 0.7).abs() < 1e-12,
+            "{}",
+            res.infeasibility
+        );
+    }
+
     #[test]
     fn each_termination_names_its_status_and_rule() {
         let all = [
@@ -3095,6 +3134,7 @@ mod tests {
             Termination::Progress,
             Termination::Infeasible,
             Termination::Stalled,
+            Termination::Unsolvable,
             Termination::IterationLimit,
         ];
         let status = all.map(|t| t.status());
@@ -3104,6 +3144,7 @@ mod tests {
                 ScpStatus::Converged,
                 ScpStatus::Converged,
                 ScpStatus::Infeasible,
+                ScpStatus::Stalled,
                 ScpStatus::Stalled,
                 ScpStatus::IterationLimit
             ]
