@@ -1672,6 +1672,21 @@ fn design_problem(
     let node_peak = crate::design::scp::peak_of(&problem.torques(&res.z), 2, problem.norm)
         * problem.torque_unit;
     let attitude_error = problem.terminal_error(&res.z);
+    if res.termination == crate::design::scp::Termination::Unsolvable {
+        // an error, as before the executor kept its point: the callers'
+        // fallbacks (another seed, the plain start) key on it
+        return Err(crate::error::Error::Solver {
+            what: format!("SCP subproblem {}", first + res.iterations.len()),
+            status: format!(
+                "Unsolvable ({} failures in a row, however small the trust region)",
+                settings.trust.max_failures + 1
+            ),
+            hint: format!(
+                "The design's last point misses the landing by {:.3} deg. Try another seed (--seed), more free.nodes, or report the config",
+                attitude_error.to_degrees()
+            ),
+        });
+    }
     let z_scaled = std::mem::take(&mut res.z);
     res.z = problem.to_physical(&z_scaled);
     let track = problem.release.map(|r| {

@@ -515,7 +515,8 @@ mod tests {
     }
 
     /// The residual vanishes belly-down only (not belly-up, where the
-    /// horizontal components vanish too), its length is the landing error,
+    /// horizontal components vanish too), its length is the landing error
+    /// and it points along the belly's horizontal part,
     /// and its derivative matches differences in the series near straight
     /// down and in the closed form.
     #[test]
@@ -551,6 +552,13 @@ mod tests {
             let want = pi - a;
             assert!((tilt - want).abs() < 1e-9, "{a}: tilt {tilt}, want {want}");
             assert!((rel.landing_error(x) - want).abs() < 1e-9);
+            // along the belly's horizontal part, not against it
+            let b = rotate(x, [1.0, 0.0, 0.0]);
+            let s = b[1].hypot(b[2]);
+            if s > 0.0 {
+                let along = (r[0] * b[1] + r[1] * b[2]) / s;
+                assert!((along - tilt).abs() < 1e-9, "{a}: {r:?} against {b:?}");
+            }
             if a == 0.0 {
                 continue; // belly-up exactly: the direction is undefined
             }

@@ -192,8 +192,10 @@ fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
         // where the plan's jumps are large, below)
         let straddled = landing_on(&r, s, &y, ff, None, &motor, p, &[], None).0;
         let (off, long_off) = ((straddled - next).abs(), (next_long - next).abs());
+        // where the straddle matters (off by over 1e-3 rad) by far
+        let factor = if off > 1e-3 { 100.0 } else { 1.0 };
         assert!(
-            off > long_off,
+            off > factor * long_off,
             "at {frac}: straddling the jumps {straddled}, not {next_long}, vs {next} rad"
         );
         worst_straddle = worst_straddle.max(off);
