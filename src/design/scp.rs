@@ -1587,13 +1587,13 @@ impl<'a> Scp<'a> {
                 state.failures = 0;
                 x
             }
-            Err(Error::Solver { .. }) if state.failures < self.s.trust.max_failures => {
-                self.failed(state);
-                return Ok(Step::Failed);
-            }
             Err(Error::Solver { .. }) => {
                 self.failed(state);
-                return Ok(Step::Unsolvable);
+                return Ok(if state.failures <= self.s.trust.max_failures {
+                    Step::Failed
+                } else {
+                    Step::Unsolvable
+                });
             }
             Err(e) => return Err(e),
         };
