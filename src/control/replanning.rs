@@ -226,14 +226,14 @@ impl InFlight {
                 let fresh = self.in_use.filter(|&(at, _)| k < at + REFRESH);
                 let bar = fresh.map(|(_, est)| 2.0 * est + SCREEN_SLACK);
                 let next_long = if bar.is_some_and(|b| own > b) {
-                    (f64::INFINITY, false)
+                    f64::INFINITY
                 } else {
                     cmp.new_plan(r, &ff, p)
                 };
-                let better = if bar.is_some_and(|b| next_long.0 > b) {
+                let better = if bar.is_some_and(|b| next_long > b) {
                     None
                 } else {
-                    let (better, now) = cmp.decide(r, &ff, next_long);
+                    let (better, now) = cmp.decide(r, next_long);
                     self.in_use = Some((k, now));
                     Some(better)
                 };
@@ -291,13 +291,12 @@ impl InFlight {
 /// feed-forward and under the plan in use with the TVLQR correcting about
 /// its nominal.
 ///
-/// Both are flown first on long steps (one a control period), each long
-/// step ending at the plans' torque jumps (phase junctions, nodes, the end),
+/// Both are flown on long steps (one a control period), each long step
+/// ending at the plans' torque jumps (phase junctions, nodes, the end),
 /// which are taken on the simulator's own steps: there RK4 converges at its
 /// order and lands within about 1e-5 rad of the flight on the simulator's
-/// steps (docs/benchmarks.md). The landings decide when they differ by more
-/// than a tolerance; else they are flown again on shorter steps, and at
-/// last on the simulator's, as before (a near tie).
+/// steps (docs/control.md), so the long steps decide as the simulator's
+/// steps would but on near ties, where either plan lands as well.
 pub struct Comparison<'a> {
     pub from: usize,
     pub y: Y,
@@ -308,31 +307,16 @@ pub struct Comparison<'a> {
     pub new: Vec<usize>,
 }
 
-/// The decision tolerance `(absolute rad, relative)` of each level but the
-/// last, and the levels' strides as fractions of the control period.
-/// Where the motor envelope binds on either flight (a kink in the torque,
-/// where RK4 converges more slowly) the relative tolerances are `CLIPPED`'s.
-const TOLERANCE: [(f64, f64); 4] = [(1e-3, 5e-3), (3e-4, 1e-3), (1e-4, 2e-4), (2e-5, 5e-5)];
-const CLIPPED: [f64; 4] = [0.15, 0.05, 0.01, 2e-3];
-const LEVELS: [usize; 4] = [1, 2, 4, 10];
-
 impl Comparison<'_> {
-    /// The new plan's landing error, rad, on steps of `stride`, and whether
-    /// the motor envelope bound on the way.
-    pub fn new_plan(
-        &self,
-        r: &Reference,
-        ff: &impl Fn(usize) -> [f64; 2],
-        stride: usize,
-    ) -> (f64, bool) {
+    /// The new plan's landing error, rad, on steps of `stride`.
+    pub fn new_plan(&self, r: &Reference, ff: &impl Fn(usize) -> [f64; 2], stride: usize) -> f64 {
         landing_on(
             r, self.from, &self.y, ff, None, self.motor, stride, &self.new, None,
         )
     }
 
-    /// The plan in use's landing error under the TVLQR, rad, on steps of
-    /// `stride`, and whether the motor envelope bound on the way.
-    pub fn in_use(&self, r: &Reference, stride: usize) -> (f64, bool) {
+    /// The plan in use's landing error under the TVLQR, rad, on steps of `stride`.
+    pub fn in_use(&self, r: &Reference, stride: usize) -> f64 {
         let tv = Some(self.tv);
         landing_on(
             r,
@@ -347,51 +331,26 @@ impl Comparison<'_> {
         )
     }
 
-    /// Whether the new plan lands the model at least as well as the plan in
-    /// use, and the plan in use's landing error: on the long steps when
-    /// they tell (`next_long`: the new plan's there), else on shorter ones.
-    pub fn decide(
-        &self,
-        r: &mut Reference,
-        ff: &impl Fn(usize) -> [f64; 2],
-        next_long: (f64, bool),
-    ) -> (bool, f64) {
+    /// Whether the new plan, landing `next` rad off on the long steps, lands
+    /// the model at least as well as the plan in use, and the plan in use's
+    /// landing error there.
+    pub fn decide(&self, r: &mut Reference, next: f64) -> (bool, f64) {
         let p = self.tv.period_steps;
-        // a nominal neither flown nor estimated: fly it
-        if r.rough.is_empty() {
+        // a nominal neither flown nor estimated that far: fly it
+        let mut now = self.in_use(r, p);
+        if now.is_nan() {
             r.extend_nominal(r.steps);
+            now = self.in_use(r, p);
         }
-        for (i, &(abs, rel)) in TOLERANCE.iter().enumerate() {
-            let stride = divisor_at_most(p, p / LEVELS[i]);
-            let (next, a) = if i == 0 {
-                next_long
-            } else {
-                self.new_plan(r, ff, stride)
-            };
-            let (now, b) = self.in_use(r, stride);
-            let rel = if a || b { CLIPPED[i] } else { rel };
-            if now.is_finite() && next.is_finite() && (next - now).abs() > abs + rel * now.max(next)
-            {
-                return (next <= now, now);
-            }
-        }
-        self.exact(r, ff)
+        (next.is_finite() && next <= now, now)
     }
 
     /// The decision on the simulator's steps.
     pub fn exact(&self, r: &mut Reference, ff: &impl Fn(usize) -> [f64; 2]) -> (bool, f64) {
         r.extend_nominal(r.steps);
-        let now = self.in_use(r, 1).0;
-        (self.new_plan(r, ff, 1).0 <= now, now)
+        let now = self.in_use(r, 1);
+        (self.new_plan(r, ff, 1) <= now, now)
     }
-}
-
-/// The largest divisor of `p` not above `m` (at least 1).
-fn divisor_at_most(p: usize, m: usize) -> usize {
-    (1..=m.max(1))
-        .rev()
-        .find(|d| p.is_multiple_of(*d))
-        .unwrap_or(1)
 }
 
 /// The steps around the torque jumps of `plan` (time 0 at flight time
@@ -424,6 +383,7 @@ pub fn torque_of(plan: &dyn ShapePlan, cat: &Cat, t: f64) -> [f64; 2] {
 /// flown, about its rough estimate), on steps of `stride` simulator steps
 /// aligned with the control steps, the steps in `fine` (sorted) single, the
 /// last one what remains; `rough` takes the state at each step's end.
+/// A flight that blows up lands infinitely far off.
 #[allow(clippy::too_many_arguments)]
 pub fn landing_on(
     r: &Reference,
@@ -435,8 +395,18 @@ pub fn landing_on(
     stride: usize,
     fine: &[usize],
     mut rough: Option<&mut Vec<Option<Y>>>,
-) -> (f64, bool) {
-    let mut clipped = false;
+) -> f64 {
+    // an RK4 step asks for its middle twice and starts where the last ended:
+    // the last two samples serve both (a plan's sample costs its inverse dynamics)
+    let mut memo = [(usize::MAX, [0.0; 2]); 2];
+    let mut ff = |i: usize| match memo.iter().find(|m| m.0 == i) {
+        Some(m) => m.1,
+        None => {
+            let v = ff(i);
+            memo = [(i, v), memo[0]];
+            v
+        }
+    };
     let mut y = *y;
     let mut j = from;
     let mut u = [0.0; 2];
@@ -457,7 +427,7 @@ pub fn landing_on(
             && tv.starts[k] == j
         {
             let Some(nom) = r.nominal_or_rough(j) else {
-                return (f64::NAN, clipped);
+                return f64::NAN;
             };
             let x = super::plant::error(&y, nom);
             let mut c = -(tv.gains[k] * x);
@@ -474,23 +444,18 @@ pub fn landing_on(
             if !(ys[6].is_finite() && ys[7].is_finite()) {
                 return want;
             }
-            let got = motor.clip(want, [ys[6], ys[7]]);
-            clipped |= got != want;
-            got
+            motor.clip(want, [ys[6], ys[7]])
         });
         j += n;
         if !y.iter().all(|v| v.is_finite()) {
-            return (f64::INFINITY, clipped);
+            return f64::INFINITY;
         }
         if let Some(rough) = rough.as_deref_mut() {
             rough[j] = Some(y);
         }
     }
     if !y.iter().all(|v| v.is_finite()) {
-        return (f64::INFINITY, clipped);
+        return f64::INFINITY;
     }
-    (
-        landing_error(attitude(&y).to_rotation_matrix().matrix()),
-        clipped,
-    )
+    landing_error(attitude(&y).to_rotation_matrix().matrix())
 }

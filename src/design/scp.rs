@@ -345,6 +345,10 @@ settings! {
         /// huge step there, or 70 to 200 interior-point iterations to find
         /// none).
         pub slack_weight: f64 = 10.0,
+        /// Whether the conic correction is tried at all. A real-time
+        /// iteration leaves it out: it costs about as much as the
+        /// subproblem, and the next period's iteration goes on from the step.
+        pub conic: bool = true,
     }
 }
 
@@ -1859,7 +1863,7 @@ impl<'a> Scp<'a> {
                 fallback = Some((corrected, at_c));
             }
         }
-        if best.is_none() {
+        if best.is_none() && s.correction.conic {
             let tries = [
                 (true, &mut state.solvers.bounded_correction),
                 (false, &mut state.solvers.correction),
@@ -2777,6 +2781,49 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A real-time iteration leaves the conic correction out: a step off
+    /// the circle, whose sensitivity correction is off too (no rounds),
+    /// sets up the conic correction's solver only when it is on.
+    #[test]
+    fn the_conic_correction_runs_only_when_it_is_on() {
+        let run = |conic: bool| {
+            let settings = ScpSettings {
+                max_iterations: 1,
+                correction: Correction {
+                    rounds: 0,
+                    conic,
+                    ..Default::default()
+                },
+                ..Default::default()
+            };
+            let mut solvers = Solvers::default();
+            let r = Executor::new(&settings)
+                .run_reusing(
+                    &circle(),
+                    vec![0.6, 0.8],
+                    &mut |_: &ScpIteration| {},
+                    &mut solvers,
+                )
+                .unwrap();
+            let first = r.iterations[0];
+            (solvers.correction.is_some(), first)
+        };
+        let (with, on) = run(true);
+        let (without, off) = run(false);
+        assert!(
+            with && !without,
+            "conic solver set up: on {with}, off {without}"
+        );
+        // the same model step, corrected only when the conic correction is on
+        assert_eq!(on.predicted, off.predicted);
+        assert!(
+            on.actual > off.actual,
+            "merit decrease {} with the correction, {} without",
+            on.actual,
+            off.actual
+        );
     }
 
     #[test]

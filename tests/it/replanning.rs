@@ -181,8 +181,8 @@ fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
         };
         let (cat, h) = (r.cat, r.h);
         let ff = |j: usize| torque_of(new.as_ref(), &cat, 0.5 * h * (j as f64 - 2.0 * s as f64));
-        let (now, next) = (cmp.in_use(&r, 1).0, cmp.new_plan(&r, &ff, 1).0);
-        let (now_long, next_long) = (cmp.in_use(&r, p).0, cmp.new_plan(&r, &ff, p).0);
+        let (now, next) = (cmp.in_use(&r, 1), cmp.new_plan(&r, &ff, 1));
+        let (now_long, next_long) = (cmp.in_use(&r, p), cmp.new_plan(&r, &ff, p));
         assert!(
             (now_long - now).abs() < 1e-4 && (next_long - next).abs() < 1e-4,
             "at {frac}: in use {now_long} vs {now}, new {next_long} vs {next} rad"
@@ -190,7 +190,7 @@ fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
         // the jumps are what the long steps must not straddle: the new plan's
         // flight over them is off by more than the long steps' error (by far
         // where the plan's jumps are large, below)
-        let straddled = landing_on(&r, s, &y, ff, None, &motor, p, &[], None).0;
+        let straddled = landing_on(&r, s, &y, ff, None, &motor, p, &[], None);
         let (off, long_off) = ((straddled - next).abs(), (next_long - next).abs());
         // where the straddle matters (off by over 1e-3 rad) by far
         let factor = if off > 1e-3 { 100.0 } else { 1.0 };
@@ -202,7 +202,7 @@ fn the_long_step_comparison_lands_and_decides_as_the_simulators_steps() {
         worst_long = worst_long.max(long_off);
         let mut a = r.clone();
         let mut b = r.clone();
-        let decided = cmp.decide(&mut a, &ff, cmp.new_plan(&r, &ff, p));
+        let decided = cmp.decide(&mut a, next_long);
         assert_eq!(decided.0, cmp.exact(&mut b, &ff).0, "at {frac}");
         assert_eq!(decided.0, next <= now);
     }
