@@ -294,9 +294,10 @@ impl InFlight {
 /// Both are flown on long steps (one a control period), each long step
 /// ending at the plans' torque jumps (phase junctions, nodes, the end),
 /// which are taken on the simulator's own steps: there RK4 converges at its
-/// order and lands within about 1e-5 rad of the flight on the simulator's
-/// steps (docs/control.md), so the long steps decide as the simulator's
-/// steps would but on near ties, where either plan lands as well.
+/// order, so the long steps decide as the simulator's steps would except on
+/// near ties (and where the motor envelope's kinks slow RK4's convergence),
+/// where either plan lands about as well. A flight that blows up on the
+/// long steps lands infinitely far off: the other plan wins.
 pub struct Comparison<'a> {
     pub from: usize,
     pub y: Y,
@@ -345,7 +346,8 @@ impl Comparison<'_> {
         (next.is_finite() && next <= now, now)
     }
 
-    /// The decision on the simulator's steps.
+    /// The decision on the simulator's steps: what the long steps' decision
+    /// is checked against (tests/it/replanning.rs), too slow for a period.
     pub fn exact(&self, r: &mut Reference, ff: &impl Fn(usize) -> [f64; 2]) -> (bool, f64) {
         r.extend_nominal(r.steps);
         let now = self.in_use(r, 1);

@@ -324,7 +324,7 @@ settings! {
 settings! {
     /// The second-order correction of a step whose `rho` falls short: the
     /// sensitivity correction ([`sensitivity_correction`]) first, the conic
-    /// one ([`correction`]) when it recovers too little.
+    /// one ([`correction`]) when it recovers too little and is enabled.
     #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
     pub struct Correction {
         /// A correction is tried when `rho` is below this.
@@ -346,9 +346,9 @@ settings! {
         /// none).
         pub slack_weight: f64 = 10.0,
         /// Whether the conic correction is tried at all. A real-time
-        /// iteration leaves it out: it costs about as much as the
-        /// subproblem, and the next period's iteration goes on from the step.
-        pub conic: bool = true,
+        /// iteration leaves it out: it is a second conic solve in a period
+        /// that has room for one, and the next period goes on from the step.
+        pub conic_enabled: bool = true,
     }
 }
 
@@ -1814,8 +1814,8 @@ impl<'a> Scp<'a> {
     /// correction first, the conic one (with the terms' bounds, then
     /// without when the solver fails on that one) when it recovers too
     /// little. A cheap correction that falls short is kept only when the
-    /// conic one fails: it took the path to worse points. Returns the point
-    /// kept and its merit.
+    /// conic one fails or is disabled: it took the path to worse points.
+    /// Returns the point kept and its merit.
     // the trial's three parts (point, values, merit) travel together; the
     // SCP's own layout (issue 25 item 2) owns this signature
     #[allow(clippy::too_many_arguments)]
@@ -1863,7 +1863,7 @@ impl<'a> Scp<'a> {
                 fallback = Some((corrected, at_c));
             }
         }
-        if best.is_none() && s.correction.conic {
+        if best.is_none() && s.correction.conic_enabled {
             let tries = [
                 (true, &mut state.solvers.bounded_correction),
                 (false, &mut state.solvers.correction),
@@ -2793,7 +2793,7 @@ mod tests {
                 max_iterations: 1,
                 correction: Correction {
                     rounds: 0,
-                    conic,
+                    conic_enabled: conic,
                     ..Default::default()
                 },
                 ..Default::default()

@@ -115,11 +115,11 @@ impl Replanner {
     /// For a real-time iteration (one or a few SCP iterations a control
     /// period): no tentative steps, whose follow-up the replan's iteration
     /// limit would cut off (undoing them: the step would be lost), and no
-    /// conic correction (the sensitivity correction alone), whose solve
-    /// would double a period's work.
+    /// conic correction (the sensitivity correction alone): a second conic
+    /// solve in the period.
     pub fn real_time(mut self) -> Self {
         self.settings.watchdog.enabled = false;
-        self.settings.correction.conic = false;
+        self.settings.correction.conic_enabled = false;
         self
     }
 
