@@ -37,7 +37,8 @@ pub struct ControlConfig {
     /// peak torque (default 2): far from the design a linear gain asks for
     /// torques no actuator has; the motor envelope, when set, clips as well.
     pub max_correction: f64,
-    /// Collocation nodes per phase of a replan in flight (default 10).
+    /// Collocation nodes per phase of a replan in flight (default 6: the
+    /// replan's p99 well inside a 100 Hz period, see docs/control.md).
     pub replan_nodes: usize,
     /// SCP iterations of a replan at most (default 1: a real-time iteration,
     /// each replan warm-started from the last).
@@ -59,7 +60,7 @@ impl Default for ControlConfig {
             rate_weight: 0.1,
             torque_weight: 1.0,
             max_correction: 2.0,
-            replan_nodes: 10,
+            replan_nodes: 6,
             replan_iterations: 1,
             replan_every: 1,
         }
