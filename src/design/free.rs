@@ -111,6 +111,13 @@ pub struct FreeProblem {
     /// The shape `q` (rad) and its rate `q_dot` (rad/s) at the start, when
     /// not straight and at rest (a replan from a measured state in flight).
     pub initial: Option<([f64; 2], [f64; 2])>,
+    /// Whether the manoeuvre lasts the whole time the fall leaves: with
+    /// angular momentum the straight cat goes on turning after it (F8), and
+    /// its landing, judged `fall.margin` after the manoeuvre's end, is the
+    /// one at touchdown only if nothing is left between. Set for a design
+    /// from a start with momentum, unless the time is minimised (there the
+    /// drop is the least one, touchdown right after the margin).
+    pub fills_the_fall: bool,
 }
 
 /// Torque check points per interval on the design's own mesh: the node and
@@ -200,6 +207,8 @@ impl FreeProblem {
             second_terms: Default::default(),
             release: Release::of(spec, time_unit),
             initial: None,
+            fills_the_fall: spec.objective != Objective::Time
+                && spec.release().momentum(&spec.cat).iter().any(|&c| c != 0.0),
             checks: CHECKS_PER_INTERVAL,
             extra: Default::default(),
         }
@@ -1099,12 +1108,19 @@ impl ScpProblem for FreeProblem {
             d.row(row, -r);
         }
         zero += dz.len();
+        // total time within the fall (unless the time is minimised), all
+        // of it when the cat turns as a whole ([`FreeProblem::fills_the_fall`]);
+        // each phase at least min_phase
+        let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
+        let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        let fills = self.fills_the_fall;
+        if fills {
+            d.row(&durs, 1.0 - total);
+            zero += 1;
+        }
         d.cone(Cone::Zero(zero));
-        // total time within the fall (unless the time is minimised); each
-        // phase at least min_phase
-        if self.objective != Objective::Time {
-            let durs: Vec<_> = (0..3).map(|p| (var(tr.duration(p)), 1.0)).collect();
-            let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        let within = self.objective != Objective::Time && !fills;
+        if within {
             d.row(&durs, 1.0 - total);
         }
         for p in 0..3 {
@@ -1113,9 +1129,7 @@ impl ScpProblem for FreeProblem {
                 z[tr.duration(p)] - self.min_phase,
             );
         }
-        d.cone(Cone::Nonneg(
-            3 + usize::from(self.objective != Objective::Time),
-        ));
+        d.cone(Cone::Nonneg(3 + usize::from(within)));
         // speed limit |q^| <= w T_p everywhere: the rate is quadratic on an
         // interval, so it lies in the convex hull of its Bernstein points
         // q^_k, q^_k + h q^^_k / 2, q^_{k+1}; bounding them bounds it exactly
@@ -1643,7 +1657,7 @@ fn design_problem(
         .check_bounded(problem.max_torque.is_some() || problem.max_speed.is_some())?;
     let mut z0 = problem.to_scaled(z0);
     let total: f64 = (0..3).map(|p| z0[tr.duration(p)]).sum();
-    if total > 1.0 && problem.objective != Objective::Time {
+    if (total > 1.0 && problem.objective != Objective::Time) || problem.fills_the_fall {
         for p in 0..3 {
             z0[tr.duration(p)] /= total;
         }

@@ -171,6 +171,10 @@ impl Replanner {
             inertias: crate::model::momentum::straight_inertias(cat),
         });
         problem.initial = Some(([y[4], y[5]], [y[6], y[7]]));
+        // a replan may end its manoeuvre early: its comparison flies every
+        // plan to touchdown before one is taken (held to the whole time left,
+        // the replans landed fewer of the seed's trials)
+        problem.fills_the_fall = false;
         // the check points the attitude map knows the momentum at
         let checks = problem.checks;
         let problem = problem.with_checks(checks);
