@@ -83,7 +83,15 @@ impl Reference {
             pending: None,
             rough: Vec::new(),
         };
-        r.splice(0, release(&cat, &cfg.start.start()), plan);
+        let start = cfg.start.start();
+        let y0 = release(&cat, &start);
+        let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
+        if start.momentum(&cat).iter().any(|&c| c != 0.0) && (pd.kp, pd.kd) != (0.0, 0.0) {
+            r.replace_plan(0, plan);
+            r.fly_held(y0, pd.kp, pd.kd);
+        } else {
+            r.splice(0, y0, plan);
+        }
         let norm = cfg.norm();
         r.peak_torque = r.ff.iter().map(|t| norm.of(*t)).fold(0.0, f64::max);
         r
@@ -179,6 +187,33 @@ impl Reference {
     pub fn fly_from(&mut self, from: usize, y: Y, motor: Option<&Motor>) {
         self.fly_lazily(from, y, motor);
         self.extend_nominal(self.steps);
+    }
+
+    /// The nominal from the release `y`, the planned shape held by the
+    /// joint PD (`kp`, `kd`, from the state at each step's start, acting
+    /// from the step's end and half of it at its middle), its torque folded
+    /// into the feed-forward, so that the feed-forward flown alone is the
+    /// nominal still. From a start with momentum the flight under the
+    /// plan's feed-forward alone is unstable and loses the design (it can
+    /// land tens of degrees off where the design lands belly-down); the
+    /// nominal, and the TVLQR about it, must be the design's motion.
+    fn fly_held(&mut self, y: Y, kp: f64, kd: f64) {
+        self.nominal[0] = y;
+        let (cat, h) = (self.cat, self.h);
+        let mut hold = [0.0; 2];
+        for j in 0..self.steps {
+            let (q, qd) = self.shape[j];
+            let x = &self.nominal[j];
+            let next = [0, 1].map(|i| kp * (q[i] - x[4 + i]) + kd * (qd[i] - x[6 + i]));
+            for i in 0..2 {
+                self.ff[2 * j + 1][i] += 0.5 * (hold[i] + next[i]);
+                self.ff[2 * j + 2][i] += next[i];
+            }
+            hold = next;
+            let ff = &self.ff;
+            self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, _| ff[2 * j + s]);
+        }
+        self.flown = self.steps;
     }
 
     /// [`Reference::fly_from`] deferred: the nominal from `from` on is flown
