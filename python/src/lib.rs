@@ -1673,12 +1673,14 @@ impl Controller {
     fn fly(&self, py: Python<'_>, trial: Option<usize>, seed: u64) -> Flight {
         py.detach(|| {
             let o = self.lock().clone();
-            let r = &o.design;
+            let r = o.flight_reference();
             let (draw, flight) = match trial {
                 None => (None, catflip::control::closed_loop::Flight::nominal(r)),
                 Some(i) => {
                     let (d, f) =
-                        catflip::control::robustness::trial_flight(&self.cfg, r, &o.tvlqr, seed, i);
+                        catflip::control::robustness::trial_flight(
+                            &self.cfg, &o.design, &o.tvlqr, seed, i,
+                        );
                     (Some(d), f)
                 }
             };

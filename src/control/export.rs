@@ -38,6 +38,11 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
     let motor = cfg.motor();
     let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
     let nominal = |fb| fly(&r, fb, &motor, Flight::nominal(&r)).error_deg;
+    let open = if r.is_held() {
+        Reference::unheld(cfg, plan)
+    } else {
+        r.clone()
+    };
     let keys = [
         ("step_s", r.h),
         ("steps", r.steps as f64),
@@ -47,18 +52,32 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         ("peak_torque_nm", r.peak_torque),
         ("pd_kp", pd.kp),
         ("pd_kd", pd.kd),
+        ("nominal_held", if r.is_held() { 1.0 } else { 0.0 }),
         (
             "nominal_landing_error_deg_tvlqr",
             nominal(Feedback::Tvlqr(&tv)),
         ),
         (
             "nominal_landing_error_deg_open_loop",
-            nominal(Feedback::JointPd {
-                kp: pd.kp,
-                kd: pd.kd,
-            }),
+            fly(
+                &open,
+                Feedback::JointPd {
+                    kp: pd.kp,
+                    kd: pd.kd,
+                },
+                &motor,
+                Flight::nominal(&open),
+            )
+            .error_deg,
         ),
     ];
+    if r.is_held() {
+        s.push_str(
+            "# From this start (angular momentum) the nominal holds the planned shape: its feed-forward is the\n\
+             # schedule's torque plus the joint PD (pd_kp, pd_kd) on the planned shape along the nominal\n\
+             # (nominal_held = 1); the schedule's controls alone lack it (the Python package's feedforward has it).\n",
+        );
+    }
     s.push_str(
         "# The closed loop's grid (touchdown at steps * step_s), the correction's cap, the PD gains and\n\
          # catflip's landing error of the nominal flight (the model, no delay or noise) under each controller:\n",

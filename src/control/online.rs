@@ -48,6 +48,9 @@ pub struct Online {
     pub reference: Reference,
     /// The design's, what a new flight starts on.
     pub design: Reference,
+    /// The open loop's ([`Reference::unheld`]; the design's but from a
+    /// start with momentum).
+    pub open_loop: Reference,
     pub tvlqr: Tvlqr,
     pub motor: Motor,
     /// Today's PD gains (the open loop's).
@@ -61,12 +64,22 @@ pub struct Online {
 
 impl Online {
     pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> Online {
-        let reference = Reference::new(cfg, plan.as_ref());
-        let tvlqr = Tvlqr::new(&reference, &cfg.control);
+        let design = Reference::new(cfg, plan.as_ref());
+        let tvlqr = Tvlqr::new(&design, &cfg.control);
+        let open_loop = if design.is_held() {
+            Reference::unheld(cfg, plan.as_ref())
+        } else {
+            design.clone()
+        };
         Online {
             kind,
-            design: reference.clone(),
-            reference,
+            reference: if kind == Kind::OpenLoop {
+                open_loop.clone()
+            } else {
+                design.clone()
+            },
+            design,
+            open_loop,
             tvlqr,
             motor: cfg.motor(),
             pd: Controller::from_spec(&cfg.design_spec()),
@@ -143,10 +156,17 @@ impl Online {
     /// Forgets the corrections sent and the replans (a new flight, on the design).
     pub fn reset(&mut self) {
         self.issued.clear();
-        if self.kind == Kind::Replan {
-            self.reference = self.design.clone();
-        }
+        self.reference = self.flight_reference().clone();
         self.in_flight = InFlight::new(self.replanning.design.clone());
+    }
+
+    /// What a new flight starts on: the design's nominal, or the open
+    /// loop's for the open loop.
+    pub fn flight_reference(&self) -> &Reference {
+        match self.kind {
+            Kind::OpenLoop => &self.open_loop,
+            Kind::Tvlqr | Kind::Replan => &self.design,
+        }
     }
 
     /// The corrections sent so far, by control step.

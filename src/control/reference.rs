@@ -1,7 +1,8 @@
 //! The nominal motion a controller tracks: a design's feed-forward torque
 //! on the fixed-step grid of the closed-loop simulator, and the state the
 //! model reaches under it from the config's start, through `fall.margin`
-//! (straight, no torque) to touchdown.
+//! (straight, no torque) to touchdown. From a start with momentum the
+//! feed-forward also holds the planned shape ([`Reference::new`]).
 
 use super::plant::{Y, rk4};
 use crate::config::Config;
@@ -19,7 +20,8 @@ pub struct Reference {
     /// Simulator step, s: touchdown at `steps * h` exactly.
     pub h: f64,
     pub steps: usize,
-    /// Feed-forward torque at every half step, `2 * steps + 1` values.
+    /// Feed-forward torque at every half step, `2 * steps + 1` values (with
+    /// the holding torque of a held nominal).
     pub ff: Vec<[f64; 2]>,
     /// Planned shape `(q, q_dot)` at every step (the joint PD's reference).
     pub shape: Vec<([f64; 2], [f64; 2])>,
@@ -40,6 +42,9 @@ pub struct Reference {
     /// Where `nominal` is not flown yet: the model's state on the control
     /// steps as a flight on long steps estimates it (a comparison's nominal).
     pub rough: Vec<Option<Y>>,
+    /// The design's nominal flown held ([`Reference::fly_held`]): `ff`
+    /// carries the holding torque too.
+    held: bool,
 }
 
 /// A plan whose samples are taken as they are needed: its time 0 at step `from`.
@@ -64,7 +69,27 @@ pub fn release(cat: &Cat, start: &Start) -> Y {
 }
 
 impl Reference {
+    /// The design's nominal for a full-state feedback: from a start with
+    /// momentum held on the planned shape ([`Reference::fly_held`]), else
+    /// the feed-forward's flight.
     pub fn new(cfg: &Config, plan: &dyn ShapePlan) -> Reference {
+        Self::build(cfg, plan, true)
+    }
+
+    /// The feed-forward's flight from any start, never held: what the joint
+    /// PD of the open loop adds its correction to (a held feed-forward would
+    /// carry a second PD).
+    pub fn unheld(cfg: &Config, plan: &dyn ShapePlan) -> Reference {
+        Self::build(cfg, plan, false)
+    }
+
+    /// Whether the design's nominal was flown held ([`Reference::fly_held`];
+    /// a replan's plan, spliced in later, is not).
+    pub fn is_held(&self) -> bool {
+        self.held
+    }
+
+    fn build(cfg: &Config, plan: &dyn ShapePlan, hold: bool) -> Reference {
         let cat = cfg.cat();
         let tf = cfg.fall_time();
         let steps = (tf * cfg.control.sim_rate_hz).ceil().max(1.0) as usize;
@@ -82,13 +107,14 @@ impl Reference {
             ff_filled: 2 * steps,
             pending: None,
             rough: Vec::new(),
+            held: false,
         };
         let start = cfg.start.start();
         let y0 = release(&cat, &start);
         let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
-        if start.momentum(&cat).iter().any(|&c| c != 0.0) && (pd.kp, pd.kd) != (0.0, 0.0) {
+        if hold && start.momentum(&cat).iter().any(|&c| c != 0.0) && (pd.kp, pd.kd) != (0.0, 0.0) {
             r.replace_plan(0, plan);
-            r.fly_held(y0, pd.kp, pd.kd);
+            r.fly_held(y0, pd.kp, pd.kd, &cfg.motor());
         } else {
             r.splice(0, y0, plan);
         }
@@ -190,14 +216,14 @@ impl Reference {
     }
 
     /// The nominal from the release `y`, the planned shape held by the
-    /// joint PD (`kp`, `kd`, from the state at each step's start, acting
-    /// from the step's end and half of it at its middle), its torque folded
-    /// into the feed-forward, so that the feed-forward flown alone is the
-    /// nominal still. From a start with momentum the flight under the
-    /// plan's feed-forward alone is unstable and loses the design (it can
-    /// land tens of degrees off where the design lands belly-down); the
-    /// nominal, and the TVLQR about it, must be the design's motion.
-    fn fly_held(&mut self, y: Y, kp: f64, kd: f64) {
+    /// joint PD (`kp`, `kd`, from the state at each step's start: its torque
+    /// acts from the step's end, the mean of the last and the new one at the
+    /// step's middle), inside `motor`'s envelope, its torque folded into the
+    /// feed-forward, so that the feed-forward flown alone is the nominal
+    /// still. From a start with momentum the flight under the plan's
+    /// feed-forward alone is unstable and loses the design; the nominal, and
+    /// the TVLQR about it, must be the design's motion.
+    fn fly_held(&mut self, y: Y, kp: f64, kd: f64, motor: &Motor) {
         self.nominal[0] = y;
         let (cat, h) = (self.cat, self.h);
         let mut hold = [0.0; 2];
@@ -211,9 +237,12 @@ impl Reference {
             }
             hold = next;
             let ff = &self.ff;
-            self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, _| ff[2 * j + s]);
+            self.nominal[j + 1] = rk4(&cat, &self.nominal[j], h, |s, ys| {
+                motor.clip(ff[2 * j + s], [ys[6], ys[7]])
+            });
         }
         self.flown = self.steps;
+        self.held = true;
     }
 
     /// [`Reference::fly_from`] deferred: the nominal from `from` on is flown

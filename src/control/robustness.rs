@@ -168,6 +168,8 @@ pub struct Study<'a> {
     pub cfg: &'a Config,
     pub seed: u64,
     pub reference: Reference,
+    /// The open loop's: the feed-forward never held ([`Reference::unheld`]).
+    pub open_loop: Reference,
     pub tvlqr: Tvlqr,
     pub pd: Controller,
     pub replanning: Replanning,
@@ -177,10 +179,16 @@ impl<'a> Study<'a> {
     pub fn new(cfg: &'a Config, plan: SharedPlan, seed: u64) -> Study<'a> {
         let reference = Reference::new(cfg, plan.as_ref());
         let tvlqr = Tvlqr::new(&reference, &cfg.control);
+        let open_loop = if reference.is_held() {
+            Reference::unheld(cfg, plan.as_ref())
+        } else {
+            reference.clone()
+        };
         Study {
             cfg,
             seed,
             reference,
+            open_loop,
             tvlqr,
             pd: Controller::from_spec(&cfg.design_spec()),
             replanning: Replanning::new(cfg, plan),
@@ -196,7 +204,12 @@ impl<'a> Study<'a> {
         let (cfg, r) = (self.cfg, &self.reference);
         let (draw, flight) = trial_flight(cfg, r, &self.tvlqr, self.seed, trial);
         let motor = cfg.motor();
-        let open = fly(r, open_loop(&self.pd, &draw), &motor, flight.clone());
+        let open = fly(
+            &self.open_loop,
+            open_loop(&self.pd, &draw),
+            &motor,
+            flight.clone(),
+        );
         let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight.clone());
         let fb = Feedback::Replan(&self.tvlqr, &self.replanning);
         let replan = fly(r, fb, &motor, flight);

@@ -169,8 +169,14 @@ impl FreeProblem {
                 }
             }
         }
-        let manoeuvre =
-            ((0..3).map(|p| z0[tr.duration(p)]).sum::<f64>() / time_unit).clamp(1e-3, 1.0);
+        let fills_the_fall = spec.objective != Objective::Time
+            && spec.release().momentum(&spec.cat).iter().any(|&c| c != 0.0);
+        // (a manoeuvre that fills the fall is stretched to it before the solve)
+        let manoeuvre = if fills_the_fall {
+            1.0
+        } else {
+            ((0..3).map(|p| z0[tr.duration(p)]).sum::<f64>() / time_unit).clamp(1e-3, 1.0)
+        };
         let mut scales = vec![0.0; tr.dim()];
         for p in 0..3 {
             for k in 0..nodes {
@@ -207,8 +213,7 @@ impl FreeProblem {
             second_terms: Default::default(),
             release: Release::of(spec, time_unit),
             initial: None,
-            fills_the_fall: spec.objective != Objective::Time
-                && spec.release().momentum(&spec.cat).iter().any(|&c| c != 0.0),
+            fills_the_fall,
             checks: CHECKS_PER_INTERVAL,
             extra: Default::default(),
         }

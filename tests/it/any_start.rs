@@ -3,6 +3,7 @@
 //! integrate the attitude and momentum with their own adaptive method.
 
 use crate::util;
+use std::sync::OnceLock;
 
 use catflip::control::closed_loop::{Feedback, Flight, fly};
 use catflip::control::plant::attitude;
@@ -118,6 +119,26 @@ fn the_default_start_is_todays_problem() {
     assert!(a.plan.track.is_none());
 }
 
+/// A design from a spinning start, seeded as `catflip run` seeds it (a
+/// robustness trial's start, rounded, from which the design used to end
+/// early at its iteration limit).
+fn spinning() -> &'static (catflip::Config, FreeResult) {
+    static DESIGN: OnceLock<(catflip::Config, FreeResult)> = OnceLock::new();
+    DESIGN.get_or_init(|| {
+        let cfg = util::seed(&[
+            "start.rotation_deg=[0, 3.2, 4.3]",
+            "start.angular_velocity=[-0.04, 0.007, -0.005]",
+        ]);
+        let spec = cfg.design_spec();
+        let phased = catflip::design::phased::optimize(&spec, |_| {}).unwrap();
+        let r = FreeDesign::new(&spec)
+            .from_plan(&phased.plan, "phased")
+            .solve()
+            .unwrap();
+        (cfg, r)
+    })
+}
+
 /// With angular momentum the straight cat goes on turning after the
 /// manoeuvre (F8), and touchdown is at the fall time whatever the schedule:
 /// a design from a spinning start lasts the whole time the fall leaves, and
@@ -126,19 +147,7 @@ fn the_default_start_is_todays_problem() {
 /// ended early was judged `fall.margin` after its own end.
 #[test]
 fn a_design_from_a_spinning_start_lasts_the_fall_and_lands_at_touchdown() {
-    // (a robustness trial's start, rounded: the design ended after 0.18 s,
-    // the SCP at its iteration limit, 3.2 deg off by its own account)
-    let cfg = util::seed(&[
-        "start.rotation_deg=[0, 3.2, 4.3]",
-        "start.angular_velocity=[-0.04, 0.007, -0.005]",
-    ]);
-    // seeded as `catflip run` seeds it
-    let spec = cfg.design_spec();
-    let phased = catflip::design::phased::optimize(&spec, |_| {}).unwrap();
-    let r = FreeDesign::new(&spec)
-        .from_plan(&phased.plan, "phased")
-        .solve()
-        .unwrap();
+    let (cfg, r) = spinning();
     assert_eq!(r.status, ScpStatus::Converged);
     assert!(r.attitude_error_rad < 1e-6, "{}", r.attitude_error_rad);
     let available = cfg.available_time();
@@ -151,7 +160,7 @@ fn a_design_from_a_spinning_start_lasts_the_fall_and_lands_at_touchdown() {
     let flown = dynamic_landing(
         &cfg.cat(),
         &r.plan,
-        &Controller::from_spec(&spec),
+        &Controller::from_spec(&cfg.design_spec()),
         &tight(),
         &cfg.start.start(),
         to_touchdown,
@@ -162,24 +171,55 @@ fn a_design_from_a_spinning_start_lasts_the_fall_and_lands_at_touchdown() {
         "lands {} deg off at touchdown",
         flown.landing_error_deg
     );
-    // the closed loop's nominal is the design's motion: its feed-forward
-    // alone, flown on the 4 kHz steps, lost it (128 deg off); held on the
-    // planned shape, it lands as designed, and so does the TVLQR about it
-    let reference = Reference::new(&cfg, &r.plan);
-    let last = reference.nominal.last().unwrap();
-    let e = landing_error(attitude(last).to_rotation_matrix().matrix()).to_degrees();
+}
+
+/// From a spinning start the model flown under a design's feed-forward
+/// alone loses the design (the flight is unstable); the closed loop's
+/// nominal holds the planned shape, its holding torque in the feed-forward:
+/// it lands as designed, the feed-forward alone flies it to the bit, and the
+/// TVLQR corrects nothing on it. The open loop's nominal is the unheld
+/// feed-forward's, and at rest nothing is held.
+#[test]
+fn the_closed_loops_nominal_from_a_spinning_start_is_the_designs_motion() {
+    let (cfg, r) = spinning();
+    let landing = |reference: &Reference| {
+        let last = reference.nominal.last().unwrap();
+        landing_error(attitude(last).to_rotation_matrix().matrix()).to_degrees()
+    };
+    let reference = Reference::new(cfg, &r.plan);
+    assert!(reference.is_held());
+    let e = landing(&reference);
     assert!(e < 1e-3, "the nominal lands {e} deg off");
+    let unheld = Reference::unheld(cfg, &r.plan);
+    assert!(!unheld.is_held());
+    assert!(
+        landing(&unheld) > 1.0,
+        "the feed-forward alone lands {} deg off",
+        landing(&unheld)
+    );
+    // the feed-forward alone, inside the motor's envelope, flies the held nominal
+    let motor = cfg.motor();
+    let mut again = reference.clone();
+    again.fly_from(0, reference.nominal[0], Some(&motor));
+    assert!(again.nominal == reference.nominal);
     let tv = Tvlqr::new(&reference, &cfg.control);
     let closed = fly(
         &reference,
         Feedback::Tvlqr(&tv),
-        &cfg.motor(),
+        &motor,
         Flight::nominal(&reference),
     );
     assert!(
-        (closed.error_deg - e).abs() < 1e-6,
+        (closed.error_deg - e).abs() < 1e-9,
         "{} against {e}",
         closed.error_deg
     );
-    assert!(closed.max_correction_nm < 1e-6 * reference.peak_torque);
+    assert!(closed.max_correction_nm < 1e-9 * reference.peak_torque);
+    // at rest the nominal is the feed-forward's flight, unheld
+    let rest = util::seed(&[]);
+    let today = FreeDesign::new(&rest.design_spec()).solve().unwrap();
+    let a = Reference::new(&rest, &today.plan);
+    let b = Reference::unheld(&rest, &today.plan);
+    assert!(!a.is_held());
+    assert!(a.nominal == b.nominal && a.ff == b.ff);
 }
