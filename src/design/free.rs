@@ -169,8 +169,7 @@ impl FreeProblem {
                 }
             }
         }
-        let fills_the_fall = spec.objective != Objective::Time
-            && spec.release().momentum(&spec.cat).iter().any(|&c| c != 0.0);
+        let fills_the_fall = spec.objective != Objective::Time && spec.has_momentum();
         // (a manoeuvre that fills the fall is stretched to it before the solve)
         let manoeuvre = if fills_the_fall {
             1.0

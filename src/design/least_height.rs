@@ -37,8 +37,9 @@ pub struct HeightAnswer {
     /// proven the shortest).
     pub status: Status,
     /// A lower bound on the least drop height, m: the least time with the
-    /// stall torque alone ([`stall_only`]; absent without a torque limit or
-    /// before the free-form designs).
+    /// stall torque alone ([`stall_only`]; absent without a torque limit,
+    /// before the free-form designs, or from a start with momentum, where
+    /// its time scaling does not hold).
     pub least_height_lower_bound_m: Option<f64>,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
@@ -231,7 +232,10 @@ pub fn heights(
         (others, (bound, from_stall))
     });
     let mut answer = phased?;
-    answer.least_height_lower_bound_m = bound.map(|t| crate::design::envelope::height_for(spec, t));
+    // (the stall-only design's time scaling, F3, holds at zero momentum only: F9)
+    answer.least_height_lower_bound_m = bound
+        .filter(|_| !spec.has_momentum())
+        .map(|t| crate::design::envelope::height_for(spec, t));
     let phased_m = answer.least_height_m;
     let mut fastest: Option<(FreeResult, SimReport)> = None;
     for fr in from_stall.into_iter().chain([from_analytic]).flatten() {

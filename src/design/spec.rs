@@ -418,6 +418,11 @@ impl DesignSpec {
         self.start.is_none()
     }
 
+    /// Whether the start has angular momentum (a spin; a tilt at rest has none).
+    pub fn has_momentum(&self) -> bool {
+        self.release().momentum(&self.cat).iter().any(|&c| c != 0.0)
+    }
+
     /// The release (today's when none is given).
     pub fn release(&self) -> Start {
         self.start.unwrap_or_default()

@@ -122,3 +122,19 @@ fn the_least_stretch_is_inside_and_no_less_would_do() {
     slow.durations = slow.durations.map(|d| d * 1.01 * k);
     assert_eq!(least_stretch(&cfg.design_spec(), &slow), 1.0);
 }
+
+/// The stall-only bound is the peak design time-scaled to the stall torque
+/// (F3), which holds at zero momentum only (F9): from a spinning start the
+/// answer gives no bound, and its sentence none.
+#[test]
+fn a_spinning_start_has_no_stall_only_bound() {
+    let a = least(&robot(&[
+        "start.angular_velocity=[0, 0, 0.3]",
+        "free.nodes=20",
+    ]))
+    .answer;
+    assert!(a.from_start);
+    assert!(a.least_height_m.is_finite());
+    assert_eq!(a.least_height_lower_bound_m, None);
+    assert!(!a.sentence().contains("at least"), "{}", a.sentence());
+}
