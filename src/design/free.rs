@@ -2293,6 +2293,43 @@ mod tests {
     use super::*;
 
     #[test]
+    fn only_a_start_with_momentum_and_no_time_objective_fills_the_fall() {
+        let spec = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            crate::test_support::spec_of(include_str!("../../configs/seed.toml"), "seed", &sets)
+        };
+        let fills = |s: &DesignSpec| {
+            let tr = Transcription::new(3, 8);
+            let z0 = tr.sample(&crate::design::analytic::analytic_plan(s));
+            let p = FreeProblem::on(s, tr, &z0);
+            // the durations' row: among the equalities exactly when it fills
+            let d = p.projection_data(&p.to_scaled(&z0));
+            let zeros: usize = d
+                .cones
+                .iter()
+                .map(|c| match c {
+                    Cone::Zero(k) => *k,
+                    _ => 0,
+                })
+                .sum();
+            (p.fills_the_fall, zeros)
+        };
+        let (rest, zeros) = fills(&spec(&[]));
+        assert!(!rest);
+        let spin = spec(&["start.angular_velocity=[0.1, 0, 0.3]"]);
+        assert_eq!(fills(&spin), (true, zeros + 1));
+        assert!(!fills(&spin.with_objective(Objective::Time)).0);
+        assert!(!fills(&spec(&["start.rotation_deg=[0, 0, 20]"])).0);
+        assert!(
+            fills(&spec(&[
+                "start.angular_velocity=[0, 0, 0.3]",
+                "design.objective=\"energy\""
+            ]))
+            .0
+        );
+    }
+
+    #[test]
     fn the_continuation_coarsens_by_a_third_then_a_half_down_to_twenty_nodes() {
         let chain = |mut n: usize| {
             let mut meshes = vec![n];
