@@ -37,12 +37,8 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
     // what a controller run from this file needs, one `# key = value` a line
     let motor = cfg.motor();
     let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
-    let nominal = |fb| fly(&r, fb, &motor, Flight::nominal(&r)).error_deg;
-    let open = if r.is_held() {
-        Reference::unheld(cfg, plan)
-    } else {
-        r.clone()
-    };
+    let nominal = |r: &Reference, fb| fly(r, fb, &motor, Flight::nominal(r)).error_deg;
+    let open = r.for_open_loop(cfg, plan);
     let keys = [
         ("step_s", r.h),
         ("steps", r.steps as f64),
@@ -55,20 +51,17 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         ("nominal_held", if r.is_held() { 1.0 } else { 0.0 }),
         (
             "nominal_landing_error_deg_tvlqr",
-            nominal(Feedback::Tvlqr(&tv)),
+            nominal(&r, Feedback::Tvlqr(&tv)),
         ),
         (
             "nominal_landing_error_deg_open_loop",
-            fly(
+            nominal(
                 &open,
                 Feedback::JointPd {
                     kp: pd.kp,
                     kd: pd.kd,
                 },
-                &motor,
-                Flight::nominal(&open),
-            )
-            .error_deg,
+            ),
         ),
     ];
     if r.is_held() {

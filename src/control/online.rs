@@ -66,11 +66,7 @@ impl Online {
     pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> Online {
         let design = Reference::new(cfg, plan.as_ref());
         let tvlqr = Tvlqr::new(&design, &cfg.control);
-        let open_loop = if design.is_held() {
-            Reference::unheld(cfg, plan.as_ref())
-        } else {
-            design.clone()
-        };
+        let open_loop = design.for_open_loop(cfg, plan.as_ref());
         Online {
             kind,
             reference: if kind == Kind::OpenLoop {

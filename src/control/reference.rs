@@ -83,6 +83,16 @@ impl Reference {
         Self::build(cfg, plan, false)
     }
 
+    /// The open loop's reference for `plan` (this one made by
+    /// [`Reference::new`] from it): itself, or its unheld twin when held.
+    pub fn for_open_loop(&self, cfg: &Config, plan: &dyn ShapePlan) -> Reference {
+        if self.held {
+            Self::unheld(cfg, plan)
+        } else {
+            self.clone()
+        }
+    }
+
     /// Whether the design's nominal was flown held ([`Reference::fly_held`];
     /// a replan's plan, spliced in later, is not).
     pub fn is_held(&self) -> bool {
@@ -109,10 +119,10 @@ impl Reference {
             rough: Vec::new(),
             held: false,
         };
-        let start = cfg.start.start();
-        let y0 = release(&cat, &start);
-        let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
-        if hold && start.momentum(&cat).iter().any(|&c| c != 0.0) && (pd.kp, pd.kd) != (0.0, 0.0) {
+        let spec = cfg.design_spec();
+        let y0 = release(&cat, &spec.release());
+        let pd = crate::verify::simulate::Controller::from_spec(&spec);
+        if hold && spec.has_momentum() && (pd.kp, pd.kd) != (0.0, 0.0) {
             r.replace_plan(0, plan);
             r.fly_held(y0, pd.kp, pd.kd, &cfg.motor());
         } else {

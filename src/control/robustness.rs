@@ -179,11 +179,7 @@ impl<'a> Study<'a> {
     pub fn new(cfg: &'a Config, plan: SharedPlan, seed: u64) -> Study<'a> {
         let reference = Reference::new(cfg, plan.as_ref());
         let tvlqr = Tvlqr::new(&reference, &cfg.control);
-        let open_loop = if reference.is_held() {
-            Reference::unheld(cfg, plan.as_ref())
-        } else {
-            reference.clone()
-        };
+        let open_loop = reference.for_open_loop(cfg, plan.as_ref());
         Study {
             cfg,
             seed,
