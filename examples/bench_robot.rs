@@ -14,7 +14,10 @@
 //!   other in one thread, each timed (wall/CPU s);
 //! - `free:CONFIG:OBJECTIVE:SEED`: the free-form design inside the motor
 //!   envelope from 6 m (`peak-torque`, `time`, `energy`; `phased`,
-//!   `analytic`), the seeding design not counted.
+//!   `analytic`), the seeding design not counted;
+//! - `sweep:CONFIG:KEY:FROM:TO:COUNT`: `catflip sweep CONFIG --set-range
+//!   KEY=FROM:TO:COUNT --threads 2` with every method (files not written),
+//!   e.g. `sweep:robot-universal:cat.length:0.18:0.24:40`.
 //!
 //! The default cases: `run` and `height` on `robot-universal` and
 //! `box-robot`, and the six free-form designs of `robot-universal`.
@@ -149,8 +152,40 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
                 cpu_s() - c,
             ));
         }
+        ["sweep", name, key, from, to, count] => {
+            // `catflip sweep CONFIG --set-range KEY=FROM:TO:COUNT --threads 2`
+            // (every method; files not written)
+            let path = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
+            let spec: catflip::sweep::SweepSpec = format!("{key}={from}:{to}:{count}").parse()?;
+            let methods = catflip::sweep::Methods {
+                analytic: true,
+                phased: true,
+                free: true,
+            };
+            let points = catflip::sweep::sweep(
+                std::path::Path::new(&path),
+                extra,
+                &spec,
+                methods,
+                2,
+                |_, _| {},
+            )?;
+            let free: Vec<f64> = points
+                .iter()
+                .filter_map(|p| p.least_height_free_m)
+                .collect();
+            let falls = free.windows(2).filter(|w| w[1] < w[0]).count();
+            format!(
+                "{} points, {} free least heights ({:.4} to {:.4} m), {falls} of {} steps falling",
+                points.len(),
+                free.len(),
+                free.first().copied().unwrap_or(f64::NAN),
+                free.last().copied().unwrap_or(f64::NAN),
+                free.len().saturating_sub(1)
+            )
+        }
         _ => anyhow::bail!(
-            "unknown case {case} (run:CONFIG, height:CONFIG, parts:CONFIG, free:CONFIG:OBJECTIVE:SEED)"
+            "unknown case {case} (run:CONFIG, height:CONFIG, parts:CONFIG, free:CONFIG:OBJECTIVE:SEED, sweep:CONFIG:KEY:FROM:TO:COUNT)"
         ),
     };
     Ok((text, t.elapsed().as_secs_f64(), cpu_s() - c))

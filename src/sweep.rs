@@ -6,13 +6,17 @@
 //! order and each free-form design starts from its neighbour's solution (in
 //! the optimiser's dimensionless units, so a change of height or time is no
 //! change at all, F3); the first point of a chunk starts from its phased
-//! design. Chunks run in parallel, and `--shard K/N` computes a contiguous
+//! design. The least heights inside a motor envelope continue the same way
+//! (`HeightChain`): the chunk's first point is `run`'s answer. Chunks run
+//! in parallel, and `--shard K/N` computes a contiguous
 //! run of whole chunks, so every point's result is the same whether the
 //! sweep runs on one machine or on many.
 
 use crate::config::Config;
 use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
+use crate::design::least_height::{Heights, heights, heights_near};
+use crate::design::phased::BendHint;
 use crate::design::phased::least_height;
 use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
@@ -211,6 +215,59 @@ struct Continuation {
     /// and its manoeuvre time, once computed.
     phased: Option<Option<(f64, crate::design::phased::PhasedResult)>>,
     bends: Vec<f64>,
+    height: HeightChain,
+}
+
+/// What the least-height stage carries from point to point: the last two
+/// free-form `time` designs, the second only when both points produced
+/// one, and the phased `time` designs' bends of consecutive points.
+#[derive(Default)]
+struct HeightChain {
+    warm: Option<FreeResult>,
+    before: Option<FreeResult>,
+    /// Whether the point before produced a design (`warm`).
+    last_ok: bool,
+    bends: Vec<f64>,
+}
+
+impl HeightChain {
+    /// The least heights at this point: continued from the chunk's last
+    /// least-height design when there is one, else the cold stage (so the
+    /// chunk's first point answers as `run` does).
+    fn heights(&mut self, spec: &DesignSpec, with_free: bool) -> Result<Option<Heights>> {
+        let hint = self.bends.last().map(|&last| {
+            BendHint::from_neighbours(last, self.bends.len().checked_sub(2).map(|i| self.bends[i]))
+        });
+        let h = match (&self.warm, with_free) {
+            (Some(prev), true) => heights_near(spec, prev, self.before.as_ref(), hint),
+            _ => heights(spec, with_free, |_| {}),
+        };
+        match &h {
+            Ok(Some(h)) => self.bends.push(h.phased_bend),
+            _ => self.bends.clear(),
+        }
+        let fr = h
+            .as_ref()
+            .ok()
+            .and_then(|h| h.as_ref())
+            .and_then(|h| h.free.clone());
+        let produced = fr.is_some();
+        if let Some(fr) = fr {
+            let last = self.warm.replace(fr);
+            self.before = last.filter(|_| self.last_ok);
+        } else {
+            self.before = None;
+        }
+        self.last_ok = produced;
+        h
+    }
+
+    /// A point whose config is invalid: no secant across it.
+    fn skip(&mut self) {
+        self.before = None;
+        self.last_ok = false;
+        self.bends.clear();
+    }
 }
 
 impl Continuation {
@@ -223,15 +280,7 @@ impl Continuation {
 
     /// The point at `value`, continued from the chunk's points before it.
     fn point(&mut self, cfg: &Config, value: f64, methods: Methods) -> SweepPoint {
-        let (p, fr) = point(
-            cfg,
-            value,
-            methods,
-            self.warm.as_ref(),
-            self.before.as_ref(),
-            self.phased.as_mut(),
-            &mut self.bends,
-        );
+        let (p, fr) = point(cfg, value, methods, self);
         // a failed point leaves the last good design as the start, and no
         // secant until two consecutive points have designs again
         let produced = fr.is_some();
@@ -246,6 +295,7 @@ impl Continuation {
         self.bends.clear();
         self.before = None;
         self.last_ok = false;
+        self.height.skip();
     }
 }
 
@@ -259,11 +309,17 @@ fn point(
     cfg: &Config,
     value: f64,
     methods: Methods,
-    warm: Option<&FreeResult>,
-    before: Option<&FreeResult>,
-    phased_warm: Option<&mut Option<(f64, crate::design::phased::PhasedResult)>>,
-    bends: &mut Vec<f64>,
+    chain: &mut Continuation,
 ) -> (SweepPoint, Option<FreeResult>) {
+    let Continuation {
+        warm,
+        before,
+        phased: phased_warm,
+        bends,
+        height,
+        ..
+    } = chain;
+    let (warm, before) = (warm.as_ref(), before.as_ref());
     let mut p = SweepPoint {
         value,
         ..Default::default()
@@ -297,7 +353,7 @@ fn point(
         // within a chunk the free-form design continues from its neighbour
         // and needs no phased seed
         let reuse = phased_warm
-            .as_deref()
+            .as_ref()
             .and_then(|w| w.as_ref())
             .filter(|_| !cfg.uses_envelope());
         let ph = if let Some((t_prev, prev)) = reuse {
@@ -333,7 +389,7 @@ fn point(
                 reason: "not computed".into(),
             })
         };
-        if let (Ok(r), Some(slot)) = (&ph, phased_warm)
+        if let (Ok(r), Some(slot)) = (&ph, phased_warm.as_mut())
             && slot.is_none()
         {
             *slot = Some((cfg.available_time(), r.clone()));
@@ -394,7 +450,7 @@ fn point(
     }
     if envelope && (methods.phased || methods.free) {
         let limited = limited_cfg.design_spec();
-        match crate::design::least_height::heights(&limited, methods.free, |_| {}) {
+        match height.heights(&limited, methods.free) {
             Ok(Some(h)) => {
                 if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);

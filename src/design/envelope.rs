@@ -59,8 +59,8 @@
 //! whatever the size of the cat; each bend gets a fresh Clarabel solver so
 //! that its equilibration matches the bend's data.
 
-use crate::design::bend_search::{BendEvaluation, bend_range, bend_scan};
-use crate::design::bend_search::{Scored, scan_then_brent};
+use crate::design::bend_search::{BendEvaluation, BendHint, bend_range, bend_scan};
+use crate::design::bend_search::{Scored, bracket_then_brent, scan_then_brent};
 use crate::design::conic::{Cone, ConicData, ConicSolver, SolveStatus, solve_reusing};
 use crate::design::objective::Objective;
 use crate::design::path::{GridTiming, Path, PhasedPlan, Timing};
@@ -879,8 +879,16 @@ pub struct EnvelopeResult {
 }
 
 /// The phased optimiser inside the motor envelope, for `design.objective`.
-pub fn optimize(
+pub fn optimize(spec: &DesignSpec, observe: impl FnMut(&BendEvaluation)) -> Result<EnvelopeResult> {
+    optimize_near(spec, None, observe)
+}
+
+/// [`optimize`] with the bend search started at a neighbour's bend (a
+/// sweep's continuation, see [`bracket_then_brent`]); the whole scan when
+/// no bend near it fits.
+pub fn optimize_near(
     spec: &DesignSpec,
+    hint: Option<BendHint>,
     mut observe: impl FnMut(&BendEvaluation),
 ) -> Result<EnvelopeResult> {
     let start = Instant::now();
@@ -912,7 +920,19 @@ pub fn optimize(
     let scan = bend_scan(spec, lo, hi);
     let spacing = (hi - lo) / (scan.len().max(2) - 1) as f64;
     let tol = spec.phased.bend_tol_deg.to_radians();
-    let mut best = search(&cat, &mut coarse, scan, tol, &mut record)?;
+    let near = match hint {
+        Some(h) => bracket_then_brent(h.bend, h.step, (lo, hi), tol, |b| {
+            let d = design_at(&cat, &mut coarse, b, 1.0)?;
+            record(&d);
+            Ok(d)
+        })?
+        .filter(|d| d.value.is_finite()),
+        None => None,
+    };
+    let mut best = match near {
+        Some(d) => d,
+        None => search(&cat, &mut coarse, scan, tol, &mut record)?,
+    };
     let mut fastest_bend = None;
     if !best.value.is_finite() && budget.is_some() {
         // a budget close to the least time leaves a narrow band of feasible

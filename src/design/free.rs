@@ -1245,6 +1245,10 @@ pub struct FreeResult {
     pub z_scaled: Vec<f64>,
     #[serde(skip)]
     pub warm: WarmStart,
+    /// The check points [`refine_checks`] added (per phase: interval,
+    /// fraction): a neighbour on the same grid starts with them.
+    #[serde(skip)]
+    pub extra_checks: [Vec<(usize, f64)>; 3],
     #[serde(skip)]
     pub plan: CollocationPlan,
 }
@@ -1584,6 +1588,8 @@ struct Solved {
     attitude_error: f64,
     /// Peak at the check points, N m.
     node_peak: f64,
+    /// The check points added to the grid's ([`FreeProblem::with_extra_checks`]).
+    extra: [Vec<(usize, f64)>; 3],
 }
 
 impl FreeProblem {
@@ -1676,7 +1682,19 @@ fn design_problem(
         ..Default::default()
     };
     let unit = problem.objective_unit();
-    let warm = warm.filter(|w| problem.multipliers_fit(&w.multipliers));
+    // a neighbour's multipliers that do not fit this problem's rows (added
+    // check points) are dropped; its weight and radius still hold
+    let warm = warm.map(|w| {
+        if problem.multipliers_fit(&w.multipliers) {
+            w.clone()
+        } else {
+            WarmStart {
+                multipliers: Default::default(),
+                ..w.clone()
+            }
+        }
+    });
+    let warm = warm.as_ref();
     let mut res = Executor::new(&settings)
         .warm(warm)
         .numbered_from(first)
@@ -1726,6 +1744,7 @@ fn design_problem(
         plan,
         attitude_error,
         node_peak,
+        extra: problem.extra.clone(),
     })
 }
 
@@ -1827,7 +1846,7 @@ fn refine_checks(
     first: usize,
     observe: &mut dyn FnMut(&ScpIteration),
 ) -> Result<Solved> {
-    let mut extra: [Vec<(usize, f64)>; 3] = Default::default();
+    let mut extra = solved.extra.clone();
     for _ in 0..REFINE_ROUNDS {
         if solved.res.status != ScpStatus::Converged {
             break;
@@ -1883,14 +1902,24 @@ fn refine_checks(
 fn optimize_start(
     spec: &DesignSpec,
     z0: &[f64],
-    warm: Option<&WarmStart>,
+    prev: Option<&FreeResult>,
     seed: &str,
     nodes: usize,
     first: usize,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<FreeResult> {
     let start = std::time::Instant::now();
-    let solved = design(spec, z0, warm, nodes, Mesh::Final, first, &mut observe)?;
+    check_resolvable(spec, nodes)?;
+    let tr = grid(spec, nodes, Mesh::Final);
+    // a neighbour on the same grid hands on the check points it added, so
+    // that the design does not find them again one round at a time
+    let extra = prev
+        .filter(|p| p.plan.tr == tr)
+        .map(|p| p.extra_checks.clone())
+        .unwrap_or_default();
+    let problem = FreeProblem::on(spec, tr, z0).with_extra_checks(extra);
+    let warm = prev.map(|p| &p.warm);
+    let solved = design_problem(spec, problem, z0, warm, Mesh::Final, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(spec, &solved));
     }
@@ -1905,6 +1934,7 @@ fn optimize_start(
         plan,
         attitude_error: att,
         node_peak,
+        extra,
     } = solved;
     let tr = plan.tr;
     let solve_time = start.elapsed().as_secs_f64();
@@ -1953,6 +1983,7 @@ fn optimize_start(
         }],
         z_scaled,
         warm: res.warm.clone(),
+        extra_checks: extra,
         iterations: res.iterations,
         plan,
     })
@@ -2028,15 +2059,8 @@ fn continue_from(
             let i = tr.duration(p);
             z[i] = z[i].max(0.5 * prev.z_scaled[i]) * spec.available_time();
         }
-        if let Ok(r) = optimize_start(
-            spec,
-            &z,
-            Some(&prev.warm),
-            "continuation",
-            nodes,
-            0,
-            &mut observe,
-        ) {
+        if let Ok(r) = optimize_start(spec, &z, Some(prev), "continuation", nodes, 0, &mut observe)
+        {
             return Ok(r);
         }
     }
@@ -2053,15 +2077,7 @@ fn continue_from(
     for p in 0..3 {
         z0[tr.duration(p)] *= spec.available_time();
     }
-    optimize_start(
-        spec,
-        &z0,
-        Some(&prev.warm),
-        "continuation",
-        nodes,
-        0,
-        observe,
-    )
+    optimize_start(spec, &z0, Some(prev), "continuation", nodes, 0, observe)
 }
 
 /// The grid of a design at `nodes` per phase. For a peak-torque design the

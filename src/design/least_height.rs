@@ -6,6 +6,7 @@
 
 use crate::design::free::{self, FreeResult};
 use crate::design::objective::Objective;
+use crate::design::phased::BendHint;
 use crate::design::plan::Schedule;
 use crate::design::scp::ScpIteration;
 use crate::design::spec::DesignSpec;
@@ -60,15 +61,20 @@ pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
     if !spec.motor.is_limited() {
         return Ok(None);
     }
-    answer_for(spec, &reference(spec)).map(Some)
+    answer_for(spec, &reference(spec), None).map(|(a, _)| Some(a))
 }
 
-/// [`answer`] with the phased `time` design made for `reference`.
-fn answer_for(spec: &DesignSpec, reference: &DesignSpec) -> Result<HeightAnswer> {
-    let r = crate::design::phased::optimize(reference, |_| {})?;
+/// [`answer`] with the phased `time` design made for `reference`, its bend
+/// search started at `hint` when given; and that design's bend, rad.
+fn answer_for(
+    spec: &DesignSpec,
+    reference: &DesignSpec,
+    hint: Option<BendHint>,
+) -> Result<(HeightAnswer, f64)> {
+    let r = crate::design::phased::optimize_near(reference, hint, |_| {})?;
     let sim = crate::verify::simulate::dynamic_spec(reference, &r.plan)?;
     let least = crate::design::envelope::height_for(spec, r.manoeuvre_time_s);
-    Ok(HeightAnswer {
+    let answer = HeightAnswer {
         possible: fits(spec, least),
         height_m: spec.fall.height,
         least_height_m: least,
@@ -79,7 +85,8 @@ fn answer_for(spec: &DesignSpec, reference: &DesignSpec) -> Result<HeightAnswer>
         flip_error_rad: sim.flip_error_rad,
         from_start: spec.is_default_start(),
         schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
-    })
+    };
+    Ok((answer, r.bend_deg.to_radians()))
 }
 
 /// Whether a drop from `height` is within the configured one (to rounding).
@@ -92,8 +99,9 @@ pub fn fits(spec: &DesignSpec, height: f64) -> bool {
 pub struct Heights {
     /// The better of the two (see [`HeightAnswer::improve_with`]).
     pub answer: HeightAnswer,
-    /// The phased time design's least height, m.
+    /// The phased time design's least height, m, and its bend, rad.
     pub phased_m: f64,
+    pub phased_bend: f64,
     /// The shortest free-form time design that verifies ([`verified`]).
     pub free: Option<FreeResult>,
 }
@@ -198,9 +206,10 @@ pub fn heights(
     }
     let reference = reference(spec);
     if !with_free {
-        let answer = answer_for(spec, &reference)?;
+        let (answer, phased_bend) = answer_for(spec, &reference, None)?;
         return Ok(Some(Heights {
             phased_m: answer.least_height_m,
+            phased_bend,
             answer,
             free: None,
         }));
@@ -208,7 +217,7 @@ pub fn heights(
     let analytic_plan = crate::design::analytic::analytic_plan(&reference);
     let ((phased, from_analytic), (bound, from_stall)) = std::thread::scope(|s| {
         let others = s.spawn(|| {
-            let phased = answer_for(spec, &reference);
+            let phased = answer_for(spec, &reference, None);
             let analytic = free::FreeDesign::new(&reference)
                 .from_plan(&analytic_plan, "analytic")
                 .solve();
@@ -231,18 +240,65 @@ pub fn heights(
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (others, (bound, from_stall))
     });
-    let mut answer = phased?;
+    let (mut answer, phased_bend) = phased?;
     // (the stall-only design's time scaling, F3, holds at zero momentum only: F9)
     answer.least_height_lower_bound_m = bound
         .filter(|_| !spec.has_momentum())
         .map(|t| crate::design::envelope::height_for(spec, t));
+    Ok(Some(concluded(
+        spec,
+        &reference,
+        (answer, phased_bend),
+        from_stall.into_iter().chain([from_analytic]).flatten(),
+    )))
+}
+
+/// [`heights`] at a point next to one already answered (a sweep's
+/// continuation): one free-form `time` design, started from the
+/// neighbour's (`prev`, and the secant through `before`), beside the
+/// phased design, whose bend search starts at `hint` (the neighbour's). A
+/// neighbour's optimum is a few iterations from this one, where the cold
+/// starts take dozens each; without the stall-only design the answer
+/// carries no lower bound. When the continued design does not verify, the
+/// cold stage answers.
+pub fn heights_near(
+    spec: &DesignSpec,
+    prev: &FreeResult,
+    before: Option<&FreeResult>,
+    hint: Option<BendHint>,
+) -> Result<Option<Heights>> {
+    if !spec.motor.is_limited() {
+        return Ok(None);
+    }
+    let reference = reference(spec);
+    let answer = answer_for(spec, &reference, hint)?;
+    let continued = free::FreeDesign::new(&reference)
+        .warm(prev, before)
+        .solve()
+        .ok();
+    let h = concluded(spec, &reference, answer, continued);
+    if h.free.is_some() {
+        Ok(Some(h))
+    } else {
+        heights(spec, true, |_| {})
+    }
+}
+
+/// The answer from the phased one (`answer`) and the free-form `time`
+/// designs: the shortest that verifies improves it.
+fn concluded(
+    spec: &DesignSpec,
+    reference: &DesignSpec,
+    (mut answer, phased_bend): (HeightAnswer, f64),
+    designs: impl IntoIterator<Item = FreeResult>,
+) -> Heights {
     let phased_m = answer.least_height_m;
     let mut fastest: Option<(FreeResult, SimReport)> = None;
-    for fr in from_stall.into_iter().chain([from_analytic]).flatten() {
+    for fr in designs {
         if fastest
             .as_ref()
             .is_none_or(|(f, _)| fr.manoeuvre_time_s < f.manoeuvre_time_s)
-            && let Some(sim) = verified(&reference, &fr)
+            && let Some(sim) = verified(reference, &fr)
         {
             fastest = Some((fr, sim));
         }
@@ -257,11 +313,12 @@ pub fn heights(
     } else if !spec.is_default_start() {
         answer.possible = false;
     }
-    Ok(Some(Heights {
+    Heights {
         answer,
         phased_m,
+        phased_bend,
         free: fastest.map(|(fr, _)| fr),
-    }))
+    }
 }
 
 /// Whether a free-form design can answer the robot question: its

@@ -271,15 +271,17 @@ pub fn optimize(spec: &DesignSpec, observe: impl FnMut(&BendEvaluation)) -> Resu
 }
 
 /// [`optimize`] with the bend search started at a neighbour's bend (a
-/// sweep's continuation; see [`search_bend`]). The motor-envelope design
-/// ignores the hint.
+/// sweep's continuation; see [`search_bend`]).
 pub fn optimize_near(
     spec: &DesignSpec,
     hint: Option<BendHint>,
     observe: impl FnMut(&BendEvaluation),
 ) -> Result<PhasedResult> {
     if spec.uses_envelope() {
-        return finish_envelope(spec, crate::design::envelope::optimize(spec, observe)?);
+        return finish_envelope(
+            spec,
+            crate::design::envelope::optimize_near(spec, hint, observe)?,
+        );
     }
     let start = Instant::now();
     let mut problem = TimingProblem::new(spec.phased.nodes, spec.norm());

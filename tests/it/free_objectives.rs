@@ -142,5 +142,29 @@ fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
             "{seed:?}: written {} s, the SCP ended at {ended} s",
             r.manoeuvre_time_s
         );
+        // continued from itself (a sweep's next point at no change), the
+        // design keeps the check points it added, its penalty weight and
+        // trust radius, so it starts where it ended: a few iterations, and
+        // no slower (with the weight reset, the steps wandered off the
+        // optimum for dozens of iterations)
+        let again = FreeDesign::new(&cfg.design_spec())
+            .warm(&r, None)
+            .solve()
+            .unwrap();
+        assert_eq!(again.status, catflip::design::scp::ScpStatus::Converged);
+        for (added, kept) in r.extra_checks.iter().zip(&again.extra_checks) {
+            assert!(added.iter().all(|c| kept.contains(c)), "{seed:?}");
+        }
+        assert!(
+            again.scp_iterations <= 10,
+            "{seed:?}: {} iterations from its own optimum",
+            again.scp_iterations
+        );
+        assert!(
+            again.manoeuvre_time_s <= r.manoeuvre_time_s * (1.0 + 1e-6),
+            "{seed:?}: {} s from {} s",
+            again.manoeuvre_time_s,
+            r.manoeuvre_time_s
+        );
     }
 }
