@@ -29,7 +29,7 @@ import pathlib
 import mujoco
 import numpy as np
 
-from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args,
+from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args, pd_tolerance,
                            peak_of, quat_log, read_controls, reference, report, right_jacobian,
                            run_folder)
 
@@ -213,7 +213,8 @@ def main():
             model.opt.timestep = c["dt"]
         for mode in ("ff", "pd"):
             results.append((method, mode, replay(model, c, mode == "pd")))
-    fails += report("MuJoCo", summary, results, {"pd": args.tol_deg}, args.ff_tol_deg,
+    pd_tol = {"pd": lambda m: pd_tolerance(args.tol_deg, args.default_tol_deg, m)}
+    fails += report("MuJoCo", summary, results, pd_tol, args.ff_tol_deg,
                     args.land_tol_deg, args.land_methods.split(","))
     if summary["joint"] == "universal":
         pd_flips = {m: r["flip_deg"] for m, mode, r in results if mode == "pd"}
