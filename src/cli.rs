@@ -432,9 +432,12 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
 
 fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
+    // each seed its own set: a design from the analytic seed does not
+    // replace the one from the default (phased) seed
     let set = match optimizer {
         Optimizer::Phased => "optimize-phased",
-        Optimizer::Free(_) => "optimize-free",
+        Optimizer::Free(catflip::design::free::Seed::Phased) => "optimize-free",
+        Optimizer::Free(catflip::design::free::Seed::Analytic) => "optimize-free-analytic",
     };
     let publisher = publisher(c, &cfg, set)?;
     let spec = cfg.design_spec();

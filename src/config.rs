@@ -222,6 +222,7 @@ impl Config {
                 expected: "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (catflip keeps its sets in hidden folders)".into(),
             });
         }
+        ranges::check_documented(self)?;
         let c = &self.cat;
         check(
             "cat.mass",

@@ -41,7 +41,7 @@ pub enum Error {
         status: String,
         hint: String,
     },
-    #[error("the flip is impossible: {reason}")]
+    #[error("not possible as configured: {reason}")]
     Unreachable { reason: String },
     /// The phased seed of a free-form design is impossible where the
     /// free-form design may not be.

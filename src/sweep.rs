@@ -618,7 +618,11 @@ fn checked_configs(
         };
         return Err(Error::Range {
             arg: arg.into(),
-            message: if bad == configs.len() {
+            message: if bad == configs.len() && message.contains("expected a name") {
+                format!(
+                    "`{key}` takes a name, not a number: a sweep varies a numeric key ({message})"
+                )
+            } else if bad == configs.len() {
                 format!("every point is invalid; {message}")
             } else {
                 format!(

@@ -69,7 +69,7 @@ def assert_close(a, b, path="", tol=1e-12):
 # each design through Python and through the CLI: the command and its files' folder and stem
 METHODS = {
     ("free", None): (["optimize", "--mode", "free"], "optimize-free", "free"),
-    ("free", "analytic"): (["optimize", "--mode", "free", "--seed", "analytic"], "optimize-free", "free"),
+    ("free", "analytic"): (["optimize", "--mode", "free", "--seed", "analytic"], "optimize-free-analytic", "free"),
     ("phased", None): (["optimize", "--mode", "phased"], "optimize-phased", "phased"),
     ("analytic", None): (["analyze"], "analyze", "analytic"),
 }

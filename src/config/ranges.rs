@@ -198,6 +198,13 @@ fn invalid(key: &str, value: f64, expected: String) -> Error {
 /// Every key of [`RANGES`] that the config sets, the radii against the
 /// lengths, and the analytic split's fractions.
 pub fn check_ranges(cfg: &Config) -> Result<()> {
+    check_documented(cfg)?;
+    check_derived(cfg)
+}
+
+/// The keys of [`RANGES`] within their documented ranges: checked first,
+/// so that a value outside is told its range, not only its sign.
+pub fn check_documented(cfg: &Config) -> Result<()> {
     let c = &cfg.cat;
     let fr = c.front.clone().unwrap_or_default();
     let l = &cfg.limits;
@@ -222,6 +229,12 @@ pub fn check_ranges(cfg: &Config) -> Result<()> {
             r.check(v)?;
         }
     }
+    Ok(())
+}
+
+/// The ranges that depend on other keys (radii against lengths, the split,
+/// ...).
+fn check_derived(cfg: &Config) -> Result<()> {
     let cat = cfg.cat();
     for (key, h) in [("cat.radius", &cat.rear), ("cat.front.radius", &cat.front)] {
         if h.radius < 1e-3 * h.length {

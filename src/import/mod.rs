@@ -283,8 +283,32 @@ fn half(
             axis: c.axis.unwrap_or(axis),
         },
     };
-    if let Some(p) = r.problem() {
-        return Err(invalid(key, format!("{r:?}"), p));
+    if let Some((field, why)) = r.problem_in() {
+        let value = match field {
+            "mass" => format!("{}", r.mass),
+            "com" => format!("{:?}", r.com),
+            "joint" => format!("{:?}", r.joint),
+            "axis" => format!("{:?}", r.axis),
+            _ => format!("{:?}", r.inertia),
+        };
+        // the key the user gave, or the file's value it kept
+        let given = match field {
+            "mass" => c.mass.is_some(),
+            "com" => c.com.is_some(),
+            "joint" => c.joint.is_some(),
+            "axis" => c.axis.is_some(),
+            _ => c.inertia.is_some(),
+        };
+        let source = if given {
+            ""
+        } else {
+            " (from the robot description)"
+        };
+        return Err(invalid(
+            &format!("{key}.{field}"),
+            value,
+            format!("{why}{source}"),
+        ));
     }
     Ok(r)
 }

@@ -104,46 +104,66 @@ impl Rigid {
         }
     }
 
-    /// Why this half cannot be modelled, if it cannot: `name` is how the
-    /// message calls it (a config key or a file's element).
+    /// Why this half cannot be modelled, if it cannot.
     pub fn problem(&self) -> Option<String> {
-        let finite = self.mass.is_finite()
-            && self.com.iter().all(|x| x.is_finite())
-            && self.joint.iter().all(|x| x.is_finite())
-            && self.axis.iter().all(|x| x.is_finite())
-            && self.inertia.iter().flatten().all(|x| x.is_finite());
-        if !finite {
-            return Some("a number is not finite".into());
+        self.problem_in().map(|(_, why)| why)
+    }
+
+    /// [`Rigid::problem`] with the field it lies in (`mass`, `com`,
+    /// `inertia`, `joint` or `axis`): a config's key names it.
+    pub fn problem_in(&self) -> Option<(&'static str, String)> {
+        for (field, finite) in [
+            ("mass", self.mass.is_finite()),
+            ("com", self.com.iter().all(|x| x.is_finite())),
+            ("joint", self.joint.iter().all(|x| x.is_finite())),
+            ("axis", self.axis.iter().all(|x| x.is_finite())),
+            (
+                "inertia",
+                self.inertia.iter().flatten().all(|x| x.is_finite()),
+            ),
+        ] {
+            if !finite {
+                return Some((field, "a number is not finite".into()));
+            }
         }
         if self.mass <= 0.0 {
-            return Some(format!(
-                "its mass {} kg must be > 0 (a massless moving link has no dynamics)",
-                self.mass
+            return Some((
+                "mass",
+                format!(
+                    "its mass {} kg must be > 0 (a massless moving link has no dynamics)",
+                    self.mass
+                ),
             ));
         }
         let i = &self.inertia;
         let scale = i[0][0].abs() + i[1][1].abs() + i[2][2].abs();
         for (r, c) in [(0, 1), (0, 2), (1, 2)] {
             if (i[r][c] - i[c][r]).abs() > 1e-12 * scale {
-                return Some("its inertia tensor is not symmetric".into());
+                return Some(("inertia", "its inertia tensor is not symmetric".into()));
             }
         }
         let (p, _) = self.principal();
         if p[0] <= 0.0 {
-            return Some(format!(
-                "its inertia tensor is not positive definite (principal moments {:.3e}, {:.3e}, {:.3e} kg m^2)",
-                p[0], p[1], p[2]
+            return Some((
+                "inertia",
+                format!(
+                    "its inertia tensor is not positive definite (principal moments {:.3e}, {:.3e}, {:.3e} kg m^2)",
+                    p[0], p[1], p[2]
+                ),
             ));
         }
         if p[0] + p[1] < p[2] * (1.0 - 1e-9) {
-            return Some(format!(
-                "its principal moments {:.3e}, {:.3e}, {:.3e} kg m^2 break the triangle inequality (no rigid body has them)",
-                p[0], p[1], p[2]
+            return Some((
+                "inertia",
+                format!(
+                    "its principal moments {:.3e}, {:.3e}, {:.3e} kg m^2 break the triangle inequality (no rigid body has them)",
+                    p[0], p[1], p[2]
+                ),
             ));
         }
         let n = self.axis.iter().map(|x| x * x).sum::<f64>().sqrt();
         if (n - 1.0).abs() > 1e-9 {
-            return Some(format!("its joint axis has length {n}, not 1"));
+            return Some(("axis", format!("its joint axis has length {n}, not 1")));
         }
         None
     }

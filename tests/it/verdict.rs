@@ -42,14 +42,14 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
                 .unwrap();
             // a method that fails prints no design (an error, exit 1); one the
             // motors cannot do in this fall is not attempted by `run`, and
-            // `optimize` refuses it saying why (the flip is impossible, or the
+            // `optimize` refuses it saying why (not possible as configured, or the
             // phased seed does not fit)
             let (verdict, status) =
                 match json_or_error(&["optimize", &cfg, "--mode", mode], dir.path()) {
                     Ok(o) => (o["verdict"].clone(), o["status"].clone()),
                     Err(e) if m["verdict"] == "impossible" => {
                         assert!(
-                            e.contains("the flip is impossible")
+                            e.contains("not possible as configured")
                                 || e.contains("the phased seed does not fit"),
                             "{cfg} {mode}: run says impossible, optimize says {e}"
                         );
