@@ -299,8 +299,15 @@ pub fn check_fall_time(cfg: &Config) -> Result<()> {
 /// rad: bent further, the halves pass through each other.
 pub fn closest_theta(cfg: &Config) -> f64 {
     let cat = cfg.cat();
-    let l = cat.rear.length.min(cat.front.length);
-    let r = cat.rear.radius + cat.front.radius;
+    closest_theta_of(
+        cat.rear.length.min(cat.front.length),
+        cat.rear.radius + cat.front.radius,
+    )
+}
+
+/// [`closest_theta`] of halves whose shorter length is `l` and whose radii
+/// sum to `r`.
+pub fn closest_theta_of(l: f64, r: f64) -> f64 {
     if r >= l { PI / 2.0 } else { (r / l).asin() }
 }
 

@@ -704,6 +704,11 @@ impl FreeProblem {
 /// ([`FreeProblem::between_checks`]).
 const BETWEEN_SAMPLES: usize = 32;
 
+/// The share of `limits.max_bend_deg` the free-form design keeps inside at
+/// its check points, so that the bend between them (a cubic) stays within
+/// the limit.
+const BEND_MARGIN: f64 = 1e-3;
+
 impl FreeProblem {
     /// Where the limited term between the check points of `z` (problem
     /// units) is above the torque limit by more than `tol` (relative): per
@@ -1187,14 +1192,24 @@ impl ScpProblem for FreeProblem {
                 d.cone(Cone::Nonneg(nonneg));
             }
         }
-        // bend limit |q| <= b_max at every node
-        if let Some(b) = self.max_bend {
+        // bend limit |q| <= b_max (1 - BEND_MARGIN) at every check point
+        // (the nodes and the points between them, where the torque is
+        // checked): with the nodes alone, the cubic between them bent past
+        // the limit
+        if let Some(b) = self.max_bend.map(|b| b * (1.0 - BEND_MARGIN)) {
             for p in 0..3 {
-                for k in 0..n {
-                    let i = tr.q(p, k);
+                for (k, q, _, _, [dq, _, _]) in self.check_points(z, p) {
+                    let at = [tr.q(p, k), tr.v(p, k), tr.a(p, k), tr.a_in(p, k + 1)];
                     d.row(&[], b);
-                    d.row(&[(var(i), -1.0)], z[i]);
-                    d.row(&[(var(i + 1), -1.0)], z[i + 1]);
+                    for (j, qj) in q.iter().enumerate() {
+                        let e: Vec<(usize, f64)> = at
+                            .iter()
+                            .zip(&dq)
+                            .filter(|&(_, &c)| c != 0.0)
+                            .map(|(&i, &c)| (var(i + j), -c))
+                            .collect();
+                        d.row(&e, *qj);
+                    }
                     d.cone(Cone::Soc(3));
                 }
             }

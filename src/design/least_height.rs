@@ -44,6 +44,12 @@ pub struct HeightAnswer {
     pub least_height_lower_bound_m: Option<f64>,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
+    /// Whether that schedule flips (from another start: lands) in the
+    /// simulation within `simulate.flip_tolerance`. A phased design that
+    /// fits the motors but misses the flip (its grid too coarse for many
+    /// twist turns under a tight bend limit) answers nothing: `possible` is
+    /// then false and the sentence says no verified design was found.
+    pub verified: bool,
     /// Whether the answer is a design from the configured start (always at
     /// the default start). From another start only a free-form design that
     /// lands answers; without one the numbers are the start at rest's and
@@ -74,8 +80,15 @@ fn answer_for(
     let r = crate::design::phased::optimize_near(reference, hint, |_| {})?;
     let sim = crate::verify::simulate::dynamic_spec(reference, &r.plan)?;
     let least = crate::design::envelope::height_for(spec, r.manoeuvre_time_s);
+    let verified = crate::verdict::flip_misses(
+        sim.flip_error_rad,
+        sim.tilt_deg,
+        spec.simulate.flip_tolerance,
+    )
+    .is_empty();
     let answer = HeightAnswer {
-        possible: fits(spec, least),
+        possible: verified && fits(spec, least),
+        verified,
         height_m: spec.fall.height,
         least_height_m: least,
         least_time_s: r.manoeuvre_time_s,
@@ -341,6 +354,13 @@ pub fn verified(spec: &DesignSpec, fr: &FreeResult) -> Option<SimReport> {
 
 /// [`verified`] for a design already flown as `sim`.
 pub fn verifies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
+    fr.certificate.constraint_violation <= spec.free.attitude_tolerance && flies(spec, fr, sim)
+}
+
+/// Whether a design flown as `sim` flips (from another start: lands)
+/// inside the motor envelope at every written row, whatever the SCP's own
+/// residual at its last point: the simulation judges the flight.
+pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
     let usage = crate::design::envelope::usage_of(spec, &fr.plan);
     let v = verdict(
         &Targets::of(spec),
@@ -364,9 +384,7 @@ pub fn verifies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
             }
         },
     );
-    fr.certificate.constraint_violation <= spec.free.attitude_tolerance
-        && v.within_envelope()
-        && v.flips()
+    v.within_envelope() && v.flips()
 }
 
 impl HeightAnswer {
@@ -374,9 +392,10 @@ impl HeightAnswer {
     /// inside the envelope and flipping; designs that stopped at the
     /// iteration limit count too) when it is shorter than the answer's.
     pub fn improve_with(&mut self, spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) {
-        if fr.manoeuvre_time_s >= self.least_time_s {
+        if self.verified && fr.manoeuvre_time_s >= self.least_time_s {
             return;
         }
+        self.verified = true;
         self.least_time_s = fr.manoeuvre_time_s;
         self.least_height_m = crate::design::envelope::height_for(spec, fr.manoeuvre_time_s);
         self.possible = fits(spec, self.least_height_m);
@@ -401,7 +420,12 @@ impl HeightAnswer {
             .least_height_lower_bound_m
             .map(|b| format!(" (at least {b:.3} m)"))
             .unwrap_or_default();
-        if !self.from_start {
+        if !self.verified && self.from_start {
+            format!(
+                "No verified design found: the {} time design fits the motors from {:.3} m but misses the flip in the simulation (see the least-height row).",
+                self.method, self.least_height_m
+            )
+        } else if !self.from_start {
             format!(
                 "No design found lands belly-down from this start in the fall from {} m (at rest the motors would need {:.3} m).",
                 self.height_m, self.least_height_m
@@ -422,5 +446,38 @@ impl HeightAnswer {
                 self.height_m, self.least_height_m, self.least_time_s
             )
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An answer whose design misses the flip in the simulation says that no
+    /// verified design was found, not that the flip is possible from its
+    /// height; once a verified design improves it, it answers as usual.
+    #[test]
+    fn an_unverified_answer_claims_no_height() {
+        let mut a = HeightAnswer {
+            possible: false,
+            height_m: 20.0,
+            least_height_m: 62.514,
+            least_time_s: 3.47,
+            method: "phased",
+            status: Status::Solved,
+            least_height_lower_bound_m: Some(1.7),
+            flip_error_rad: 5e-4,
+            verified: false,
+            from_start: true,
+            schedule: Schedule { rows: Vec::new() },
+        };
+        let s = a.sentence();
+        assert!(s.starts_with("No verified design found"), "{s}");
+        assert!(!s.contains("it is ("), "{s}");
+        a.verified = true;
+        assert!(
+            a.sentence()
+                .contains("from 62.514 m (at least 1.700 m) it is")
+        );
     }
 }

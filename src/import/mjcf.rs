@@ -323,6 +323,7 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
         joint,
         max_torque: limit,
         max_speed: None,
+        max_bend: None,
     })
 }
 

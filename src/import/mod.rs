@@ -87,6 +87,9 @@ pub struct Imported {
     pub max_torque: Option<f64>,
     /// The smallest speed bound (URDF `velocity`), rad/s.
     pub max_speed: Option<f64>,
+    /// The largest bend within every joint's range (URDF revolute `lower`
+    /// and `upper`), rad.
+    pub max_bend: Option<f64>,
 }
 
 /// Reads a robot description by its extension's kind.
@@ -238,7 +241,20 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
             .or_insert_with(|| toml::Value::Table(toml::Table::new()))
             .as_table_mut()
             .ok_or_else(|| invalid("limits", "not a table", "a table [limits]"))?;
-        for (key, v) in [("max_torque", f.max_torque), ("max_speed", f.max_speed)] {
+        // a joint range wider than the halves' own fold limit limits nothing
+        let fold = crate::config::ranges::closest_theta_of(
+            er.length.min(ef.length),
+            er.radius + ef.radius,
+        );
+        let bend_deg = f
+            .max_bend
+            .filter(|&b| b < std::f64::consts::PI - fold)
+            .map(f64::to_degrees);
+        for (key, v) in [
+            ("max_torque", f.max_torque),
+            ("max_speed", f.max_speed),
+            ("max_bend_deg", bend_deg),
+        ] {
             if let Some(v) = v
                 && !limits.contains_key(key)
             {

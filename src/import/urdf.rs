@@ -28,6 +28,8 @@ struct JointData<'a> {
     axis: nalgebra::Vector3<f64>,
     effort: Option<f64>,
     velocity: Option<f64>,
+    /// A revolute joint's range `(lower, upper)`, rad.
+    range: Option<(f64, f64)>,
 }
 
 fn origin(node: &Node, file: &str) -> Result<Pose> {
@@ -119,6 +121,15 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
                 .map(|l| number(&l, "velocity", Some(f64::NAN), file))
                 .transpose()?
                 .filter(|x| x.is_finite()),
+            // URDF: a revolute joint's `lower` and `upper` default to 0; a
+            // continuous joint has no range
+            range: match (kind.as_str(), limit) {
+                ("revolute", Some(l)) => Some((
+                    number(&l, "lower", Some(0.0), file)?,
+                    number(&l, "upper", Some(0.0), file)?,
+                )),
+                _ => None,
+            },
             kind,
         };
         for l in [&j.parent, &j.child] {
@@ -299,11 +310,38 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
         site(&links[&front_name].node),
     );
     let (max_torque, max_speed) = limits(&used);
+    let max_bend = bend_limit(&used, file)?;
     let (halves, joint) = assemble(file, rear, front, link)?;
     Ok(Imported {
         halves,
         joint,
         max_torque,
         max_speed,
+        max_bend,
     })
+}
+
+/// The largest bend every joint range allows, rad: each revolute joint
+/// turns at least this far both ways (the disc inside their box, so a
+/// design within it is within every range); `None` without a range. A range
+/// that does not reach both sides of zero leaves no bend in one direction:
+/// refused, naming the joint.
+fn bend_limit(used: &[&JointData], file: &str) -> Result<Option<f64>> {
+    let mut least: Option<f64> = None;
+    for j in used {
+        let Some((lower, upper)) = j.range else {
+            continue;
+        };
+        if !(lower < 0.0 && upper > 0.0) {
+            return Err(site(&j.node).error(
+                file,
+                format!(
+                    "the joint's range [{lower}, {upper}] rad does not reach both sides of the straight body: catflip's halves bend both ways (give lower < 0 < upper, or a continuous joint)"
+                ),
+            ));
+        }
+        let b = (-lower).min(upper);
+        least = Some(least.map_or(b, |l| l.min(b)));
+    }
+    Ok(least)
 }

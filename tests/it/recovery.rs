@@ -175,3 +175,51 @@ fn grid_sizes_out_of_range_are_refused_with_the_flag_and_range_and_nothing_writt
         );
     }
 }
+
+/// The flight decides: a designed start lands exactly when its design,
+/// flown in the simulation, lands within the tolerance (the seed has no
+/// motor limits), also when the design stopped at the map's iteration
+/// limit. A spin of 0.5 rad/s about the belly's axis (x-z plane, 90 deg)
+/// stops there and lands 0.01 deg off: it was once counted a miss.
+#[test]
+fn a_start_lands_when_its_flown_design_lands_whatever_its_status() {
+    use catflip::recovery::{Source, tolerance_deg};
+    let cfg = util::seed(&[]);
+    let grid = Grid {
+        axes: 4,
+        spins: 1,
+        max_spin: 0.5,
+        tilts: 0,
+        bisect: 0,
+        ..Default::default()
+    };
+    let lines = map(&cfg, &grid, 2, Shard::ALL).expect("a map");
+    let tol = tolerance_deg(&cfg);
+    let mut stopped_and_landed = 0;
+    for l in &lines {
+        for p in l.points.iter().filter(|p| p.error_source == Source::Design) {
+            assert_eq!(
+                p.outcome.lands(),
+                p.landing_error_deg <= tol,
+                "{:?} {} deg {} rad/s: {:?}",
+                l.line.plane,
+                l.line.axis_deg,
+                p.magnitude,
+                p
+            );
+            let limited = p.design_status.is_some_and(|s| !s.is_proven());
+            stopped_and_landed += usize::from(limited && p.outcome.lands());
+        }
+    }
+    let belly = lines
+        .iter()
+        .find(|l| l.line.axis() == [1.0, 0.0, 0.0])
+        .expect("the x-z plane's 90 deg line");
+    assert_eq!(
+        belly.points[1].outcome,
+        Outcome::Lands,
+        "{:?}",
+        belly.points[1]
+    );
+    assert!(stopped_and_landed >= 1, "{lines:?}");
+}
