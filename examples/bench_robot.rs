@@ -90,7 +90,12 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
                 .solve()?;
             lap(
                 "free(analytic)",
-                format!("{:.5} s, {} it", fr.manoeuvre_time_s, fr.scp_iterations),
+                format!(
+                    "{:.5} s, {} it ({})",
+                    fr.manoeuvre_time_s,
+                    fr.scp_iterations,
+                    catflip::design::free::iterations_text(&fr.mesh_levels)
+                ),
                 &mut t,
             );
             if let Some((least, sr)) = catflip::design::least_height::stall_only(&reference)? {
@@ -113,7 +118,12 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
                     .solve()?;
                 lap(
                     "free(stall-only)",
-                    format!("{:.5} s, {} it", fr.manoeuvre_time_s, fr.scp_iterations),
+                    format!(
+                        "{:.5} s, {} it ({})",
+                        fr.manoeuvre_time_s,
+                        fr.scp_iterations,
+                        catflip::design::free::iterations_text(&fr.mesh_levels)
+                    ),
                     &mut t,
                 );
             }
