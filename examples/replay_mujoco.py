@@ -31,7 +31,7 @@ import numpy as np
 
 from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args, pd_tolerance,
                            peak_of, quat_log, read_controls, reference, report, right_jacobian,
-                           run_folder)
+                           run_folder, RIDING_FACTOR)
 
 
 def is_dc_motor(model):
@@ -213,7 +213,7 @@ def main():
             model.opt.timestep = c["dt"]
         for mode in ("ff", "pd"):
             results.append((method, mode, replay(model, c, mode == "pd")))
-    pd_tol = {"pd": lambda m: pd_tolerance(args.tol_deg, args.default_tol_deg, m)}
+    pd_tol = {"pd": lambda m: pd_tolerance(args.tol_deg, args.default_tol_deg, m, RIDING_FACTOR)}
     fails += report("MuJoCo", summary, results, pd_tol, args.ff_tol_deg,
                     args.land_tol_deg, args.land_methods.split(","))
     if summary["joint"] == "universal":

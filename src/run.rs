@@ -265,19 +265,17 @@ impl Question {
 
     /// Why the free-form design is not attempted, if no schedule found fits.
     fn free_impossible(&self) -> Option<String> {
-        self.answer.as_ref().filter(|a| !a.possible).map(|a| {
-            if a.verified {
+        // an unverified answer shows nothing either way: the free-form
+        // design is tried in the configured fall
+        self.answer
+            .as_ref()
+            .filter(|a| !a.possible && a.verified)
+            .map(|a| {
                 format!(
                     "no schedule found fits the motors in the fall from {} m (fall.height); the least height found is {:.3} m (the {} time design, least-height.csv)",
                     a.height_m, a.least_height_m, a.method
                 )
-            } else {
-                format!(
-                    "no verified schedule found fits the motors in the fall from {} m (fall.height); the {} time design fits them from {:.3} m but misses the flip (least-height.csv)",
-                    a.height_m, a.method, a.least_height_m
-                )
-            }
-        })
+            })
     }
 
     /// After the designs: a verified free-form schedule inside the envelope
@@ -291,8 +289,9 @@ impl Question {
                 .iter()
                 .find(|m| m.method == "free" && m.verdict == Grade::Ok)
         {
+            // (an unverified answer stays so: its least height is still
+            // the unverified design's, which the sentence says)
             a.possible = true;
-            a.verified = true;
             a.method = m.method;
         }
         if let Some(a) = &self.answer {

@@ -1199,14 +1199,14 @@ impl ScpProblem for FreeProblem {
         if let Some(b) = self.max_bend.map(|b| b * (1.0 - BEND_MARGIN)) {
             for p in 0..3 {
                 for (k, q, _, _, [dq, _, _]) in self.check_points(z, p) {
-                    let at = [tr.q(p, k), tr.v(p, k), tr.a(p, k), tr.a_in(p, k + 1)];
                     d.row(&[], b);
                     for (j, qj) in q.iter().enumerate() {
-                        let e: Vec<(usize, f64)> = at
+                        let e: Vec<(usize, f64)> = tr
+                            .interval_columns(p, k, j)
                             .iter()
                             .zip(&dq)
                             .filter(|&(_, &c)| c != 0.0)
-                            .map(|(&i, &c)| (var(i + j), -c))
+                            .map(|(&i, &c)| (var(i), -c))
                             .collect();
                         d.row(&e, *qj);
                     }

@@ -44,8 +44,9 @@ pub struct HeightAnswer {
     pub least_height_lower_bound_m: Option<f64>,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
-    /// Whether that schedule flips (from another start: lands) in the
-    /// simulation within `simulate.flip_tolerance`. A phased design that
+    /// Whether that schedule flips in the simulation within
+    /// `simulate.flip_tolerance` (a free-form design: also lands from
+    /// another start, as [`verified`] checks). A phased design that
     /// fits the motors but misses the flip (its grid too coarse for many
     /// twist turns under a tight bend limit) answers nothing: `possible` is
     /// then false and the sentence says no verified design was found.
@@ -358,8 +359,9 @@ pub fn verifies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
 }
 
 /// Whether a design flown as `sim` flips (from another start: lands)
-/// inside the motor envelope at every written row, whatever the SCP's own
-/// residual at its last point: the simulation judges the flight.
+/// inside the motor envelope at every written row and within the bend
+/// limit, whatever the SCP's own residual at its last point: the
+/// simulation judges the flight.
 pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
     let usage = crate::design::envelope::usage_of(spec, &fr.plan);
     let v = verdict(
@@ -384,7 +386,11 @@ pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
             }
         },
     );
-    v.within_envelope() && v.flips()
+    let bent = v
+        .misses
+        .iter()
+        .any(|m| matches!(m, crate::verdict::Miss::Bend { .. }));
+    v.within_envelope() && v.flips() && !bent
 }
 
 impl HeightAnswer {
@@ -420,7 +426,12 @@ impl HeightAnswer {
             .least_height_lower_bound_m
             .map(|b| format!(" (at least {b:.3} m)"))
             .unwrap_or_default();
-        if !self.verified && self.from_start {
+        if !self.verified && self.from_start && self.possible {
+            format!(
+                "The flip is possible from {} m: the {} design fits the motors in this fall; no verified least drop height was found (the phased time design fits them from {:.3} m but misses the flip; see the least-height row).",
+                self.height_m, self.method, self.least_height_m
+            )
+        } else if !self.verified && self.from_start {
             format!(
                 "No verified design found: the {} time design fits the motors from {:.3} m but misses the flip in the simulation (see the least-height row).",
                 self.method, self.least_height_m

@@ -121,13 +121,19 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
                 .map(|l| number(&l, "velocity", Some(f64::NAN), file))
                 .transpose()?
                 .filter(|x| x.is_finite()),
-            // URDF: a revolute joint's `lower` and `upper` default to 0; a
-            // continuous joint has no range
+            // a revolute joint's range when the file gives one (URDF
+            // defaults a missing end to 0, but files that give only
+            // `effort` and `velocity` mean no range); a continuous joint
+            // has none
             range: match (kind.as_str(), limit) {
-                ("revolute", Some(l)) => Some((
-                    number(&l, "lower", Some(0.0), file)?,
-                    number(&l, "upper", Some(0.0), file)?,
-                )),
+                ("revolute", Some(l))
+                    if l.attribute("lower").is_some() || l.attribute("upper").is_some() =>
+                {
+                    Some((
+                        number(&l, "lower", Some(0.0), file)?,
+                        number(&l, "upper", Some(0.0), file)?,
+                    ))
+                }
                 _ => None,
             },
             kind,

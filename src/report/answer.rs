@@ -26,7 +26,12 @@ pub fn lower_bound(a: &HeightAnswer) -> Option<f64> {
 
 /// The headline: possible or not, from the configured height.
 pub fn headline(a: &HeightAnswer) -> String {
-    if a.possible {
+    if !a.possible && !a.verified {
+        format!(
+            "No verified design flips it from {} m with these motors.",
+            a.height_m
+        )
+    } else if a.possible {
         format!("Possible from {} m with these motors.", a.height_m)
     } else {
         format!("Not possible from {} m with these motors.", a.height_m)
@@ -39,6 +44,12 @@ pub fn height_text(a: &HeightAnswer) -> String {
     let bound = lower_bound(a)
         .map(|b| format!(" (at least {b:.3} m)"))
         .unwrap_or_default();
+    if !a.verified {
+        return format!(
+            "No verified least drop height: the {} time design fits the motors from {:.3} m but misses the flip in the simulation (the least-height row below).",
+            a.method, a.least_height_m
+        );
+    }
     if a.possible && a.least_height_m > a.height_m {
         // a design fits this fall although the least-height one needs more
         format!(
@@ -55,6 +66,9 @@ pub fn height_text(a: &HeightAnswer) -> String {
 
 /// What the least-height schedule is and where it is shown.
 fn shown_text(a: &HeightAnswer) -> String {
+    if !a.verified {
+        return "Its schedule is the least-height row below (flagged), shown and written as least-height.csv so that it can be examined, not flown.".into();
+    }
     let proven = if a.status.is_proven() {
         format!("the {} time design, {}", a.method, a.status)
     } else {

@@ -152,6 +152,10 @@ fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
             .solve()
             .unwrap();
         assert_eq!(again.status, catflip::design::scp::ScpStatus::Converged);
+        assert!(
+            r.extra_checks.iter().any(|e| !e.is_empty()),
+            "{seed:?}: no added check points"
+        );
         for (added, kept) in r.extra_checks.iter().zip(&again.extra_checks) {
             assert!(added.iter().all(|c| kept.contains(c)), "{seed:?}");
         }

@@ -158,9 +158,12 @@ fn a_urdf_joint_range_bounds_the_bend_unless_the_config_sets_it() {
     let back = imported(dir.path(), "urdf", "r.urdf", &narrow).unwrap();
     let bend = back.limits.max_bend_deg.expect("the ranges bound the bend");
     assert!((bend - 0.5f64.to_degrees()).abs() < 1e-12, "{bend}");
-    // catflip's own export (+-pi) bounds nothing
+    // catflip's own export (+-pi) bounds nothing, nor does a limit that
+    // gives no range
     let wide = imported(dir.path(), "urdf", "r.urdf", &exported).unwrap();
     assert_eq!(wide.limits.max_bend_deg, None);
+    let none = imported(dir.path(), "urdf", "r.urdf", &ranged("", "")).unwrap();
+    assert_eq!(none.limits.max_bend_deg, None);
     // the config's own limit wins
     std::fs::write(dir.path().join("r.urdf"), &narrow).unwrap();
     let text = "name = \"r\"\n[fall]\nheight = 3.0\n[limits]\nmax_bend_deg = 20.0\n[body]\nurdf = \"r.urdf\"\n";
