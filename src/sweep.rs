@@ -454,6 +454,12 @@ fn point(
             Ok(Some(h)) => {
                 if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);
+                    if !h.phased_verified {
+                        errors.push(
+                            "phased least height: its time design misses the flip in the simulation (the phased family's number, not a verified height)"
+                                .into(),
+                        );
+                    }
                 }
                 if methods.free {
                     p.least_height_free_m = h

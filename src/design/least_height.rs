@@ -116,6 +116,10 @@ pub struct Heights {
     /// The phased time design's least height, m, and its bend, rad.
     pub phased_m: f64,
     pub phased_bend: f64,
+    /// Whether that phased design flips in the simulation (see
+    /// [`HeightAnswer::verified`]): otherwise `phased_m` is the phased
+    /// family's number, not a height it is shown to flip from.
+    pub phased_verified: bool,
     /// The shortest free-form time design that verifies ([`verified`]).
     pub free: Option<FreeResult>,
 }
@@ -224,6 +228,7 @@ pub fn heights(
         return Ok(Some(Heights {
             phased_m: answer.least_height_m,
             phased_bend,
+            phased_verified: answer.verified,
             answer,
             free: None,
         }));
@@ -306,7 +311,7 @@ fn concluded(
     (mut answer, phased_bend): (HeightAnswer, f64),
     designs: impl IntoIterator<Item = FreeResult>,
 ) -> Heights {
-    let phased_m = answer.least_height_m;
+    let (phased_m, phased_verified) = (answer.least_height_m, answer.verified);
     let mut fastest: Option<(FreeResult, SimReport)> = None;
     for fr in designs {
         if fastest
@@ -331,6 +336,7 @@ fn concluded(
         answer,
         phased_m,
         phased_bend,
+        phased_verified,
         free: fastest.map(|(fr, _)| fr),
     }
 }
