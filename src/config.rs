@@ -317,7 +317,7 @@ impl Config {
         self.land.validate()?;
         self.control.validate()?;
         self.robustness.validate()?;
-        ranges::check_ranges(self)?;
+        ranges::check_derived(self)?;
         ranges::impossible(self)
     }
 

@@ -207,10 +207,7 @@ const FALL_ONLY: [&str; 3] = ["fall.height", "fall.gravity", "fall.margin"];
 /// order (the bend search's hint).
 #[derive(Default)]
 struct Continuation {
-    warm: Option<FreeResult>,
-    before: Option<FreeResult>,
-    /// Whether the point before produced a free-form design (`warm`).
-    last_ok: bool,
+    free: Neighbours,
     /// `Some` in a sweep of the fall alone: the chunk's first phased design
     /// and its manoeuvre time, once computed.
     phased: Option<Option<(f64, crate::design::phased::PhasedResult)>>,
@@ -218,15 +215,40 @@ struct Continuation {
     height: HeightChain,
 }
 
-/// What the least-height stage carries from point to point: the last two
-/// free-form `time` designs, the second only when both points produced
-/// one, and the phased `time` designs' bends of consecutive points.
+/// A chunk's last two free-form designs of consecutive points (the start
+/// and the secant predictor): a failed point leaves the last good design
+/// as the start, and no secant until two consecutive points have designs
+/// again.
 #[derive(Default)]
-struct HeightChain {
+struct Neighbours {
     warm: Option<FreeResult>,
     before: Option<FreeResult>,
     /// Whether the point before produced a design (`warm`).
     last_ok: bool,
+}
+
+impl Neighbours {
+    /// After a point: its design, if it produced one.
+    fn advance(&mut self, fr: Option<FreeResult>) {
+        let produced = fr.is_some();
+        let last = fr.and_then(|fr| self.warm.replace(fr));
+        self.before = last.filter(|_| self.last_ok);
+        self.last_ok = produced;
+    }
+
+    /// A point whose config is invalid: no secant across it.
+    fn skip(&mut self) {
+        self.before = None;
+        self.last_ok = false;
+    }
+}
+
+/// What the least-height stage carries from point to point: its free-form
+/// `time` designs and the phased `time` designs' bends of consecutive
+/// points.
+#[derive(Default)]
+struct HeightChain {
+    designs: Neighbours,
     bends: Vec<f64>,
 }
 
@@ -235,37 +257,31 @@ impl HeightChain {
     /// least-height design when there is one, else the cold stage (so the
     /// chunk's first point answers as `run` does).
     fn heights(&mut self, spec: &DesignSpec, with_free: bool) -> Result<Option<Heights>> {
-        let hint = self.bends.last().map(|&last| {
-            BendHint::from_neighbours(last, self.bends.len().checked_sub(2).map(|i| self.bends[i]))
-        });
-        let h = match (&self.warm, with_free) {
-            (Some(prev), true) => heights_near(spec, prev, self.before.as_ref(), hint),
+        let d = &self.designs;
+        let h = match (&d.warm, with_free) {
+            (Some(prev), true) => heights_near(
+                spec,
+                prev,
+                d.before.as_ref(),
+                BendHint::from_chain(&self.bends),
+            ),
             _ => heights(spec, with_free, |_| {}),
         };
         match &h {
             Ok(Some(h)) => self.bends.push(h.phased_bend),
             _ => self.bends.clear(),
         }
-        let fr = h
-            .as_ref()
-            .ok()
-            .and_then(|h| h.as_ref())
-            .and_then(|h| h.free.clone());
-        let produced = fr.is_some();
-        if let Some(fr) = fr {
-            let last = self.warm.replace(fr);
-            self.before = last.filter(|_| self.last_ok);
-        } else {
-            self.before = None;
-        }
-        self.last_ok = produced;
+        self.designs.advance(
+            h.as_ref()
+                .ok()
+                .and_then(|h| h.as_ref())
+                .and_then(|h| h.free.clone()),
+        );
         h
     }
 
-    /// A point whose config is invalid: no secant across it.
     fn skip(&mut self) {
-        self.before = None;
-        self.last_ok = false;
+        self.designs.skip();
         self.bends.clear();
     }
 }
@@ -281,20 +297,14 @@ impl Continuation {
     /// The point at `value`, continued from the chunk's points before it.
     fn point(&mut self, cfg: &Config, value: f64, methods: Methods) -> SweepPoint {
         let (p, fr) = point(cfg, value, methods, self);
-        // a failed point leaves the last good design as the start, and no
-        // secant until two consecutive points have designs again
-        let produced = fr.is_some();
-        let last = fr.and_then(|fr| self.warm.replace(fr));
-        self.before = last.filter(|_| self.last_ok);
-        self.last_ok = produced;
+        self.free.advance(fr);
         p
     }
 
     /// A point whose config is invalid: the next scans its bend afresh.
     fn skip(&mut self) {
         self.bends.clear();
-        self.before = None;
-        self.last_ok = false;
+        self.free.skip();
         self.height.skip();
     }
 }
@@ -312,14 +322,12 @@ fn point(
     chain: &mut Continuation,
 ) -> (SweepPoint, Option<FreeResult>) {
     let Continuation {
-        warm,
-        before,
+        free,
         phased: phased_warm,
         bends,
         height,
-        ..
     } = chain;
-    let (warm, before) = (warm.as_ref(), before.as_ref());
+    let (warm, before) = (free.warm.as_ref(), free.before.as_ref());
     let mut p = SweepPoint {
         value,
         ..Default::default()
@@ -368,13 +376,8 @@ fn point(
             Ok(r)
         } else if methods.phased || warm.is_none() {
             // the chunk's previous bends predict this one's (continuation)
-            let hint = bends.last().map(|&last| {
-                crate::design::phased::BendHint::from_neighbours(
-                    last,
-                    bends.len().checked_sub(2).map(|i| bends[i]),
-                )
-            });
-            let r = crate::design::phased::optimize_near(&spec, hint, |_| {});
+            let r =
+                crate::design::phased::optimize_near(&spec, BendHint::from_chain(bends), |_| {});
             // only a solved design at the point just before predicts this
             // one: after a failure the next point scans afresh
             match &r {

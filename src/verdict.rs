@@ -378,6 +378,11 @@ impl Verdict {
         self.error.is_none() && !self.misses.iter().any(Miss::is_flip)
     }
 
+    /// Within every motor and bend limit ([`Miss::is_limit`]).
+    pub fn within_limits(&self) -> bool {
+        !self.misses.iter().any(Miss::is_limit)
+    }
+
     /// Inside the motor envelope at every written row.
     pub fn within_envelope(&self) -> bool {
         !self

@@ -195,15 +195,9 @@ fn invalid(key: &str, value: f64, expected: String) -> Error {
     }
 }
 
-/// Every key of [`RANGES`] that the config sets, the radii against the
-/// lengths, and the analytic split's fractions.
-pub fn check_ranges(cfg: &Config) -> Result<()> {
-    check_documented(cfg)?;
-    check_derived(cfg)
-}
-
-/// The keys of [`RANGES`] within their documented ranges: checked first,
-/// so that a value outside is told its range, not only its sign.
+/// Every key of [`RANGES`] that the config sets within its documented
+/// range: checked before the other checks, so that a value outside is told
+/// its range, not only its sign.
 pub fn check_documented(cfg: &Config) -> Result<()> {
     let c = &cfg.cat;
     let fr = c.front.clone().unwrap_or_default();
@@ -223,7 +217,7 @@ pub fn check_documented(cfg: &Config) -> Result<()> {
             "simulate.pd_damping" => Some(cfg.simulate.pd_damping),
             "phased.bend_tol_deg" => Some(cfg.phased.bend_tol_deg),
             "free.max_iterations" => Some(cfg.free.max_iterations as f64),
-            other => unreachable!("RANGES names {other}, which check_ranges does not read"),
+            other => unreachable!("RANGES names {other}, which check_documented does not read"),
         };
         if let Some(v) = v {
             r.check(v)?;
@@ -232,9 +226,9 @@ pub fn check_documented(cfg: &Config) -> Result<()> {
     Ok(())
 }
 
-/// The ranges that depend on other keys (radii against lengths, the split,
-/// ...).
-fn check_derived(cfg: &Config) -> Result<()> {
+/// The ranges that depend on other keys: the radii against the lengths,
+/// the analytic split's fractions.
+pub fn check_derived(cfg: &Config) -> Result<()> {
     let cat = cfg.cat();
     for (key, h) in [("cat.radius", &cat.rear), ("cat.front.radius", &cat.front)] {
         if h.radius < 1e-3 * h.length {

@@ -71,10 +71,17 @@ pub struct BendHint {
 }
 
 impl BendHint {
+    /// The hint from a chain's bends of consecutive points, in order
+    /// (none before the first).
+    pub fn from_chain(bends: &[f64]) -> Option<Self> {
+        let (&last, rest) = bends.split_last()?;
+        Some(Self::from_neighbours(last, rest.last().copied()))
+    }
+
     /// The prediction from the last two points' bends (linear
     /// extrapolation), or from the last alone; the bracket is as wide as
     /// the last change, and at least a degree.
-    pub fn from_neighbours(last: f64, before: Option<f64>) -> Self {
+    fn from_neighbours(last: f64, before: Option<f64>) -> Self {
         let change = before.map_or(0.0, |b| last - b);
         BendHint {
             bend: last + change,

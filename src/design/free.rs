@@ -1699,17 +1699,17 @@ fn design_problem(
     let unit = problem.objective_unit();
     // a neighbour's multipliers that do not fit this problem's rows (added
     // check points) are dropped; its weight and radius still hold
-    let warm = warm.map(|w| {
-        if problem.multipliers_fit(&w.multipliers) {
-            w.clone()
-        } else {
-            WarmStart {
+    let stripped;
+    let warm = match warm {
+        Some(w) if !problem.multipliers_fit(&w.multipliers) => {
+            stripped = WarmStart {
                 multipliers: Default::default(),
                 ..w.clone()
-            }
+            };
+            Some(&stripped)
         }
-    });
-    let warm = warm.as_ref();
+        w => w,
+    };
     let mut res = Executor::new(&settings)
         .warm(warm)
         .numbered_from(first)

@@ -365,8 +365,8 @@ pub fn verifies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
 }
 
 /// Whether a design flown as `sim` flips (from another start: lands)
-/// inside the motor envelope at every written row and within the bend
-/// limit, whatever the SCP's own residual at its last point: the
+/// within every motor and bend limit (the envelope at every written row),
+/// whatever the SCP's own residual at its last point: the
 /// simulation judges the flight.
 pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
     let usage = crate::design::envelope::usage_of(spec, &fr.plan);
@@ -392,11 +392,7 @@ pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
             }
         },
     );
-    let bent = v
-        .misses
-        .iter()
-        .any(|m| matches!(m, crate::verdict::Miss::Bend { .. }));
-    v.within_envelope() && v.flips() && !bent
+    v.within_limits() && v.flips()
 }
 
 impl HeightAnswer {
@@ -439,8 +435,8 @@ impl HeightAnswer {
             )
         } else if !self.verified && self.from_start {
             format!(
-                "No verified design found: the {} time design fits the motors from {:.3} m but misses the flip in the simulation (see the least-height row).",
-                self.method, self.least_height_m
+                "No verified design found: the phased time design fits the motors from {:.3} m but misses the flip in the simulation (see the least-height row).",
+                self.least_height_m
             )
         } else if !self.from_start {
             format!(

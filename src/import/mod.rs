@@ -300,20 +300,13 @@ fn half(
         },
     };
     if let Some((field, why)) = r.problem_in() {
-        let value = match field {
-            "mass" => format!("{}", r.mass),
-            "com" => format!("{:?}", r.com),
-            "joint" => format!("{:?}", r.joint),
-            "axis" => format!("{:?}", r.axis),
-            _ => format!("{:?}", r.inertia),
-        };
-        // the key the user gave, or the file's value it kept
-        let given = match field {
-            "mass" => c.mass.is_some(),
-            "com" => c.com.is_some(),
-            "joint" => c.joint.is_some(),
-            "axis" => c.axis.is_some(),
-            _ => c.inertia.is_some(),
+        // the value, and whether the user's key gave it (else the file did)
+        let (value, given) = match field {
+            "mass" => (format!("{}", r.mass), c.mass.is_some()),
+            "com" => (format!("{:?}", r.com), c.com.is_some()),
+            "joint" => (format!("{:?}", r.joint), c.joint.is_some()),
+            "axis" => (format!("{:?}", r.axis), c.axis.is_some()),
+            _ => (format!("{:?}", r.inertia), c.inertia.is_some()),
         };
         let source = if given {
             ""

@@ -45,9 +45,11 @@ pub fn height_text(a: &HeightAnswer) -> String {
         .map(|b| format!(" (at least {b:.3} m)"))
         .unwrap_or_default();
     if !a.verified {
+        // (only the phased design is ever unverified: the free-form ones
+        // that answer are flown first)
         return format!(
-            "No verified least drop height: the {} time design fits the motors from {:.3} m but misses the flip in the simulation (the least-height row below).",
-            a.method, a.least_height_m
+            "No verified least drop height: the phased time design fits the motors from {:.3} m but misses the flip in the simulation (the least-height row below).",
+            a.least_height_m
         );
     }
     if a.possible && a.least_height_m > a.height_m {
