@@ -30,7 +30,9 @@
 //! and so on while 20 or more remain per phase), loosely, and each starts
 //! the next ([`coarse_start`], mesh continuation); the coarsest is also
 //! solved from the analytic schedule ([`other_starts`]) and the lower
-//! design continued.
+//! design continued. A time design inside the motor envelope is solved at
+//! half the nodes first, and the fine mesh continues from it with its
+//! penalty weight and trust radius ([`envelope_coarse_start`]).
 
 use crate::design::collocation::Transcription;
 use crate::design::collocation_plan::CollocationPlan;
@@ -1298,7 +1300,8 @@ impl Seed {
 pub use crate::design::scp::Observer;
 
 /// Runs the SCP from a seed plan at `nodes` per phase; a peak-torque design
-/// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`).
+/// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`), a
+/// time design inside the motor envelope on one ([`envelope_coarse_start`]).
 /// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
 /// order (`mesh_levels`), numbered on by the SCP's [`Executor`] as the
 /// observer sees them. A fine design the coarse one cannot start is solved
@@ -1313,27 +1316,35 @@ fn from_plan(
     let clock = std::time::Instant::now();
     let seed_start = || grid(spec, nodes, Mesh::Final).sample(seed_plan);
     let mut levels = Vec::new();
-    let z0 = if spec.free.mesh_continuation && !spec.uses_envelope() {
-        coarse_start(
+    // the fine mesh's start, what it carries from a coarse mesh, and
+    // whether it starts from a coarse design (not the seed)
+    let (z0, carried, from_coarse) = if !spec.free.mesh_continuation {
+        (seed_start(), None, false)
+    } else if !spec.uses_envelope() {
+        let (z, from_coarse) = coarse_start(
             spec,
             seed_plan,
             seed == "analytic",
             (nodes, Mesh::Final),
             observe,
             &mut levels,
-        )
+        );
+        (z, None, from_coarse)
+    } else if spec.objective == Objective::Time {
+        let (z, warm) = envelope_coarse_start(spec, seed_plan, nodes, observe, &mut levels);
+        let from_coarse = warm.is_some();
+        (z, warm, from_coarse)
     } else {
-        seed_start()
+        (seed_start(), None, false)
     };
     if !levels.is_empty() {
         observe.mesh(nodes);
     }
     let mut before = clock.elapsed().as_secs_f64();
-    // whether the fine mesh starts from a coarse design (not the seed)
-    let from_coarse = levels.last().is_some_and(|l: &Coarse| l.0.converged);
     // the fine mesh's iterations are numbered on from the coarse meshes'
     let first = recorded(&levels);
-    let mut r = match optimize_start(spec, &z0, None, seed, nodes, first, |it| {
+    let start = carried.as_ref().map_or(Carried::Nothing, Carried::Coarse);
+    let mut r = match optimize_start(spec, &z0, start, seed, nodes, first, |it| {
         observe.iteration(it)
     }) {
         // a fine design the coarse one could not start: from the seed (the
@@ -1343,9 +1354,15 @@ fn from_plan(
             before = clock.elapsed().as_secs_f64();
             // the failed attempt is not on the record: its numbers are reused
             observe.mesh(nodes);
-            optimize_start(spec, &seed_start(), None, seed, nodes, first, |it| {
-                observe.iteration(it)
-            })?
+            optimize_start(
+                spec,
+                &seed_start(),
+                Carried::Nothing,
+                seed,
+                nodes,
+                first,
+                |it| observe.iteration(it),
+            )?
         }
         r => r?,
     };
@@ -1436,12 +1453,11 @@ impl MeshLevel {
 /// The iteration limit of a coarse mesh: it only starts the finer one
 /// (the coarse meshes of issue 11's cases took 7 to 16; the seed's per-motor
 /// design from the analytic seed, on a path since left, crawled past 50).
-/// A coarse design stopped by the limit leaves the fine mesh to start from
-/// the seed, where an iteration costs about ten coarse ones (the box
-/// robot's stall-only design hit 25 at 20 nodes and took 59 more at 60);
-/// a limit of 60 made its least-height stage 40 % cheaper but, with the
-/// added check points, its least time 0.12 % longer (docs/benchmarks.md,
-/// `bench_robot`), so it stays at 25.
+/// A coarse design stopped by the limit still starts the finer mesh: it is
+/// nearer than the seed, from which a fine iteration costs about ten coarse
+/// ones (docs/benchmarks.md, `bench_robot`). A limit of 60 made the box
+/// robot's least-height stage 40 % cheaper but, with the added check
+/// points, its least time 0.12 % longer, so it stays at 25.
 const COARSE_MAX_ITERATIONS: usize = 25;
 
 /// "17 SCP iterations, 8 at 20 and 9 at 40 nodes per phase", or "9 SCP
@@ -1483,7 +1499,8 @@ fn recorded(levels: &[Coarse]) -> usize {
 /// instead of 37) and the robot's least time rose 0.5 % (0.7540 s against
 /// 0.7497 s); the robot's envelope peak design from 6 m took 7.7 s instead
 /// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Those
-/// start on the finest mesh. From the coarse design the fine one takes 2
+/// start on the finest mesh, but for a time design inside the envelope
+/// ([`envelope_coarse_start`]). From the coarse design the fine one takes 2
 /// to 4 iterations. When the continuation was introduced (half the nodes,
 /// midpoints checked; since then [`coarser`] and
 /// [`FreeProblem::at_nodes_only`] made the coarse meshes cheaper), a
@@ -1491,8 +1508,10 @@ fn recorded(levels: &[Coarse]) -> usize {
 /// the robot's design from the phased seed 12 iterations and 6.1 G
 /// instructions, seeding included, instead of 15 and 10.9 G on one mesh;
 /// the seed's per-motor design at 120 nodes per phase 13.1 G instead of
-/// 54.5 G, 0.317201 N m instead of 0.317395). A coarse design that fails
-/// or does not converge leaves the seed itself as the start.
+/// 54.5 G, 0.317201 N m instead of 0.317395). A coarse design that fails,
+/// or ends neither converged nor at its iteration limit, leaves the seed
+/// itself as the start. Returns the start and whether a coarse design
+/// made it.
 fn coarse_start(
     spec: &DesignSpec,
     seed_plan: &dyn crate::design::plan::ShapePlan,
@@ -1500,12 +1519,12 @@ fn coarse_start(
     (nodes, mesh): (usize, Mesh),
     observe: &mut dyn Observer,
     levels: &mut Vec<Coarse>,
-) -> Vec<f64> {
+) -> (Vec<f64>, bool) {
     let tr = grid(spec, nodes, mesh);
     let Some(coarse) = coarser(nodes) else {
-        return tr.sample(seed_plan);
+        return (tr.sample(seed_plan), false);
     };
-    let z0 = coarse_start(
+    let (z0, _) = coarse_start(
         spec,
         seed_plan,
         seed_is_analytic,
@@ -1567,11 +1586,75 @@ fn coarse_start(
         its,
     ));
     match solved {
-        Ok(s) if converged => tr.sample(&s.plan),
+        Ok(s) if converged || s.res.status == ScpStatus::IterationLimit => {
+            (tr.sample(&s.plan), true)
+        }
         // the finer mesh starts from the seed again
-        _ => tr.sample(seed_plan),
+        _ => (tr.sample(seed_plan), false),
     }
 }
+
+/// The coarse mesh of a `time` design inside the motor envelope (a
+/// torque-speed line or a speed limit): half the nodes per phase, while
+/// that leaves [`COARSEST_NODES`]. The design takes about as many SCP
+/// iterations there as on the fine mesh (the envelope's rows, more than
+/// the start's distance, set their number), each a third as costly, and
+/// the fine mesh then usually needs far fewer. It starts from the coarse design's last
+/// point whatever its status (stopped by [`ENVELOPE_COARSE_MAX_ITERATIONS`]
+/// or judged infeasible at the coarse mesh's resolution, it is still nearer
+/// than the seed; the fine mesh judges), with its penalty weight and trust
+/// radius (a fine mesh started at the cold weight wandered for dozens of
+/// iterations); from the seed when the coarse solve failed. Returns the
+/// fine mesh's start and what it carries.
+fn envelope_coarse_start(
+    spec: &DesignSpec,
+    seed_plan: &dyn crate::design::plan::ShapePlan,
+    nodes: usize,
+    observe: &mut dyn Observer,
+    levels: &mut Vec<Coarse>,
+) -> (Vec<f64>, Option<WarmStart>) {
+    let fine = grid(spec, nodes, Mesh::Final);
+    let coarse = nodes / 2;
+    if coarse < COARSEST_NODES {
+        return (fine.sample(seed_plan), None);
+    }
+    observe.mesh(coarse);
+    let z = grid(spec, coarse, Mesh::Coarse).sample(seed_plan);
+    let mut its = Vec::new();
+    let solved = design(
+        spec,
+        &z,
+        None,
+        coarse,
+        Mesh::Coarse,
+        recorded(levels),
+        |it| {
+            observe.iteration(it);
+            its.push(*it);
+        },
+    );
+    let status = solved.as_ref().map(|s| s.res.status).ok();
+    levels.push((
+        MeshLevel {
+            nodes: coarse,
+            scp_iterations: its.len(),
+            converged: status == Some(ScpStatus::Converged),
+            starts: 1,
+            other_iterations: 0,
+        },
+        its,
+    ));
+    match solved {
+        Ok(s) => (fine.sample(&s.plan), Some(s.res.warm)),
+        Err(_) => (fine.sample(seed_plan), None),
+    }
+}
+
+/// The iteration limit of [`envelope_coarse_start`]'s mesh: most of the
+/// bundled robots' least-time designs converge below it there
+/// (docs/benchmarks.md, `bench_robot`), and one stopped by it still starts
+/// the fine mesh.
+const ENVELOPE_COARSE_MAX_ITERATIONS: usize = 60;
 
 /// The other starts of the coarsest mesh: the configured analytic schedule
 /// (`configured`, unless it is the seed), whose designs end in another
@@ -1666,7 +1749,12 @@ fn design_problem(
     let (problem, max_iterations, tolerance, conic) = match mesh {
         Mesh::Coarse => (
             problem.at_nodes_only(),
-            COARSE_MAX_ITERATIONS.min(spec.free.max_iterations),
+            if spec.uses_envelope() {
+                ENVELOPE_COARSE_MAX_ITERATIONS
+            } else {
+                COARSE_MAX_ITERATIONS
+            }
+            .min(spec.free.max_iterations),
             COARSE_TOLERANCE.max(spec.free.tolerance),
             ConicSettings::COARSE,
         ),
@@ -1911,13 +1999,25 @@ fn refine_checks(
     Ok(solved)
 }
 
+/// What a design carries into its SCP beside its start point.
+#[derive(Clone, Copy)]
+enum Carried<'a> {
+    Nothing,
+    /// A neighbour's design: its penalty weight, trust radius and
+    /// multipliers (when they fit), and the check points it added.
+    Neighbour(&'a FreeResult),
+    /// The coarse mesh's penalty weight and trust radius (its multipliers
+    /// do not fit the finer mesh's rows).
+    Coarse(&'a WarmStart),
+}
+
 /// Runs the SCP from a start `z0` in physical units (see [`design`]) and
 /// keeps the schedule inside the motor envelope (see [`inside_envelope`]);
 /// the pipeline, not the design, flies it.
 fn optimize_start(
     spec: &DesignSpec,
     z0: &[f64],
-    prev: Option<&FreeResult>,
+    carried: Carried,
     seed: &str,
     nodes: usize,
     first: usize,
@@ -1928,12 +2028,16 @@ fn optimize_start(
     let tr = grid(spec, nodes, Mesh::Final);
     // a neighbour on the same grid hands on the check points it added, so
     // that the design does not find them again one round at a time
-    let extra = prev
-        .filter(|p| p.plan.tr == tr)
-        .map(|p| p.extra_checks.clone())
-        .unwrap_or_default();
+    let extra = match carried {
+        Carried::Neighbour(p) if p.plan.tr == tr => p.extra_checks.clone(),
+        _ => Default::default(),
+    };
     let problem = FreeProblem::on(spec, tr, z0).with_extra_checks(extra);
-    let warm = prev.map(|p| &p.warm);
+    let warm = match carried {
+        Carried::Nothing => None,
+        Carried::Neighbour(p) => Some(&p.warm),
+        Carried::Coarse(w) => Some(w),
+    };
     let solved = design_problem(spec, problem, z0, warm, Mesh::Final, first, &mut observe)?;
     if solved.res.status == ScpStatus::Infeasible {
         return Err(infeasible(spec, &solved));
@@ -2074,8 +2178,15 @@ fn continue_from(
             let i = tr.duration(p);
             z[i] = z[i].max(0.5 * prev.z_scaled[i]) * spec.available_time();
         }
-        if let Ok(r) = optimize_start(spec, &z, Some(prev), "continuation", nodes, 0, &mut observe)
-        {
+        if let Ok(r) = optimize_start(
+            spec,
+            &z,
+            Carried::Neighbour(prev),
+            "continuation",
+            nodes,
+            0,
+            &mut observe,
+        ) {
             return Ok(r);
         }
     }
@@ -2092,7 +2203,15 @@ fn continue_from(
     for p in 0..3 {
         z0[tr.duration(p)] *= spec.available_time();
     }
-    optimize_start(spec, &z0, Some(prev), "continuation", nodes, 0, observe)
+    optimize_start(
+        spec,
+        &z0,
+        Carried::Neighbour(prev),
+        "continuation",
+        nodes,
+        0,
+        observe,
+    )
 }
 
 /// The grid of a design at `nodes` per phase. For a peak-torque design the

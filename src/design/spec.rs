@@ -182,11 +182,12 @@ pub struct FreeSettings {
     pub tolerance: f64,
     /// Flip tolerance of the converged design, rad (default 1e-6).
     pub attitude_tolerance: f64,
-    /// Mesh continuation of peak-torque designs without a torque-speed
-    /// line or speed limit (default true): from a
-    /// seed, solve at a third of the nodes first (or half; again while that
-    /// leaves at least 20 per phase), loosely, and refine; see
-    /// `design::free::coarse_start`.
+    /// Mesh continuation (default true): a peak-torque design without a
+    /// torque-speed line or speed limit is solved from its seed at a third
+    /// of the nodes first (or half; again while that leaves at least 20 per
+    /// phase), loosely, and refined (`design::free::coarse_start`); a time
+    /// design inside the motor envelope at half the nodes first
+    /// (`design::free::envelope_coarse_start`).
     pub mesh_continuation: bool,
     /// Leave out of each SCP subproblem the torque-speed rows that cannot
     /// bind there (the subproblem's solution is the same, with fewer rows);

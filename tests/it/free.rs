@@ -945,7 +945,9 @@ fn the_per_motor_designs_from_both_seeds_agree_and_hold_between_check_points() {
 /// (`free.screen_limits`, the default) leaves the optimum where holding
 /// every row puts it, to the optimiser's tolerance (the two SCP runs part
 /// by rounding, so not to the bit), and the screened design keeps every
-/// check point and the samples between them inside the line.
+/// check point and the samples between them inside the line. On the fine
+/// mesh alone (`free.mesh_continuation=false`): a coarse mesh's design
+/// stopped by its iteration limit carries that rounding on to the fine one.
 #[test]
 fn screening_the_torque_speed_rows_keeps_the_least_time_and_every_row() {
     use catflip::design::envelope::usage_of;
@@ -956,6 +958,7 @@ fn screening_the_torque_speed_rows_keeps_the_least_time_and_every_row() {
                 &[
                     "fall.height=6",
                     "design.objective=time",
+                    "free.mesh_continuation=false",
                     &format!("free.screen_limits={screen}"),
                 ],
             );

@@ -118,7 +118,13 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
 /// reverses in the twist).
 #[test]
 fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
-    let cfg = util::config("robot-universal", &["design.objective=time"]);
+    // on the fine mesh alone: the restart below is checked from the optimum
+    // the fine mesh finds (a design continued from the coarse mesh stops
+    // within the SCP's tolerances, where its restart moved by 5e-5)
+    let cfg = util::config(
+        "robot-universal",
+        &["design.objective=time", "free.mesh_continuation=false"],
+    );
     for seed in [
         catflip::design::free::Seed::Phased,
         catflip::design::free::Seed::Analytic,
