@@ -307,9 +307,15 @@ def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_metho
             fails.append(f"{name}: {mode} replay flip differs by {diff:.3e} deg (> {tol:g})")
         # the checked feedback replay (MuJoCo: pd; pyBullet: pd-x, its step error removed)
         if mode in flip_tol:
-            if abs(r["peak_nm"] - m["sim_peak_torque_nm"]) > 0.02 * m["sim_peak_torque_nm"]:
+            # the controls hold each step's mean torque: a peak narrower than a step (a torque
+            # that jumps at a phase boundary and falls steeply) is below catflip's by as much
+            # in the exported feed-forward itself, which any engine replays
+            sim = m["sim_peak_torque_nm"]
+            held = max(0.0, sim - r["ff_peak_nm"])
+            if not sim * 0.98 - held <= r["peak_nm"] <= sim * 1.02:
                 fails.append(f"{name}: PD replay peak torque {r['peak_nm']:.5f} vs catflip "
-                             f"{m['sim_peak_torque_nm']:.5f} N m (> 2 %)")
+                             f"{sim:.5f} N m (> 2 %, {held:.5f} N m below it allowed for the "
+                             f"controls' step means)")
             if not saturating and r["shape_error_rad"] > 1e-3:
                 fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight")
         elif mode == "ff" and ff_tol is not None and name != "analytic" and not saturating \

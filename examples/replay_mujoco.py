@@ -82,7 +82,9 @@ def replay(model, c, pd):
 
 
 def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, vel, ff):
-    peak = 0.0
+    # the peak applied, and the peak of the exported feed-forward alone (the schedule's
+    # mean over each control step)
+    peak = ff_peak = 0.0
     for k in range(c["steps"]):
         if ball:
             v = quat_log(data.qpos[qa:qa + 4])
@@ -92,6 +94,7 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
             vd_ref = np.linalg.solve(right_jacobian(v_ref), vel[k])
             # catflip's PD acts on the rotation-vector coordinates; the twist v3 is held at 0
             tau_v = jr.T @ ff[k]
+            ff_peak = max(ff_peak, peak_of(tau_v, c["norm"]))
             if pd:
                 tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
             tau_v = limit_catflip_torque(tau_v, vd, c)
@@ -104,6 +107,7 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
             # instant, ctrl = tau + k qd, so the motor gives catflip's clip at the stage's speed.
             q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
             ff_tau = ff[k] - c["slope"] * (pos[k + 1] - pos[k]) / c["dt"]
+            ff_peak = max(ff_peak, peak_of(ff_tau, c["norm"]))
             if pd:
                 stage[:] = [k, data.time, *ff_tau]
                 tau_v = limit_catflip_torque(
@@ -114,6 +118,7 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
         else:
             q, qd = data.qpos[qa:qa + 2], data.qvel[va:va + 2]
             tau_v = ff[k].copy()
+            ff_peak = max(ff_peak, peak_of(tau_v, c["norm"]))
             if pd:
                 tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
             tau_v = limit_catflip_torque(tau_v, qd, c)
@@ -136,6 +141,7 @@ def run_steps(model, data, c, pd, ball, dc, stage, qa, va, rear, tracker, pos, v
         "landing_deg": tracker.landing,
         "shape_error_rad": float(shape),
         "peak_nm": peak,
+        "ff_peak_nm": ff_peak,
         "spinning": bool(np.any(c["start_body_rate"] != 0)),
     }
 

@@ -82,7 +82,9 @@ def replay(urdf, c, pd, substeps=1):
         _, q0 = p.getBasePositionAndOrientation(body, physicsClientId=cid)
         tracker = FlipTracker(xyzw_to_wxyz(q0), c["start_attitude"])
         pos, vel, ff = c["pick"]("pos"), c["pick"]("vel"), c["pick"]("force")
-        peak = 0.0
+        # the peak applied, and the peak of the exported feed-forward alone (the schedule's
+        # mean over each control step)
+        peak = ff_peak = 0.0
         for k in range(c["steps"]):
             if ball:
                 st = p.getJointStateMultiDof(body, joints[0], physicsClientId=cid)
@@ -92,6 +94,7 @@ def replay(urdf, c, pd, substeps=1):
                 v_ref = quat_log(xyzw_to_wxyz(pos[k]))
                 vd_ref = np.linalg.solve(right_jacobian(v_ref), vel[k])
                 tau_v = jr.T @ ff[k]
+                ff_peak = max(ff_peak, peak_of(tau_v, c["norm"]))
                 if pd:
                     tau_v = tau_v + c["kp"] * (v_ref - v) + c["kd"] * (vd_ref - vd)
                 tau_v = limit_catflip_torque(tau_v, vd, c)
@@ -101,6 +104,7 @@ def replay(urdf, c, pd, substeps=1):
                 q = np.array([s[0] for s in st])
                 qd = np.array([s[1] for s in st])
                 tau_v = ff[k].copy()
+                ff_peak = max(ff_peak, peak_of(tau_v, c["norm"]))
                 if pd:
                     tau_v = tau_v + c["kp"] * (pos[k] - q) + c["kd"] * (vel[k] - qd)
                 tau_v = limit_catflip_torque(tau_v, qd, c)
@@ -146,6 +150,7 @@ def replay(urdf, c, pd, substeps=1):
             "attitude": tracker.r,
             "shape_error_rad": float(shape),
             "peak_nm": peak,
+            "ff_peak_nm": ff_peak,
             "spinning": bool(np.any(c["start_body_rate"] != 0)),
         }
     finally:

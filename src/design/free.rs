@@ -30,9 +30,9 @@
 //! and so on while 20 or more remain per phase), loosely, and each starts
 //! the next ([`coarse_start`], mesh continuation); the coarsest is also
 //! solved from the analytic schedule ([`other_starts`]) and the lower
-//! design continued. A time design inside the motor envelope is solved at
-//! half the nodes first, and the fine mesh continues from it with its
-//! penalty weight and trust radius ([`envelope_coarse_start`]).
+//! design continued. A design inside the motor envelope is solved at half
+//! the nodes first, and the fine mesh continues from it with its penalty
+//! weight and trust radius ([`envelope_coarse_start`]).
 
 use crate::design::collocation::Transcription;
 use crate::design::collocation_plan::CollocationPlan;
@@ -1301,7 +1301,7 @@ pub use crate::design::scp::Observer;
 
 /// Runs the SCP from a seed plan at `nodes` per phase; a peak-torque design
 /// first on coarser meshes ([`coarse_start`], `free.mesh_continuation`), a
-/// time design inside the motor envelope on one ([`envelope_coarse_start`]).
+/// design inside the motor envelope on one ([`envelope_coarse_start`]).
 /// `iterations`, `scp_iterations` and `solve_time_s` cover every mesh, in
 /// order (`mesh_levels`), numbered on by the SCP's [`Executor`] as the
 /// observer sees them. A fine design the coarse one cannot start is solved
@@ -1330,12 +1330,10 @@ fn from_plan(
             &mut levels,
         );
         (z, None, from_coarse)
-    } else if spec.objective == Objective::Time {
+    } else {
         let (z, warm) = envelope_coarse_start(spec, seed_plan, nodes, observe, &mut levels);
         let from_coarse = warm.is_some();
         (z, warm, from_coarse)
-    } else {
-        (seed_start(), None, false)
     };
     if !levels.is_empty() {
         observe.mesh(nodes);
@@ -1498,8 +1496,8 @@ fn recorded(levels: &[Coarse]) -> usize {
 /// iterations with it (the robot's least time from the analytic seed 62
 /// instead of 37) and the robot's least time rose 0.5 % (0.7540 s against
 /// 0.7497 s); the robot's envelope peak design from 6 m took 7.7 s instead
-/// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Those
-/// start on the finest mesh, but for a time design inside the envelope
+/// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Designs
+/// inside the envelope have a coarse mesh of their own
 /// ([`envelope_coarse_start`]). From the coarse design the fine one takes 2
 /// to 4 iterations. When the continuation was introduced (half the nodes,
 /// midpoints checked; since then [`coarser`] and
@@ -1594,8 +1592,8 @@ fn coarse_start(
     }
 }
 
-/// The coarse mesh of a `time` design inside the motor envelope (a
-/// torque-speed line or a speed limit): half the nodes per phase, while
+/// The coarse mesh of a design inside the motor envelope (a torque-speed
+/// line or a speed limit), whatever its objective: half the nodes per phase, while
 /// that leaves [`COARSEST_NODES`]. The design takes about as many SCP
 /// iterations there as on the fine mesh (the envelope's rows, more than
 /// the start's distance, set their number), each a third as costly, and
@@ -1651,7 +1649,7 @@ fn envelope_coarse_start(
 }
 
 /// The iteration limit of [`envelope_coarse_start`]'s mesh: most of the
-/// bundled robots' least-time designs converge below it there
+/// bundled robots' designs converge below it there
 /// (docs/benchmarks.md, `bench_robot`), and one stopped by it still starts
 /// the fine mesh.
 const ENVELOPE_COARSE_MAX_ITERATIONS: usize = 60;

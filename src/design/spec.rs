@@ -185,7 +185,7 @@ pub struct FreeSettings {
     /// Mesh continuation (default true): a peak-torque design without a
     /// torque-speed line or speed limit is solved from its seed at a third
     /// of the nodes first (or half; again while that leaves at least 20 per
-    /// phase), loosely, and refined (`design::free::coarse_start`); a time
+    /// phase), loosely, and refined (`design::free::coarse_start`); a
     /// design inside the motor envelope at half the nodes first
     /// (`design::free::envelope_coarse_start`).
     pub mesh_continuation: bool,
