@@ -79,13 +79,19 @@ impl BendHint {
     }
 
     /// The prediction from the last two points' bends (linear
-    /// extrapolation), or from the last alone; the bracket is as wide as
-    /// the last change, and at least a degree.
+    /// extrapolation), its bracket half the last change and at least a
+    /// fifth of a degree (the bracket widens when the bend lies outside);
+    /// from the last alone, a degree either side.
     fn from_neighbours(last: f64, before: Option<f64>) -> Self {
-        let change = before.map_or(0.0, |b| last - b);
-        BendHint {
-            bend: last + change,
-            step: change.abs().max(1f64.to_radians()),
+        match before {
+            Some(b) => BendHint {
+                bend: 2.0 * last - b,
+                step: (0.5 * (last - b).abs()).max(0.2f64.to_radians()),
+            },
+            None => BendHint {
+                bend: last,
+                step: 1f64.to_radians(),
+            },
         }
     }
 }
