@@ -83,7 +83,9 @@ pub fn iteration_header(objective: &str) -> String {
 }
 
 /// `--verbose`: one line per SCP iteration on stderr, and a line where each
-/// mesh begins (mesh continuation: the trust radius starts again there).
+/// mesh begins (mesh continuation: the trust radius starts again there,
+/// but inside the motor envelope, where the fine mesh carries the coarse
+/// one's radius and penalty weight).
 pub struct IterationTable {
     pub verbose: bool,
 }

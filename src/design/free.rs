@@ -30,9 +30,10 @@
 //! and so on while 20 or more remain per phase), loosely, and each starts
 //! the next ([`coarse_start`], mesh continuation); the coarsest is also
 //! solved from the analytic schedule ([`other_starts`]) and the lower
-//! design continued. A design inside the motor envelope is solved at half
-//! the nodes first, and the fine mesh continues from it with its penalty
-//! weight and trust radius ([`envelope_coarse_start`]).
+//! design continued. Any other design (`DesignSpec::uses_envelope`: a
+//! time or energy design, or one under a torque-speed line or speed limit)
+//! is solved at half the nodes first, and the fine mesh continues from it
+//! with its penalty weight and trust radius ([`envelope_coarse_start`]).
 
 use crate::design::collocation::Transcription;
 use crate::design::collocation_plan::CollocationPlan;
@@ -475,7 +476,7 @@ impl FreeProblem {
 
     /// Simpson weights of one phase's check points (in [`Self::check_points`]
     /// order) for `integral_0^1 f ds`; trapezoid weights at the nodes only
-    /// (only the energy objective reads them, which has no coarse meshes).
+    /// (an energy design's coarse mesh inside the envelope).
     fn quadrature(&self) -> Vec<f64> {
         let h = self.tr.h();
         let m = self.checks;
@@ -1412,7 +1413,8 @@ const COARSE_TOLERANCE: f64 = 1e-3;
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Mesh {
     /// A coarser mesh, whose design only starts the next one: to
-    /// [`COARSE_TOLERANCE`], at most [`COARSE_MAX_ITERATIONS`], subproblems
+    /// [`COARSE_TOLERANCE`], at most [`COARSE_MAX_ITERATIONS`]
+    /// ([`ENVELOPE_COARSE_MAX_ITERATIONS`] inside the envelope), subproblems
     /// to [`ConicSettings::COARSE`], the torque checked at the nodes only
     /// ([`FreeProblem::at_nodes_only`]).
     Coarse,
@@ -1421,8 +1423,9 @@ enum Mesh {
 }
 
 /// One mesh a design was solved on: nodes per phase, SCP iterations, and
-/// whether it converged (a coarse mesh that did not leaves the seed as the
-/// next one's start).
+/// whether it converged (one that did not still starts the next mesh when
+/// it stopped at its iteration limit, or inside the envelope whenever its
+/// solve returned; see [`coarse_start`], [`envelope_coarse_start`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub struct MeshLevel {
     pub nodes: usize,
@@ -1519,7 +1522,8 @@ fn coarse_start(
     levels: &mut Vec<Coarse>,
 ) -> (Vec<f64>, bool) {
     let tr = grid(spec, nodes, mesh);
-    let Some(coarse) = coarser(nodes) else {
+    // (a mesh too coarse for the bend's turns is skipped, not recorded)
+    let Some(coarse) = coarser(nodes).filter(|&c| check_resolvable(spec, c).is_ok()) else {
         return (tr.sample(seed_plan), false);
     };
     let (z0, _) = coarse_start(
@@ -1592,9 +1596,10 @@ fn coarse_start(
     }
 }
 
-/// The coarse mesh of a design inside the motor envelope (a torque-speed
-/// line or a speed limit), whatever its objective: half the nodes per phase, while
-/// that leaves [`COARSEST_NODES`]. The design takes about as many SCP
+/// The coarse mesh of a design inside the motor envelope
+/// (`DesignSpec::uses_envelope`: a torque-speed line or a speed limit, or a
+/// time or energy design under a torque limit): half the nodes per phase,
+/// while that leaves [`COARSEST_NODES`] and resolves the bend's turns. The design takes about as many SCP
 /// iterations there as on the fine mesh (the envelope's rows, more than
 /// the start's distance, set their number), each a third as costly, and
 /// the fine mesh then usually needs far fewer. It starts from the coarse design's last
@@ -1613,7 +1618,8 @@ fn envelope_coarse_start(
 ) -> (Vec<f64>, Option<WarmStart>) {
     let fine = grid(spec, nodes, Mesh::Final);
     let coarse = nodes / 2;
-    if coarse < COARSEST_NODES {
+    // (a mesh too coarse for the bend's turns is skipped, not recorded)
+    if coarse < COARSEST_NODES || check_resolvable(spec, coarse).is_err() {
         return (fine.sample(seed_plan), None);
     }
     observe.mesh(coarse);

@@ -185,8 +185,9 @@ pub struct FreeSettings {
     /// Mesh continuation (default true): a peak-torque design without a
     /// torque-speed line or speed limit is solved from its seed at a third
     /// of the nodes first (or half; again while that leaves at least 20 per
-    /// phase), loosely, and refined (`design::free::coarse_start`); a
-    /// design inside the motor envelope at half the nodes first
+    /// phase), loosely, and refined (`design::free::coarse_start`); any
+    /// other design (`DesignSpec::uses_envelope`) at half the nodes first,
+    /// while that leaves at least 20 per phase
     /// (`design::free::envelope_coarse_start`).
     pub mesh_continuation: bool,
     /// Leave out of each SCP subproblem the torque-speed rows that cannot

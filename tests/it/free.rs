@@ -945,9 +945,10 @@ fn the_per_motor_designs_from_both_seeds_agree_and_hold_between_check_points() {
 /// (`free.screen_limits`, the default) leaves the optimum where holding
 /// every row puts it, to the optimiser's tolerance (the two SCP runs part
 /// by rounding, so not to the bit), and the screened design keeps every
-/// check point and the samples between them inside the line. On the fine
-/// mesh alone (`free.mesh_continuation=false`): a coarse mesh's design
-/// stopped by its iteration limit carries that rounding on to the fine one.
+/// check point and the samples between them inside the line. Compared on
+/// the fine mesh alone (`free.mesh_continuation=false`): a coarse mesh's
+/// design stopped by its iteration limit carries that rounding on to the
+/// fine one; the default path, a coarse mesh first, keeps every row too.
 #[test]
 fn screening_the_torque_speed_rows_keeps_the_least_time_and_every_row() {
     use catflip::design::envelope::usage_of;
@@ -979,4 +980,18 @@ fn screening_the_torque_speed_rows_keeps_the_least_time_and_every_row() {
             "{name}: least time {screened} s screened, {whole} s whole"
         );
     }
+    // the default path (a coarse mesh first) screens its rows too
+    let c = util::config(
+        "robot-universal",
+        &["fall.height=6", "design.objective=time"],
+    );
+    let spec = c.design_spec();
+    let r = catflip::design::free::FreeDesign::new(&spec)
+        .from_plan(&analytic_plan(&spec), "analytic")
+        .solve()
+        .unwrap();
+    assert_eq!(r.status, ScpStatus::Converged);
+    assert_eq!(r.mesh_levels.len(), 2);
+    let margin = usage_of(&spec, &r.plan).min_margin.unwrap();
+    assert!(margin >= -1e-6, "with mesh continuation: margin {margin}");
 }

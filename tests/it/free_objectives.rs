@@ -115,9 +115,33 @@ fn every_objective_stays_inside_the_envelope_flips_and_beats_the_phased_design()
 /// dense samples at the time the SCP itself ended (not slowed down
 /// afterwards by what broke the line between check points: 1.05 % from the
 /// phased seed with the quarter points alone, where the second motor
-/// reverses in the twist).
+/// reverses in the twist); by default solved on 30 nodes per phase first
+/// (mesh continuation inside the envelope), and then within 0.5 % of the
+/// design the fine mesh alone finds.
 #[test]
 fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
+    let held = |cfg: &catflip::Config, r: &catflip::design::free::FreeResult, what: &str| {
+        assert_eq!(
+            r.status,
+            catflip::design::scp::ScpStatus::Converged,
+            "{what}"
+        );
+        let dense = catflip::verify::analyze::dense_samples(&cfg.design_spec());
+        let sched = catflip::design::plan::Schedule::sample(&cfg.cat(), &r.plan, dense);
+        let margin = cfg
+            .motor()
+            .usage(sched.rows.iter().map(|row| (row.tau, row.qd)))
+            .min_margin
+            .unwrap();
+        assert!(margin >= -1e-7, "{what}: margin {margin}");
+        let ended = r.iterations.last().unwrap().objective;
+        assert!(
+            r.manoeuvre_time_s <= ended * (1.0 + 1e-3),
+            "{what}: written {} s, the SCP ended at {ended} s",
+            r.manoeuvre_time_s
+        );
+    };
+    let continued = util::config("robot-universal", &["design.objective=time"]);
     // on the fine mesh alone: the restart below is checked from the optimum
     // the fine mesh finds (a design continued from the coarse mesh stops
     // within the SCP's tolerances, where its restart moved by 5e-5)
@@ -129,23 +153,23 @@ fn the_robots_least_time_holds_the_torque_speed_line_between_check_points() {
         catflip::design::free::Seed::Phased,
         catflip::design::free::Seed::Analytic,
     ] {
+        let c = FreeDesign::new(&continued.design_spec())
+            .seed(seed)
+            .solve()
+            .unwrap();
+        held(&continued, &c, &format!("{seed:?}, continued"));
+        let meshes: Vec<usize> = c.mesh_levels.iter().map(|l| l.nodes).collect();
+        assert_eq!(meshes, [30, 60], "{seed:?}");
         let r = FreeDesign::new(&cfg.design_spec())
             .seed(seed)
             .solve()
             .unwrap();
-        assert_eq!(r.status, catflip::design::scp::ScpStatus::Converged);
-        let dense = catflip::verify::analyze::dense_samples(&cfg.design_spec());
-        let sched = catflip::design::plan::Schedule::sample(&cfg.cat(), &r.plan, dense);
-        let margin = cfg
-            .motor()
-            .usage(sched.rows.iter().map(|row| (row.tau, row.qd)))
-            .min_margin
-            .unwrap();
-        assert!(margin >= -1e-7, "{seed:?}: margin {margin}");
-        let ended = r.iterations.last().unwrap().objective;
+        held(&cfg, &r, &format!("{seed:?}"));
+        assert_eq!(r.mesh_levels.len(), 1, "{seed:?}");
         assert!(
-            r.manoeuvre_time_s <= ended * (1.0 + 1e-3),
-            "{seed:?}: written {} s, the SCP ended at {ended} s",
+            (c.manoeuvre_time_s - r.manoeuvre_time_s).abs() <= 5e-3 * r.manoeuvre_time_s,
+            "{seed:?}: {} s continued, {} s on the fine mesh alone",
+            c.manoeuvre_time_s,
             r.manoeuvre_time_s
         );
         // continued from itself (a sweep's next point at no change), the
