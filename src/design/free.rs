@@ -1599,16 +1599,17 @@ fn coarse_start(
 /// The coarse mesh of a design inside the motor envelope
 /// (`DesignSpec::uses_envelope`: a torque-speed line or a speed limit, or a
 /// time or energy design under a torque limit): half the nodes per phase,
-/// while that leaves [`COARSEST_NODES`] and resolves the bend's turns. The design takes about as many SCP
-/// iterations there as on the fine mesh (the envelope's rows, more than
-/// the start's distance, set their number), each a third as costly, and
-/// the fine mesh then usually needs far fewer. It starts from the coarse design's last
-/// point whatever its status (stopped by [`ENVELOPE_COARSE_MAX_ITERATIONS`]
-/// or judged infeasible at the coarse mesh's resolution, it is still nearer
-/// than the seed; the fine mesh judges), with its penalty weight and trust
-/// radius (a fine mesh started at the cold weight wandered for dozens of
-/// iterations); from the seed when the coarse solve failed. Returns the
-/// fine mesh's start and what it carries.
+/// while that leaves [`COARSEST_NODES`] and resolves the bend's turns. The
+/// design takes about as many SCP iterations there as on the fine mesh
+/// (the envelope's rows, more than the start's distance, set their number),
+/// each a third as costly, and the fine mesh then usually needs far fewer.
+/// The fine mesh starts from the coarse design's last point whatever its
+/// status (stopped by [`ENVELOPE_COARSE_MAX_ITERATIONS`] or judged
+/// infeasible at the coarse mesh's resolution, it is still nearer than the
+/// seed; the fine mesh judges), with its penalty weight and trust radius (a
+/// fine mesh started at the cold weight wandered for dozens of iterations);
+/// from the seed when the coarse solve failed. Returns the fine mesh's
+/// start and what it carries.
 fn envelope_coarse_start(
     spec: &DesignSpec,
     seed_plan: &dyn crate::design::plan::ShapePlan,
@@ -1637,12 +1638,11 @@ fn envelope_coarse_start(
             its.push(*it);
         },
     );
-    let status = solved.as_ref().map(|s| s.res.status).ok();
     levels.push((
         MeshLevel {
             nodes: coarse,
             scp_iterations: its.len(),
-            converged: status == Some(ScpStatus::Converged),
+            converged: matches!(&solved, Ok(s) if s.res.status == ScpStatus::Converged),
             starts: 1,
             other_iterations: 0,
         },
