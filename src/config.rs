@@ -8,7 +8,7 @@
 use crate::design::spec::{
     AnalyticSettings, DesignSpec, Fall, FreeSettings, PhasedSettings, SimulateSettings,
 };
-use crate::error::{Error, Result, check};
+use crate::error::{Error, Result, ValueKind, check};
 use crate::model::{Cat, Half, InertiaFormula, Joint, TorqueNorm};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -130,6 +130,25 @@ fn plain_types(message: &str) -> String {
     .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
 }
 
+/// The kind of value the parser expected when a value's type was wrong
+/// (read from its message, before [`plain_types`] rewords it).
+fn expected_kind(message: &str) -> Option<ValueKind> {
+    let numbers = [
+        "expected f64",
+        "expected usize",
+        "expected u64",
+        "expected u32",
+        "expected i64",
+    ];
+    if numbers.iter().any(|n| message.contains(n)) {
+        Some(ValueKind::Number)
+    } else if message.contains("expected string only") {
+        Some(ValueKind::Name)
+    } else {
+        None
+    }
+}
+
 impl Config {
     /// Reads, overrides and validates a config file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config> {
@@ -178,6 +197,7 @@ impl Config {
                 return Err(Error::Override {
                     arg: arg.clone(),
                     message: plain_types(e.message().trim()),
+                    expects: expected_kind(e.message()),
                 });
             }
             apply_override(&mut table, arg)?;
@@ -435,6 +455,7 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
     let err = |m: &str| Error::Override {
         arg: arg.into(),
         message: m.into(),
+        expects: None,
     };
     let (key, raw) = arg
         .split_once('=')
@@ -571,15 +592,23 @@ gravity = 9.8
 
     #[test]
     fn wrong_types_are_named_in_toml_words_not_rusts() {
-        for (set, plain) in [
-            ("cat.mass=abc", "expected a number"),
-            ("phased.nodes=10.5", "expected a whole number"),
-            ("cat.joint=1", "expected a name"),
-            ("cat.joint=true", "expected a name"),
+        for (set, plain, kind) in [
+            ("cat.mass=abc", "expected a number", ValueKind::Number),
+            (
+                "phased.nodes=10.5",
+                "expected a whole number",
+                ValueKind::Number,
+            ),
+            ("cat.joint=1", "expected a name", ValueKind::Name),
+            ("cat.joint=true", "expected a name", ValueKind::Name),
         ] {
-            let e = Config::from_toml(SEED, "t", &[set.into()])
-                .unwrap_err()
-                .to_string();
+            let e = Config::from_toml(SEED, "t", &[set.into()]).unwrap_err();
+            // the kind is typed, for callers such as the sweep
+            assert!(
+                matches!(e, Error::Override { expects: Some(k), .. } if k == kind),
+                "{set}: {e:?}"
+            );
+            let e = e.to_string();
             assert!(e.contains(plain), "{set}: {e}");
             for rust in ["f64", "usize", "variant"] {
                 assert!(!e.contains(rust), "{set}: {e}");

@@ -14,8 +14,14 @@ pub enum Error {
         value: String,
         expected: String,
     },
+    /// A `--set` that does not fit the config; `expects` is the kind of
+    /// value the key takes when the value's type was wrong.
     #[error("`--set {arg}`: {message}")]
-    Override { arg: String, message: String },
+    Override {
+        arg: String,
+        message: String,
+        expects: Option<ValueKind>,
+    },
     #[error("`--set-range {arg}`: {message}")]
     Range { arg: String, message: String },
     /// A bad command-line argument other than `--set` and `--set-range`.
@@ -86,6 +92,15 @@ impl Error {
 }
 
 pub type Result<T> = std::result::Result<T, Error>;
+
+/// The kind of value a config key takes, as far as a wrong value tells.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ValueKind {
+    /// A number (or a whole number).
+    Number,
+    /// A name, such as `universal`.
+    Name,
+}
 
 /// A number as the user would read it: `1e308`, not 309 digits.
 pub fn show(x: f64) -> String {

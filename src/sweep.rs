@@ -19,7 +19,7 @@ use crate::design::least_height::{Heights, heights, heights_near};
 use crate::design::phased::BendHint;
 use crate::design::phased::least_height;
 use crate::design::spec::DesignSpec;
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, ValueKind};
 use crate::verdict::{Simulated, Status};
 use crate::verify::analyze::peak_along;
 use serde::{Deserialize, Serialize};
@@ -606,10 +606,21 @@ fn checked_configs(
     values: &[f64],
     load: impl Fn(f64) -> Result<Config>,
 ) -> Result<Vec<Result<Config>>> {
-    let configs: Vec<Result<Config>> = values
-        .iter()
-        .map(|&v| {
-            load(v).map_err(|e| Error::Range {
+    let loaded: Vec<Result<Config>> = values.iter().map(|&v| load(v)).collect();
+    let takes_a_name = loaded.iter().all(|c| {
+        matches!(
+            c,
+            Err(Error::Override {
+                expects: Some(ValueKind::Name),
+                ..
+            })
+        )
+    });
+    let configs: Vec<Result<Config>> = loaded
+        .into_iter()
+        .zip(values)
+        .map(|(c, v)| {
+            c.map_err(|e| Error::Range {
                 arg: arg.into(),
                 message: match e {
                     // the override is internal: name the point, not a `--set`
@@ -627,7 +638,7 @@ fn checked_configs(
         };
         return Err(Error::Range {
             arg: arg.into(),
-            message: if bad == configs.len() && message.contains("expected a name") {
+            message: if takes_a_name {
                 format!(
                     "`{key}` takes a name, not a number: a sweep varies a numeric key ({message})"
                 )

@@ -288,3 +288,36 @@ fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
         String::from_utf8_lossy(&o.stderr)
     );
 }
+
+/// A key that takes a name (`cat.joint`) cannot be swept: the sweep fails
+/// as bad input before any work, saying the key takes a name; a numeric key
+/// whose every point is out of range is told apart from it.
+#[test]
+fn sweeping_a_key_that_takes_a_name_is_bad_input_that_says_so() {
+    let dir = temp_dir();
+    let cfg = configs().join("seed.toml");
+    let sweep = |range: &str| {
+        bin()
+            .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
+            .args(["--methods", "phased", "--out", "out"])
+            .current_dir(dir.path())
+            .output()
+            .unwrap()
+    };
+    let o = sweep("cat.joint=1:2:2");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("`cat.joint` takes a name, not a number"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
+    let o = sweep("cat.mass=-2:-1:2");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("every point is invalid") && !err.contains("takes a name"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
+}
