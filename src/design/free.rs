@@ -1314,13 +1314,108 @@ fn from_plan(
     nodes: usize,
     observe: &mut dyn Observer,
 ) -> Result<FreeResult> {
+    stage(spec, seed_plan, seed, nodes, observe).finish(spec, observe)
+}
+
+/// A free-form design from a schedule, its coarse meshes solved: the fine
+/// mesh's start and what it carries ([`FreeDesign::coarse_stage`]). Two
+/// starts can be ranked here and only the better one finished.
+pub struct Staged {
+    seed: String,
+    nodes: usize,
+    clock: std::time::Instant,
+    /// Time spent before the fine mesh, s.
+    before: f64,
+    z0: Vec<f64>,
+    /// The seed sampled on the fine mesh (the fallback when the fine design
+    /// fails from the coarse one).
+    seed_z: Vec<f64>,
+    carried: Option<WarmStart>,
+    from_coarse: bool,
+    levels: Vec<Coarse>,
+    coarse: Option<CoarseOutcome>,
+}
+
+/// How the coarse mesh of an envelope design ended: its objective (in its
+/// physical unit) and whether it met the constraints there.
+#[derive(Debug, Clone, Copy)]
+pub struct CoarseOutcome {
+    pub objective: f64,
+    pub feasible: bool,
+}
+
+impl Staged {
+    /// The coarse design's outcome (none when no coarse mesh was solved).
+    pub fn coarse(&self) -> Option<CoarseOutcome> {
+        self.coarse
+    }
+
+    /// The fine mesh from the staged start.
+    pub fn finish(self, spec: &DesignSpec, observe: &mut dyn Observer) -> Result<FreeResult> {
+        let Staged {
+            seed,
+            nodes,
+            clock,
+            mut before,
+            z0,
+            seed_z,
+            carried,
+            from_coarse,
+            levels,
+            ..
+        } = self;
+        let seed = seed.as_str();
+        if !levels.is_empty() {
+            observe.mesh(nodes);
+        }
+        // the fine mesh's iterations are numbered on from the coarse meshes'
+        let first = recorded(&levels);
+        let start = carried.as_ref().map_or(Carried::Nothing, Carried::Coarse);
+        let mut r = match optimize_start(spec, &z0, start, seed, nodes, first, |it| {
+            observe.iteration(it)
+        }) {
+            // a fine design the coarse one could not start: from the seed (the
+            // coarse meshes stay on the record); not an impossible flip, which
+            // the seed would only find again
+            Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
+                before = clock.elapsed().as_secs_f64();
+                // the failed attempt is not on the record: its numbers are reused
+                observe.mesh(nodes);
+                optimize_start(spec, &seed_z, Carried::Nothing, seed, nodes, first, |it| {
+                    observe.iteration(it)
+                })?
+            }
+            r => r?,
+        };
+        if !levels.is_empty() {
+            r.solve_time_s += before;
+            let mut meshes: Vec<MeshLevel> = levels.iter().map(|l| l.0).collect();
+            meshes.extend(r.mesh_levels.iter().copied());
+            r.mesh_levels = meshes;
+            let mut iterations: Vec<ScpIteration> = levels.into_iter().flat_map(|l| l.1).collect();
+            iterations.append(&mut r.iterations);
+            r.iterations = iterations;
+            r.scp_iterations = r.iterations.len();
+        }
+        Ok(r)
+    }
+}
+
+/// The first stage of [`from_plan`]: the coarse meshes.
+fn stage(
+    spec: &DesignSpec,
+    seed_plan: &dyn crate::design::plan::ShapePlan,
+    seed: &str,
+    nodes: usize,
+    observe: &mut dyn Observer,
+) -> Staged {
     let clock = std::time::Instant::now();
-    let seed_start = || grid(spec, nodes, Mesh::Final).sample(seed_plan);
+    let seed_z = grid(spec, nodes, Mesh::Final).sample(seed_plan);
     let mut levels = Vec::new();
     // the fine mesh's start, what it carries from a coarse mesh, and
     // whether it starts from a coarse design (not the seed)
-    let (z0, carried, from_coarse) = if !spec.free.mesh_continuation {
-        (seed_start(), None, false)
+    let (z0, carried, from_coarse, coarse) = if !spec.free.mesh_continuation {
+        (seed_z.clone(), None, false, None)
     } else if !spec.uses_envelope() {
         let (z, from_coarse) = coarse_start(
             spec,
@@ -1330,52 +1425,24 @@ fn from_plan(
             observe,
             &mut levels,
         );
-        (z, None, from_coarse)
+        (z, None, from_coarse, None)
     } else {
-        let (z, warm) = envelope_coarse_start(spec, seed_plan, nodes, observe, &mut levels);
+        let (z, warm, coarse) = envelope_coarse_start(spec, seed_plan, nodes, observe, &mut levels);
         let from_coarse = warm.is_some();
-        (z, warm, from_coarse)
+        (z, warm, from_coarse, coarse)
     };
-    if !levels.is_empty() {
-        observe.mesh(nodes);
+    Staged {
+        seed: seed.to_string(),
+        nodes,
+        before: clock.elapsed().as_secs_f64(),
+        clock,
+        z0,
+        seed_z,
+        carried,
+        from_coarse,
+        levels,
+        coarse,
     }
-    let mut before = clock.elapsed().as_secs_f64();
-    // the fine mesh's iterations are numbered on from the coarse meshes'
-    let first = recorded(&levels);
-    let start = carried.as_ref().map_or(Carried::Nothing, Carried::Coarse);
-    let mut r = match optimize_start(spec, &z0, start, seed, nodes, first, |it| {
-        observe.iteration(it)
-    }) {
-        // a fine design the coarse one could not start: from the seed (the
-        // coarse meshes stay on the record); not an impossible flip, which
-        // the seed would only find again
-        Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
-            before = clock.elapsed().as_secs_f64();
-            // the failed attempt is not on the record: its numbers are reused
-            observe.mesh(nodes);
-            optimize_start(
-                spec,
-                &seed_start(),
-                Carried::Nothing,
-                seed,
-                nodes,
-                first,
-                |it| observe.iteration(it),
-            )?
-        }
-        r => r?,
-    };
-    if !levels.is_empty() {
-        r.solve_time_s += before;
-        let mut meshes: Vec<MeshLevel> = levels.iter().map(|l| l.0).collect();
-        meshes.extend(r.mesh_levels.iter().copied());
-        r.mesh_levels = meshes;
-        let mut iterations: Vec<ScpIteration> = levels.into_iter().flat_map(|l| l.1).collect();
-        iterations.append(&mut r.iterations);
-        r.iterations = iterations;
-        r.scp_iterations = r.iterations.len();
-    }
-    Ok(r)
 }
 
 /// The coarsest mesh of the continuation, nodes per phase: 20 took the
@@ -1616,12 +1683,12 @@ fn envelope_coarse_start(
     nodes: usize,
     observe: &mut dyn Observer,
     levels: &mut Vec<Coarse>,
-) -> (Vec<f64>, Option<WarmStart>) {
+) -> (Vec<f64>, Option<WarmStart>, Option<CoarseOutcome>) {
     let fine = grid(spec, nodes, Mesh::Final);
     let coarse = nodes / 2;
     // (a mesh too coarse for the bend's turns is skipped, not recorded)
     if coarse < COARSEST_NODES || check_resolvable(spec, coarse).is_err() {
-        return (fine.sample(seed_plan), None);
+        return (fine.sample(seed_plan), None, None);
     }
     observe.mesh(coarse);
     let z = grid(spec, coarse, Mesh::Coarse).sample(seed_plan);
@@ -1649,8 +1716,14 @@ fn envelope_coarse_start(
         its,
     ));
     match solved {
-        Ok(s) => (fine.sample(&s.plan), Some(s.res.warm)),
-        Err(_) => (fine.sample(seed_plan), None),
+        Ok(s) => {
+            let outcome = CoarseOutcome {
+                objective: s.res.objective,
+                feasible: s.res.infeasibility <= spec.free.attitude_tolerance,
+            };
+            (fine.sample(&s.plan), Some(s.res.warm), Some(outcome))
+        }
+        Err(_) => (fine.sample(seed_plan), None, None),
     }
 }
 
@@ -2408,6 +2481,24 @@ impl<'a> FreeDesign<'a> {
     /// [`FreeDesign::observe`] with a closure that sees the iterations only.
     pub fn on_iteration<F: FnMut(&ScpIteration)>(self, f: &'a mut F) -> Self {
         self.observe(f)
+    }
+
+    /// The coarse meshes of a design from a given schedule
+    /// ([`FreeDesign::from_plan`]), to be ranked and finished
+    /// ([`Staged::finish`]); the observer sees the coarse iterations.
+    pub fn coarse_stage(self) -> Result<Staged> {
+        let Start::Plan(plan, name) = self.start else {
+            return Err(crate::error::Error::Usage(
+                "a staged free-form design starts from a given schedule".into(),
+            ));
+        };
+        check_resolvable(self.spec, self.nodes)?;
+        let mut quiet = |_: &ScpIteration| {};
+        let observe: &mut dyn Observer = match self.observer {
+            Some(o) => o,
+            None => &mut quiet,
+        };
+        Ok(stage(self.spec, plan, name, self.nodes, observe))
     }
 
     pub fn solve(self) -> Result<FreeResult> {

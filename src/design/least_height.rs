@@ -234,31 +234,65 @@ pub fn heights(
         }));
     }
     let analytic_plan = crate::design::analytic::analytic_plan(&reference);
-    // the design from the analytic plan takes about as long as the other
-    // three together (on the bundled robots)
-    let (from_analytic, (phased, bound, from_stall)) = std::thread::scope(|s| {
-        let others = s.spawn(|| {
+    // two starts (the analytic plan, and the stall-only design stretched
+    // onto the line) solved on the coarse mesh, and only the better one
+    // finished on the fine mesh; the phased design beside them
+    let (phased, bound, designs) = std::thread::scope(|s| {
+        let from_analytic = s.spawn(|| {
             free::FreeDesign::new(&reference)
                 .from_plan(&analytic_plan, "analytic")
-                .solve()
+                .coarse_stage()
         });
-        let phased = answer_for(spec, &reference, None);
+        let phased = s.spawn(|| answer_for(spec, &reference, None));
         let stall = stall_only(&reference);
         let (bound, from_stall) = match stall {
             Ok(Some((least, sr))) => {
                 let plan = stretched(&sr.plan, least / sr.manoeuvre_time_s);
-                let fr = free::FreeDesign::new(&reference)
+                let staged = free::FreeDesign::new(&reference)
                     .from_plan(&plan, "stall-only")
                     .on_iteration(&mut observe)
-                    .solve();
-                (Some(least), Some(fr))
+                    .coarse_stage();
+                (Some(least), Some(staged))
             }
             _ => (None, None),
         };
-        let from_analytic = others
+        let from_analytic = from_analytic
             .join()
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
-        (from_analytic, (phased, bound, from_stall))
+        let staged: Vec<free::Staged> = from_stall
+            .into_iter()
+            .chain([from_analytic])
+            .filter_map(|r| r.ok())
+            .collect();
+        let designs: Vec<FreeResult> = match better_start(&staged) {
+            Some(i) => {
+                let st = staged.into_iter().nth(i).expect("a ranked start");
+                st.finish(&reference, &mut observe).into_iter().collect()
+            }
+            // not ranked on the coarse mesh: each finished
+            None => std::thread::scope(|s2| {
+                let mut staged = staged.into_iter();
+                let first = staged.next();
+                let rest: Vec<_> = staged
+                    .map(|st| s2.spawn(|| st.finish(&reference, &mut |_: &ScpIteration| {})))
+                    .collect();
+                let mut out: Vec<FreeResult> = first
+                    .map(|st| st.finish(&reference, &mut observe))
+                    .into_iter()
+                    .flatten()
+                    .collect();
+                for h in rest {
+                    if let Ok(r) = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)) {
+                        out.push(r);
+                    }
+                }
+                out
+            }),
+        };
+        let phased = phased
+            .join()
+            .unwrap_or_else(|e| std::panic::resume_unwind(e));
+        (phased, bound, designs)
     });
     let (mut answer, phased_bend) = phased?;
     // (the stall-only design's time scaling, F3, holds at zero momentum only: F9)
@@ -269,9 +303,43 @@ pub fn heights(
         spec,
         &reference,
         (answer, phased_bend),
-        from_stall.into_iter().chain([from_analytic]).flatten(),
+        designs,
     )))
 }
+
+/// Which of the staged starts to finish: the one whose coarse design met
+/// its constraints with the shorter time (a feasible one before an
+/// infeasible one); none when one has no coarse design to rank, or when
+/// the best two are feasible and within [`START_TIE`] of each other.
+fn better_start(staged: &[free::Staged]) -> Option<usize> {
+    better_of(&staged.iter().map(|s| s.coarse()).collect::<Vec<_>>())
+}
+
+/// [`better_start`] on the starts' coarse outcomes.
+fn better_of(outcomes: &[Option<free::CoarseOutcome>]) -> Option<usize> {
+    let outcomes: Vec<free::CoarseOutcome> = outcomes.iter().copied().collect::<Option<_>>()?;
+    let mut order: Vec<usize> = (0..outcomes.len()).collect();
+    order.sort_by(|&a, &b| {
+        let (oa, ob) = (outcomes[a], outcomes[b]);
+        ob.feasible
+            .cmp(&oa.feasible)
+            .then(oa.objective.total_cmp(&ob.objective))
+    });
+    let best = *order.first()?;
+    match order.get(1).map(|&i| outcomes[i]) {
+        Some(next)
+            if next.feasible && next.objective <= outcomes[best].objective * (1.0 + START_TIE) =>
+        {
+            None
+        }
+        _ => Some(best),
+    }
+}
+
+/// Coarse times closer than this (relative) do not rank two starts: the
+/// fine mesh moved the robot's designs by up to 0.3 % from their coarse
+/// times and reordered two that were 0.16 % apart there.
+const START_TIE: f64 = 2e-3;
 
 /// [`heights`] at a point next to one already answered (a sweep's
 /// continuation): one free-form `time` design, started from the
@@ -493,5 +561,41 @@ mod tests {
             a.sentence()
                 .contains("from 62.514 m (at least 1.700 m) it is")
         );
+    }
+
+    /// The start finished is the feasible coarse design with the shorter
+    /// time; starts that cannot be ranked (one without a coarse design, or
+    /// two feasible ones within the tie) are all finished (`None`).
+    #[test]
+    fn the_better_coarse_start_is_the_feasible_shorter_one_unless_they_tie() {
+        let o = |objective: f64, feasible: bool| {
+            Some(free::CoarseOutcome {
+                objective,
+                feasible,
+            })
+        };
+        let tie = 1.0 + START_TIE;
+        let cases: &[(&[Option<free::CoarseOutcome>], Option<usize>)] = &[
+            (&[o(0.74, true), o(0.75, true)], Some(0)),
+            (&[o(0.75, true), o(0.74, true)], Some(1)),
+            // a shorter coarse design that breaks its constraints loses
+            (&[o(0.7437, false), o(0.7427, true)], Some(1)),
+            (&[o(0.7427, true), o(0.7437, false)], Some(0)),
+            (&[o(0.70, false), o(0.74, false)], Some(0)),
+            // within the tie: both finished
+            (&[o(0.7437, true), o(0.7437 * tie * 0.9999, true)], None),
+            (&[o(0.7437 * tie * 0.9999, true), o(0.7437, true)], None),
+            // just outside it: ranked
+            (&[o(0.7437, true), o(0.7437 * tie * 1.0001, true)], Some(0)),
+            // an infeasible runner-up does not tie
+            (&[o(0.7437, true), o(0.7437, false)], Some(0)),
+            // one start without a coarse design: not ranked
+            (&[o(0.74, true), None], None),
+            (&[o(0.74, true)], Some(0)),
+            (&[], None),
+        ];
+        for (outcomes, want) in cases {
+            assert_eq!(better_of(outcomes), *want, "{outcomes:?}");
+        }
     }
 }
