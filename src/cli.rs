@@ -55,7 +55,7 @@ enum Command {
         )]
         methods: Vec<MethodArg>,
         /// Points computed at once, at least 1 (default: the machine's cores).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_parser = thread_count)]
         threads: Option<u32>,
         /// K/N: compute only the K-th of N disjoint slices of the grid (for a
         /// batch scheduler's job array); the shards' CSVs concatenate into the
@@ -89,7 +89,7 @@ enum Command {
         #[arg(long, default_value_t = 1)]
         seed: u64,
         /// Trials flown at once, at least 1 (default: the machine's cores).
-        #[arg(long, value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_parser = thread_count)]
         threads: Option<u32>,
         /// K/N: fly only the K-th of N contiguous slices of the trials; the
         /// shards' CSVs concatenate into the whole study's.
@@ -139,13 +139,13 @@ enum Command {
         /// SCP iteration limit of each design of the map (5 to 1000; default 40).
         #[arg(long = "max-iterations")]
         max_iterations: Option<usize>,
-        /// Lines designed at once (default: the machine's cores).
-        #[arg(long)]
-        threads: Option<usize>,
+        /// Lines designed at once, at least 1 (default: the machine's cores).
+        #[arg(long, value_parser = thread_count)]
+        threads: Option<u32>,
         /// K/N: only the K-th of N contiguous runs of whole lines; the
         /// shards' CSVs concatenate into the whole map's.
-        #[arg(long, value_name = "K/N")]
-        shard: Option<String>,
+        #[arg(long, value_name = "K/N", value_parser = parsed::<Shard>)]
+        shard: Option<Shard>,
     },
     /// Optimise the torque schedule: `phased` (certified fold / twist / unfold) or `free`.
     Optimize {
@@ -213,8 +213,21 @@ fn trials(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `--threads`: a whole number, at least 1.
+fn thread_count(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if n >= 1 => Ok(n),
+        Ok(_) => Err(format!(
+            "{s}: at least one thread; give 1 or more, or leave --threads out for one per core"
+        )),
+        Err(_) => Err(format!(
+            "{s}: expected a whole number of threads, 1 or more"
+        )),
+    }
+}
+
 /// Threads to use: as asked, else one per core.
-fn threads_or_cores(threads: Option<u32>) -> usize {
+pub(crate) fn threads_or_cores(threads: Option<u32>) -> usize {
     threads.map(|t| t as usize).unwrap_or_else(|| {
         std::thread::available_parallelism()
             .map(|n| n.get())
@@ -324,7 +337,7 @@ pub fn run() -> Result<Status> {
                 bisect: bisect.unwrap_or(d.bisect),
                 max_iterations: max_iterations.unwrap_or(d.max_iterations),
             };
-            crate::recovery_cli::cmd_recovery(&common, grid, threads, shard.as_deref())
+            crate::recovery_cli::cmd_recovery(&common, grid, threads_or_cores(threads), shard)
         }
         Command::Simulate { common, schedule } => cmd_simulate(&common, schedule.as_deref()),
         Command::Optimize {
@@ -511,7 +524,7 @@ fn cmd_run(c: &Common) -> Result<Status> {
         &dir.join("index.html"),
         written.len(),
     ));
-    if let Some(word) = console::run::closing(outcome) {
+    if let Some(word) = console::run::closing(&r.summary) {
         eprintln!("{word}");
     }
     Ok(outcome.into())

@@ -125,6 +125,11 @@ fn plain_types(message: &str) -> String {
             "invalid type: unit variant, expected string only",
             "expected a name (a word such as `universal`), not a number, true/false or a list",
         ),
+        ("expected a string", "expected a name (text)"),
+        (
+            "expected a sequence",
+            "expected a list such as [0.25, 0.5, 0.25]",
+        ),
     ]
     .iter()
     .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
@@ -142,8 +147,10 @@ fn expected_kind(message: &str) -> Option<ValueKind> {
     ];
     if numbers.iter().any(|n| message.contains(n)) {
         Some(ValueKind::Number)
-    } else if message.contains("expected string only") {
+    } else if message.contains("expected string only") || message.contains("expected a string") {
         Some(ValueKind::Name)
+    } else if message.contains("expected a sequence") {
+        Some(ValueKind::List)
     } else {
         None
     }
@@ -298,7 +305,9 @@ impl Config {
             "fall.margin",
             f.margin,
             f.margin < 0.95 * ft,
-            &format!("must leave time to move: less than 95 % of the fall time {ft:.4} s"),
+            &format!(
+                "the landing margin must be under 95 % of the fall time ({ft:.4} s from this height), to leave time to move: lower fall.margin or raise the height"
+            ),
         )?;
         self.analytic.validate()?;
         if let Some(t) = self.limits.max_torque {
@@ -601,6 +610,8 @@ gravity = 9.8
             ),
             ("cat.joint=1", "expected a name", ValueKind::Name),
             ("cat.joint=true", "expected a name", ValueKind::Name),
+            ("name=1", "expected a name", ValueKind::Name),
+            ("analytic.split=1", "expected a list", ValueKind::List),
         ] {
             let e = Config::from_toml(SEED, "t", &[set.into()]).unwrap_err();
             // the kind is typed, for callers such as the sweep
@@ -610,7 +621,7 @@ gravity = 9.8
             );
             let e = e.to_string();
             assert!(e.contains(plain), "{set}: {e}");
-            for rust in ["f64", "usize", "variant"] {
+            for rust in ["f64", "usize", "variant", "sequence", "expected a string"] {
                 assert!(!e.contains(rust), "{set}: {e}");
             }
         }

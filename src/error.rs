@@ -100,6 +100,19 @@ pub enum ValueKind {
     Number,
     /// A name, such as `universal`.
     Name,
+    /// A list, such as `[0.25, 0.5, 0.25]`.
+    List,
+}
+
+impl ValueKind {
+    /// The kind in words, with an article: "a name".
+    pub fn words(self) -> &'static str {
+        match self {
+            ValueKind::Number => "a number",
+            ValueKind::Name => "a name",
+            ValueKind::List => "a list",
+        }
+    }
 }
 
 /// A number as the user would read it: `1e308`, not 309 digits.

@@ -33,26 +33,12 @@ struct Summary<'a> {
 pub fn cmd_recovery(
     c: &Common,
     grid: Grid,
-    threads: Option<usize>,
-    shard: Option<&str>,
+    threads: usize,
+    shard: Option<catflip::sweep::Shard>,
 ) -> Result<Status> {
     let cfg = load(c)?;
     grid.validate()?;
-    if threads == Some(0) {
-        return Err(catflip::Error::Usage(
-            "--threads 0: at least one line must be designed at a time; give --threads 1 or more, or leave it out for one per core".into(),
-        )
-        .into());
-    }
-    let shard: catflip::sweep::Shard = match shard {
-        Some(s) => s.parse()?,
-        None => catflip::sweep::Shard::ALL,
-    };
-    let threads = threads.unwrap_or_else(|| {
-        std::thread::available_parallelism()
-            .map(|n| n.get())
-            .unwrap_or(1)
-    });
+    let shard = shard.unwrap_or(catflip::sweep::Shard::ALL);
     let all = grid.lines();
     let range = shard_lines(shard, all.len());
     if range.is_empty() {
@@ -79,13 +65,13 @@ pub fn cmd_recovery(
             }
             let origin = catflip::recovery::Origin::new(&cfg, &grid)?;
             catflip::recovery::compute_into(&origin, &lines, threads, &store, |done, total| {
-                let line = catflip::sweep::progress_line(
+                progress.show(&catflip::console::progress::bar(
                     "recovery",
                     done,
                     total,
+                    "lines",
                     clock.elapsed().as_secs_f64(),
-                );
-                progress.show(&line.replace(" points", " lines"));
+                ));
             });
             Ok(())
         }

@@ -71,9 +71,11 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             study.run_into(range, threads, &store, |done, total| {
                 // a log gets a line per 5 % of the trials
                 if progress.is_live() || done % (total / 20).max(1) == 0 || done == total {
-                    progress.show(&catflip::console::robustness::progress_line(
+                    progress.show(&catflip::console::progress::bar(
+                        "robustness",
                         done,
                         total,
+                        "trials",
                         clock.elapsed().as_secs_f64(),
                     ));
                 }

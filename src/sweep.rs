@@ -341,7 +341,12 @@ fn point(
     let envelope = limit.is_some() && (cfg.motor().slope() > 0.0 || cfg.limits.max_speed.is_some());
     let limited_cfg = cfg;
     let mut cfg = cfg.clone();
-    cfg.limits.max_torque = None;
+    // the peak columns are the least-peak designs without the motor's
+    // limits (a speed limit left alone would leave them empty below the
+    // least height); the limits enter through the least heights
+    if cfg.limits.max_torque.take().is_some() {
+        cfg.limits.max_speed = None;
+    }
     let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);
     if methods.analytic {
@@ -607,15 +612,19 @@ fn checked_configs(
     load: impl Fn(f64) -> Result<Config>,
 ) -> Result<Vec<Result<Config>>> {
     let loaded: Vec<Result<Config>> = values.iter().map(|&v| load(v)).collect();
-    let takes_a_name = loaded.iter().all(|c| {
-        matches!(
-            c,
-            Err(Error::Override {
-                expects: Some(ValueKind::Name),
-                ..
-            })
-        )
-    });
+    // a key that takes no number: every point fails with the same kind
+    let kinds: Vec<Option<ValueKind>> = loaded
+        .iter()
+        .map(|c| match c {
+            Err(Error::Override { expects, .. }) => *expects,
+            _ => None,
+        })
+        .collect();
+    let takes = kinds
+        .first()
+        .copied()
+        .flatten()
+        .filter(|k| *k != ValueKind::Number && kinds.iter().all(|x| *x == Some(*k)));
     let configs: Vec<Result<Config>> = loaded
         .into_iter()
         .zip(values)
@@ -638,9 +647,10 @@ fn checked_configs(
         };
         return Err(Error::Range {
             arg: arg.into(),
-            message: if takes_a_name {
+            message: if let Some(kind) = takes {
                 format!(
-                    "`{key}` takes a name, not a number: a sweep varies a numeric key ({message})"
+                    "`{key}` takes {}, not a number: a sweep varies a numeric key ({message})",
+                    kind.words()
                 )
             } else if bad == configs.len() {
                 format!("every point is invalid; {message}")
@@ -732,23 +742,7 @@ fn compute_into(
 /// A progress line for `done` of `total` points after `elapsed` seconds:
 /// a bar and the estimated time left (from the mean time per point so far).
 pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> String {
-    let width = 24;
-    let filled = (width * done) / total.max(1);
-    let eta = if done > 0 {
-        elapsed / done as f64 * (total - done) as f64
-    } else {
-        f64::NAN
-    };
-    let eta = if eta.is_finite() {
-        format!("ETA {eta:.0} s")
-    } else {
-        "ETA -".into()
-    };
-    format!(
-        "sweep {key} [{}{}] {done}/{total} points, {elapsed:.0} s, {eta}",
-        "#".repeat(filled),
-        ".".repeat(width - filled)
-    )
+    crate::console::progress::bar(&format!("sweep {key}"), done, total, "points", elapsed)
 }
 
 fn cell(x: Option<f64>) -> String {

@@ -118,3 +118,26 @@ impl Observer for IterationTable {
         }
     }
 }
+
+/// The progress bar of a long job (`sweep`, `recovery`, `robustness`):
+/// `what [####....] done/total units, elapsed, ETA` (the time left from the
+/// mean time per unit so far).
+pub fn bar(what: &str, done: usize, total: usize, units: &str, elapsed: f64) -> String {
+    let width = 24;
+    let filled = (width * done.min(total)) / total.max(1);
+    let eta = if done > 0 {
+        elapsed / done as f64 * total.saturating_sub(done) as f64
+    } else {
+        f64::NAN
+    };
+    let eta = if eta.is_finite() {
+        format!("ETA {eta:.0} s")
+    } else {
+        "ETA -".into()
+    };
+    format!(
+        "{what} [{}{}] {done}/{total} {units}, {elapsed:.0} s, {eta}",
+        "#".repeat(filled),
+        ".".repeat(width - filled)
+    )
+}

@@ -59,14 +59,3 @@ pub fn study(
     }
     lines
 }
-
-/// The progress bar after `done` of `total` trials, `seconds` in.
-pub fn progress_line(done: usize, total: usize, seconds: f64) -> String {
-    let w = 30;
-    let filled = w * done / total.max(1);
-    format!(
-        "robustness [{}{}] {done}/{total} trials, {seconds:.1} s",
-        "#".repeat(filled),
-        "-".repeat(w - filled)
-    )
-}

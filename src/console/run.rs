@@ -2,6 +2,7 @@
 //! and where the report is; and the closing word on stderr.
 
 use crate::run::{Outcome, RunSummary};
+use crate::verdict::Grade;
 use std::path::Path;
 
 /// The lines `run` prints on stdout (a blank line after the stage lines).
@@ -31,13 +32,33 @@ pub fn summary(s: &RunSummary, report: &Path, files: usize) -> Vec<String> {
     lines
 }
 
-/// What `run` says on stderr at the end about its exit status, if anything.
-pub fn closing(outcome: Outcome) -> Option<&'static str> {
-    match outcome {
+/// What `run` says on stderr at the end about its exit status, if anything:
+/// for a partial result, which methods make it so and why.
+pub fn closing(s: &RunSummary) -> Option<String> {
+    match s.outcome {
         Outcome::Ok => None,
-        Outcome::Impossible => Some("the flip is not possible from this height: exit status 4"),
-        Outcome::Partial => Some(
-            "warning: partial result: some methods are FLAGGED or FAILED (see the verdict column); exit status 3",
-        ),
+        Outcome::Impossible => {
+            Some("the flip is not possible from this height: exit status 4".into())
+        }
+        Outcome::Partial => {
+            let against: Vec<String> = s
+                .methods
+                .iter()
+                .filter(|m| m.counts_against())
+                .map(|m| {
+                    let why = match m.verdict {
+                        Grade::Flagged => "FLAGGED",
+                        Grade::Failed => "FAILED",
+                        Grade::Impossible => "not possible in this fall",
+                        Grade::Ok => "ok",
+                    };
+                    format!("{} {why}", m.method)
+                })
+                .collect();
+            Some(format!(
+                "warning: partial result: {} (see the verdict column); exit status 3",
+                against.join(", ")
+            ))
+        }
     }
 }

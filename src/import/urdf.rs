@@ -82,6 +82,28 @@ fn link_name<'a>(joint: &Node<'a, 'a>, tag: &str, file: &str) -> Result<String> 
         .ok_or_else(|| site(joint).error(file, format!("needs <{tag} link=\"...\"/>")))
 }
 
+/// A joint limit's `effort` or `velocity`, which catflip reads as the
+/// motor's `key`: none when absent or 0 (exporters write 0 for "not
+/// given"); a negative one is an error at its element, naming the key that
+/// replaces it.
+fn motor_limit(
+    l: &Node,
+    attr: &str,
+    key: &str,
+    file: &str,
+) -> Result<Option<f64>> {
+    let x = number(l, attr, Some(f64::NAN), file)?;
+    if x < 0.0 {
+        return Err(site(l).error(
+            file,
+            format!(
+                "{attr}=\"{x}\" is negative: give the motor's limit (> 0; 0 or none means not given), or remove it and set {key} in the config"
+            ),
+        ));
+    }
+    Ok(Some(x).filter(|x| x.is_finite() && *x > 0.0))
+}
+
 /// Reads `text` (the file `file`).
 pub fn read(text: &str, file: &str) -> Result<Imported> {
     let doc = xml::parse(text, file)?;
@@ -114,13 +136,13 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
                 None => nalgebra::Vector3::x(),
             },
             effort: limit
-                .map(|l| number(&l, "effort", Some(f64::NAN), file))
+                .map(|l| motor_limit(&l, "effort", "limits.max_torque", file))
                 .transpose()?
-                .filter(|x| x.is_finite()),
+                .flatten(),
             velocity: limit
-                .map(|l| number(&l, "velocity", Some(f64::NAN), file))
+                .map(|l| motor_limit(&l, "velocity", "limits.max_speed", file))
                 .transpose()?
-                .filter(|x| x.is_finite()),
+                .flatten(),
             // a revolute joint's range when the file gives one (URDF
             // defaults a missing end to 0, but files that give only
             // `effort` and `velocity` mean no range); a continuous joint

@@ -274,6 +274,14 @@ fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
             "the document",
             "not well-formed",
         ),
+        (
+            "negative motor limit",
+            std::fs::read_to_string(util::configs().join("box-robot.urdf"))
+                .unwrap()
+                .replacen("effort=\"1.4\"", "effort=\"-1\"", 1),
+            "<limit>",
+            "effort=\"-1\" is negative",
+        ),
     ];
     for (what, text, element, why) in cases {
         let dir = temp_dir();

@@ -303,6 +303,27 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(code, Some(3), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["outcome"], "partial");
+    // the console's closing line names what makes it partial, and only that
+    // (the analytic reference beyond the motors does not count)
+    let table = temp_dir();
+    let (code, _, err) = run(
+        &[
+            "run",
+            seed_toml().to_str().unwrap(),
+            "--set",
+            "limits.max_torque=0.5",
+            "--set",
+            "fall.height=12",
+        ],
+        table.path(),
+    );
+    assert_eq!(code, Some(3), "{err}");
+    let closing = err.lines().last().unwrap_or_default();
+    assert!(
+        closing.contains("partial result: phased not possible in this fall")
+            && !closing.contains("analytic"),
+        "{closing}"
+    );
     let m = |name: &str| {
         v["methods"]
             .as_array()
@@ -661,6 +682,17 @@ fn sweeps_bound_the_count_keep_good_points_and_check_threads() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("--threads"), "{err}");
     assert!(!dir.path().join("output").exists());
+    // every command with --threads says the same, in words, before any work
+    for cmd in ["sweep", "robustness", "recovery"] {
+        let mut args = vec![cmd, c, "--threads", "0"];
+        if cmd == "sweep" {
+            args.extend(["--set-range", "cat.mass=1:2:2"]);
+        }
+        let (code, _, err) = run(&args, dir.path());
+        assert_eq!(code, Some(2), "{cmd}: {err}");
+        assert!(err.contains("at least one thread"), "{cmd}: {err}");
+        assert!(!dir.path().join("output").exists(), "{cmd}");
+    }
     // points outside the key's range are refused up front, naming the
     // first, before any work; a range inside is computed
     let (code, out, err) = run(

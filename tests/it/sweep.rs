@@ -289,11 +289,12 @@ fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
     );
 }
 
-/// A key that takes a name (`cat.joint`) cannot be swept: the sweep fails
-/// as bad input before any work, saying the key takes a name; a numeric key
+/// A key that takes a name (`cat.joint`) or a list (`analytic.split`)
+/// cannot be swept: the sweep fails as bad input before any work, saying
+/// what the key takes; a numeric key
 /// whose every point is out of range is told apart from it.
 #[test]
-fn sweeping_a_key_that_takes_a_name_is_bad_input_that_says_so() {
+fn sweeping_a_key_that_takes_no_number_is_bad_input_that_says_what_it_takes() {
     let dir = temp_dir();
     let cfg = configs().join("seed.toml");
     let sweep = |range: &str| {
@@ -312,6 +313,14 @@ fn sweeping_a_key_that_takes_a_name_is_bad_input_that_says_so() {
         "{err}"
     );
     assert!(!dir.path().join("out").exists());
+    let o = sweep("analytic.split=1:2:2");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("`analytic.split` takes a list, not a number") && !err.contains("sequence"),
+        "{err}"
+    );
+    assert!(!dir.path().join("out").exists());
     let o = sweep("cat.mass=-2:-1:2");
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -320,4 +329,36 @@ fn sweeping_a_key_that_takes_a_name_is_bad_input_that_says_so() {
         "{err}"
     );
     assert!(!dir.path().join("out").exists());
+}
+
+/// With a torque limit the peak columns are the least-peak designs without
+/// the motor's limits, a speed limit included: below the least height they
+/// are those of the same body without any limit (not empty, with an error),
+/// and the least heights come from the limited motor.
+#[test]
+fn peak_columns_under_a_speed_limit_are_the_unlimited_designs() {
+    let dir = temp_dir();
+    let cfg = configs().join("seed.toml");
+    let sweep = |sets: &[&str]| -> serde_json::Value {
+        let mut args = vec!["sweep", cfg.to_str().unwrap()];
+        for s in sets {
+            args.extend(["--set", s]);
+        }
+        args.extend(["--set-range", "fall.height=5:5:1", "--json", "--out", "out"]);
+        let (code, out, err) = util::run(&args, dir.path());
+        assert_eq!(code, Some(0), "{sets:?}: {err}");
+        serde_json::from_str::<serde_json::Value>(&out).unwrap()[0].clone()
+    };
+    let limited = sweep(&["limits.max_torque=0.5", "limits.max_speed=6"]);
+    let free = sweep(&[]);
+    assert!(limited["error"].is_null(), "{limited}");
+    for col in ["analytic_peak_nm", "phased_peak_nm", "free_peak_nm"] {
+        let (a, b) = (limited[col].as_f64(), free[col].as_f64());
+        assert!(a.is_some() && a == b, "{col}: {a:?} against {b:?}");
+    }
+    // the motor's least height is above the question's 5 m, and only the
+    // limited sweep has one
+    let h = limited["least_height_free_m"].as_f64().unwrap();
+    assert!(h > 5.0, "{h}");
+    assert!(free["least_height_free_m"].is_null(), "{free}");
 }
