@@ -589,7 +589,7 @@ fn cmd_sweep(
                 shard,
                 &store,
                 |done, total| {
-                    progress.show(&catflip::sweep::progress_line(
+                    progress.show(&catflip::console::sweep::progress_line(
                         &spec.key,
                         done,
                         total,

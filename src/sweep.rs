@@ -346,6 +346,7 @@ fn point(
     // least height); the limits enter through the least heights
     if cfg.limits.max_torque.take().is_some() {
         cfg.limits.max_speed = None;
+        cfg.limits.no_load_speed = None;
     }
     let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);
@@ -737,12 +738,6 @@ fn compute_into(
         }
     });
     Ok(())
-}
-
-/// A progress line for `done` of `total` points after `elapsed` seconds:
-/// a bar and the estimated time left (from the mean time per point so far).
-pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> String {
-    crate::console::progress::bar(&format!("sweep {key}"), done, total, "points", elapsed)
 }
 
 fn cell(x: Option<f64>) -> String {

@@ -81,3 +81,9 @@ pub fn empty_shard_warning(shard: crate::sweep::Shard, count: usize) -> String {
         count.div_ceil(crate::sweep::CHUNK)
     )
 }
+
+/// A sweep's progress line for `done` of `total` points after `elapsed`
+/// seconds ([`super::progress::bar`]).
+pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> String {
+    super::progress::bar(&format!("sweep {key}"), done, total, "points", elapsed)
+}

@@ -1323,8 +1323,7 @@ fn from_plan(
 pub struct Staged {
     seed: String,
     nodes: usize,
-    clock: std::time::Instant,
-    /// Time spent before the fine mesh, s.
+    /// Time the coarse meshes took, s.
     before: f64,
     z0: Vec<f64>,
     /// The seed sampled on the fine mesh (the fallback when the fine design
@@ -1345,17 +1344,20 @@ pub struct CoarseOutcome {
 }
 
 impl Staged {
-    /// The coarse design's outcome (none when no coarse mesh was solved).
+    /// The coarse design's outcome: none without one to rank (a design
+    /// outside the motor envelope, whose continuation is the peak's; no
+    /// coarse mesh, as with `free.mesh_continuation = false` or a mesh too
+    /// coarse for the bend's turns; or a coarse solve that failed).
     pub fn coarse(&self) -> Option<CoarseOutcome> {
         self.coarse
     }
 
     /// The fine mesh from the staged start.
     pub fn finish(self, spec: &DesignSpec, observe: &mut dyn Observer) -> Result<FreeResult> {
+        let clock = std::time::Instant::now();
         let Staged {
             seed,
             nodes,
-            clock,
             mut before,
             z0,
             seed_z,
@@ -1378,7 +1380,8 @@ impl Staged {
             // coarse meshes stay on the record); not an impossible flip, which
             // the seed would only find again
             Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
-                before = clock.elapsed().as_secs_f64();
+                // the failed attempt's time is spent before the design too
+                before += clock.elapsed().as_secs_f64();
                 // the failed attempt is not on the record: its numbers are reused
                 observe.mesh(nodes);
                 optimize_start(spec, &seed_z, Carried::Nothing, seed, nodes, first, |it| {
@@ -1435,7 +1438,6 @@ fn stage(
         seed: seed.to_string(),
         nodes,
         before: clock.elapsed().as_secs_f64(),
-        clock,
         z0,
         seed_z,
         carried,
@@ -2485,7 +2487,8 @@ impl<'a> FreeDesign<'a> {
 
     /// The coarse meshes of a design from a given schedule
     /// ([`FreeDesign::from_plan`]), to be ranked and finished
-    /// ([`Staged::finish`]); the observer sees the coarse iterations.
+    /// ([`Staged::finish`]); the observer sees the coarse iterations. The
+    /// mesh check ([`FreeDesign::check_mesh`]) is not made.
     pub fn coarse_stage(self) -> Result<Staged> {
         let Start::Plan(plan, name) = self.start else {
             return Err(crate::error::Error::Usage(

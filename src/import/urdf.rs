@@ -86,12 +86,7 @@ fn link_name<'a>(joint: &Node<'a, 'a>, tag: &str, file: &str) -> Result<String> 
 /// motor's `key`: none when absent or 0 (exporters write 0 for "not
 /// given"); a negative one is an error at its element, naming the key that
 /// replaces it.
-fn motor_limit(
-    l: &Node,
-    attr: &str,
-    key: &str,
-    file: &str,
-) -> Result<Option<f64>> {
+fn motor_limit(l: &Node, attr: &str, key: &str, file: &str) -> Result<Option<f64>> {
     let x = number(l, attr, Some(f64::NAN), file)?;
     if x < 0.0 {
         return Err(site(l).error(

@@ -394,3 +394,29 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
         "from 1.01 x its least height it can"
     );
 }
+
+/// A URDF's `effort` and `velocity` of 0 (what exporters write for "not
+/// given") set no motor limit; the config's own keys still do.
+#[test]
+fn zero_effort_and_velocity_in_a_urdf_mean_no_limit() {
+    let dir = temp_dir();
+    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf"))
+        .unwrap()
+        .replace(
+            "effort=\"1.4\" velocity=\"5.969\"",
+            "effort=\"0\" velocity=\"0\"",
+        );
+    assert!(urdf.contains("effort=\"0\""));
+    std::fs::write(dir.path().join("robot.urdf"), &urdf).unwrap();
+    let toml = dir.path().join("robot.toml");
+    std::fs::write(
+        &toml,
+        "name = \"zero\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
+    )
+    .unwrap();
+    let cfg = Config::load(&toml, &[]).unwrap();
+    assert_eq!(cfg.limits.max_torque, None);
+    assert_eq!(cfg.limits.max_speed, None);
+    let cfg = Config::load(&toml, &["limits.max_torque=1.2".into()]).unwrap();
+    assert_eq!(cfg.limits.max_torque, Some(1.2));
+}

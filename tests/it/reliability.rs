@@ -305,7 +305,7 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     assert_eq!(v["outcome"], "partial");
     // the console's closing line names what makes it partial, and only that
     // (the analytic reference beyond the motors does not count)
-    let table = temp_dir();
+    let console_run = temp_dir();
     let (code, _, err) = run(
         &[
             "run",
@@ -315,7 +315,7 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
             "--set",
             "fall.height=12",
         ],
-        table.path(),
+        console_run.path(),
     );
     assert_eq!(code, Some(3), "{err}");
     let closing = err.lines().last().unwrap_or_default();

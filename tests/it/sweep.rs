@@ -2,7 +2,8 @@
 
 use crate::util;
 
-use catflip::sweep::{CHUNK, Shard, progress_line};
+use catflip::console::sweep::progress_line;
+use catflip::sweep::{CHUNK, Shard};
 use util::{bin, configs, run_written, temp_dir};
 
 #[test]
