@@ -341,12 +341,12 @@ fn point(
     let envelope = limit.is_some() && (cfg.motor().slope() > 0.0 || cfg.limits.max_speed.is_some());
     let limited_cfg = cfg;
     let mut cfg = cfg.clone();
-    // the peak columns are the least-peak designs without the motor's
-    // limits (a speed limit left alone would leave them empty below the
-    // least height); the limits enter through the least heights
+    // the peak columns are the least-peak designs without the torque and
+    // speed limits (a speed limit left alone would leave them empty below
+    // the least height); the limits enter through the least heights. The
+    // no-load speed stays: without the stall torque it draws no line
     if cfg.limits.max_torque.take().is_some() {
         cfg.limits.max_speed = None;
-        cfg.limits.no_load_speed = None;
     }
     let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);

@@ -333,7 +333,7 @@ fn sweeping_a_key_that_takes_no_number_is_bad_input_that_says_what_it_takes() {
 }
 
 /// With a torque limit the peak columns are the least-peak designs without
-/// the motor's limits, a speed limit included: below the least height they
+/// the torque and speed limits: below the least height they
 /// are those of the same body without any limit (not empty, with an error),
 /// and the least heights come from the limited motor.
 #[test]
