@@ -215,7 +215,11 @@ impl Config {
             table
                 .try_into()
                 .map_err(|e: toml::de::Error| Error::ConfigParse {
-                    origin: format!("{origin} (with --set overrides)"),
+                    origin: if overrides.is_empty() {
+                        origin.to_string()
+                    } else {
+                        format!("{origin} (with --set overrides)")
+                    },
                     message: plain_types(e.message().trim()),
                 })?;
         if let Some(b) = cfg.body.as_mut() {

@@ -16,6 +16,9 @@ pub enum Error {
     },
     /// A `--set` that does not fit the config; `expects` is the kind of
     /// value the key takes when the value's type was wrong.
+    /// A key a command needs that the config does not set.
+    #[error("config key `{key}` is not set: {why}")]
+    Missing { key: String, why: String },
     #[error("`--set {arg}`: {message}")]
     Override {
         arg: String,
@@ -81,6 +84,7 @@ impl Error {
             Error::ConfigRead { .. }
                 | Error::ConfigParse { .. }
                 | Error::Invalid { .. }
+                | Error::Missing { .. }
                 | Error::Override { .. }
                 | Error::Range { .. }
                 | Error::Usage(_)

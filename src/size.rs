@@ -219,10 +219,9 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
         ),
     ] {
         if set.is_none() {
-            return Err(Error::Invalid {
+            return Err(Error::Missing {
                 key: key.into(),
-                value: "unset".into(),
-                expected: format!(
+                why: format!(
                     "catflip size scales the motors' torque-speed line, so it needs limits.max_torque and limits.no_load_speed: set {key} ({what}) to your motor's, in the config's [limits] or with --set {key}=VALUE"
                 ),
             });

@@ -187,7 +187,10 @@ fn a_config_without_a_torque_speed_line_names_the_keys_to_set() {
     );
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("limits.max_torque"), "{err}");
+    assert!(
+        err.contains("`limits.max_torque` is not set") && !err.contains("unset"),
+        "{err}"
+    );
     assert!(!dir.path().join("out").exists());
     // a stall torque alone: the no-load speed is named
     let out = util::output(
