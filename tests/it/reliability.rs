@@ -287,36 +287,24 @@ fn unwritable_out_fails_before_computing_with_one_message() {
 fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
     // under a 0.5 N m limit from 12 m the phased optimum (0.565 N m) is
     // impossible, the analytic schedule saturates, the free-form design fits
+    let seed = seed_toml();
+    let args = [
+        "run",
+        seed.to_str().unwrap(),
+        "--set",
+        "limits.max_torque=0.5",
+        "--set",
+        "fall.height=12",
+    ];
     let dir = temp_dir();
-    let (code, out, err) = run(
-        &[
-            "run",
-            seed_toml().to_str().unwrap(),
-            "--set",
-            "limits.max_torque=0.5",
-            "--set",
-            "fall.height=12",
-            "--json",
-        ],
-        dir.path(),
-    );
+    let (code, out, err) = run(&[&args[..], &["--json"]].concat(), dir.path());
     assert_eq!(code, Some(3), "{err}");
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["outcome"], "partial");
     // the console's closing line names what makes it partial, and only that
     // (the analytic reference beyond the motors does not count)
     let console_run = temp_dir();
-    let (code, _, err) = run(
-        &[
-            "run",
-            seed_toml().to_str().unwrap(),
-            "--set",
-            "limits.max_torque=0.5",
-            "--set",
-            "fall.height=12",
-        ],
-        console_run.path(),
-    );
+    let (code, _, err) = run(&args, console_run.path());
     assert_eq!(code, Some(3), "{err}");
     let closing = err.lines().last().unwrap_or_default();
     assert!(

@@ -259,29 +259,38 @@ fn whole_ends_and_steps_give_whole_grid_values() {
     }
 }
 
+/// A phased sweep of the seed over `range`, writing into `dir/out`.
+fn seed_sweep(dir: &std::path::Path, range: &str) -> std::process::Output {
+    let cfg = configs().join("seed.toml");
+    bin()
+        .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
+        .args(["--methods", "phased", "--out", "out"])
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+/// [`seed_sweep`] refused as bad input before any work (exit 2, nothing
+/// written): its stderr.
+fn refused_sweep(dir: &std::path::Path, range: &str) -> String {
+    let o = seed_sweep(dir, range);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(2), "{range}: {err}");
+    assert!(!dir.join("out").exists(), "{range}: nothing written");
+    err
+}
+
 /// A key that takes whole numbers on a grid with fractions fails as bad
 /// input before any work, naming the key and the value; a whole grid runs.
 #[test]
 fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
     let dir = temp_dir();
-    let cfg = configs().join("seed.toml");
-    let sweep = |range: &str| {
-        bin()
-            .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
-            .args(["--methods", "phased", "--out", "out"])
-            .current_dir(dir.path())
-            .output()
-            .unwrap()
-    };
-    let o = sweep("phased.nodes=10.5:20:2");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused_sweep(dir.path(), "phased.nodes=10.5:20:2");
     assert!(
         err.contains("phased.nodes takes whole numbers") && err.contains("10.5"),
         "{err}"
     );
-    assert!(!dir.path().join("out").exists());
-    let o = sweep("phased.nodes=10:20:3");
+    let o = seed_sweep(dir.path(), "phased.nodes=10:20:3");
     assert_eq!(
         o.status.code(),
         Some(0),
@@ -297,39 +306,21 @@ fn a_whole_number_key_on_a_fractional_grid_is_bad_input() {
 #[test]
 fn sweeping_a_key_that_takes_no_number_is_bad_input_that_says_what_it_takes() {
     let dir = temp_dir();
-    let cfg = configs().join("seed.toml");
-    let sweep = |range: &str| {
-        bin()
-            .args(["sweep", cfg.to_str().unwrap(), "--set-range", range])
-            .args(["--methods", "phased", "--out", "out"])
-            .current_dir(dir.path())
-            .output()
-            .unwrap()
-    };
-    let o = sweep("cat.joint=1:2:2");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused_sweep(dir.path(), "cat.joint=1:2:2");
     assert!(
         err.contains("`cat.joint` takes a name, not a number"),
         "{err}"
     );
-    assert!(!dir.path().join("out").exists());
-    let o = sweep("analytic.split=1:2:2");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused_sweep(dir.path(), "analytic.split=1:2:2");
     assert!(
         err.contains("`analytic.split` takes a list, not a number") && !err.contains("sequence"),
         "{err}"
     );
-    assert!(!dir.path().join("out").exists());
-    let o = sweep("cat.mass=-2:-1:2");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{err}");
+    let err = refused_sweep(dir.path(), "cat.mass=-2:-1:2");
     assert!(
         err.contains("every point is invalid") && !err.contains("takes a name"),
         "{err}"
     );
-    assert!(!dir.path().join("out").exists());
 }
 
 /// With a torque limit the peak columns are the least-peak designs without
