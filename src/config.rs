@@ -112,48 +112,60 @@ pub struct LimitsConfig {
     pub max_speed: Option<f64>,
 }
 
+/// The parser's words for a value of the wrong type, the user's (TOML)
+/// words for them, and the kind of value the key takes.
+const TYPE_WORDS: &[(&str, &str, ValueKind)] = &[
+    ("expected f64", "expected a number", ValueKind::Number),
+    (
+        "expected usize",
+        "expected a whole number (0 or more)",
+        ValueKind::Number,
+    ),
+    (
+        "expected u64",
+        "expected a whole number (0 or more)",
+        ValueKind::Number,
+    ),
+    (
+        "expected u32",
+        "expected a whole number (0 or more)",
+        ValueKind::Number,
+    ),
+    ("expected i64", "expected a whole number", ValueKind::Number),
+    (
+        "invalid type: unit variant, expected string only",
+        "expected a name (a word such as `universal`), not a number, true/false or a list",
+        ValueKind::Name,
+    ),
+    (
+        "expected a string",
+        "expected a name (text)",
+        ValueKind::Name,
+    ),
+    (
+        "expected a sequence",
+        "expected a list such as [0.25, 0.5, 0.25]",
+        ValueKind::List,
+    ),
+];
+
 /// The parser's messages name Rust's types ("expected f64"); the user
 /// wrote TOML.
 fn plain_types(message: &str) -> String {
-    [
-        ("expected f64", "expected a number"),
-        ("expected usize", "expected a whole number (0 or more)"),
-        ("expected u64", "expected a whole number (0 or more)"),
-        ("expected u32", "expected a whole number (0 or more)"),
-        ("expected i64", "expected a whole number"),
-        (
-            "invalid type: unit variant, expected string only",
-            "expected a name (a word such as `universal`), not a number, true/false or a list",
-        ),
-        ("expected a string", "expected a name (text)"),
-        (
-            "expected a sequence",
-            "expected a list such as [0.25, 0.5, 0.25]",
-        ),
-    ]
-    .iter()
-    .fold(message.to_string(), |m, (rust, toml)| m.replace(rust, toml))
+    TYPE_WORDS
+        .iter()
+        .fold(message.to_string(), |m, (rust, toml, _)| {
+            m.replace(rust, toml)
+        })
 }
 
 /// The kind of value the parser expected when a value's type was wrong
 /// (read from its message, before [`plain_types`] rewords it).
 fn expected_kind(message: &str) -> Option<ValueKind> {
-    let numbers = [
-        "expected f64",
-        "expected usize",
-        "expected u64",
-        "expected u32",
-        "expected i64",
-    ];
-    if numbers.iter().any(|n| message.contains(n)) {
-        Some(ValueKind::Number)
-    } else if message.contains("expected string only") || message.contains("expected a string") {
-        Some(ValueKind::Name)
-    } else if message.contains("expected a sequence") {
-        Some(ValueKind::List)
-    } else {
-        None
-    }
+    TYPE_WORDS
+        .iter()
+        .find(|(rust, _, _)| message.contains(rust))
+        .map(|&(_, _, kind)| kind)
 }
 
 impl Config {

@@ -304,39 +304,29 @@ fn finished(
 ) -> Vec<Candidate> {
     let outcomes: Vec<_> = staged.iter().map(|s| s.coarse()).collect();
     let mut staged: Vec<Option<free::Staged>> = staged.into_iter().map(Some).collect();
+    let run = |st: free::Staged, observe: &mut dyn free::Observer| {
+        st.finish(reference, observe)
+            .ok()
+            .map(|fr| flown(reference, fr))
+    };
     let mut out = Vec::new();
     if let Finish::One(i) = rank(&outcomes) {
-        let st = staged[i].take().expect("a ranked start");
-        if let Ok(fr) = st.finish(reference, observe) {
-            let c = flown(reference, fr);
-            let landed = c.1.is_some();
-            out.push(c);
-            if landed {
-                return out;
-            }
+        let c = run(staged[i].take().expect("a ranked start"), observe);
+        let landed = c.as_ref().is_some_and(|c| c.1.is_some());
+        out.extend(c);
+        if landed {
+            return out;
         }
     }
     let mut rest = staged.into_iter().flatten();
     let first = rest.next();
     std::thread::scope(|s| {
         let others: Vec<_> = rest
-            .map(|st| {
-                s.spawn(move || {
-                    st.finish(reference, &mut |_: &ScpIteration| {})
-                        .ok()
-                        .map(|fr| flown(reference, fr))
-                })
-            })
+            .map(|st| s.spawn(move || run(st, &mut |_: &ScpIteration| {})))
             .collect();
-        if let Some(st) = first
-            && let Ok(fr) = st.finish(reference, observe)
-        {
-            out.push(flown(reference, fr));
-        }
+        out.extend(first.and_then(|st| run(st, observe)));
         for h in others {
-            if let Some(c) = h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)) {
-                out.push(c);
-            }
+            out.extend(h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)));
         }
     });
     out
