@@ -168,10 +168,14 @@ fn round_to_digits(x: f64, digits: i32) -> f64 {
 /// The least time with the stall torque alone (no torque-speed line, no
 /// speed limit), s, and its design: the free-form peak-torque design at the
 /// reference drop, time-scaled until its peak is the stall torque (F3, F7:
-/// exact for a torque bound alone). The torque-speed line takes torque
-/// from a motor that is speeding up, so this bounds the least time under
-/// the line from below (the design is a local optimum: the bound is the
-/// best one found). Its torque is continuous (`free.torque_jumps` off): it
+/// exact for a torque bound alone): the least time of a motor that never
+/// gives more than its stall torque. The torque-speed line takes torque
+/// from a motor that is speeding up but gives more while braking
+/// (`T + k |w|`), and a joint can outrun the no-load speed through the
+/// other's reaction, so under the line this is a bound only for designs
+/// that stay within the stall torque (the robot's answer brakes with 2.0 N m
+/// against 1.4; it is 7 times this time); the design is a local optimum,
+/// the bound the best one found. Its torque is continuous (`free.torque_jumps` off): it
 /// seeds the time design, whose grid is continuous (seeded by a design with
 /// steps, the time design ended higher and slower on the box robot).
 pub fn stall_only(reference: &DesignSpec) -> Result<Option<(f64, FreeResult)>> {
