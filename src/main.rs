@@ -5,7 +5,8 @@
 //! written; 3 partial: results written, but some are flagged or failed (the
 //! seed's analytic schedule beyond the motor limits, a reference, excepted);
 //! 4 impossible: the motors cannot flip the cat from the configured height
-//! (the least drop height and its schedule are written); 130 interrupted
+//! (`run`: the least drop height and its schedule are written; a design
+//! command: the error names the height that would do); 130 interrupted
 //! (a sweep or a robustness study publishes what it finished as a partial set).
 mod cli;
 mod common;
@@ -23,10 +24,11 @@ fn main() -> std::process::ExitCode {
         }
         Err(e) => {
             eprintln!("error: {e:#}");
-            let bad_input = e
-                .downcast_ref::<catflip::Error>()
-                .is_some_and(|e| e.is_bad_input());
-            std::process::ExitCode::from(if bad_input { 2 } else { 1 })
+            std::process::ExitCode::from(match e.downcast_ref::<catflip::Error>() {
+                Some(e) if e.is_bad_input() => 2,
+                Some(e) if e.is_beyond_motors() => 4,
+                _ => 1,
+            })
         }
     }
 }

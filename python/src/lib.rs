@@ -54,7 +54,9 @@ fn err(e: catflip::Error) -> PyErr {
     use catflip::Error as E;
     let msg = e.to_string();
     match e {
-        E::Unreachable { .. } | E::SeedUnfit { .. } => ImpossibleError::new_err(msg),
+        E::Unreachable { .. } | E::BeyondMotors { .. } | E::SeedUnfit { .. } => {
+            ImpossibleError::new_err(msg)
+        }
         e if e.is_bad_input() => ConfigError::new_err(msg),
         _ => DesignError::new_err(msg),
     }
@@ -1677,10 +1679,9 @@ impl Controller {
             let (draw, flight) = match trial {
                 None => (None, catflip::control::closed_loop::Flight::nominal(r)),
                 Some(i) => {
-                    let (d, f) =
-                        catflip::control::robustness::trial_flight(
-                            &self.cfg, &o.design, &o.tvlqr, seed, i,
-                        );
+                    let (d, f) = catflip::control::robustness::trial_flight(
+                        &self.cfg, &o.design, &o.tvlqr, seed, i,
+                    );
                     (Some(d), f)
                 }
             };

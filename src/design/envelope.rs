@@ -988,7 +988,7 @@ fn unreachable_here(spec: &DesignSpec, fastest_bend: Option<f64>) -> Error {
             .map(|r| r.plan.durations.iter().sum::<f64>())
     };
     let least = least_time.map(|t| height_for(spec, t));
-    Error::Unreachable {
+    Error::BeyondMotors {
         reason: match least {
             Some(h) => format!(
                 "no phased {} schedule fits the motor envelope ({}) in the {:.4} s the fall from {} m leaves for the manoeuvre; the phased design needs a drop of at least {h:.3} m (fall.height) or stronger or faster motors; `catflip run` also tries the free-form design, which may need less",

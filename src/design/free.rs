@@ -1379,7 +1379,14 @@ impl Staged {
             // a fine design the coarse one could not start: from the seed (the
             // coarse meshes stay on the record); not an impossible flip, which
             // the seed would only find again
-            Err(e) if from_coarse && !matches!(e, crate::error::Error::Unreachable { .. }) => {
+            Err(e)
+                if from_coarse
+                    && !matches!(
+                        e,
+                        crate::error::Error::Unreachable { .. }
+                            | crate::error::Error::BeyondMotors { .. }
+                    ) =>
+            {
                 // the failed attempt's time is spent before the design too
                 before += clock.elapsed().as_secs_f64();
                 // the failed attempt is not on the record: its numbers are reused
@@ -2219,7 +2226,7 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
     {
         return e;
     }
-    crate::error::Error::Unreachable {
+    crate::error::Error::BeyondMotors {
         reason: format!(
             "the free-form design cannot keep inside the motor limits in the fall from {} m; `catflip run` (or design.objective = \"time\") gives the least drop height",
             spec.fall.height
@@ -2517,7 +2524,10 @@ impl<'a> FreeDesign<'a> {
                 let plan = match seed.plan(spec) {
                     // the phased family's least height is not the free-form
                     // design's: say so rather than pass it on as the answer
-                    Err(crate::error::Error::Unreachable { reason }) => {
+                    Err(
+                        crate::error::Error::Unreachable { reason }
+                        | crate::error::Error::BeyondMotors { reason },
+                    ) => {
                         return Err(crate::error::Error::SeedUnfit { reason });
                     }
                     r => r?,

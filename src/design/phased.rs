@@ -254,7 +254,7 @@ pub fn check_limit(spec: &DesignSpec, unit_peak: f64, peak: f64, what: &str) -> 
     if let Some(lim) = spec.motor.max_torque
         && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
-        return Err(Error::Unreachable {
+        return Err(Error::BeyondMotors {
             reason: format!(
                 "the {what} needs {peak:.4} N m but limits.max_torque = {lim} N m; drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
                 least_height(spec, unit_peak, lim)

@@ -409,6 +409,49 @@ fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
     assert!(out.contains(&count), "{count} in\n{out}");
 }
 
+/// `optimize` under a torque limit below the phased optimum: the motors
+/// cannot do it from this height. That is the answer, as `run`'s (exit 4),
+/// not a failure: the message names the drop height that would do (F7: the
+/// least height grows as the limit falls), and nothing is written.
+#[test]
+fn optimize_beyond_the_motors_exits_4_naming_the_height() {
+    let dir = temp_dir();
+    let seed = util::config_arg("seed");
+    let least = |torque: f64| {
+        let (code, out, err) = util::run(
+            &[
+                "optimize",
+                &seed,
+                "--mode",
+                "phased",
+                "--set",
+                &format!("limits.max_torque={torque}"),
+            ],
+            dir.path(),
+        );
+        assert_eq!(code, Some(4), "{out}{err}");
+        assert!(err.contains("not possible as configured"), "{err}");
+        let h: f64 = err
+            .split("drop the cat from at least ")
+            .nth(1)
+            .and_then(|t| t.split(' ').next())
+            .and_then(|t| t.parse().ok())
+            .unwrap_or_else(|| panic!("no height in {err}"));
+        h
+    };
+    let (h3, h2) = (least(0.3), least(0.2));
+    let fall = util::seed(&[]).fall.height;
+    assert!(
+        fall < h3 && h3 < h2,
+        "{fall} m, at 0.3 N m {h3} m, at 0.2 N m {h2} m"
+    );
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "nothing written"
+    );
+}
+
 /// The robot from its configured 2 m: the motors cannot do it. That is the
 /// answer (exit 4), not a failure: the phased and free-form designs are not
 /// attempted (not `failed`), and the least-height schedule is a method like

@@ -169,7 +169,7 @@ fn torque_limit_below_the_optimum_names_the_least_drop_height() {
     let c = cfg("seed", &["limits.max_torque=0.3"]);
     let e = optimize(&c.design_spec(), |_| {}).unwrap_err();
     let msg = e.to_string();
-    assert!(matches!(e, Error::Unreachable { .. }), "{msg}");
+    assert!(matches!(e, Error::BeyondMotors { .. }), "{msg}");
     let h: f64 = msg
         .split("at least ")
         .nth(1)

@@ -5,7 +5,8 @@ use crate::util;
 use std::path::Path;
 
 /// The command's JSON, or its stderr when it printed none.
-fn json_or_error(args: &[&str], out: &Path) -> Result<serde_json::Value, String> {
+/// The command's JSON, or its exit status and error message.
+fn json_or_error(args: &[&str], out: &Path) -> Result<serde_json::Value, (Option<i32>, String)> {
     let o = util::bin()
         .args(args)
         .args(["--json", "--out"])
@@ -13,7 +14,12 @@ fn json_or_error(args: &[&str], out: &Path) -> Result<serde_json::Value, String>
         .current_dir(util::repo())
         .output()
         .unwrap();
-    serde_json::from_slice(&o.stdout).map_err(|_| String::from_utf8_lossy(&o.stderr).into_owned())
+    serde_json::from_slice(&o.stdout).map_err(|_| {
+        (
+            o.status.code(),
+            String::from_utf8_lossy(&o.stderr).into_owned(),
+        )
+    })
 }
 
 fn json(args: &[&str], out: &Path) -> Option<serde_json::Value> {
@@ -42,20 +48,29 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
                 .unwrap();
             // a method that fails prints no design (an error, exit 1); one the
             // motors cannot do in this fall is not attempted by `run`, and
-            // `optimize` refuses it saying why (not possible as configured, or the
-            // phased seed does not fit)
+            // `optimize` refuses it saying why: not possible as configured (the
+            // answer, exit 4, as `run`'s), or the phased seed does not fit (exit
+            // 1: the free-form design from another seed may)
             let (verdict, status) =
                 match json_or_error(&["optimize", &cfg, "--mode", mode], dir.path()) {
                     Ok(o) => (o["verdict"].clone(), o["status"].clone()),
-                    Err(e) if m["verdict"] == "impossible" => {
-                        assert!(
-                            e.contains("not possible as configured")
-                                || e.contains("the phased seed does not fit"),
-                            "{cfg} {mode}: run says impossible, optimize says {e}"
-                        );
+                    Err((code, e)) if m["verdict"] == "impossible" => {
+                        let expected = if e.contains("not possible as configured") {
+                            4
+                        } else {
+                            assert!(
+                                e.contains("the phased seed does not fit"),
+                                "{cfg} {mode}: run says impossible, optimize says {e}"
+                            );
+                            1
+                        };
+                        assert_eq!(code, Some(expected), "{cfg} {mode}: {e}");
                         ("impossible".into(), "not-attempted".into())
                     }
-                    Err(_) => ("failed".into(), "failed".into()),
+                    Err((code, e)) => {
+                        assert_eq!(code, Some(1), "{cfg} {mode}: {e}");
+                        ("failed".into(), "failed".into())
+                    }
                 };
             assert_eq!(m["verdict"], verdict, "{cfg} {mode}: run {m}");
             assert_eq!(m["status"], status, "{cfg} {mode}");
