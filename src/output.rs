@@ -24,6 +24,17 @@ use crate::error::{Error, Result};
 use std::fs::{self, File, OpenOptions};
 use std::path::{Path, PathBuf};
 
+/// `s` as one CSV field (RFC 4180): quoted, its quotes doubled, when it
+/// holds a comma, a quote or a line break, so that a reason keeps its own
+/// punctuation and any CSV reader gets it back whole.
+pub fn csv_field(s: &str) -> std::borrow::Cow<'_, str> {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\"")).into()
+    } else {
+        s.into()
+    }
+}
+
 /// The paths (`a.b[2]`) of the nulls in a JSON value: the NaN and infinite
 /// numbers serde_json writes as null. Empty when every number is finite.
 pub fn null_numbers(v: &serde_json::Value) -> Vec<String> {
@@ -523,6 +534,23 @@ fn remove_created(created: &[PathBuf]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A field reads back whole with a CSV reader's rule: plain text as is;
+    /// with a comma, quote or line break quoted, its quotes doubled.
+    #[test]
+    fn a_csv_field_keeps_its_punctuation() {
+        assert_eq!(csv_field("converged"), "converged");
+        assert_eq!(csv_field(""), "");
+        assert_eq!(
+            csv_field("needs 1,000 trials; see \"x\""),
+            "\"needs 1,000 trials; see \"\"x\"\"\""
+        );
+        assert_eq!(csv_field("a\nb"), "\"a\nb\"");
+        // read back: strip the quotes, undouble
+        let f = csv_field("a, \"b\", c");
+        let back = f[1..f.len() - 1].replace("\"\"", "\"");
+        assert_eq!(back, "a, \"b\", c");
+    }
 
     fn hidden_sets(dir: &Path) -> Vec<String> {
         let mut v: Vec<String> = fs::read_dir(dir)

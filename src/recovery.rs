@@ -606,7 +606,7 @@ pub fn to_csv(lines: &[LineResult], header: bool) -> String {
                 p.design_status.map_or("", Status::name),
                 cell(p.peak_torque_nm),
                 cell(p.least_height_m),
-                p.note.as_deref().unwrap_or("").replace([',', '\n'], ";")
+                crate::output::csv_field(p.note.as_deref().unwrap_or(""))
             ));
         }
     }

@@ -761,7 +761,7 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
             cell(p.least_height_phased_m),
             cell(p.least_height_free_m),
             p.free_status.map_or("", Status::name),
-            p.error.as_deref().unwrap_or("").replace([',', '\n'], ";")
+            crate::output::csv_field(p.error.as_deref().unwrap_or(""))
         ));
     }
     s
