@@ -49,8 +49,12 @@ import sys
 import tempfile
 import time
 
-import mujoco
-import numpy as np
+try:
+    import mujoco
+    import numpy as np
+except ModuleNotFoundError as missing:
+    sys.exit(f"this script needs the `{missing.name}` Python package: "
+             "python3 -m venv venv && venv/bin/pip install mujoco pybullet numpy (docs/replay.md)")
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 from replay_common import landing_of, quat_conj, quat_log, quat_mul, right_jacobian  # noqa: E402

@@ -13,8 +13,12 @@ src/export/urdf.rs), so it agrees only to about that.
 import sys
 from pathlib import Path
 
-import mujoco
-import numpy as np
+try:
+    import mujoco
+    import numpy as np
+except ModuleNotFoundError as missing:
+    sys.exit(f"this script needs the `{missing.name}` Python package: "
+             "python3 -m venv venv && venv/bin/pip install mujoco pybullet numpy (docs/replay.md)")
 
 TOL = 1e-9
 

@@ -25,9 +25,14 @@ Needs: pip install mujoco numpy
 
 import math
 import pathlib
+import sys
 
-import mujoco
-import numpy as np
+try:
+    import mujoco
+    import numpy as np
+except ModuleNotFoundError as missing:
+    sys.exit(f"this script needs the `{missing.name}` Python package: "
+             "python3 -m venv venv && venv/bin/pip install mujoco pybullet numpy (docs/replay.md)")
 
 from replay_common import (FlipTracker, finish, limit_catflip_torque, load_summary, parse_args, pd_tolerance,
                            peak_of, quat_log, read_controls, reference, report, right_jacobian,

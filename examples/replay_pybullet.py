@@ -28,8 +28,12 @@ import math
 import pathlib
 import sys
 
-import numpy as np
-import pybullet as p
+try:
+    import pybullet as p
+    import numpy as np
+except ModuleNotFoundError as missing:
+    sys.exit(f"this script needs the `{missing.name}` Python package: "
+             "python3 -m venv venv && venv/bin/pip install mujoco pybullet numpy (docs/replay.md)")
 
 from replay_common import (FlipTracker, finish, landing_of, limit_catflip_torque, load_summary, parse_args, pd_tolerance,
                            quat_conj, quat_mul,

@@ -239,7 +239,9 @@ pub(crate) fn threads_or_cores(threads: Option<u32>) -> usize {
 #[derive(Clone, Copy)]
 enum Optimizer {
     Phased,
-    Free(catflip::design::free::Seed),
+    /// The free-form design from the named seed; none named: the phased
+    /// seed, or the analytic one where no phased schedule fits.
+    Free(Option<catflip::design::free::Seed>),
 }
 
 impl Optimizer {
@@ -251,7 +253,7 @@ impl Optimizer {
             )
             .into()),
             (Mode::Phased, None) => Ok(Optimizer::Phased),
-            (Mode::Free, seed) => Ok(Optimizer::Free(seed.unwrap_or(SeedArg::Phased).into())),
+            (Mode::Free, seed) => Ok(Optimizer::Free(seed.map(Into::into))),
         }
     }
 }
@@ -449,8 +451,8 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     // replace the one from the default (phased) seed
     let set = match optimizer {
         Optimizer::Phased => "optimize-phased",
-        Optimizer::Free(catflip::design::free::Seed::Phased) => "optimize-free",
-        Optimizer::Free(catflip::design::free::Seed::Analytic) => "optimize-free-analytic",
+        Optimizer::Free(None | Some(catflip::design::free::Seed::Phased)) => "optimize-free",
+        Optimizer::Free(Some(catflip::design::free::Seed::Analytic)) => "optimize-free-analytic",
     };
     let publisher = publisher(c, &cfg, set)?;
     let spec = cfg.design_spec();
@@ -467,13 +469,21 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
                     console::progress::iteration_header(cfg.design.objective.short_name())
                 );
             }
-            Design::Free(
-                catflip::design::free::FreeDesign::new(&spec)
-                    .seed(seed)
-                    .check_mesh()
-                    .observe(&mut console::progress::IterationTable { verbose })
-                    .solve()?,
-            )
+            let design = catflip::design::free::FreeDesign::new(&spec);
+            let design = match seed {
+                Some(seed) => design.seed(seed),
+                None => design.phased_or_analytic(),
+            };
+            let r = design
+                .check_mesh()
+                .observe(&mut console::progress::IterationTable { verbose })
+                .solve()?;
+            if seed.is_none() && r.seed == catflip::design::free::Seed::Analytic.name() {
+                eprintln!(
+                    "note: no phased schedule fits the motors in this fall, so the free-form design started from the analytic seed"
+                );
+            }
+            Design::Free(r)
         }
     };
     // the same stage as `run`: schedule, verdict, files

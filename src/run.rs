@@ -84,6 +84,26 @@ pub struct RunSummary {
     pub answer: Option<HeightAnswer>,
 }
 
+impl RunSummary {
+    /// What makes the run partial: each method that counts against it and
+    /// why, e.g. `phased not possible in this fall` (empty when none does).
+    pub fn against(&self) -> Vec<String> {
+        self.methods
+            .iter()
+            .filter(|m| m.counts_against())
+            .map(|m| {
+                let why = match m.verdict {
+                    Grade::Flagged => "FLAGGED",
+                    Grade::Failed => "FAILED",
+                    Grade::Impossible => "not possible in this fall",
+                    Grade::Ok => "ok",
+                };
+                format!("{} {why}", m.method)
+            })
+            .collect()
+    }
+}
+
 /// A finished run: its summary and the files to write.
 pub struct RunResult {
     pub summary: RunSummary,
@@ -381,7 +401,7 @@ impl Methods {
         stages: &mut Stages<F>,
     ) {
         let clock = stages.begin(
-            "free-form optimiser (collocation + SCP, seeded by the phased design, or the analytic one if that failed)",
+            "free-form optimiser (collocation + SCP, seeded by the phased design, else by the least-height design, else by the analytic schedule)",
         );
         if let Some(reason) = q.free_impossible() {
             (stages.progress)(Progress::StageSkipped { reason: &reason });
@@ -553,7 +573,19 @@ fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
     if summary.outcome == Outcome::Partial {
         notes.insert(
             0,
-            "PARTIAL RESULT: some methods are flagged or failed; the verdict column says why. Their schedules, if any, are written but miss a target.".into(),
+            format!(
+                "PARTIAL RESULT: {}; the verdict column says why.{}",
+                summary.against().join(", "),
+                if summary
+                    .methods
+                    .iter()
+                    .any(|m| m.counts_against() && m.verdict == Grade::Flagged)
+                {
+                    " A flagged method's schedule is written but misses a target."
+                } else {
+                    ""
+                }
+            ),
         );
     }
 }

@@ -31,7 +31,8 @@ class DesignError(CatflipError):
 
 class ImpossibleError(DesignError):
     """The motors cannot flip the cat from ``fall.height``; the message gives the least drop
-    height (``catflip optimize`` stops with it, exit 1; ``catflip run`` reports it, exit 4)."""
+    height, or points to ``least_height`` for it (``catflip optimize`` stops with it and
+    ``catflip run`` reports it, both exit 4)."""
 
 class UnitSlipWarning(UserWarning):
     """A config value that is valid but likely a unit slip (the CLI's ``warning:`` lines),
@@ -151,9 +152,11 @@ def design(config: Config, method: Method = "free", objective: Optional[Objectiv
     """Designs a torque schedule, as the CLI's ``optimize --mode METHOD [--seed SEED]``
     (``analyze`` for ``method="analytic"``), with the GIL released.
 
-    ``objective`` overrides ``design.objective``; ``seed`` (``"phased"`` default,
-    ``"analytic"``) applies to ``method="free"`` only. Raises ConfigError, ImpossibleError
-    (the motors cannot flip the cat from ``fall.height``) or DesignError, with the CLI's messages."""
+    ``objective`` overrides ``design.objective``; ``seed`` (``"phased"``, ``"analytic"``;
+    None: the phased design, or the analytic schedule where no phased one fits the motors in
+    this fall) applies to ``method="free"`` only. Raises ConfigError, ImpossibleError
+    (the motors cannot flip the cat from ``fall.height``) or DesignError (also a named phased
+    seed that does not fit), with the CLI's messages."""
 
 class Simulation:
     """A forward simulation in the full free-floating model (feed-forward, PD if ``simulate.pd``,
@@ -229,6 +232,10 @@ class LeastHeight:
     @property
     def least_height_m(self) -> float:
         """The least drop height found, m (an upper bound on the true one)."""
+    @property
+    def least_height_lower_bound_m(self) -> Optional[float]:
+        """A lower bound on the least drop height, m, or None (the answer's
+        ``least_height_lower_bound_m``: the stall-only design's)."""
     @property
     def phased_least_height_m(self) -> float:
         """The phased time design's least height, m."""

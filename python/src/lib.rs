@@ -54,9 +54,7 @@ fn err(e: catflip::Error) -> PyErr {
     use catflip::Error as E;
     let msg = e.to_string();
     match e {
-        E::Unreachable { .. } | E::BeyondMotors { .. } | E::SeedUnfit { .. } => {
-            ImpossibleError::new_err(msg)
-        }
+        E::BeyondMotors { .. } => ImpossibleError::new_err(msg),
         e if e.is_bad_input() => ConfigError::new_err(msg),
         _ => DesignError::new_err(msg),
     }
@@ -424,17 +422,18 @@ fn run_design(
     let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
         match method {
             "free" => {
-                let seed = match seed.unwrap_or("phased") {
-                    "phased" => catflip::design::free::Seed::Phased,
-                    "analytic" => catflip::design::free::Seed::Analytic,
-                    other => {
+                let design = catflip::design::free::FreeDesign::new(&spec);
+                let design = match seed {
+                    None => design.phased_or_analytic(),
+                    Some("phased") => design.seed(catflip::design::free::Seed::Phased),
+                    Some("analytic") => design.seed(catflip::design::free::Seed::Analytic),
+                    Some(other) => {
                         return Err(ConfigError::new_err(format!(
                             "unknown seed `{other}`; use \"phased\" or \"analytic\""
                         )));
                     }
                 };
-                let r = catflip::design::free::FreeDesign::new(&spec)
-                    .seed(seed)
+                let r = design
                     .check_mesh()
                     .solve()
                     .map_err(err)?;
@@ -930,6 +929,12 @@ impl LeastHeight {
     #[getter]
     fn least_height_m(&self) -> f64 {
         self.answer.least_height_m
+    }
+    /// A lower bound on the least drop height, m, or None (the answer's
+    /// `least_height_lower_bound_m`: the stall-only design's).
+    #[getter]
+    fn least_height_lower_bound_m(&self) -> Option<f64> {
+        self.answer.least_height_lower_bound_m
     }
     /// The phased time design's least height, m.
     #[getter]

@@ -146,11 +146,24 @@ def test_the_exception_hierarchy():
 def test_impossible_from_this_height(tmp_path):
     robot = ROOT / "configs" / "robot-universal.toml"
     status, _, stderr = cli("optimize", robot, "--mode", "phased", out=tmp_path)
-    assert status == 1
+    assert status == 4
     with pytest.raises(catflip.ImpossibleError) as e:
         catflip.design(catflip.Config.from_toml(robot), "phased")
     assert message(e) == cli_error(stderr)
     assert "at least 5.663 m" in str(e.value)
+
+
+def test_a_named_phased_seed_that_does_not_fit_is_no_impossibility(tmp_path):
+    # from 4 m the robot flips (the least height is 3.487 m), but no phased schedule fits:
+    # the named phased seed fails as the CLI's exit 1, not as the motors' impossibility
+    robot = ROOT / "configs" / "robot-universal.toml"
+    status, _, stderr = cli("optimize", robot, "--mode", "free", "--seed", "phased",
+                            "--set", "fall.height=4", out=tmp_path)
+    assert status == 1
+    with pytest.raises(catflip.DesignError) as e:
+        catflip.design(catflip.Config.from_toml(robot, ["fall.height=4"]), seed="phased")
+    assert not isinstance(e.value, catflip.ImpossibleError)
+    assert message(e) == cli_error(stderr)
 
 
 def test_set_and_objective_apply_like_the_cli(tmp_path):
@@ -264,6 +277,8 @@ def test_least_height_is_runs_answer():
     assert not h.possible and not answer["possible"]
     assert h.least_height_m == pytest.approx(answer["least_height_m"], rel=1e-12)
     assert h.least_time_s == pytest.approx(answer["least_time_s"], rel=1e-12)
+    assert h.least_height_lower_bound_m == pytest.approx(answer["least_height_lower_bound_m"], rel=1e-12)
+    assert 0 < h.least_height_lower_bound_m < h.least_height_m
     # F7's relation between the least time and height, with the robot's margin
     g, margin = robot.to_dict()["fall"]["gravity"], robot.to_dict()["fall"]["margin"]
     assert h.least_height_m == pytest.approx(g * (h.least_time_s + margin) ** 2 / 2, rel=1e-9)

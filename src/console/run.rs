@@ -74,26 +74,10 @@ pub fn closing(s: &RunSummary) -> Option<String> {
         Outcome::Impossible => {
             Some("the flip is not possible from this height: exit status 4".into())
         }
-        Outcome::Partial => {
-            let against: Vec<String> = s
-                .methods
-                .iter()
-                .filter(|m| m.counts_against())
-                .map(|m| {
-                    let why = match m.verdict {
-                        Grade::Flagged => "FLAGGED",
-                        Grade::Failed => "FAILED",
-                        Grade::Impossible => "not possible in this fall",
-                        Grade::Ok => "ok",
-                    };
-                    format!("{} {why}", m.method)
-                })
-                .collect();
-            Some(format!(
-                "warning: partial result: {} (see the verdict column); exit status 3",
-                against.join(", ")
-            ))
-        }
+        Outcome::Partial => Some(format!(
+            "warning: partial result: {} (see the verdict column); exit status 3",
+            s.against().join(", ")
+        )),
     }
 }
 

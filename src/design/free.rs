@@ -2420,6 +2420,9 @@ pub enum Start<'a> {
     /// A seed the design makes itself (the phased design's schedule or the
     /// analytic one).
     Seed(Seed),
+    /// The phased seed, or the analytic one where no phased schedule fits
+    /// the motors in this fall ([`FreeDesign::phased_or_analytic`]).
+    PhasedOrAnalytic,
     /// A given schedule, named in the result (`phased`, `analytic`, ...).
     Plan(&'a dyn ShapePlan, &'a str),
     /// A neighbouring design (continuation, in the optimiser's
@@ -2453,6 +2456,16 @@ impl<'a> FreeDesign<'a> {
     /// Start from a seed the design makes ([`Seed::plan`]).
     pub fn seed(mut self, seed: Seed) -> Self {
         self.start = Start::Seed(seed);
+        self
+    }
+
+    /// Start from the phased seed, or from the analytic one where no phased
+    /// schedule fits the motors in this fall: the start `optimize` and the
+    /// Python package take when no seed is named (the result's `seed` says
+    /// which). A named phased seed that does not fit is an error instead
+    /// ([`crate::error::Error::SeedUnfit`]).
+    pub fn phased_or_analytic(mut self) -> Self {
+        self.start = Start::PhasedOrAnalytic;
         self
     }
 
@@ -2531,6 +2544,18 @@ impl<'a> FreeDesign<'a> {
                         return Err(crate::error::Error::SeedUnfit { reason });
                     }
                     r => r?,
+                };
+                from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?
+            }
+            Start::PhasedOrAnalytic => {
+                check_resolvable(spec, self.nodes)?;
+                let (plan, seed) = match Seed::Phased.plan(spec) {
+                    Ok(plan) => (plan, Seed::Phased),
+                    Err(
+                        crate::error::Error::Unreachable { .. }
+                        | crate::error::Error::BeyondMotors { .. },
+                    ) => (Seed::Analytic.plan(spec)?, Seed::Analytic),
+                    Err(e) => return Err(e),
                 };
                 from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?
             }

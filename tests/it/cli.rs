@@ -409,6 +409,33 @@ fn verbose_free_form_names_the_objective_column_and_prints_every_iteration() {
     assert!(out.contains(&count), "{count} in\n{out}");
 }
 
+/// `optimize --mode free` without `--seed` where no phased schedule fits
+/// the motors in this fall (the robot from 4 m, whose least height is about
+/// 3.5 m): it starts from the analytic seed, says so, and the design flips
+/// inside the envelope (exit 0); its JSON names the seed.
+#[test]
+fn optimize_free_without_a_seed_starts_from_the_analytic_one_where_no_phased_fits() {
+    let dir = temp_dir();
+    let robot = util::config_arg("robot-universal");
+    let (code, out, err) = util::run(
+        &[
+            "optimize",
+            &robot,
+            "--mode",
+            "free",
+            "--set",
+            "fall.height=4",
+            "--json",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("started from the analytic seed"), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(v["seed"], "analytic", "{v}");
+    assert_eq!(v["verdict"], "ok", "{v}");
+}
+
 /// `optimize` under a torque limit below the phased optimum: the motors
 /// cannot do it from this height. That is the answer, as `run`'s (exit 4),
 /// not a failure: the message names the drop height that would do (F7: the

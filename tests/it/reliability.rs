@@ -312,6 +312,22 @@ fn a_failed_method_keeps_the_others_reports_why_and_exits_partial() {
             && !closing.contains("analytic"),
         "{closing}"
     );
+    // the report's banner names the same, and no flagged schedule
+    let page = std::fs::read_to_string(
+        console_run
+            .path()
+            .join("output/seed/run@limits.max_torque=0.5,fall.height=12/index.html"),
+    )
+    .unwrap();
+    let banner = page
+        .split("PARTIAL RESULT: ")
+        .nth(1)
+        .and_then(|b| b.split('<').next())
+        .unwrap_or_else(|| panic!("no banner in the report"));
+    assert!(
+        banner.starts_with("phased not possible in this fall;") && !banner.contains("flagged"),
+        "{banner}"
+    );
     let m = |name: &str| {
         v["methods"]
             .as_array()
