@@ -324,6 +324,14 @@ impl Judged {
             if let (serde_json::Value::Object(j), serde_json::Value::Object(f)) = (&mut json, flown)
             {
                 j.extend(f);
+                let manoeuvre = match &self.design {
+                    Design::Phased(r) => r.manoeuvre_time_s,
+                    Design::Free(r) => r.manoeuvre_time_s,
+                    Design::Analytic(_) | Design::LeastHeight(_) => f64::NAN,
+                };
+                if let Some(h) = least_height_of_time_design(spec, manoeuvre) {
+                    j.insert("least_height_m".into(), h.into());
+                }
             }
             crate::output::ensure_finite(&json, &DESIGN_FINITE)?;
         }
@@ -547,6 +555,15 @@ impl MethodSummary {
     pub fn peak(&self) -> Option<f64> {
         self.result.as_ref().map(|r| r.peak_torque_nm)
     }
+}
+
+/// A `time` design's least drop height, m: its manoeuvre plus `fall.margin`
+/// (the time objective answers "from what height", not "within this fall").
+/// None for other objectives, and from a start with momentum, whose design
+/// lasts the whole fall.
+pub fn least_height_of_time_design(spec: &DesignSpec, manoeuvre: f64) -> Option<f64> {
+    (spec.objective == crate::design::objective::Objective::Time && !spec.has_momentum())
+        .then(|| crate::design::envelope::height_for(spec, manoeuvre))
 }
 
 #[cfg(test)]

@@ -175,6 +175,7 @@ pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBu
             r.analytic_peak_same_bend_nm, r.improvement_factor
         ),
     );
+    least_height_row(&mut t, cfg, r.manoeuvre_time_s);
     design_rows(
         &mut t,
         r.phase_durations_s,
@@ -187,6 +188,22 @@ pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBu
         written,
     );
     t
+}
+
+/// A `time` design's least drop height, with what the configured fall
+/// leaves ([`crate::pipeline::least_height_of_time_design`]).
+fn least_height_row(t: &mut Rows, cfg: &Config, manoeuvre_s: f64) {
+    let spec = cfg.design_spec();
+    if let Some(h) = crate::pipeline::least_height_of_time_design(&spec, manoeuvre_s) {
+        t.row(
+            "least drop height",
+            format!(
+                "{h:.3} m for this manoeuvre and fall.margin (the fall from {} m leaves {:.4} s)",
+                cfg.fall.height,
+                spec.available_time()
+            ),
+        );
+    }
 }
 
 /// `optimize --mode free`'s table.
@@ -220,6 +237,7 @@ pub fn free(cfg: &Config, r: &FreeResult, sim: &SimReport, written: &[PathBuf]) 
         format!("{:.3} / {:.3} deg", r.bend_deg, r.theta_deg),
     )
     .row("twist of bend direction", format!("{:.4} rad", r.twist_rad));
+    least_height_row(&mut t, cfg, r.manoeuvre_time_s);
     let cert = &r.certificate;
     t.row(
         "certificate",

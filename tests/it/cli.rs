@@ -436,6 +436,58 @@ fn optimize_free_without_a_seed_starts_from_the_analytic_one_where_no_phased_fit
     assert_eq!(v["verdict"], "ok", "{v}");
 }
 
+/// A `time` design answers "from what height": its JSON and table give the
+/// least drop height, F7's `g (T + margin)^2 / 2` of its own manoeuvre, and
+/// the table says what the configured fall leaves.
+#[test]
+fn a_time_design_gives_its_least_drop_height() {
+    let dir = temp_dir();
+    let robot = util::config_arg("robot-universal");
+    let args = [
+        "optimize",
+        &robot,
+        "--mode",
+        "phased",
+        "--set",
+        "design.objective=time",
+        "--set",
+        "fall.height=6",
+    ];
+    let (code, out, err) = util::run(&[&args[..], &["--json"]].concat(), dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let cfg = util::config("robot-universal", &[]);
+    let t = v["manoeuvre_time_s"].as_f64().unwrap();
+    let h = 0.5 * cfg.fall.gravity * (t + cfg.fall.margin).powi(2);
+    assert!(
+        (v["least_height_m"].as_f64().unwrap() - h).abs() < 1e-12 * h,
+        "{} against {h}",
+        v["least_height_m"]
+    );
+    let (code, out, err) = util::run(&args, dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        out.contains(&format!("least drop height                  {h:.3} m"))
+            && out.contains("the fall from 6 m leaves"),
+        "{out}"
+    );
+    // another objective has none
+    let (_, out, _) = util::run(
+        &[
+            "optimize",
+            &robot,
+            "--mode",
+            "phased",
+            "--set",
+            "fall.height=6",
+            "--json",
+        ],
+        dir.path(),
+    );
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v.get("least_height_m").is_none(), "{v}");
+}
+
 /// `optimize` under a torque limit below the phased optimum: the motors
 /// cannot do it from this height. That is the answer, as `run`'s (exit 4),
 /// not a failure: the message names the drop height that would do (F7: the
