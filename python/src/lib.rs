@@ -433,10 +433,7 @@ fn run_design(
                         )));
                     }
                 };
-                let r = design
-                    .check_mesh()
-                    .solve()
-                    .map_err(err)?;
+                let r = design.check_mesh().solve().map_err(err)?;
                 staged(&spec, catflip::pipeline::Design::Free(r))?
             }
             "phased" => {
@@ -1464,6 +1461,7 @@ impl Controller {
                         .plan,
                 )),
             };
+            catflip::control::online::check_fits(&cfg, plan.plan()).map_err(err)?;
             let mut online = Online::new(&cfg, plan.shared(), kind);
             online.replanning.budget_s = budget_s;
             Ok(Controller {

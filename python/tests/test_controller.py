@@ -163,6 +163,15 @@ def test_unknown_kinds_and_bad_budgets_are_refused():
         catflip.Controller(config("seed"), kind="replan", budget_s=-1.0)
 
 
+def test_a_design_longer_than_the_fall_is_refused():
+    # the robot's shortest manoeuvre (a time design, made from 6 m) needs about 3.5 m
+    robot = ROOT / "configs" / "robot-universal.toml"
+    d = catflip.design(catflip.Config.from_toml(robot, ["fall.height=6"]), "phased", objective="time")
+    with pytest.raises(catflip.ConfigError, match="fly it with a config whose fall.height is at least"):
+        catflip.Controller(catflip.Config.from_toml(robot), design=d)
+    assert catflip.Controller(catflip.Config.from_toml(robot, ["fall.height=6"]), design=d).kind == "tvlqr"
+
+
 def test_bad_arguments_raise_config_errors():
     c = controller("seed")
     with pytest.raises(catflip.ConfigError, match="state has 10 values; give 11"):

@@ -62,6 +62,23 @@ pub struct Online {
     issued: Vec<[f64; 2]>,
 }
 
+/// Whether a design can be flown under `cfg`: its manoeuvre must end within
+/// the fall (a shorter one holds the straight shape to touchdown); a longer
+/// one, made for a higher drop, would land wherever the ground cuts it off.
+pub fn check_fits(cfg: &Config, plan: &dyn crate::design::plan::ShapePlan) -> crate::Result<()> {
+    let spec = cfg.design_spec();
+    let (t, available) = (plan.duration(), spec.available_time());
+    if t > available * (1.0 + crate::verdict::tolerance::HEIGHT) {
+        let least = crate::design::envelope::height_for(&spec, t);
+        return Err(crate::Error::Usage(format!(
+            "the design's manoeuvre lasts {t:.4} s, but the fall from {} m leaves {available:.4} s for it (the fall time minus fall.margin): fly it with a config whose fall.height is at least {:.3} m",
+            cfg.fall.height,
+            (least * 1e3).ceil() / 1e3
+        )));
+    }
+    Ok(())
+}
+
 impl Online {
     pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> Online {
         let design = Reference::new(cfg, plan.as_ref());

@@ -243,3 +243,32 @@ fn bad_input_is_refused_before_anything_is_written() {
         );
     }
 }
+
+/// A design longer than the fall is refused before any flight, naming the
+/// height it needs (its manoeuvre plus `fall.margin`, rounded up so that it
+/// fits); the config it was made for takes it, and so does a higher drop.
+#[test]
+fn a_design_longer_than_the_fall_is_refused_with_the_height_it_needs() {
+    use catflip::control::online::check_fits;
+    let at = |h: f64| {
+        crate::util::config(
+            "robot-universal",
+            &[&format!("fall.height={h}"), "design.objective=time"],
+        )
+    };
+    let design = catflip::design::phased::optimize(&at(6.0).design_spec(), |_| {}).unwrap();
+    let t: f64 = design.plan.durations.iter().sum();
+    let e = check_fits(&at(2.0), &design.plan).unwrap_err();
+    assert!(e.is_bad_input(), "{e}");
+    let msg = e.to_string();
+    let need: f64 = msg
+        .split("at least ")
+        .nth(1)
+        .and_then(|s| s.split(' ').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no height in {msg}"));
+    assert!(msg.contains(&format!("lasts {t:.4} s")), "{msg}");
+    check_fits(&at(need), &design.plan).unwrap();
+    check_fits(&at(6.0), &design.plan).unwrap();
+    assert!(check_fits(&at(need - 0.01), &design.plan).is_err());
+}
