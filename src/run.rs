@@ -77,6 +77,10 @@ pub struct RunSummary {
     pub nodes: usize,
     /// The free-form design's meshes (mesh continuation), coarse to fine.
     pub mesh_levels: Vec<crate::design::free::MeshLevel>,
+    /// What the free-form design started from: `phased` (the phased
+    /// design), `free least-time` (the least-height stage's design, where no
+    /// phased one fits this fall) or `analytic` (absent without one).
+    pub free_seed: Option<String>,
     pub analytic: ClosedForms,
     pub figures: Vec<String>,
     /// With motor limits: can the motors flip the cat from `fall.height`, and
@@ -452,6 +456,7 @@ fn report_of(cfg: &Config, spec: &DesignSpec, done: Methods, question: Question)
     let iterations = free.map(|fr| fr.iterations.clone()).unwrap_or_default();
     // none when the free-form design failed
     let mesh_levels = free.map(|fr| fr.mesh_levels.clone()).unwrap_or_default();
+    let free_seed = free.map(|fr| fr.seed.clone());
     let mut notes = question.notes;
     let figures = figures(cfg, &traces, &iterations, &mesh_levels, &mut notes);
     let peak = |name: &str| methods.iter().find(|m| m.method == name)?.peak();
@@ -478,6 +483,7 @@ fn report_of(cfg: &Config, spec: &DesignSpec, done: Methods, question: Question)
         scp_iterations,
         nodes,
         mesh_levels,
+        free_seed,
         analytic: crate::design::analytic::closed_forms(spec),
         figures: figures.iter().map(|f| f.0.to_string()).collect(),
         answer,
@@ -545,18 +551,23 @@ fn figures(
 /// The page's notes above the figures: the comparison in a sentence, where
 /// the flip comes from, and the partial result first when it is one.
 fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
-    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+    let ratios = crate::table::peak_ratios(summary.free_over_phased, summary.phased_over_analytic);
     notes.insert(
         0,
         format!(
-            "{} joint, peak norm {}; fall time {:.4} s, manoeuvre {:.4} s. Free-form / phased peak: {}; phased / analytic: {}. Free-form design: {}.",
+            "{} joint, peak norm {}; fall time {:.4} s, manoeuvre {:.4} s. {}{}Free-form design: {}.",
             summary.joint,
             cfg.norm().name(),
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,
-            show(summary.free_over_phased),
-            show(summary.phased_over_analytic),
-            crate::table::free_design_text(&summary.methods, &summary.mesh_levels)
+            // (the ratios' own words start lower case: a sentence here)
+            ratios.get(..1).map(str::to_uppercase).unwrap_or_default() + ratios.get(1..).unwrap_or(""),
+            if ratios.is_empty() { "" } else { ". " },
+            crate::table::free_design_text(
+                &summary.methods,
+                &summary.mesh_levels,
+                summary.free_seed.as_deref()
+            )
         ),
     );
     notes.insert(

@@ -10,7 +10,7 @@ pub const TABLE_HEADER: [&str; 12] = [
     "method",
     "status",
     "peak N m",
-    "energy N2m2s",
+    "energy (N m)^2 s",
     "bend deg",
     "durations s",
     "flip error rad",
@@ -79,17 +79,42 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
     row
 }
 
+/// The peak ratios that exist, in words (`free-form / phased peak 0.595,
+/// phased / analytic 0.032`); a ratio whose method is missing is left out,
+/// and with neither the text is empty.
+pub fn peak_ratios(free_over_phased: Option<f64>, phased_over_analytic: Option<f64>) -> String {
+    [
+        free_over_phased.map(|r| format!("free-form / phased peak {r:.3}")),
+        phased_over_analytic.map(|r| format!("phased / analytic {r:.3}")),
+    ]
+    .into_iter()
+    .flatten()
+    .collect::<Vec<_>>()
+    .join(", ")
+}
+
 /// How the free-form design went, for the lines under the table: its
-/// meshes and iterations, or that it was not attempted.
+/// meshes and iterations and what it started from (`seed`), or that it was
+/// not attempted.
 pub fn free_design_text(
     methods: &[MethodSummary],
     mesh_levels: &[crate::design::free::MeshLevel],
+    seed: Option<&str>,
 ) -> String {
     let free = methods.iter().find(|m| m.method == "free");
     if free.is_some_and(|m| m.verdict == Grade::Impossible) {
         "not attempted (the motors cannot do it in this fall), see its row".into()
     } else {
-        crate::design::free::iterations_text(mesh_levels)
+        let from = match seed {
+            Some("phased") => "from the phased design, ",
+            Some("free least-time") => "from the least-height design, ",
+            Some("analytic") => "from the analytic schedule, ",
+            _ => "",
+        };
+        format!(
+            "{from}{}",
+            crate::design::free::iterations_text(mesh_levels)
+        )
     }
 }
 
@@ -111,6 +136,21 @@ pub fn track_status(m: &MethodSummary) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The ratios that exist are named, the missing ones left out.
+    #[test]
+    fn peak_ratios_name_only_the_ratios_that_exist() {
+        assert_eq!(
+            peak_ratios(Some(0.5951), Some(0.0321)),
+            "free-form / phased peak 0.595, phased / analytic 0.032"
+        );
+        assert_eq!(peak_ratios(None, Some(0.0321)), "phased / analytic 0.032");
+        assert_eq!(
+            peak_ratios(Some(0.5951), None),
+            "free-form / phased peak 0.595"
+        );
+        assert_eq!(peak_ratios(None, None), "");
+    }
 
     #[test]
     fn a_verdict_reads_as_the_grade_and_its_reason() {

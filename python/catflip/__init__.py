@@ -30,6 +30,7 @@ from ._catflip import (
     run,
     simulate,
 )
+from ._catflip import __version__
 from ._catflip import sweep_columns as _sweep_columns
 
 __all__ = [

@@ -11,6 +11,8 @@ from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
 import numpy as np
 import numpy.typing as npt
 
+__version__: str
+
 F64 = npt.NDArray[np.float64]
 Method = Literal["free", "phased", "analytic"]
 Objective = Literal["peak-torque", "time", "energy"]

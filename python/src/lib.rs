@@ -1777,6 +1777,7 @@ impl Flight {
 #[pymodule]
 fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("CatflipError", py.get_type::<CatflipError>())?;
     m.add("ConfigError", py.get_type::<ConfigError>())?;
     m.add("DesignError", py.get_type::<DesignError>())?;

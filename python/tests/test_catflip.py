@@ -136,6 +136,11 @@ def test_bad_files_raise_config_error_with_the_cli_message(tmp_path):
         assert message(e) == cli_error(stderr)
 
 
+def test_the_version_is_the_packages():
+    import importlib.metadata
+    assert catflip.__version__ == importlib.metadata.version("catflip")
+
+
 def test_the_exception_hierarchy():
     assert issubclass(catflip.ConfigError, catflip.CatflipError)
     assert issubclass(catflip.DesignError, catflip.CatflipError)

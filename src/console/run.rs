@@ -18,12 +18,11 @@ pub fn summary(s: &RunSummary, report: &Path, files: usize) -> Vec<String> {
     ];
     let rows = s.methods.iter().map(crate::table::table_row).collect();
     lines.extend(super::Columns::new(&crate::table::TABLE_HEADER, rows).lines());
-    let show = |x: Option<f64>| x.map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+    let ratios = crate::table::peak_ratios(s.free_over_phased, s.phased_over_analytic);
     lines.push(format!(
-        "  free-form / phased peak {}, phased / analytic {}; free-form design: {}",
-        show(s.free_over_phased),
-        show(s.phased_over_analytic),
-        crate::table::free_design_text(&s.methods, &s.mesh_levels)
+        "  {ratios}{}free-form design: {}",
+        if ratios.is_empty() { "" } else { "; " },
+        crate::table::free_design_text(&s.methods, &s.mesh_levels, s.free_seed.as_deref())
     ));
     if let Some(note) = braking_note(s) {
         lines.push(note);

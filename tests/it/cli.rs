@@ -296,11 +296,19 @@ fn impossible_limits_fail_with_a_clear_reason_and_write_nothing() {
         "{err}"
     );
     // from 4 m the robot's phased family needs 5.66 m, while `run` flips it
-    // from about 3.5 m with a free-form design: the phased seed's height is
-    // no answer for the free-form design
+    // from about 3.5 m with a free-form design: the named phased seed's height
+    // is no answer for the free-form design (without `--seed` the design
+    // starts from the analytic one instead, as a test below checks)
     let (code, err) = optimize(
         "robot-universal.toml",
-        &["--mode", "free", "--set", "fall.height=4"],
+        &[
+            "--mode",
+            "free",
+            "--seed",
+            "phased",
+            "--set",
+            "fall.height=4",
+        ],
     );
     assert_eq!(code, Some(1), "{err}");
     assert!(!err.contains("not possible as configured"), "{err}");
@@ -642,4 +650,8 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
     assert!(lead < html.find("<table>").unwrap());
     assert!(html.contains("Possible from 6 m with these motors."));
     assert!(html.contains("a reference beyond the motors, not counted"));
+    // the phased design fits this fall: it seeds the free-form one, as the
+    // summary and the page say
+    assert_eq!(s["free_seed"], "phased");
+    assert!(html.contains("Free-form design: from the phased design, "));
 }
