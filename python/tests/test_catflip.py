@@ -97,10 +97,12 @@ def test_every_bundled_design_equals_the_cli(config, method, seed, tmp_path):
         assert list(d.durations) == pytest.approx(written["phase_durations_s"], rel=1e-12)
     else:
         # the CLI's exit reason, as the documented exception, with its message
-        expected = {1: catflip.DesignError, 2: catflip.ConfigError}[status]
+        expected = {1: catflip.DesignError, 2: catflip.ConfigError, 4: catflip.ImpossibleError}[status]
         with pytest.raises(expected) as e:
             catflip.design(cfg, method, seed=seed)
         assert message(e) == cli_error(stderr)
+        # exit 1 is a failure, not the motors' impossibility (exit 4)
+        assert (status == 4) == isinstance(e.value, catflip.ImpossibleError)
 
 
 @pytest.mark.parametrize("key,value,cli_value", [
