@@ -153,7 +153,7 @@ enum Command {
         common: Common,
         #[arg(long, value_enum, default_value = "phased")]
         mode: Mode,
-        /// Seed of the free-form optimiser (default: phased; only with `--mode free`).
+        /// Seed of the free-form optimiser (default: phased, or analytic where no phased schedule fits the motors in this fall; only with `--mode free`).
         #[arg(long, value_enum)]
         seed: Option<SeedArg>,
         /// Print each iteration (bend evaluations, SCP iterations).
@@ -447,8 +447,9 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
 
 fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
-    // each seed its own set: a design from the analytic seed does not
-    // replace the one from the default (phased) seed
+    // each named seed its own set: a design from `--seed analytic` does not
+    // replace the one without `--seed` (the phased seed, or the analytic one
+    // where no phased schedule fits)
     let set = match optimizer {
         Optimizer::Phased => "optimize-phased",
         Optimizer::Free(None | Some(catflip::design::free::Seed::Phased)) => "optimize-free",

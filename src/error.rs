@@ -54,7 +54,7 @@ pub enum Error {
     Unreachable { reason: String },
     /// The motors cannot do it in the configured fall (exit status 4): the
     /// reason names the drop height, or the motor, that would do.
-    #[error("not possible as configured: {reason}")]
+    #[error("not possible with these motors in this fall: {reason}")]
     BeyondMotors { reason: String },
     /// The phased seed of a free-form design is impossible where the
     /// free-form design may not be.
@@ -80,14 +80,14 @@ pub enum Error {
 }
 
 impl Error {
-    /// True when the user's input is at fault (config, arguments, files given,
-    /// output folder) rather than a computation: the CLI exits with 2.
     /// Whether the motors cannot do it in the configured fall: the answer
     /// to the robot question, not a failure (exit status 4).
     pub fn is_beyond_motors(&self) -> bool {
         matches!(self, Error::BeyondMotors { .. })
     }
 
+    /// True when the user's input is at fault (config, arguments, files given,
+    /// output folder) rather than a computation: the CLI exits with 2.
     pub fn is_bad_input(&self) -> bool {
         matches!(
             self,

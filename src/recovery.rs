@@ -349,7 +349,9 @@ impl Origin {
         grid.validate()?;
         let mut at_rest = cfg.clone();
         at_rest.start = Default::default();
-        let design = FreeDesign::new(&at_rest.design_spec()).solve()?;
+        let design = FreeDesign::new(&at_rest.design_spec())
+            .phased_or_analytic()
+            .solve()?;
         Ok(Origin {
             cfg: at_rest,
             grid: grid.clone(),

@@ -80,6 +80,7 @@ pub struct RunSummary {
     /// What the free-form design started from: `phased` (the phased
     /// design), `free least-time` (the least-height stage's design, where no
     /// phased one fits this fall) or `analytic` (absent without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub free_seed: Option<String>,
     pub analytic: ClosedForms,
     pub figures: Vec<String>,

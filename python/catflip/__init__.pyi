@@ -33,7 +33,7 @@ class DesignError(CatflipError):
 
 class ImpossibleError(DesignError):
     """The motors cannot flip the cat from ``fall.height``; the message gives the least drop
-    height, or points to ``least_height`` for it (``catflip optimize`` stops with it and
+    height, or says how to find it (``catflip run``; here ``least_height``) (``catflip optimize`` stops with it and
     ``catflip run`` reports it, both exit 4)."""
 
 class UnitSlipWarning(UserWarning):

@@ -46,7 +46,7 @@ create_exception!(
     catflip,
     ImpossibleError,
     DesignError,
-    "The motors cannot flip the cat from this height; the message gives the least height."
+    "The motors cannot flip the cat from this height; the message names the least height, or how to find it."
 );
 
 /// The library's error as the exception of its kind, with the CLI's message.
@@ -482,7 +482,8 @@ fn run_design(
 /// (`analyze` for `method="analytic"`), with the GIL released.
 ///
 /// `objective` (`"peak-torque"`, `"time"`, `"energy"`) overrides `design.objective`;
-/// `seed` (`"phased"` default, `"analytic"`) applies to `method="free"` only.
+/// `seed` (`"phased"`, `"analytic"`; None: the phased design, or the analytic schedule
+/// where no phased one fits the motors in this fall) applies to `method="free"` only.
 /// Raises ConfigError, ImpossibleError (the motors cannot flip the cat from
 /// `fall.height`) or DesignError, with the CLI's messages.
 #[pyfunction]

@@ -988,16 +988,19 @@ fn unreachable_here(spec: &DesignSpec, fastest_bend: Option<f64>) -> Error {
             .map(|r| r.plan.durations.iter().sum::<f64>())
     };
     let least = least_time.map(|t| height_for(spec, t));
-    Error::BeyondMotors {
-        reason: match least {
-            Some(h) => format!(
+    match least {
+        Some(h) => Error::BeyondMotors {
+            reason: format!(
                 "no phased {} schedule fits the motor envelope ({}) in the {:.4} s the fall from {} m leaves for the manoeuvre; the phased design needs a drop of at least {h:.3} m (fall.height) or stronger or faster motors; `catflip run` also tries the free-form design, which may need less",
                 spec.objective.name(),
                 spec.envelope_keys(),
                 spec.available_time(),
                 spec.fall.height
             ),
-            None => "no phased schedule fits the motor envelope at any bend; widen phased.bend_min_deg / bend_max_deg or relax the limits".into(),
+        },
+        // no height helps: the time design itself found no schedule
+        None => Error::Unreachable {
+            reason: "no phased schedule fits the motor envelope at any bend; widen phased.bend_min_deg / bend_max_deg or relax the limits".into(),
         },
     }
 }

@@ -2551,10 +2551,14 @@ impl<'a> FreeDesign<'a> {
                 check_resolvable(spec, self.nodes)?;
                 let (plan, seed) = match Seed::Phased.plan(spec) {
                     Ok(plan) => (plan, Seed::Phased),
-                    Err(
-                        crate::error::Error::Unreachable { .. }
-                        | crate::error::Error::BeyondMotors { .. },
-                    ) => (Seed::Analytic.plan(spec)?, Seed::Analytic),
+                    // the motors, in this fall: the analytic seed may still fit
+                    Err(crate::error::Error::BeyondMotors { .. }) => {
+                        (Seed::Analytic.plan(spec)?, Seed::Analytic)
+                    }
+                    // another dead end of the phased family (its bend range)
+                    Err(crate::error::Error::Unreachable { reason }) => {
+                        return Err(crate::error::Error::SeedUnfit { reason });
+                    }
                     Err(e) => return Err(e),
                 };
                 from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?

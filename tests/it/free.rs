@@ -826,8 +826,10 @@ fn a_bend_limit_too_small_for_the_mesh_fails_fast_with_a_bend_that_works() {
         .check_mesh()
         .on_iteration(&mut count)
         .solve()
-        .unwrap_err()
-        .to_string();
+        .unwrap_err();
+    // a dead end of the config, not the motors' answer (exit 4)
+    assert!(!e.is_beyond_motors(), "{e}");
+    let e = e.to_string();
     assert_eq!(iterations, 0, "the mesh check comes before any iteration");
     assert!(e.contains("limits.max_bend_deg"), "{e}");
     // F6 oracle for the turn count: n = 1 / (2 C), C from F1 at 1 deg

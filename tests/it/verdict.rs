@@ -4,7 +4,6 @@
 use crate::util;
 use std::path::Path;
 
-/// The command's JSON, or its stderr when it printed none.
 /// The command's JSON, or its exit status and error message.
 fn json_or_error(args: &[&str], out: &Path) -> Result<serde_json::Value, (Option<i32>, String)> {
     let o = util::bin()
@@ -48,23 +47,16 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
                 .unwrap();
             // a method that fails prints no design (an error, exit 1); one the
             // motors cannot do in this fall is not attempted by `run`, and
-            // `optimize` refuses it saying why: not possible as configured (the
-            // answer, exit 4, as `run`'s), or the phased seed does not fit (exit
-            // 1: the free-form design from another seed may)
+            // `optimize` refuses it saying so: the answer, exit 4, as `run`'s
             let (verdict, status) =
                 match json_or_error(&["optimize", &cfg, "--mode", mode], dir.path()) {
                     Ok(o) => (o["verdict"].clone(), o["status"].clone()),
                     Err((code, e)) if m["verdict"] == "impossible" => {
-                        let expected = if e.contains("not possible as configured") {
-                            4
-                        } else {
-                            assert!(
-                                e.contains("the phased seed does not fit"),
-                                "{cfg} {mode}: run says impossible, optimize says {e}"
-                            );
-                            1
-                        };
-                        assert_eq!(code, Some(expected), "{cfg} {mode}: {e}");
+                        assert!(
+                            e.contains("not possible with these motors in this fall"),
+                            "{cfg} {mode}: run says impossible, optimize says {e}"
+                        );
+                        assert_eq!(code, Some(4), "{cfg} {mode}: {e}");
                         ("impossible".into(), "not-attempted".into())
                     }
                     Err((code, e)) => {
