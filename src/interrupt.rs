@@ -7,20 +7,38 @@
 //! once with [`Outcome::Interrupted`], and the caller publishes the finished
 //! items as a partial set and ends the process (exit 130), leaving the items
 //! in progress unfinished. A second signal while that happens ends the
-//! process at once. Work in progress need not poll anything, so the
-//! optimisers stay free of cancellation checks.
+//! process at once; the same signal repeated within [`REPEAT`] is the same
+//! request (GNU `timeout` signals the command, then its whole process group,
+//! so the command gets it twice at once). Work in progress need not poll
+//! anything, so the optimisers stay free of cancellation checks.
 //!
-//! The signals are caught with `signal-hook`, whose handler only sets an
-//! atomic flag (async-signal-safe), and whose registrations undo cleanly.
+//! The signals are caught with `signal-hook`, whose registrations undo
+//! cleanly; the handler only reads a monotonic clock, swaps atomics and, for
+//! a second signal, calls `_exit` (all async-signal-safe).
 
 use crate::error::{Error, Result};
 use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Duration;
 
 /// Exit status of an interrupted command: 128 + SIGINT, what a shell
 /// reports for a program that Ctrl-C ended.
 pub const EXIT_INTERRUPTED: u8 = 130;
+
+/// A signal this soon after the first is the same request, not a second
+/// one (a person pressing Ctrl-C again takes longer).
+pub const REPEAT: Duration = Duration::from_millis(250);
+
+/// Monotonic nanoseconds (`clock_gettime` is async-signal-safe), at least 1.
+fn now_ns() -> u64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: clock_gettime only writes the struct it is given
+    unsafe { libc::clock_gettime(libc::CLOCK_MONOTONIC, &mut ts) };
+    (ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64).max(1)
+}
 
 /// How often the waiting thread looks at the flag and the work.
 const POLL: Duration = Duration::from_millis(20);
@@ -33,26 +51,34 @@ pub struct Interrupt {
 }
 
 impl Interrupt {
-    /// Catches SIGINT and SIGTERM: the first sets the flag; a second, once
-    /// the flag is set, ends the process at once with [`EXIT_INTERRUPTED`].
+    /// Catches SIGINT and SIGTERM: the first sets the flag; a second, more
+    /// than [`REPEAT`] after it, ends the process at once with
+    /// [`EXIT_INTERRUPTED`].
     pub fn catch() -> Result<Interrupt> {
         use signal_hook::consts::{SIGINT, SIGTERM};
         let flag = Arc::new(AtomicBool::new(false));
+        // when the first signal came, ns (0: none yet)
+        let first = Arc::new(AtomicU64::new(0));
         let mut ids = Vec::new();
         for sig in [SIGINT, SIGTERM] {
-            let err = |e: std::io::Error| {
-                Error::Usage(format!("cannot catch signal {sig} to stop safely: {e}"))
+            let (flag, first) = (Arc::clone(&flag), Arc::clone(&first));
+            let handler = move || {
+                let now = now_ns();
+                match first.compare_exchange(0, now, Ordering::SeqCst, Ordering::SeqCst) {
+                    Ok(_) => flag.store(true, Ordering::SeqCst),
+                    Err(t0) if now.saturating_sub(t0) > REPEAT.as_nanos() as u64 => {
+                        // SAFETY: _exit is async-signal-safe
+                        unsafe { libc::_exit(EXIT_INTERRUPTED as i32) }
+                    }
+                    Err(_) => {}
+                }
             };
-            // the shutdown first: it sees the flag as it was before this signal
-            ids.push(
-                signal_hook::flag::register_conditional_shutdown(
-                    sig,
-                    EXIT_INTERRUPTED as i32,
-                    Arc::clone(&flag),
-                )
-                .map_err(err)?,
-            );
-            ids.push(signal_hook::flag::register(sig, Arc::clone(&flag)).map_err(err)?);
+            // SAFETY: the handler only reads the clock, swaps atomics and
+            // calls _exit, all async-signal-safe
+            let id = unsafe { signal_hook::low_level::register(sig, handler) }.map_err(|e| {
+                Error::Usage(format!("cannot catch signal {sig} to stop safely: {e}"))
+            })?;
+            ids.push(id);
         }
         Ok(Interrupt { flag, ids })
     }

@@ -234,6 +234,7 @@ fn interrupt_after(
     args: &[String],
     points: usize,
     signal: &str,
+    times: usize,
 ) -> (Option<i32>, std::time::Duration, String) {
     use std::io::BufRead;
     let mut child = bin()
@@ -256,13 +257,15 @@ fn interrupt_after(
     }
     let sent = std::time::Instant::now();
     let pid = child.id().to_string();
-    assert!(
-        Command::new("kill")
-            .args([signal, &pid])
-            .status()
-            .unwrap()
-            .success()
-    );
+    for _ in 0..times {
+        assert!(
+            Command::new("kill")
+                .args([signal, &pid])
+                .status()
+                .unwrap()
+                .success()
+        );
+    }
     let status = child.wait().unwrap();
     let took = sent.elapsed();
     let mut rest = String::new();
@@ -293,7 +296,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
     let whole = read(set("whole").join("sweep-cat_mass.csv"));
     // SIGINT after the first chunk (10 points) and one more point
     let args = sweep_args("part");
-    let (code, took, err) = interrupt_after(dir.path(), &args, 11, "-INT");
+    let (code, took, err) = interrupt_after(dir.path(), &args, 11, "-INT", 1);
     assert_eq!(code, Some(130), "{err}");
     assert!(
         took < std::time::Duration::from_secs(1),
@@ -389,7 +392,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
 #[test]
 fn sigterm_stops_a_sweep_too() {
     let dir = util::temp_dir();
-    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM");
+    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM", 1);
     assert_eq!(code, Some(130), "{err}");
     assert!(
         took < std::time::Duration::from_secs(1),
@@ -774,9 +777,11 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     assert!(o.status.success(), "{}", stderr(&o));
     let whole = read(set("whole").join("robustness.csv"));
     let whole_json = read(set("whole").join("robustness.json"));
-    // SIGINT once the progress shows 10 of the 40 trials (a line every 2)
+    // SIGINT once the progress shows 10 of the 40 trials (a line every 2),
+    // twice at once, as GNU `timeout` sends it (to the command, then to its
+    // process group): one request, the finished trials still published
     let args = robustness_args("part", 40);
-    let (code, took, err) = interrupt_after(dir.path(), &args, 10, "-INT");
+    let (code, took, err) = interrupt_after(dir.path(), &args, 10, "-INT", 2);
     eprintln!("robustness stopped {took:?} after SIGINT");
     assert_eq!(code, Some(130), "{err}");
     assert!(
