@@ -593,16 +593,31 @@ impl SizeAnswer {
                 can(g.configured_possible),
                 self.height_m
             ),
-            format!(
-                "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m.",
-                g.best_ratio,
-                g.stall_torque_nm,
-                g.no_load_speed_rad_s,
-                g.least_height_m,
-                g.least_time_s,
-                can(g.possible),
-                self.height_m
-            ),
+            if g.evaluations.len() > 1 {
+                format!(
+                    "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m.",
+                    g.best_ratio,
+                    g.stall_torque_nm,
+                    g.no_load_speed_rad_s,
+                    g.least_height_m,
+                    g.least_time_s,
+                    can(g.possible),
+                    self.height_m
+                )
+            } else {
+                // no search (--gear-evaluations 0): only the configured ratio was designed
+                let best = g
+                    .predicted
+                    .iter()
+                    .min_by(|a, b| a.least_height_m.total_cmp(&b.least_height_m));
+                format!(
+                    "No gear ratio but the configured one was designed (no gear search){}.",
+                    best.map_or(String::new(), |p| format!(
+                        "; the curve's designs predict that N = {:.4} needs {:.3} m",
+                        p.gear_ratio, p.least_height_m
+                    ))
+                )
+            },
         ]
     }
 }

@@ -6,7 +6,25 @@ use catflip::output::Output;
 use catflip::size::{SizeAnswer, SizeSettings, files};
 
 pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Result<Status> {
-    let cfg = load(c)?;
+    // `--height` replaces `fall.height` before the config is checked: the
+    // configured drop is not used, and the margin is judged against this one
+    let with_height = Common {
+        set: [c.set.clone(), vec![format!("fall.height={height}")]].concat(),
+        ..c.clone()
+    };
+    let cfg = load(&with_height).map_err(|e| match e.downcast::<catflip::Error>() {
+        Ok(catflip::Error::Override { arg, message, .. }) if arg.starts_with("fall.height=") => {
+            catflip::Error::Usage(format!("--height {height}: {message}")).into()
+        }
+        Ok(catflip::Error::Invalid { key, expected, .. })
+            if key == "fall.height" || key == "fall.margin" =>
+        {
+            catflip::Error::Usage(format!("--height {height}: {expected} (checked as {key})"))
+                .into()
+        }
+        Ok(e) => e.into(),
+        Err(e) => e,
+    })?;
     settings.validate()?;
     let q = catflip::size::question(&cfg, height)?;
     let publisher = publisher(c, &cfg, &format!("size-{height}m"))?;

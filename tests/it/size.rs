@@ -226,6 +226,16 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
         (vec!["--height", "0.04"], "--height"),
         (vec!["--height", "2", "--points", "1"], "--points"),
         (vec!["--height", "2", "--points", "41"], "--points"),
+        // the configured fall.height is not used: a bad one passes to the
+        // next check, and the margin is judged against --height's fall
+        (
+            vec!["--height", "1", "--set", "fall.height=-3", "--points", "1"],
+            "--points",
+        ),
+        (
+            vec!["--height", "1", "--set", "fall.margin=5"],
+            "(0.4515 s from this height)",
+        ),
         // a spinning release: time scaling needs the momentum scaled too (F9)
         (
             vec!["--height", "2", "--set", "start.angular_velocity=[0, 0, 1]"],
@@ -343,4 +353,29 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
     let html = std::fs::read_to_string(set.join("index.html")).unwrap();
     assert!(html.contains("size.svg") && html.contains("size-gear.svg"));
     assert!(html.contains("No motor weaker than"));
+    // with no gear search, no ratio is called the best: the prediction is named as one
+    let best = json["gear"]["predicted"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .min_by(|a, b| {
+            a["least_height_m"]
+                .as_f64()
+                .unwrap()
+                .total_cmp(&b["least_height_m"].as_f64().unwrap())
+        })
+        .unwrap()
+        .clone();
+    assert!(
+        !html.contains("Its best gear ratio"),
+        "no search, no best ratio"
+    );
+    assert!(
+        html.contains(&format!(
+            "the curve's designs predict that N = {:.4} needs {:.3} m",
+            best["gear_ratio"].as_f64().unwrap(),
+            best["least_height_m"].as_f64().unwrap()
+        )),
+        "the prediction named"
+    );
 }
