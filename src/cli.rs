@@ -55,7 +55,7 @@ enum Command {
         )]
         methods: Vec<MethodArg>,
         /// Points computed at once, at least 1 (default: the machine's cores).
-        #[arg(long, value_parser = thread_count)]
+        #[arg(long, value_parser = thread_count, allow_negative_numbers = true)]
         threads: Option<u32>,
         /// K/N: compute only the K-th of N disjoint slices of the grid (for a
         /// batch scheduler's job array); the shards' CSVs concatenate into the
@@ -83,13 +83,13 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// Trials (at most 1000000).
-        #[arg(long, default_value_t = 1000, value_parser = trials)]
+        #[arg(long, default_value_t = 1000, value_parser = trials, allow_negative_numbers = true)]
         trials: usize,
         /// Seed of the study: each trial's draws follow from it and the trial's index.
-        #[arg(long, default_value_t = 1)]
+        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
         seed: u64,
         /// Trials flown at once, at least 1 (default: the machine's cores).
-        #[arg(long, value_parser = thread_count)]
+        #[arg(long, value_parser = thread_count, allow_negative_numbers = true)]
         threads: Option<u32>,
         /// K/N: fly only the K-th of N contiguous slices of the trials; the
         /// shards' CSVs concatenate into the whole study's.
@@ -108,10 +108,10 @@ enum Command {
         #[arg(long, allow_negative_numbers = true)]
         height: f64,
         /// Points on the curve (2 to 40), each one least-time design (two when its first guess is off).
-        #[arg(long, default_value_t = catflip::size::SizeSettings::default().points)]
+        #[arg(long, default_value_t = catflip::size::SizeSettings::default().points, allow_negative_numbers = true)]
         points: usize,
         /// Least-time designs the gear-ratio search adds (0 to 20).
-        #[arg(long, default_value_t = catflip::size::SizeSettings::default().gear_evaluations)]
+        #[arg(long, default_value_t = catflip::size::SizeSettings::default().gear_evaluations, allow_negative_numbers = true)]
         gear_evaluations: usize,
     },
     /// Recovery map: from which spins and tilts at release the body, its motors and its height still land belly-down.
@@ -119,28 +119,28 @@ enum Command {
         #[command(flatten)]
         common: Common,
         /// Axis angles per plane, evenly over the turn (1 to 24; default 4).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         axes: Option<usize>,
         /// Spin magnitudes per axis after zero (1 to 20; default 2).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         spins: Option<usize>,
         /// Largest spin of the grid, rad/s (0 to 50; default 1).
-        #[arg(long = "max-spin", value_name = "W")]
+        #[arg(long = "max-spin", value_name = "W", allow_negative_numbers = true)]
         max_spin: Option<f64>,
         /// Tilt angles per axis after zero, 0 for none (0 to 20; default 2).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         tilts: Option<usize>,
         /// Largest tilt of the grid, degrees (0 to 180; default 30).
-        #[arg(long = "max-tilt", value_name = "DEG")]
+        #[arg(long = "max-tilt", value_name = "DEG", allow_negative_numbers = true)]
         max_tilt: Option<f64>,
         /// Bisection steps of the largest recoverable spin per axis (0 to 12; default 3).
-        #[arg(long)]
+        #[arg(long, allow_negative_numbers = true)]
         bisect: Option<usize>,
         /// SCP iteration limit of each design of the map (5 to 1000; default 40).
-        #[arg(long = "max-iterations")]
+        #[arg(long = "max-iterations", allow_negative_numbers = true)]
         max_iterations: Option<usize>,
         /// Lines designed at once, at least 1 (default: the machine's cores).
-        #[arg(long, value_parser = thread_count)]
+        #[arg(long, value_parser = thread_count, allow_negative_numbers = true)]
         threads: Option<u32>,
         /// K/N: only the K-th of N contiguous runs of whole lines; the
         /// shards' CSVs concatenate into the whole map's.

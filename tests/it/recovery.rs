@@ -151,6 +151,9 @@ fn grid_sizes_out_of_range_are_refused_with_the_flag_and_range_and_nothing_writt
         ("--spins", "21", "[1, 20]"),
         ("--max-spin", "0", "(0, 50]"),
         ("--max-spin", "51", "(0, 50]"),
+        // a negative value is the flag's value, checked against its range
+        ("--max-spin", "-1", "(0, 50]"),
+        ("--max-tilt", "-5", "(0, 180]"),
         ("--tilts", "21", "[0, 20]"),
         ("--max-tilt", "181", "(0, 180]"),
         ("--bisect", "13", "[0, 12]"),
