@@ -56,21 +56,19 @@ impl StudyState {
                 path.display()
             ))
         })?;
-        let differs = [
-            ("the trials (--trials)", old.trials != self.trials),
-            ("the seed (--seed)", old.seed != self.seed),
-            ("the shard (--shard)", old.shard != self.shard),
-            ("the config (file or --set)", old.config != self.config),
-        ];
-        let what: Vec<&str> = differs.iter().filter(|d| d.1).map(|d| d.0).collect();
+        let what = crate::sweep::resume::differences(
+            &[
+                ("--trials", old.trials.to_string(), self.trials.to_string()),
+                ("--seed", old.seed.to_string(), self.seed.to_string()),
+                ("--shard", old.shard.clone(), self.shard.clone()),
+            ],
+            &old.config,
+            &self.config,
+        );
         if !what.is_empty() {
             return Err(usage(format!(
-                "the study at {} was made with other settings ({} differ: it has --trials {} --seed {} --shard {}); give the same ones, or run without --resume to start afresh",
+                "the study at {} was made with other settings: {what}; give the same ones, or run without --resume to start afresh",
                 path.display(),
-                what.join(", "),
-                old.trials,
-                old.seed,
-                old.shard
             )));
         }
         let csv = set_dir.join(format!("robustness{suffix}.csv"));

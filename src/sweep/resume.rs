@@ -33,6 +33,63 @@ pub struct SweepState {
     pub points: Vec<Option<SweepPoint>>,
 }
 
+/// What differs between two resolved configs, key by key: `fall.height 2
+/// (now 4)`, a key only one has as `(none)`. For a refused `--resume`.
+pub fn config_differences(old: &serde_json::Value, new: &serde_json::Value) -> Vec<String> {
+    fn walk(
+        at: &str,
+        a: Option<&serde_json::Value>,
+        b: Option<&serde_json::Value>,
+        out: &mut Vec<String>,
+    ) {
+        use serde_json::Value::Object;
+        match (a, b) {
+            (Some(Object(x)), Some(Object(y))) => {
+                let mut keys: Vec<&String> = x.keys().chain(y.keys()).collect();
+                keys.sort();
+                keys.dedup();
+                for k in keys {
+                    let path = if at.is_empty() {
+                        k.clone()
+                    } else {
+                        format!("{at}.{k}")
+                    };
+                    walk(&path, x.get(k), y.get(k), out);
+                }
+            }
+            (a, b) if a != b => {
+                let show =
+                    |v: Option<&serde_json::Value>| v.map_or("(none)".into(), |v| v.to_string());
+                out.push(format!("{at} {} (now {})", show(a), show(b)));
+            }
+            _ => {}
+        }
+    }
+    let mut out = Vec::new();
+    walk("", Some(old), Some(new), &mut out);
+    out
+}
+
+/// A refused `--resume`'s list (a sweep's or a study's): each setting that
+/// differs, with its value then and now (`--seed 1 (now 2)`), the config key
+/// by key.
+pub fn differences(
+    settings: &[(&str, String, String)],
+    old: &serde_json::Value,
+    new: &serde_json::Value,
+) -> String {
+    let mut out: Vec<String> = settings
+        .iter()
+        .filter(|(_, a, b)| a != b)
+        .map(|(flag, a, b)| format!("{flag} {a} (now {b})"))
+        .collect();
+    let keys = config_differences(old, new);
+    if !keys.is_empty() {
+        out.push(format!("the config (file or --set): {}", keys.join(", ")));
+    }
+    out.join("; ")
+}
+
 impl Methods {
     /// `analytic`, `phased`, `free`: those computed.
     pub fn names(&self) -> Vec<String> {
@@ -128,27 +185,59 @@ impl SweepState {
                 path.display()
             ))
         })?;
-        let differs = [
-            ("the range", old.range != self.range),
-            ("the shard", old.shard != self.shard),
-            ("the methods", old.methods != self.methods),
-            ("the config (file or --set)", old.config != self.config),
-            (
-                "the number of points",
-                old.points.len() != self.points.len(),
-            ),
-        ];
-        let what: Vec<&str> = differs.iter().filter(|d| d.1).map(|d| d.0).collect();
+        let what = differences(
+            &[
+                ("--set-range", old.range.clone(), self.range.clone()),
+                ("--shard", old.shard.clone(), self.shard.clone()),
+                ("--methods", old.methods.join(","), self.methods.join(",")),
+                (
+                    "points",
+                    old.points.len().to_string(),
+                    self.points.len().to_string(),
+                ),
+            ],
+            &old.config,
+            &self.config,
+        );
         if !what.is_empty() {
             return Err(usage(format!(
-                "the sweep at {} was made with other settings ({} differ: it has --set-range {} --shard {} --methods {}); give the same ones, or run without --resume to start afresh",
+                "the sweep at {} was made with other settings: {what}; give the same ones, or run without --resume to start afresh",
                 path.display(),
-                what.join(", "),
-                old.range,
-                old.shard,
-                old.methods.join(",")
             )));
         }
         Ok(old)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A refused resume names each key that differs, then and now, a key
+    /// only one config has as `(none)`, and nothing for equal configs.
+    #[test]
+    fn config_differences_name_each_key_then_and_now() {
+        let old = serde_json::json!({"fall": {"height": 2.0, "margin": 0.1}, "name": "r"});
+        let new = serde_json::json!({"fall": {"height": 4.0, "margin": 0.1}, "name": "r", "limits": {"max_torque": 1.4}});
+        assert_eq!(
+            config_differences(&old, &new),
+            [
+                "fall.height 2.0 (now 4.0)",
+                "limits (none) (now {\"max_torque\":1.4})"
+            ]
+        );
+        assert!(config_differences(&old, &old).is_empty());
+        let listed = differences(
+            &[
+                ("--seed", "1".into(), "1".into()),
+                ("--trials", "40".into(), "41".into()),
+            ],
+            &old,
+            &new,
+        );
+        assert_eq!(
+            listed,
+            "--trials 40 (now 41); the config (file or --set): fall.height 2.0 (now 4.0), limits (none) (now {\"max_torque\":1.4})"
+        );
     }
 }

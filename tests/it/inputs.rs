@@ -340,7 +340,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
     );
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("other settings") && stderr(&o).contains("the range"),
+        stderr(&o).contains("other settings") && stderr(&o).contains("(now cat.mass=0.5:2.4:21)"),
         "{}",
         stderr(&o)
     );
@@ -822,8 +822,8 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     let mut other_seed = args.clone();
     other_seed.extend(["--seed".into(), "2".into()]);
     for (mut other, what) in [
-        (other_seed, "the seed"),
-        (robustness_args("part", 41), "the trials"),
+        (other_seed, "--seed 1 (now 2)"),
+        (robustness_args("part", 41), "--trials 40 (now 41)"),
     ] {
         other.push("--resume".into());
         let o = run(&strs(&other), dir.path());
