@@ -324,12 +324,7 @@ impl Judged {
             if let (serde_json::Value::Object(j), serde_json::Value::Object(f)) = (&mut json, flown)
             {
                 j.extend(f);
-                let manoeuvre = match &self.design {
-                    Design::Phased(r) => r.manoeuvre_time_s,
-                    Design::Free(r) => r.manoeuvre_time_s,
-                    Design::Analytic(_) | Design::LeastHeight(_) => f64::NAN,
-                };
-                if let Some(h) = least_height_of_time_design(spec, manoeuvre) {
+                if let Some(h) = least_height_of_time_design(spec, self.design.plan().duration()) {
                     j.insert("least_height_m".into(), h.into());
                 }
             }

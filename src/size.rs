@@ -237,12 +237,7 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
     }
     let mut q = cfg.clone();
     q.fall.height = height;
-    q.validate().map_err(|e| match e {
-        Error::Invalid { key, expected, .. } if key == "fall.height" || key == "fall.margin" => {
-            Error::Usage(format!("--height {height}: {expected} (checked as {key})"))
-        }
-        e => e,
-    })?;
+    q.validate().map_err(|e| height_error(height, e))?;
     if !(height.is_finite() && q.available_time() > 0.0) {
         return Err(Error::Usage(format!(
             "--height {height}: the fall leaves no time for the manoeuvre after fall.margin = {} s; give a greater height",
@@ -250,6 +245,21 @@ pub fn question(cfg: &Config, height: f64) -> Result<Config> {
         )));
     }
     Ok(q)
+}
+
+/// A check of `fall.height` or `fall.margin` that failed on the question's
+/// height `--height H`, worded as that flag's (the configured drop is not
+/// used); any other error as it is.
+pub fn height_error(height: f64, e: Error) -> Error {
+    match e {
+        Error::Invalid { key, expected, .. } if key == "fall.height" || key == "fall.margin" => {
+            Error::Usage(format!("--height {height}: {expected} (checked as {key})"))
+        }
+        Error::Override { arg, message, .. } if arg.starts_with("fall.height=") => {
+            Error::Usage(format!("--height {height}: {message}"))
+        }
+        e => e,
+    }
 }
 
 /// The configured motor with `torque` and `no_load` in place of its line;

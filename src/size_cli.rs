@@ -13,16 +13,7 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
         ..c.clone()
     };
     let cfg = load(&with_height).map_err(|e| match e.downcast::<catflip::Error>() {
-        Ok(catflip::Error::Override { arg, message, .. }) if arg.starts_with("fall.height=") => {
-            catflip::Error::Usage(format!("--height {height}: {message}")).into()
-        }
-        Ok(catflip::Error::Invalid { key, expected, .. })
-            if key == "fall.height" || key == "fall.margin" =>
-        {
-            catflip::Error::Usage(format!("--height {height}: {expected} (checked as {key})"))
-                .into()
-        }
-        Ok(e) => e.into(),
+        Ok(e) => catflip::size::height_error(height, e).into(),
         Err(e) => e,
     })?;
     settings.validate()?;

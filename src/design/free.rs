@@ -2532,32 +2532,23 @@ impl<'a> FreeDesign<'a> {
             None => &mut quiet,
         };
         let mut r = match self.start {
-            Start::Seed(seed) => {
+            Start::Seed(_) | Start::PhasedOrAnalytic => {
+                use crate::error::Error;
                 check_resolvable(spec, self.nodes)?;
-                let plan = match seed.plan(spec) {
-                    // the phased family's least height is not the free-form
-                    // design's: say so rather than pass it on as the answer
-                    Err(
-                        crate::error::Error::Unreachable { reason }
-                        | crate::error::Error::BeyondMotors { reason },
-                    ) => {
-                        return Err(crate::error::Error::SeedUnfit { reason });
-                    }
-                    r => r?,
+                let (first, fallback) = match self.start {
+                    Start::Seed(seed) => (seed, false),
+                    _ => (Seed::Phased, true),
                 };
-                from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?
-            }
-            Start::PhasedOrAnalytic => {
-                check_resolvable(spec, self.nodes)?;
-                let (plan, seed) = match Seed::Phased.plan(spec) {
-                    Ok(plan) => (plan, Seed::Phased),
+                let (plan, seed) = match first.plan(spec) {
+                    Ok(plan) => (plan, first),
                     // the motors, in this fall: the analytic seed may still fit
-                    Err(crate::error::Error::BeyondMotors { .. }) => {
+                    Err(Error::BeyondMotors { .. }) if fallback => {
                         (Seed::Analytic.plan(spec)?, Seed::Analytic)
                     }
-                    // another dead end of the phased family (its bend range)
-                    Err(crate::error::Error::Unreachable { reason }) => {
-                        return Err(crate::error::Error::SeedUnfit { reason });
+                    // the phased family's least height is not the free-form
+                    // design's: say so rather than pass it on as the answer
+                    Err(Error::Unreachable { reason } | Error::BeyondMotors { reason }) => {
+                        return Err(Error::SeedUnfit { reason });
                     }
                     Err(e) => return Err(e),
                 };

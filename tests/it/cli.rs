@@ -521,13 +521,7 @@ fn optimize_beyond_the_motors_exits_4_naming_the_height() {
             err.contains("not possible with these motors in this fall"),
             "{err}"
         );
-        let h: f64 = err
-            .split("drop the cat from at least ")
-            .nth(1)
-            .and_then(|t| t.split(' ').next())
-            .and_then(|t| t.parse().ok())
-            .unwrap_or_else(|| panic!("no height in {err}"));
-        h
+        util::number_after(&err, "drop the cat from at least ")
     };
     let (h3, h2) = (least(0.3), least(0.2));
     let fall = util::seed(&[]).fall.height;

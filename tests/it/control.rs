@@ -261,12 +261,7 @@ fn a_design_longer_than_the_fall_is_refused_with_the_height_it_needs() {
     let e = check_fits(&at(2.0), &design.plan).unwrap_err();
     assert!(e.is_bad_input(), "{e}");
     let msg = e.to_string();
-    let need: f64 = msg
-        .split("at least ")
-        .nth(1)
-        .and_then(|s| s.split(' ').next())
-        .and_then(|s| s.parse().ok())
-        .unwrap_or_else(|| panic!("no height in {msg}"));
+    let need = crate::util::number_after(&msg, "at least ");
     assert!(msg.contains(&format!("lasts {t:.4} s")), "{msg}");
     check_fits(&at(need), &design.plan).unwrap();
     check_fits(&at(6.0), &design.plan).unwrap();

@@ -170,15 +170,7 @@ fn torque_limit_below_the_optimum_names_the_least_drop_height() {
     let e = optimize(&c.design_spec(), |_| {}).unwrap_err();
     let msg = e.to_string();
     assert!(matches!(e, Error::BeyondMotors { .. }), "{msg}");
-    let h: f64 = msg
-        .split("at least ")
-        .nth(1)
-        .unwrap()
-        .split(' ')
-        .next()
-        .unwrap()
-        .parse()
-        .unwrap();
+    let h = crate::util::number_after(&msg, "at least ");
     assert!(h > 10.0);
     // F7: from a little higher it works, within the limit
     let ok_cfg = cfg(

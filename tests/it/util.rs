@@ -208,3 +208,13 @@ pub fn flown_kinematic(
 ) -> catflip::verify::simulate::SimReport {
     catflip::verify::simulate::kinematic_spec(spec, plan).expect("the shape flies")
 }
+
+/// The number that follows `phrase` in a message (`drop the cat from at
+/// least 12.4 m`: 12.4), up to the next space.
+pub fn number_after(text: &str, phrase: &str) -> f64 {
+    text.split(phrase)
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("no number after `{phrase}` in {text}"))
+}
