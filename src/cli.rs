@@ -464,26 +464,28 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             }
         })?),
         Optimizer::Free(seed) => {
+            let design = catflip::design::free::FreeDesign::new(&spec);
+            let start;
+            let design = match seed {
+                Some(seed) => design.seed(seed),
+                None => {
+                    start = catflip::pipeline::free_start(&spec)?;
+                    if let Some(note) = console::design::start_note(start.1) {
+                        eprintln!("{note}");
+                    }
+                    design.from_plan(start.0.as_ref(), start.1)
+                }
+            };
             if verbose {
                 eprintln!(
                     "{}",
                     console::progress::iteration_header(cfg.design.objective.short_name())
                 );
             }
-            let design = catflip::design::free::FreeDesign::new(&spec);
-            let design = match seed {
-                Some(seed) => design.seed(seed),
-                None => design.phased_or_analytic(),
-            };
             let r = design
                 .check_mesh()
                 .observe(&mut console::progress::IterationTable { verbose })
                 .solve()?;
-            if seed.is_none() && r.seed == catflip::design::free::Seed::Analytic.name() {
-                eprintln!(
-                    "note: no phased schedule fits the motors in this fall, so the free-form design started from the analytic seed"
-                );
-            }
             Design::Free(r)
         }
     };

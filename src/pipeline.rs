@@ -552,6 +552,46 @@ impl MethodSummary {
     }
 }
 
+/// Where a free-form design starts when no seed is named (`optimize`, the
+/// Python package, `recovery`'s design at rest), as `run` seeds it: the
+/// phased design; where no phased schedule fits the motors in this fall,
+/// the least-height answer's shortest manoeuvre (`free least-time`); the
+/// analytic schedule where neither exists. When that answer is that no
+/// schedule found fits this fall, it is the error
+/// ([`Error::BeyondMotors`], naming the least height), as `run` does not
+/// attempt the design either: the SCP would only fail to find a design
+/// after many iterations. A phased seed the landing rules out is
+/// [`Error::SeedUnfit`].
+pub fn free_start(spec: &DesignSpec) -> Result<(Box<dyn ShapePlan>, &'static str)> {
+    use crate::design::free::Seed;
+    match Seed::Phased.plan(spec) {
+        Ok(plan) => return Ok((plan, Seed::Phased.name())),
+        Err(Error::BeyondMotors { .. }) => {}
+        Err(Error::Unreachable { reason }) => return Err(Error::SeedUnfit { reason }),
+        Err(e) => return Err(e),
+    }
+    // (the least height failing leaves the analytic seed, as in `run`)
+    if let Ok(Some(h)) = crate::design::least_height::heights(spec, true, |_| {}) {
+        let a = &h.answer;
+        if !a.possible && a.verified {
+            return Err(Error::BeyondMotors {
+                reason: format!(
+                    "no schedule found fits the motors in the fall from {} m (fall.height); the least drop height found is {:.3} m (the {} time design; `catflip run` shows its schedule)",
+                    spec.fall.height, a.least_height_m, a.method
+                ),
+            });
+        }
+        if let Some(fr) = h.free {
+            return Ok((Box::new(fr.plan), FREE_LEAST_TIME));
+        }
+    }
+    Ok((Seed::Analytic.plan(spec)?, Seed::Analytic.name()))
+}
+
+/// The name of a free-form design's seed when it is the least-height
+/// answer's shortest manoeuvre ([`free_start`], `run`).
+pub const FREE_LEAST_TIME: &str = "free least-time";
+
 /// A `time` design's least drop height, m: its manoeuvre plus `fall.margin`
 /// (the time objective answers "from what height", not "within this fall").
 /// None for other objectives, and from a start with momentum, whose design

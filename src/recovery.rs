@@ -349,8 +349,10 @@ impl Origin {
         grid.validate()?;
         let mut at_rest = cfg.clone();
         at_rest.start = Default::default();
-        let design = FreeDesign::new(&at_rest.design_spec())
-            .phased_or_analytic()
+        let spec = at_rest.design_spec();
+        let (plan, seed) = crate::pipeline::free_start(&spec)?;
+        let design = FreeDesign::new(&spec)
+            .from_plan(plan.as_ref(), seed)
             .solve()?;
         Ok(Origin {
             cfg: at_rest,

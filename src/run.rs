@@ -417,7 +417,7 @@ impl Methods {
         let (seed_plan, seed_name): (&dyn ShapePlan, &str) =
             match (self.design(Method::Phased), &q.fastest_free) {
                 (Some(ph), _) => (ph.plan(), "phased"),
-                (None, Some(fr)) => (&fr.plan, "free least-time"),
+                (None, Some(fr)) => (&fr.plan, crate::pipeline::FREE_LEAST_TIME),
                 (None, None) => {
                     analytic_seed = crate::design::analytic::analytic_plan(spec);
                     (&analytic_seed, "analytic")

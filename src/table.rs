@@ -107,7 +107,7 @@ pub fn free_design_text(
     } else {
         let from = match seed {
             Some("phased") => "from the phased design, ",
-            Some("free least-time") => "from the least-height design, ",
+            Some(crate::pipeline::FREE_LEAST_TIME) => "from the least-height design, ",
             Some("analytic") => "from the analytic schedule, ",
             _ => "",
         };

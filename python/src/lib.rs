@@ -423,8 +423,12 @@ fn run_design(
         match method {
             "free" => {
                 let design = catflip::design::free::FreeDesign::new(&spec);
+                let start;
                 let design = match seed {
-                    None => design.phased_or_analytic(),
+                    None => {
+                        start = catflip::pipeline::free_start(&spec).map_err(err)?;
+                        design.from_plan(start.0.as_ref(), start.1)
+                    }
                     Some("phased") => design.seed(catflip::design::free::Seed::Phased),
                     Some("analytic") => design.seed(catflip::design::free::Seed::Analytic),
                     Some(other) => {

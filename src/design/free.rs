@@ -2420,9 +2420,6 @@ pub enum Start<'a> {
     /// A seed the design makes itself (the phased design's schedule or the
     /// analytic one).
     Seed(Seed),
-    /// The phased seed, or the analytic one where no phased schedule fits
-    /// the motors in this fall ([`FreeDesign::phased_or_analytic`]).
-    PhasedOrAnalytic,
     /// A given schedule, named in the result (`phased`, `analytic`, ...).
     Plan(&'a dyn ShapePlan, &'a str),
     /// A neighbouring design (continuation, in the optimiser's
@@ -2456,16 +2453,6 @@ impl<'a> FreeDesign<'a> {
     /// Start from a seed the design makes ([`Seed::plan`]).
     pub fn seed(mut self, seed: Seed) -> Self {
         self.start = Start::Seed(seed);
-        self
-    }
-
-    /// Start from the phased seed, or from the analytic one where no phased
-    /// schedule fits the motors in this fall: the start `optimize` and the
-    /// Python package take when no seed is named (the result's `seed` says
-    /// which). A named phased seed that does not fit is an error instead
-    /// ([`crate::error::Error::SeedUnfit`]).
-    pub fn phased_or_analytic(mut self) -> Self {
-        self.start = Start::PhasedOrAnalytic;
         self
     }
 
@@ -2532,24 +2519,16 @@ impl<'a> FreeDesign<'a> {
             None => &mut quiet,
         };
         let mut r = match self.start {
-            Start::Seed(_) | Start::PhasedOrAnalytic => {
-                use crate::error::Error;
+            Start::Seed(seed) => {
                 check_resolvable(spec, self.nodes)?;
-                let (first, fallback) = match self.start {
-                    Start::Seed(seed) => (seed, false),
-                    _ => (Seed::Phased, true),
-                };
-                let (plan, seed) = match first.plan(spec) {
-                    Ok(plan) => (plan, first),
-                    // the motors, in this fall: the analytic seed may still fit
-                    Err(Error::BeyondMotors { .. }) if fallback => {
-                        (Seed::Analytic.plan(spec)?, Seed::Analytic)
-                    }
+                let plan = match seed.plan(spec) {
+                    Ok(plan) => plan,
                     // the phased family's least height is not the free-form
                     // design's: say so rather than pass it on as the answer
-                    Err(Error::Unreachable { reason } | Error::BeyondMotors { reason }) => {
-                        return Err(Error::SeedUnfit { reason });
-                    }
+                    Err(
+                        crate::error::Error::Unreachable { reason }
+                        | crate::error::Error::BeyondMotors { reason },
+                    ) => return Err(crate::error::Error::SeedUnfit { reason }),
                     Err(e) => return Err(e),
                 };
                 from_plan(spec, plan.as_ref(), seed.name(), self.nodes, observe)?

@@ -56,6 +56,13 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
                             e.contains("not possible with these motors in this fall"),
                             "{cfg} {mode}: run says impossible, optimize says {e}"
                         );
+                        // the free-form design's refusal is run's answer
+                        let least = run["answer"]["least_height_m"].as_f64().unwrap();
+                        assert!(
+                            mode == "phased"
+                                || e.contains(&format!("least drop height found is {least:.3} m")),
+                            "{cfg}: run answers {least} m, optimize says {e}"
+                        );
                         assert_eq!(code, Some(4), "{cfg} {mode}: {e}");
                         ("impossible".into(), "not-attempted".into())
                     }
