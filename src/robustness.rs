@@ -46,9 +46,9 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     if resume {
         let old = state.resume_from(&publisher.link(), &suffix, range.clone())?;
         eprintln!(
-            "resuming: {} of {} trials kept from {}",
+            "resuming: {} of {} kept from {}",
             old.len(),
-            range.len(),
+            catflip::console::count(range.len(), "trial"),
             publisher.link().display()
         );
         for r in old {
@@ -134,7 +134,11 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             publisher,
             out,
             c.json.then_some(json.as_str()),
-            &format!("{} of {} trials", results.len(), range.len()),
+            &format!(
+                "{} of {}",
+                results.len(),
+                catflip::console::count(range.len(), "trial")
+            ),
             "; the same command with --resume continues it",
         );
     }

@@ -11,3 +11,8 @@ pub mod sweep;
 pub mod table;
 
 pub use table::{Columns, Rows};
+
+/// `n` and the noun, plural unless `n` is one ("1 trial", "20 trials").
+pub fn count(n: usize, noun: &str) -> String {
+    format!("{n} {noun}{}", if n == 1 { "" } else { "s" })
+}

@@ -16,8 +16,11 @@ pub fn study(
 ) -> Vec<String> {
     let mut lines = vec![
         format!(
-            "catflip robustness: {trials} trials {}..{} of {total} (seed {seed}), landing within {} deg of belly-down",
-            range.start, range.end, summary.max_tilt_deg
+            "catflip robustness: {} {}..{} of {total} (seed {seed}), landing within {} deg of belly-down",
+            super::count(trials, "trial"),
+            range.start,
+            range.end,
+            summary.max_tilt_deg
         ),
         format!(
             "  {:<10} {:>9} {:>17} {:>9} {:>9} {:>9}",

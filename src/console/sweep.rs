@@ -12,12 +12,11 @@ pub fn points(
     threads: usize,
     written: &[PathBuf],
 ) -> Vec<String> {
-    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
     let mut lines = vec![format!(
         "catflip sweep: {} over {} ({}, {} at a time)",
         name,
         spec.key,
-        plural(points.len(), "point"),
+        super::count(points.len(), "point"),
         threads
     )];
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());

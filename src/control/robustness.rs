@@ -452,7 +452,8 @@ pub fn to_csv(results: &[TrialResult], header: bool) -> String {
             r.landing_error_deg[2],
         ]
         .iter()
-        .map(|x| format!("{x:e}"))
+        // (+ 0.0: a negative zero is written as 0e0, not -0e0)
+        .map(|x| format!("{:e}", x + 0.0))
         .collect();
         s.push_str(&format!("{},{}\n", d.trial, v.join(",")));
     }
@@ -550,6 +551,14 @@ mod tests {
             }
         }
         assert!(from_csv("3,1,2\n").unwrap_err().contains("16 columns"));
+        // a negative zero (an error that rounds to it) is written unsigned
+        let mut zero = results[0].clone();
+        zero.landing_error_deg = [-0.0, 0.0, 1.0];
+        let csv = to_csv(&[zero], false);
+        assert!(
+            !csv.contains("-0e0") && csv.contains(",0e0,0e0,1e0"),
+            "{csv}"
+        );
     }
 
     #[test]
