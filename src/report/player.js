@@ -255,11 +255,12 @@
     out.table_scrolls = !!wide && wide.scrollWidth > wide.clientWidth;
     setTime(0);
     play(true);
-    // the clock moves from the second animation frame on: wait for it (a
-    // loaded machine draws few frames), at most 4 s
+    // the clock moves from the second animation frame on: wait for it, at
+    // most 60 s of the page's time (a headless browser's virtual time runs
+    // ahead of the frames a loaded machine draws: one frame in 4 s was seen)
     const started = performance.now();
     const report = () => {
-      if (state.t === 0 && performance.now() - started < 4000) { setTimeout(report, 100); return; }
+      if (state.t === 0 && performance.now() - started < 60000) { setTimeout(report, 100); return; }
       out.played_to_s = state.t;
       play(false);
       out.errors = window.catflipErrors || [];

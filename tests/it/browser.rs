@@ -34,7 +34,8 @@ fn open_selftest(index: &std::path::Path, width: u32) -> (String, serde_json::Va
             "--no-first-run",
             &format!("--user-data-dir={}", profile.path().display()),
             &format!("--window-size={width},900"),
-            "--virtual-time-budget=5000",
+            // (the self-check waits up to 60 s of it for the animation's frames)
+            "--virtual-time-budget=65000",
             "--dump-dom",
             &url,
         ])
