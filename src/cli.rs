@@ -593,23 +593,22 @@ fn cmd_sweep(
         let (config, set, spec, store) =
             (c.config.clone(), c.set.clone(), spec.clone(), store.clone());
         move || {
-            catflip::sweep::sweep_shard_into(
-                &config,
-                &set,
-                &spec,
-                m,
+            let run = catflip::sweep::SweepRun {
+                path: &config,
+                overrides: &set,
+                spec: &spec,
+                methods: m,
                 threads,
                 shard,
-                &store,
-                |done, total| {
-                    progress.show(&catflip::console::sweep::progress_line(
-                        &spec.key,
-                        done,
-                        total,
-                        clock.elapsed().as_secs_f64(),
-                    ))
-                },
-            )
+            };
+            run.into_store(&store, |done, total| {
+                progress.show(&catflip::console::sweep::progress_line(
+                    &spec.key,
+                    done,
+                    total,
+                    clock.elapsed().as_secs_f64(),
+                ))
+            })
         }
     };
     let outcome = catflip::interrupt::supervise(&interrupt, work);

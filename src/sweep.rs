@@ -518,89 +518,95 @@ pub fn sweep(
     threads: usize,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<Vec<SweepPoint>> {
-    sweep_shard(
+    SweepRun {
         path,
         overrides,
         spec,
         methods,
         threads,
-        Shard::ALL,
-        progress,
-    )
-}
-
-/// [`sweep`] restricted to one shard of the grid (see [`Shard::points`]).
-pub fn sweep_shard(
-    path: &Path,
-    overrides: &[String],
-    spec: &SweepSpec,
-    methods: Methods,
-    threads: usize,
-    shard: Shard,
-    progress: impl Fn(usize, usize) + Sync,
-) -> Result<Vec<SweepPoint>> {
-    let store = Mutex::new(Vec::new());
-    sweep_shard_into(
-        path, overrides, spec, methods, threads, shard, &store, progress,
-    )?;
-    Ok(store
-        .into_inner()
-        .unwrap()
-        .into_iter()
-        .map(|p| p.expect("every point ran"))
-        .collect())
-}
-
-/// [`sweep_shard`] into `store`, one slot a point of the shard, which the
-/// caller may read while it runs (an interrupted sweep publishes the points
-/// finished so far, [`crate::interrupt`]). Slots already filled (a resumed
-/// sweep, [`resume`]) are kept: a chunk whose every point is filled is
-/// skipped, a chunk filled in part is computed again from its start, so
-/// that each point has the same continuation as in an uninterrupted sweep.
-// the sweep's inputs, its shard and its store; a `SweepRun` struct is the
-// next step (the crate-wide allow is gone, issue 25)
-#[allow(clippy::too_many_arguments)]
-pub fn sweep_shard_into(
-    path: &Path,
-    overrides: &[String],
-    spec: &SweepSpec,
-    methods: Methods,
-    threads: usize,
-    shard: Shard,
-    store: &Mutex<Vec<Option<SweepPoint>>>,
-    progress: impl Fn(usize, usize) + Sync,
-) -> Result<()> {
-    let all = spec.values();
-    let range = shard.points(all.len());
-    let values = &all[range.clone()];
-    let load = |v: f64| {
-        let mut ov = overrides.to_vec();
-        ov.push(format!("{}={}", spec.key, v));
-        Config::load(path, &ov)
-    };
-    // a key that takes whole numbers fails as a whole on a grid with
-    // fractions (checked over the whole grid, so that every shard agrees)
-    if let Some(v) = all.iter().find(|v| v.fract() != 0.0)
-        && load(*v).is_err_and(|e| e.to_string().contains("expected a whole number"))
-    {
-        return Err(Error::Range {
-            arg: spec.arg(),
-            message: format!(
-                "{} takes whole numbers, and this grid has {v}: choose whole FROM and TO and a COUNT for which (TO - FROM) / (COUNT - 1) is whole",
-                spec.key
-            ),
-        });
+        shard: Shard::ALL,
     }
-    let configs = checked_configs(&spec.key, &spec.arg(), &all, load)?;
-    compute_into(
-        &spec.key,
-        values,
-        &configs[range],
-        methods,
-        threads,
-        store,
-        progress,
-    )
+    .points(progress)
+}
+
+/// One sweep's inputs: the config at `path` with `overrides`, the key and
+/// its grid, the methods, the chunks computed at once, and the shard of
+/// the grid it computes ([`Shard::points`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SweepRun<'a> {
+    pub path: &'a Path,
+    pub overrides: &'a [String],
+    pub spec: &'a SweepSpec,
+    pub methods: Methods,
+    pub threads: usize,
+    pub shard: Shard,
+}
+
+impl SweepRun<'_> {
+    /// The shard's points, in order.
+    pub fn points(&self, progress: impl Fn(usize, usize) + Sync) -> Result<Vec<SweepPoint>> {
+        let store = Mutex::new(Vec::new());
+        self.into_store(&store, progress)?;
+        Ok(store
+            .into_inner()
+            .unwrap()
+            .into_iter()
+            .map(|p| p.expect("every point ran"))
+            .collect())
+    }
+
+    /// The shard's points into `store`, one slot a point, which the caller
+    /// may read while it runs (an interrupted sweep publishes the points
+    /// finished so far, [`crate::interrupt`]). Slots already filled (a
+    /// resumed sweep, [`resume`]) are kept: a chunk whose every point is
+    /// filled is skipped, a chunk filled in part is computed again from its
+    /// start, so that each point has the same continuation as in an
+    /// uninterrupted sweep.
+    pub fn into_store(
+        &self,
+        store: &Mutex<Vec<Option<SweepPoint>>>,
+        progress: impl Fn(usize, usize) + Sync,
+    ) -> Result<()> {
+        let SweepRun {
+            path,
+            overrides,
+            spec,
+            methods,
+            threads,
+            shard,
+        } = *self;
+        let all = spec.values();
+        let range = shard.points(all.len());
+        let values = &all[range.clone()];
+        let load = |v: f64| {
+            let mut ov = overrides.to_vec();
+            ov.push(format!("{}={}", spec.key, v));
+            Config::load(path, &ov)
+        };
+        // a key that takes whole numbers fails as a whole on a grid with
+        // fractions (checked over the whole grid, so that every shard agrees)
+        if let Some(v) = all.iter().find(|v| v.fract() != 0.0)
+            && load(*v).is_err_and(|e| e.to_string().contains("expected a whole number"))
+        {
+            return Err(Error::Range {
+                arg: spec.arg(),
+                message: format!(
+                    "{} takes whole numbers, and this grid has {v}: choose whole FROM and TO and a COUNT for which (TO - FROM) / (COUNT - 1) is whole",
+                    spec.key
+                ),
+            });
+        }
+        let configs = checked_configs(&spec.key, &spec.arg(), &all, load)?;
+        compute_into(
+            &spec.key,
+            values,
+            &configs[range],
+            methods,
+            threads,
+            store,
+            progress,
+        )
+    }
 }
 
 /// The configs at `values`, or the sweep's error before any work: a point
