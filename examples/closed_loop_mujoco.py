@@ -580,11 +580,12 @@ def run_cli(cmd):
 
 def csv_route(args, out, cfg):
     """The controllers from the files catflip exports: the study's design as a schedule
-    (`catflip optimize --mode free`, from the analytic seed where the phased one cannot fit,
-    as the study), then `catflip export mjcf --schedule free.csv`: the MJCF, the controls
+    (`catflip optimize --mode free --seed phased`, or `--seed analytic` where the phased one
+    cannot fit, as the study), then `catflip export mjcf --schedule free.csv`: the MJCF, the controls
     `free.mujoco.csv` and the gains `free.tvlqr.csv`."""
     sets = sum((["--set", s] for s in args.overrides), [])
-    code, _, err = run_cli([args.catflip, "optimize", args.config, "--mode", "free", "--out", str(out)] + sets)
+    code, _, err = run_cli([args.catflip, "optimize", args.config, "--mode", "free", "--seed", "phased",
+                            "--out", str(out)] + sets)
     if code != 0:
         code, _, err = run_cli([args.catflip, "optimize", args.config, "--mode", "free", "--seed", "analytic",
                                 "--out", str(out)] + sets)

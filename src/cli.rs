@@ -153,7 +153,7 @@ enum Command {
         common: Common,
         #[arg(long, value_enum, default_value = "phased")]
         mode: Mode,
-        /// Seed of the free-form optimiser (default: phased, or analytic where no phased schedule fits the motors in this fall; only with `--mode free`).
+        /// Seed of the free-form optimiser (default: phased; where no phased schedule fits the motors in this fall, the least-height answer's shortest manoeuvre, as `run`; only with `--mode free`).
         #[arg(long, value_enum)]
         seed: Option<SeedArg>,
         /// Print each iteration (bend evaluations, SCP iterations).
@@ -239,8 +239,8 @@ pub(crate) fn threads_or_cores(threads: Option<u32>) -> usize {
 #[derive(Clone, Copy)]
 enum Optimizer {
     Phased,
-    /// The free-form design from the named seed; none named: the phased
-    /// seed, or the analytic one where no phased schedule fits.
+    /// The free-form design from the named seed; none named: where `run`
+    /// starts it (`pipeline::free_start`).
     Free(Option<catflip::design::free::Seed>),
 }
 
@@ -448,8 +448,7 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
 fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
     // each named seed its own set: a design from `--seed analytic` does not
-    // replace the one without `--seed` (the phased seed, or the analytic one
-    // where no phased schedule fits)
+    // replace the one without `--seed` (`pipeline::free_start`'s)
     let set = match optimizer {
         Optimizer::Phased => "optimize-phased",
         Optimizer::Free(None | Some(catflip::design::free::Seed::Phased)) => "optimize-free",
@@ -469,10 +468,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             let design = match seed {
                 Some(seed) => design.seed(seed),
                 None => {
-                    start = catflip::pipeline::free_start(&spec)?;
-                    if let Some(note) = console::design::start_note(start.1) {
-                        eprintln!("{note}");
-                    }
+                    start = catflip::pipeline::free_start(&spec, |n| eprintln!("note: {n}"))?;
                     design.from_plan(start.0.as_ref(), start.1)
                 }
             };

@@ -553,16 +553,23 @@ impl MethodSummary {
 }
 
 /// Where a free-form design starts when no seed is named (`optimize`, the
-/// Python package, `recovery`'s design at rest), as `run` seeds it: the
+/// Python package, `recovery`'s design at rest): the
 /// phased design; where no phased schedule fits the motors in this fall,
-/// the least-height answer's shortest manoeuvre (`free least-time`); the
-/// analytic schedule where neither exists. When that answer is that no
-/// schedule found fits this fall, it is the error
-/// ([`Error::BeyondMotors`], naming the least height), as `run` does not
-/// attempt the design either: the SCP would only fail to find a design
-/// after many iterations. A phased seed the landing rules out is
-/// [`Error::SeedUnfit`].
-pub fn free_start(spec: &DesignSpec) -> Result<(Box<dyn ShapePlan>, &'static str)> {
+/// the least-height answer's shortest manoeuvre (`free least-time`, as
+/// `run` seeds it); the analytic schedule where neither exists. When that
+/// answer is that no schedule found fits this fall, it is the error
+/// ([`Error::BeyondMotors`], naming the least drop height, [`beyond_reach`]),
+/// as `run` does not attempt the design either: the SCP would only end
+/// locally infeasible after many iterations. A phased seed the landing
+/// rules out is [`Error::SeedUnfit`]. Unlike `run`, the phased seed is not
+/// checked against a torque limit without a torque-speed line
+/// ([`crate::design::phased::seed_plan`]): the free-form design meets the
+/// limit or says from what height it would (F7). `note` is told, in words,
+/// when the least height is sought and which start was taken.
+pub fn free_start(
+    spec: &DesignSpec,
+    mut note: impl FnMut(&str),
+) -> Result<(Box<dyn ShapePlan>, &'static str)> {
     use crate::design::free::Seed;
     match Seed::Phased.plan(spec) {
         Ok(plan) => return Ok((plan, Seed::Phased.name())),
@@ -570,22 +577,40 @@ pub fn free_start(spec: &DesignSpec) -> Result<(Box<dyn ShapePlan>, &'static str
         Err(Error::Unreachable { reason }) => return Err(Error::SeedUnfit { reason }),
         Err(e) => return Err(e),
     }
+    note(
+        "no phased schedule fits the motors in this fall: finding the least drop height first, as `catflip run` does",
+    );
     // (the least height failing leaves the analytic seed, as in `run`)
     if let Ok(Some(h)) = crate::design::least_height::heights(spec, true, |_| {}) {
         let a = &h.answer;
         if !a.possible && a.verified {
             return Err(Error::BeyondMotors {
                 reason: format!(
-                    "no schedule found fits the motors in the fall from {} m (fall.height); the least drop height found is {:.3} m (the {} time design; `catflip run` shows its schedule)",
-                    spec.fall.height, a.least_height_m, a.method
+                    "{}; `catflip run` writes its schedule as least-height.csv",
+                    beyond_reach(a)
                 ),
             });
         }
         if let Some(fr) = h.free {
+            note(&format!(
+                "the least drop height found is {:.3} m; the free-form design starts from the shortest free-form manoeuvre found ({:.4} s)",
+                a.least_height_m, fr.manoeuvre_time_s
+            ));
             return Ok((Box::new(fr.plan), FREE_LEAST_TIME));
         }
     }
+    note("the free-form design starts from the analytic schedule");
     Ok((Seed::Analytic.plan(spec)?, Seed::Analytic.name()))
+}
+
+/// Why no free-form design is attempted in this fall: the least-height
+/// answer `a` says no schedule found fits (`run`'s line and `optimize`'s
+/// error).
+pub fn beyond_reach(a: &crate::design::least_height::HeightAnswer) -> String {
+    format!(
+        "no schedule found fits the motors in the fall from {} m (fall.height); the least drop height found is {:.3} m (the {} time-optimal design)",
+        a.height_m, a.least_height_m, a.method
+    )
 }
 
 /// The name of a free-form design's seed when it is the least-height

@@ -350,7 +350,7 @@ impl Origin {
         let mut at_rest = cfg.clone();
         at_rest.start = Default::default();
         let spec = at_rest.design_spec();
-        let (plan, seed) = crate::pipeline::free_start(&spec)?;
+        let (plan, seed) = crate::pipeline::free_start(&spec, |_| {})?;
         let design = FreeDesign::new(&spec)
             .from_plan(plan.as_ref(), seed)
             .solve()?;

@@ -295,12 +295,7 @@ impl Question {
         self.answer
             .as_ref()
             .filter(|a| !a.possible && a.verified)
-            .map(|a| {
-                format!(
-                    "no schedule found fits the motors in the fall from {} m (fall.height); the least height found is {:.3} m (the {} time design, least-height.csv)",
-                    a.height_m, a.least_height_m, a.method
-                )
-            })
+            .map(|a| format!("{}, least-height.csv", crate::pipeline::beyond_reach(a)))
     }
 
     /// After the designs: a verified free-form schedule inside the envelope

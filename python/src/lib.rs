@@ -426,7 +426,7 @@ fn run_design(
                 let start;
                 let design = match seed {
                     None => {
-                        start = catflip::pipeline::free_start(&spec).map_err(err)?;
+                        start = catflip::pipeline::free_start(&spec, |_| {}).map_err(err)?;
                         design.from_plan(start.0.as_ref(), start.1)
                     }
                     Some("phased") => design.seed(catflip::design::free::Seed::Phased),
@@ -486,8 +486,9 @@ fn run_design(
 /// (`analyze` for `method="analytic"`), with the GIL released.
 ///
 /// `objective` (`"peak-torque"`, `"time"`, `"energy"`) overrides `design.objective`;
-/// `seed` (`"phased"`, `"analytic"`; None: the phased design, or the analytic schedule
-/// where no phased one fits the motors in this fall) applies to `method="free"` only.
+/// `seed` (`"phased"`, `"analytic"`; None: the phased design, or where no phased one fits
+/// the motors in this fall the least-height answer's shortest manoeuvre, as `run` and
+/// `optimize`) applies to `method="free"` only.
 /// Raises ConfigError, ImpossibleError (the motors cannot flip the cat from
 /// `fall.height`) or DesignError, with the CLI's messages.
 #[pyfunction]

@@ -12,21 +12,6 @@ use crate::verify::analyze::Analysis;
 use crate::verify::simulate::SimReport;
 use std::path::PathBuf;
 
-/// The note a free-form design started without a named seed prints when
-/// its start is not the phased design ([`crate::pipeline::free_start`]).
-pub fn start_note(seed: &str) -> Option<String> {
-    let from = match seed {
-        crate::pipeline::FREE_LEAST_TIME => {
-            "the least-height answer's shortest manoeuvre (as `catflip run` does)"
-        }
-        s if s == crate::design::free::Seed::Analytic.name() => "the analytic seed",
-        _ => return None,
-    };
-    Some(format!(
-        "note: no phased schedule fits the motors in this fall, so the free-form design started from {from}"
-    ))
-}
-
 /// `analyze`'s table: the closed forms and the cosine schedule's numbers.
 pub fn analysis(a: &Analysis, written: &[PathBuf]) -> Rows {
     let cf = &a.closed;

@@ -439,8 +439,11 @@ fn optimize_free_without_a_seed_starts_from_the_least_height_design_where_no_pha
         dir.path(),
     );
     assert_eq!(code, Some(0), "{err}");
+    // the notes say what it does while it seeks the least height, and name it
     assert!(
-        err.contains("started from the least-height answer's shortest manoeuvre"),
+        err.contains("finding the least drop height first")
+            && err.contains("the least drop height found is 3.4")
+            && err.contains("starts from the shortest free-form manoeuvre found"),
         "{err}"
     );
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
