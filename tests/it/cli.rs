@@ -449,6 +449,34 @@ fn optimize_free_without_a_seed_starts_from_the_least_height_design_where_no_pha
     let v: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(v["seed"], "free least-time", "{v}");
     assert_eq!(v["verdict"], "ok", "{v}");
+    // `run` starts its free-form design there too: the same design (the
+    // run is partial, exit 3: the phased design it was asked for is not
+    // possible in this fall)
+    let (code, out, err) = util::run(
+        &["run", &robot, "--set", "fall.height=4.5", "--json"],
+        dir.path(),
+    );
+    assert_eq!(code, Some(3), "{err}");
+    let r: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(r["free_seed"], "free least-time", "{r}");
+    let free = r["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == "free")
+        .unwrap();
+    let phased = r["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == "phased")
+        .unwrap();
+    assert_eq!(phased["verdict"], "impossible", "{phased}");
+    let (a, b) = (
+        v["peak_torque_nm"].as_f64().unwrap(),
+        free["peak_torque_nm"].as_f64().unwrap(),
+    );
+    assert!((a - b).abs() <= 1e-9 * a, "optimize {a} N m, run {b} N m");
 }
 
 /// A `time` design answers "from what height": its JSON and table give the
