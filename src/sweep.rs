@@ -843,3 +843,36 @@ pub fn figures(
     }
     Ok(figs)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A point's error sentence holds commas, quotes and a line break: the
+    /// row still has the header's columns, and the sentence reads back whole.
+    #[test]
+    fn an_error_with_commas_stays_one_csv_field() {
+        let error = "phased: needs 1,000 m; free: \"stalled\", then\nfailed";
+        let points = [
+            SweepPoint {
+                value: 0.2,
+                free_peak_nm: Some(0.5),
+                error: Some(error.into()),
+                ..Default::default()
+            },
+            SweepPoint {
+                value: 0.3,
+                ..Default::default()
+            },
+        ];
+        let records = crate::test_support::csv_records(&to_csv("cat.length", &points));
+        assert_eq!(records.len(), 3, "{records:?}");
+        assert!(
+            records.iter().all(|r| r.len() == records[0].len()),
+            "{records:?}"
+        );
+        assert_eq!(records[1][0], "0.2");
+        assert_eq!(records[1].last().unwrap(), error);
+        assert_eq!(records[2].last().unwrap(), "");
+    }
+}
