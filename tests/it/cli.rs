@@ -459,18 +459,8 @@ fn optimize_free_without_a_seed_starts_from_the_least_height_design_where_no_pha
     assert_eq!(code, Some(3), "{err}");
     let r: serde_json::Value = serde_json::from_str(&out).unwrap();
     assert_eq!(r["free_seed"], "free least-time", "{r}");
-    let free = r["methods"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|m| m["method"] == "free")
-        .unwrap();
-    let phased = r["methods"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|m| m["method"] == "phased")
-        .unwrap();
+    let free = util::method_line(&r, "free");
+    let phased = util::method_line(&r, "phased");
     assert_eq!(phased["verdict"], "impossible", "{phased}");
     let (a, b) = (
         v["peak_torque_nm"].as_f64().unwrap(),
