@@ -54,10 +54,11 @@
 //!   timing SOC model's `sum 2 ds / (c_k + c_{k+1})`.
 //!
 //! Units: the program is solved in a time unit `ts` (the fall time or an
-//! estimate from the limits) and the torque unit `nu` (the stall torque, or a
-//! typical inertial torque without one), so its data are of order one
-//! whatever the size of the cat; each bend gets a fresh Clarabel solver so
-//! that its equilibration matches the bend's data.
+//! estimate from the limits) and the torque unit `nu` (the stall torque for
+//! a least-time design; for a peak or energy design a typical inertial
+//! torque in the fall, when that is smaller), so its data are of order one
+//! whatever the size of the cat and the length of the fall; each bend gets
+//! a fresh Clarabel solver so that its equilibration matches the bend's data.
 
 use crate::design::bend_search::{BendEvaluation, BendHint, bend_range, bend_scan};
 use crate::design::bend_search::{Scored, bracket_then_brent, scan_then_brent};
@@ -611,10 +612,15 @@ impl EnvelopeProblem {
                 })
                 .collect()
         });
-        // torque unit `nu`: the stall torque (the bound the design lives
-        // with), else the inertial torque of a path point at a typical
-        // phase's acceleration (36 / ts^2: a third of `ts`, bang-bang in `s`)
-        let nu = self.motor.max_torque.unwrap_or_else(|| {
+        // torque unit `nu`: a typical inertial torque of a path point at a
+        // typical phase's acceleration (36 / ts^2: a third of `ts`,
+        // bang-bang in `s`), the scale of a peak or energy design's torques;
+        // the stall torque when that is smaller (the bound the design lives
+        // with) and for a least-time design, which rides the limits. In a
+        // long fall the torques a budget needs are thousands of times below
+        // the stall torque: in its units Clarabel's tolerances blurred the
+        // objective and the bend search went astray (docs/benchmarks.md).
+        let inertial = || {
             let mut ms: Vec<f64> = data
                 .iter()
                 .flatten()
@@ -622,7 +628,12 @@ impl EnvelopeProblem {
                 .collect();
             ms.sort_by(f64::total_cmp);
             (36.0 * m0 * ms[ms.len() / 2] / (ts * ts)).max(1e-300)
-        });
+        };
+        let nu = match (self.motor.max_torque, self.budget) {
+            (Some(t), Some(_)) => t.min(inertial()),
+            (Some(t), None) => t,
+            (None, _) => inertial(),
+        };
         let per_unit = m0 / (nu * ts * ts);
         for p in data.iter_mut().flatten() {
             p.m = p.m.map(|x| x * per_unit);

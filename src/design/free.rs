@@ -85,7 +85,7 @@ pub struct FreeProblem {
     /// Shortest phase, in units of the available time.
     pub min_phase: f64,
     pub max_bend: Option<f64>,
-    /// Torque limit `T` in units of `torque_unit` (clamped, see [`LIMIT_CAP`]).
+    /// Torque limit `T` in units of `torque_unit` (see [`LIMIT_CAP`]).
     pub max_torque: Option<f64>,
     /// Slope of the torque-speed line in the problem's units: the limited
     /// term is `tau + slope q^ / T_p` (physical `tau + k qd`).
@@ -134,9 +134,11 @@ pub struct FreeProblem {
 pub const CHECKS_PER_INTERVAL: usize = 4;
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
-/// (clamped to it with a torque-speed line): no schedule that flips the cat
-/// comes near it (the cosine schedule needs about 10), and a huge bound
-/// would only wreck the conic solver's scaling.
+/// without a torque-speed line: no schedule that flips the cat comes near it
+/// (the cosine schedule needs about 10), and a huge bound would only wreck
+/// the conic solver's scaling. With a line it is kept: the limited terms
+/// are divided by it ([`crate::design::scp`]), and clamping it would have
+/// lowered the line's no-load speed `T / k` with it.
 pub const LIMIT_CAP: f64 = 1e4;
 
 /// One flattened torque row at a check point: its value and its gradient in
@@ -201,13 +203,14 @@ impl FreeProblem {
             torque_unit,
             min_phase: 0.02 * manoeuvre,
             max_bend: spec.max_bend_deg.map(f64::to_radians),
-            // without a torque-speed line, a limit above the cap can never bind
+            // without a torque-speed line, a limit above the cap can never
+            // bind; with one it is kept whole, since `T / k` is the line's
+            // no-load speed, which binds in any fall
             max_torque: spec
                 .motor
                 .max_torque
                 .map(|l| l / torque_unit)
-                .filter(|&l| l < LIMIT_CAP || spec.motor.slope() > 0.0)
-                .map(|l| l.min(LIMIT_CAP)),
+                .filter(|&l| l < LIMIT_CAP || spec.motor.slope() > 0.0),
             slope: spec.motor.slope() / (torque_unit * time_unit),
             max_speed: spec.motor.max_speed.map(|w| w * time_unit),
             objective: spec.objective,
