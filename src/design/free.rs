@@ -2401,11 +2401,14 @@ pub struct MeshCheck {
 }
 
 /// Re-optimises `r` at twice its nodes per phase (warm start: the coarse
-/// schedule sampled on the fine mesh).
+/// schedule sampled on the fine mesh, with its penalty weight and trust
+/// radius, as on a continuation's finer mesh: from the cold weight the
+/// robot's check wandered for 28 to 81 iterations to end in another basin,
+/// which measured the basin, not the mesh).
 pub fn mesh_check(spec: &DesignSpec, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = grid(spec, nodes, Mesh::Final).sample(&r.plan);
-    let fine = design(spec, &z0, None, nodes, Mesh::Final, 0, |_| {})?;
+    let fine = design(spec, &z0, Some(&r.warm), nodes, Mesh::Final, 0, |_| {})?;
     let (peak, value) = dense_objective(spec, &fine.plan);
     Ok(MeshCheck {
         nodes,
