@@ -245,11 +245,18 @@ impl Neighbours {
 
 /// What the least-height stage carries from point to point: its free-form
 /// `time` designs and the phased `time` designs' bends of consecutive
-/// points.
+/// points; in a sweep of `fall.height` the chunk's first answer.
 #[derive(Default)]
 struct HeightChain {
     designs: Neighbours,
     bends: Vec<f64>,
+    /// `Some` in a sweep of `fall.height`: the least heights do not depend
+    /// on it (the designs are made for a reference drop, [`reference`]),
+    /// so every point from a start at rest has the chunk's first answer,
+    /// which is `run`'s.
+    ///
+    /// [`reference`]: crate::design::least_height::reference
+    same_answer: Option<Option<Heights>>,
 }
 
 impl HeightChain {
@@ -257,6 +264,9 @@ impl HeightChain {
     /// least-height design when there is one, else the cold stage (so the
     /// chunk's first point answers as `run` does).
     fn heights(&mut self, spec: &DesignSpec, with_free: bool) -> Result<Option<Heights>> {
+        if let Some(Some(h)) = &self.same_answer {
+            return Ok(Some(h.clone()));
+        }
         let d = &self.designs;
         let h = match (&d.warm, with_free) {
             (Some(prev), true) => heights_near(
@@ -268,7 +278,16 @@ impl HeightChain {
             _ => heights(spec, with_free, |_| {}),
         };
         match &h {
-            Ok(Some(h)) => self.bends.push(h.phased_bend),
+            Ok(Some(h)) => {
+                self.bends.push(h.phased_bend);
+                if let Some(same) = self
+                    .same_answer
+                    .as_mut()
+                    .filter(|_| spec.is_default_start())
+                {
+                    *same = Some(h.clone());
+                }
+            }
             _ => self.bends.clear(),
         }
         self.designs.advance(
@@ -287,9 +306,14 @@ impl HeightChain {
 }
 
 impl Continuation {
-    fn new(fall_only: bool) -> Self {
+    /// A chunk's continuation in a sweep of `key`.
+    fn new(key: &str) -> Self {
         Continuation {
-            phased: fall_only.then_some(None),
+            phased: FALL_ONLY.contains(&key).then_some(None),
+            height: HeightChain {
+                same_answer: (key == "fall.height").then_some(None),
+                ..Default::default()
+            },
             ..Default::default()
         }
     }
@@ -723,7 +747,7 @@ fn compute_into(
                     if c >= chunks.len() {
                         break;
                     }
-                    let mut chain = Continuation::new(FALL_ONLY.contains(&key));
+                    let mut chain = Continuation::new(key);
                     for i in chunks[c].clone() {
                         let p = match &configs[i] {
                             Ok(cfg) => chain.point(cfg, values[i], methods),

@@ -110,6 +110,7 @@ pub fn fits(spec: &DesignSpec, height: f64) -> bool {
 
 /// The least drop heights of both design families, each from its `time`
 /// design inside the motor envelope.
+#[derive(Clone)]
 pub struct Heights {
     /// The better of the two (see [`HeightAnswer::improve_with`]).
     pub answer: HeightAnswer,

@@ -241,6 +241,36 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
     }
 }
 
+/// The least height does not depend on the height the question is asked
+/// from: a sweep of `fall.height` gives every point the same answer, the
+/// one the least-height stage gives from the config's own 2 m (continued
+/// from their neighbours, the points after the first once drifted by up
+/// to 0.2 %, a different answer to the same question at each).
+#[test]
+fn a_sweep_of_the_fall_height_gives_one_least_height_at_every_point() {
+    let path = configs().join("robot-universal.toml");
+    let spec: catflip::sweep::SweepSpec = "fall.height=4:8:3".parse().unwrap();
+    let methods = catflip::sweep::Methods {
+        analytic: false,
+        phased: true,
+        free: true,
+    };
+    let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
+    let cfg = catflip::Config::load(&path, &[]).unwrap();
+    let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
+        .unwrap()
+        .unwrap();
+    let free = catflip::design::envelope::height_for(
+        &cfg.design_spec(),
+        h.free.as_ref().unwrap().manoeuvre_time_s,
+    );
+    assert_eq!(points.len(), 3);
+    for p in &points {
+        assert_eq!(p.least_height_phased_m, Some(h.phased_m), "{}", p.value);
+        assert_eq!(p.least_height_free_m, Some(free), "{}", p.value);
+    }
+}
+
 /// A grid with whole ends and a whole step is whole at every point (the
 /// step was once formed before multiplying: 0:22:23 gave 14.999999999999998).
 #[test]
