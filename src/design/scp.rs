@@ -272,6 +272,11 @@ settings! {
         /// these, and a weight below them lets the merit trade violation for
         /// cost until the stopping rules raise it again.
         pub max_carried: f64 = 1e3,
+        /// A peak cost's limit counts in the start weight's scale up to this
+        /// multiple of the start's cost: a limit thousands of times the cost
+        /// (a torque-speed line in a long fall, where it cannot bind) made
+        /// the merit all penalty, and the design ran to its iteration limit.
+        pub max_limit_scale: f64 = 1e3,
         /// Locally infeasible when the weight exceeds this multiple of the
         /// start weight `weight` (not of a carried one: from a weight
         /// carried `max_carried` times up, three raises are left).
@@ -380,7 +385,7 @@ impl ScpSettings {
         );
         let positive = |x: f64| x.is_finite() && x > 0.0;
         let share = |x: f64| x.is_finite() && x > 0.0 && x < 1.0;
-        let checks: [(&str, f64, bool, &str); 27] = [
+        let checks: [(&str, f64, bool, &str); 28] = [
             (
                 "max_iterations",
                 self.max_iterations as f64,
@@ -467,6 +472,12 @@ impl ScpSettings {
                 "penalty.max_carried",
                 p.max_carried,
                 p.max_carried >= 1.0,
+                "at least 1",
+            ),
+            (
+                "penalty.max_limit_scale",
+                p.max_limit_scale,
+                p.max_limit_scale.is_finite() && p.max_limit_scale >= 1.0,
                 "at least 1",
             ),
             (
@@ -1534,13 +1545,18 @@ impl<'a> Scp<'a> {
         let (p, s) = (self.p, self.s);
         // the penalty's scale: the cost at the start; for a peak cost at
         // least the limit, which is in the cost's unit (a torque-speed line
-        // can make it many times the cost). A time or energy cost has
+        // can make it many times the cost), up to `max_limit_scale` times
+        // the cost. A time or energy cost has
         // another unit: there the limit's size (torque) says nothing about
         // the multipliers, and a weight hundreds of times the cost makes the
         // merit all penalty
         let (_, cost0, _) = merit(p, &z0, 0.0);
         let scale = match p.cost() {
-            Cost::Peak => cost0.abs().max(p.limit().unwrap_or(0.0)),
+            Cost::Peak => cost0.abs().max(
+                p.limit()
+                    .unwrap_or(0.0)
+                    .min(s.penalty.max_limit_scale * cost0.abs()),
+            ),
             Cost::Linear(_) | Cost::SumOfSquares => cost0.abs(),
         }
         .max(1e-12);
@@ -2672,6 +2688,7 @@ mod tests {
     struct Peaked {
         norm: TorqueNorm,
         on_epigraph: bool,
+        limit: f64,
     }
 
     impl ScpProblem for Peaked {
@@ -2721,11 +2738,32 @@ mod tests {
             vec![1.0, 1.0]
         }
         fn limit(&self) -> Option<f64> {
-            Some(2.0)
+            Some(self.limit)
         }
         fn limited_are_terms(&self) -> bool {
             self.on_epigraph
         }
+    }
+
+    #[test]
+    fn a_limit_far_above_the_cost_counts_in_the_start_weight_up_to_its_cap() {
+        let s = ScpSettings::default();
+        let z0 = vec![0.3, 0.9];
+        let problem = |limit: f64| Peaked {
+            norm: TorqueNorm::PerMotor,
+            on_epigraph: false,
+            limit,
+        };
+        let weight = |limit: f64| Scp::new(&problem(limit), &s).init(z0.clone(), None).weight;
+        let (_, cost0, _) = merit(&problem(2.0), &z0, 0.0);
+        assert!(cost0 > 0.5 && cost0 < 2.0, "{cost0}");
+        // a limit near the cost sets the scale
+        assert_eq!(weight(2.0), s.penalty.weight * 2.0);
+        // one far above it counts up to max_limit_scale times the cost
+        let capped = s.penalty.weight * s.penalty.max_limit_scale * cost0;
+        assert!(capped < s.penalty.weight * 1e9);
+        assert_eq!(weight(1e9), capped);
+        assert_eq!(weight(1e12), capped);
     }
 
     #[test]
@@ -2738,7 +2776,11 @@ mod tests {
         };
         for norm in [TorqueNorm::Euclidean, TorqueNorm::PerMotor] {
             for on_epigraph in [false, true] {
-                let p = Peaked { norm, on_epigraph };
+                let p = Peaked {
+                    norm,
+                    on_epigraph,
+                    limit: 2.0,
+                };
                 let lin = p.linearize(&z);
                 let plus = |a: &[f64], b: &[f64]| a.iter().zip(b).map(|(a, b)| a + b).collect();
                 let moved = Linearization {
@@ -2978,6 +3020,7 @@ mod tests {
         let p = Peaked {
             norm: TorqueNorm::Euclidean,
             on_epigraph: false,
+            limit: 2.0,
         };
         let z = [0.3, 0.9];
         let lin = p.linearize(&z);
