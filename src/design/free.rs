@@ -2402,9 +2402,9 @@ pub struct MeshCheck {
 
 /// Re-optimises `r` at twice its nodes per phase (warm start: the coarse
 /// schedule sampled on the fine mesh, with its penalty weight and trust
-/// radius, as on a continuation's finer mesh: from the cold weight the
-/// robot's check wandered for 28 to 81 iterations to end in another basin,
-/// which measured the basin, not the mesh).
+/// radius, as on a continuation's finer mesh: from the cold weight a check
+/// could wander into another basin, which measures the basin, not the
+/// mesh).
 pub fn mesh_check(spec: &DesignSpec, r: &FreeResult) -> Result<MeshCheck> {
     let nodes = 2 * r.nodes;
     let z0 = grid(spec, nodes, Mesh::Final).sample(&r.plan);
