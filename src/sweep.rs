@@ -253,7 +253,8 @@ struct HeightChain {
     /// `Some` in a sweep of `fall.height`: the least heights do not depend
     /// on it (the designs are made for a reference drop, [`reference`]),
     /// so every point from a start at rest has the chunk's first answer,
-    /// which is `run`'s.
+    /// which is `run`'s. (Its `answer.height_m` and `answer.possible` are
+    /// the first point's: a point reads the heights and the designs only.)
     ///
     /// [`reference`]: crate::design::least_height::reference
     same_answer: Option<Option<Heights>>,

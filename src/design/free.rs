@@ -205,7 +205,7 @@ impl FreeProblem {
             max_bend: spec.max_bend_deg.map(f64::to_radians),
             // without a torque-speed line, a limit above the cap can never
             // bind; with one it is kept whole, since `T / k` is the line's
-            // no-load speed, which binds in any fall
+            // no-load speed, which a fast enough design meets in any fall
             max_torque: spec
                 .motor
                 .max_torque
