@@ -182,6 +182,21 @@ fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_opt
     assert!(bends.windows(2).all(|w| w[1] > w[0] + 1.0), "{bends:?}");
 }
 
+/// The robot's config path and its sweep over `range` (`KEY=FROM:TO:N`)
+/// with the phased and free-form methods, whose least heights the sweep
+/// gives, in one chunk (one thread: every point after the first continues).
+fn robot_least_heights(range: &str) -> (std::path::PathBuf, Vec<catflip::sweep::SweepPoint>) {
+    let path = configs().join("robot-universal.toml");
+    let spec: catflip::sweep::SweepSpec = range.parse().unwrap();
+    let methods = catflip::sweep::Methods {
+        analytic: false,
+        phased: true,
+        free: true,
+    };
+    let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
+    (path, points)
+}
+
 /// A torque-speed line does not scale with the fall (F7 holds for a torque
 /// limit alone): a sweep of the robot must give the least heights `run`
 /// answers with, from the time designs inside the envelope (the F7 scaling
@@ -193,14 +208,7 @@ fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_opt
 /// by under 0.1 % over 0.45 to 0.47 kg, below the designs' convergence.)
 #[test]
 fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
-    let path = configs().join("robot-universal.toml");
-    let spec: catflip::sweep::SweepSpec = "limits.no_load_speed=6.1:5.9:3".parse().unwrap();
-    let methods = catflip::sweep::Methods {
-        analytic: false,
-        phased: true,
-        free: true,
-    };
-    let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
+    let (path, points) = robot_least_heights("limits.no_load_speed=6.1:5.9:3");
     let mut last = 0.0;
     for (i, p) in points.iter().enumerate() {
         let cfg =
@@ -248,14 +256,7 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
 /// to 0.2 %, a different answer to the same question at each).
 #[test]
 fn a_sweep_of_the_fall_height_gives_one_least_height_at_every_point() {
-    let path = configs().join("robot-universal.toml");
-    let spec: catflip::sweep::SweepSpec = "fall.height=4:8:3".parse().unwrap();
-    let methods = catflip::sweep::Methods {
-        analytic: false,
-        phased: true,
-        free: true,
-    };
-    let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
+    let (path, points) = robot_least_heights("fall.height=4:8:3");
     let cfg = catflip::Config::load(&path, &[]).unwrap();
     let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
         .unwrap()
