@@ -282,9 +282,12 @@ pub fn heights(
         (phased, bound, candidates)
     });
     let (mut answer, phased_bend) = phased?;
-    // (the stall-only design's time scaling, F3, holds at zero momentum only: F9)
+    // (the stall-only design's time scaling, F3, holds at zero momentum only:
+    // F9; under the stall torque alone it is the answer's own problem, whose
+    // local optimum bounds nothing)
+    let torque_alone = spec.motor.no_load_speed.is_none() && spec.motor.max_speed.is_none();
     answer.least_height_lower_bound_m = bound
-        .filter(|_| !spec.has_momentum())
+        .filter(|_| !spec.has_momentum() && !torque_alone)
         .map(|t| crate::design::envelope::height_for(spec, t));
     Ok(Some(concluded(spec, (answer, phased_bend), candidates)))
 }

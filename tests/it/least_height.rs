@@ -138,3 +138,28 @@ fn a_spinning_start_has_no_stall_only_bound() {
     assert_eq!(a.least_height_lower_bound_m, None);
     assert!(!a.sentence().contains("at least"), "{}", a.sentence());
 }
+
+/// Under a stall torque alone the least time is the peak optimum's time
+/// scaled until its peak is the limit (F3, F7): the answer is no longer than
+/// that from `optimize`'s own peak design at the same height, and the
+/// stall-only design, the answer's own problem, is no lower bound of it.
+#[test]
+fn under_a_stall_torque_alone_the_answer_is_the_peak_optimum_scaled_and_has_no_bound() {
+    use catflip::design::free::{FreeDesign, Seed};
+    use catflip::model::motor::Motor;
+    let limit = 0.3;
+    let cfg = crate::util::seed(&[&format!("limits.max_torque={limit}")]);
+    let spec = cfg.design_spec();
+    let a = least(&cfg).answer;
+    assert_eq!(a.least_height_lower_bound_m, None, "{}", a.sentence());
+    assert!(!a.sentence().contains("at least"), "{}", a.sentence());
+    // optimize's design: the peak optimum without the limit, from its seed
+    let peak = spec.with_motor(Motor::unlimited(spec.motor.norm));
+    let r = FreeDesign::new(&peak).seed(Seed::Phased).solve().unwrap();
+    let scaled = r.manoeuvre_time_s * (r.peak_torque_nm / limit).sqrt();
+    assert!(
+        a.least_time_s <= scaled * (1.0 + 1e-3),
+        "least time {} s against the scaled peak optimum's {scaled} s",
+        a.least_time_s
+    );
+}
