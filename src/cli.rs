@@ -226,6 +226,22 @@ fn thread_count(s: &str) -> Result<u32, String> {
     }
 }
 
+/// A `--set` of the key that another option sets (a sweep's key, the size's
+/// height) would be overwritten silently, yet name the output set: refused.
+pub(crate) fn refuse_set_of(c: &Common, key: &str, by: &str) -> Result<()> {
+    if let Some(s) = c
+        .set
+        .iter()
+        .find(|s| s.split('=').next().map(str::trim) == Some(key))
+    {
+        return Err(catflip::Error::Usage(format!(
+            "--set {s} conflicts with {by}, which sets {key} itself; leave the --set out"
+        ))
+        .into());
+    }
+    Ok(())
+}
+
 /// Threads to use: as asked, else one per core.
 pub(crate) fn threads_or_cores(threads: Option<u32>) -> usize {
     threads.map(|t| t as usize).unwrap_or_else(|| {
@@ -547,6 +563,7 @@ fn cmd_sweep(
     shard: Shard,
     resume: bool,
 ) -> Result<Status> {
+    refuse_set_of(c, &spec.key, &format!("--set-range {}", spec.arg()))?;
     let cfg = load(c)?;
     let quiet = c.json;
     // a file-name-safe key (an unknown key is refused below, but names the staging first)

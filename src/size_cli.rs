@@ -8,6 +8,7 @@ use catflip::size::{SizeAnswer, SizeSettings, files};
 pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Result<Status> {
     // `--height` replaces `fall.height` before the config is checked: the
     // configured drop is not used, and the margin is judged against this one
+    crate::cli::refuse_set_of(c, "fall.height", &format!("--height {height}"))?;
     let with_height = Common {
         set: [c.set.clone(), vec![format!("fall.height={height}")]].concat(),
         ..c.clone()

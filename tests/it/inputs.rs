@@ -38,6 +38,28 @@ fn refused(args: &[&str], needles: &[&str]) {
     );
 }
 
+/// A `--set` of the key a sweep or `size` sets itself would be overwritten
+/// at every point, yet name the output set: refused, naming both options.
+#[test]
+fn a_set_of_the_key_another_option_sets_is_refused() {
+    let (seed, robot) = (config("seed"), config("robot-universal"));
+    refused(
+        &[
+            "sweep",
+            &seed,
+            "--set-range",
+            "fall.height=1:5:3",
+            "--set",
+            "fall.height=2",
+        ],
+        &["--set fall.height=2", "--set-range fall.height=1:5:3"],
+    );
+    refused(
+        &["size", &robot, "--height", "1", "--set", "fall.height = 5"],
+        &["--set fall.height = 5", "--height 1"],
+    );
+}
+
 #[test]
 fn work_is_bounded_up_front_by_each_keys_range() {
     let robot = config("robot-universal");

@@ -226,11 +226,12 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
         (vec!["--height", "0.04"], "--height"),
         (vec!["--height", "2", "--points", "1"], "--points"),
         (vec!["--height", "2", "--points", "41"], "--points"),
-        // the configured fall.height is not used: a bad one passes to the
-        // next check, and the margin is judged against --height's fall
+        // the configured fall.height is not used, and a --set of it conflicts
+        // with --height (it would name the output set, yet change nothing);
+        // the margin is judged against --height's fall
         (
             vec!["--height", "1", "--set", "fall.height=-3", "--points", "1"],
-            "--points",
+            "--set fall.height=-3 conflicts with --height 1",
         ),
         (
             vec!["--height", "1", "--set", "fall.margin=5"],
