@@ -582,15 +582,10 @@ pub fn free_start(
     );
     // (the least height failing leaves the analytic seed, as in `run`)
     if let Ok(Some(h)) = crate::design::least_height::heights(spec, true, |_| {}) {
-        let a = &h.answer;
-        if !a.possible && a.verified {
-            return Err(Error::BeyondMotors {
-                reason: format!(
-                    "{}; `catflip run` writes its schedule as least-height.csv",
-                    beyond_reach(a)
-                ),
-            });
+        if let Some(e) = out_of_reach(&h.answer) {
+            return Err(e);
         }
+        let a = &h.answer;
         if let Some(fr) = h.free {
             note(&format!(
                 "the least drop height found is {:.3} m; the free-form design starts from the shortest free-form manoeuvre found ({:.4} s)",
@@ -611,6 +606,17 @@ pub fn beyond_reach(a: &crate::design::least_height::HeightAnswer) -> String {
         "no schedule found fits the motors in the fall from {} m (fall.height); the least drop height found is {:.3} m (the {} time-optimal design)",
         a.height_m, a.least_height_m, a.method
     )
+}
+
+/// The error of a design made for this fall when the least-height answer
+/// `a` is that no schedule found fits it (verified), naming the height.
+pub fn out_of_reach(a: &crate::design::least_height::HeightAnswer) -> Option<Error> {
+    (!a.possible && a.verified).then(|| Error::BeyondMotors {
+        reason: format!(
+            "{}; `catflip run` writes its schedule as least-height.csv",
+            beyond_reach(a)
+        ),
+    })
 }
 
 /// The name of a free-form design's seed when it is the least-height
