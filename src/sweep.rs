@@ -622,15 +622,13 @@ impl SweepRun<'_> {
             });
         }
         let configs = checked_configs(&spec.key, &spec.arg(), &all, load)?;
-        compute_into(
-            &spec.key,
+        let never = std::sync::atomic::AtomicBool::new(false);
+        let grid = Grid {
             values,
-            &configs[range],
-            methods,
-            threads,
-            store,
-            progress,
-        )
+            configs: &configs[range],
+            stop: &never,
+        };
+        compute_into(&spec.key, grid, methods, threads, store, progress)
     }
 }
 
@@ -699,34 +697,61 @@ fn checked_configs(
 
 /// The points of a sweep of `key` over `values` (any values, in order; the
 /// chunks of [`CHUNK`] continue along them), `load` giving the config at a
-/// value and `arg` naming the sweep in messages: what a caller with its own
-/// values (the Python package) calls.
+/// value (messages name the sweep as `KEY=[v1, v2, ...]`): what a caller
+/// with its own values (the Python package) calls. Once `stop` is set no
+/// point starts; the points computed by then are returned (`None` for the
+/// others).
 pub fn sweep_values(
     key: &str,
-    arg: &str,
     values: &[f64],
     load: impl Fn(f64) -> Result<Config>,
     methods: Methods,
     threads: usize,
+    stop: &std::sync::atomic::AtomicBool,
     progress: impl Fn(usize, usize) + Sync,
-) -> Result<Vec<SweepPoint>> {
-    let configs = checked_configs(key, arg, values, load)?;
+) -> Result<Vec<Option<SweepPoint>>> {
+    let arg = format!(
+        "{key}=[{}]",
+        values
+            .iter()
+            .map(|v| v.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let configs = checked_configs(key, &arg, values, load)?;
     let store = Mutex::new(Vec::new());
-    compute_into(key, values, &configs, methods, threads, &store, progress)?;
-    Ok(store.into_inner().unwrap().into_iter().flatten().collect())
+    let grid = Grid {
+        values,
+        configs: &configs,
+        stop,
+    };
+    compute_into(key, grid, methods, threads, &store, progress)?;
+    Ok(store.into_inner().unwrap())
 }
 
-/// Computes the points at `values` (with their `configs`) into `store`,
-/// chunk by chunk; chunks whose every slot is filled are skipped.
+/// The points a sweep computes: their values and configs, and the flag after
+/// which no point starts (a caller's stop; the CLI ends the process instead).
+struct Grid<'a> {
+    values: &'a [f64],
+    configs: &'a [Result<Config>],
+    stop: &'a std::sync::atomic::AtomicBool,
+}
+
+/// Computes the grid's points into `store`, chunk by chunk; chunks whose
+/// every slot is filled are skipped.
 fn compute_into(
     key: &str,
-    values: &[f64],
-    configs: &[Result<Config>],
+    grid: Grid<'_>,
     methods: Methods,
     threads: usize,
     store: &Mutex<Vec<Option<SweepPoint>>>,
     progress: impl Fn(usize, usize) + Sync,
 ) -> Result<()> {
+    let Grid {
+        values,
+        configs,
+        stop,
+    } = grid;
     // shards start on chunk boundaries, so local chunks are global chunks
     let results = store;
     let chunks: Vec<std::ops::Range<usize>> = {
@@ -750,6 +775,9 @@ fn compute_into(
                     }
                     let mut chain = Continuation::new(key);
                     for i in chunks[c].clone() {
+                        if stop.load(Ordering::SeqCst) {
+                            return;
+                        }
                         let p = match &configs[i] {
                             Ok(cfg) => chain.point(cfg, values[i], methods),
                             Err(e) => {

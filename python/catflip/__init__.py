@@ -60,9 +60,15 @@ __all__ = [
 SWEEP_METHODS = ("analytic", "phased", "free")
 
 
+def _restore_config(text, origin, overrides, base):
+    """Unpickles a ``Config`` (its ``__reduce__``): the text read and checked again."""
+    return Config._from_state(text, origin, overrides, base)
+
+
 def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
     """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``.
 
+    ``methods`` is a list, or one comma-separated string (``"phased,free"``).
     Each value is set on ``config`` as ``config.set(key, value)`` would (the
     same checks: an invalid value is that point's ``error``, all invalid is a
     ``ConfigError``), and every point is designed by each of ``methods``.
@@ -80,6 +86,8 @@ def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
     """
     import numpy as np
 
+    if isinstance(methods, str):
+        methods = [m.strip() for m in methods.split(",")]
     values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
     columns, csv = _sweep_columns(config, key, values, list(methods), threads)
     if frame is None or frame:

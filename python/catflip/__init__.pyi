@@ -1,5 +1,9 @@
 """Type stubs of catflip (the Python bindings of the catflip Rust library).
 
+Long calls (``design``, ``run``, ``least_height``, ``sweep``, ``Controller(...)``) run with
+the GIL released and end at Ctrl-C with KeyboardInterrupt within 50 ms (a sweep starts no
+new point; other work finishes in the background, its result dropped).
+
 Shapes: N schedule rows (3 phases of ``simulate.samples_per_phase + 1``
 samples; a phase junction appears twice), M simulation steps, n simulator
 steps. Every array is a fresh float64 (``phase``: int64) numpy array.
@@ -44,28 +48,36 @@ class Config:
     """A checked catflip configuration: the CLI's TOML keys, defaults and checks.
 
     Safe to share between threads: ``set`` takes a lock, and every computation
-    works on a copy taken when it starts."""
+    works on a copy taken when it starts. Copies (``copy``, ``copy.copy``,
+    ``copy.deepcopy``) are independent; a pickled config is read and checked
+    again when unpickled (a robot file from the same path)."""
 
     @staticmethod
-    def from_toml(path: Union[str, os.PathLike[str]], overrides: Optional[Sequence[str]] = None) -> Config:
+    def from_toml(path: Union[str, os.PathLike[str]],
+                  overrides: Union[str, Sequence[str], None] = None) -> Config:
         """Reads and checks a TOML config file with the CLI's ``--set KEY=VALUE`` ``overrides``
-        (as ``catflip CMD FILE --set ...``); raises ConfigError."""
+        (one string or a list; as ``catflip CMD FILE --set ...``); raises ConfigError."""
     @staticmethod
     def from_text(text: str, origin: str = "<string>") -> Config:
         """Checks a config given as TOML text; ``origin`` names it in messages."""
     @staticmethod
     def from_dict(d: Dict[str, Any]) -> Config:
         """Checks a config given as a dict of the TOML's tables
-        (``{"name": ..., "cat": {...}, "fall": {...}}``); None values are refused."""
+        (``{"name": ..., "cat": {...}, "fall": {...}}``): numbers (numpy's too), true/false,
+        strings, lists and numpy arrays; a key whose value is None is left unset, as
+        ``to_dict`` gives it. A relative robot file (``body.urdf``) is read from the current
+        folder."""
     def set(self, key: str, value: Value) -> None:
         """Sets one key, e.g. ``set("fall.height", 6)``, with the CLI's ``--set`` checks and
         messages; on a ConfigError the config is left as it was."""
     def copy(self) -> Config:
         """An independent copy (later ``set``s on either leave the other alone)."""
     def to_dict(self) -> Dict[str, Any]:
-        """Every key with its value, defaults included, as nested dicts."""
+        """Every key with its value, defaults included, as nested dicts (None: unset);
+        ``Config.from_dict`` reads it back. A robot file's path (``body.urdf``) is absolute."""
     def to_toml(self) -> str:
-        """Every key with its value, defaults included, as TOML text."""
+        """Every key with its value, defaults included, as TOML text (``Config.from_text``
+        reads it back). A robot file's path (``body.urdf``) is absolute."""
     @property
     def name(self) -> str:
         """The config's ``name`` (the CLI's output folder ``output/<name>/``)."""
@@ -218,7 +230,9 @@ def simulate(config: Config, design: Union[Design, str, os.PathLike[str], None] 
              start: Optional[Dict[str, Value]] = None) -> Simulation:
     """Simulates ``design`` (a Design, a schedule CSV path, or None for the analytic schedule)
     on ``config``'s cat, as ``catflip simulate [--schedule FILE]``, with the GIL released.
-    ``config`` may differ from the design's (model error); ``start`` sets its ``[start]`` keys
+    ``config`` may differ from the design's (model error), but not in its joint or in the
+    time its fall leaves for the manoeuvre (a Design is refused as a CSV of it would be);
+    ``start`` sets its ``[start]`` keys
     (``{"angular_velocity": [0, 0, 0.5], "rotation_deg": [0, 30, 0]}``) for this simulation,
     with the CLI's checks. Raises ConfigError, DesignError."""
 
@@ -273,9 +287,10 @@ def least_height(config: Config) -> Optional[LeastHeight]:
     motor limit. GIL released."""
 
 def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
-          methods: Sequence[str] = ..., threads: Optional[int] = None,
+          methods: Union[str, Sequence[str]] = ..., threads: Optional[int] = None,
           frame: Optional[bool] = None) -> Any:
-    """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``.
+    """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``
+    (``methods``: a list, or one comma-separated string such as ``"phased,free"``).
 
     Returns the CSV's columns (float64 arrays of shape ``(len(values),)``, NaN where a method
     gave no number; ``free_status`` and ``error`` lists of str or None): a
@@ -402,8 +417,9 @@ class Controller:
         ``control.replan_iterations`` SCP iterations) from the state predicted where the new
         plan acts, taken when the model lands better under it; ``feedforward`` then changes
         from that instant on. ``budget_s``: a replan taking longer (wall clock) is dropped
-        (None: none is, as in catflip's deterministic study; a robot sets its control period).
-        Another kind, or a negative budget, raises ConfigError."""
+        (None: none is, as in catflip's deterministic study; a robot sets its control period;
+        ``kind="replan"`` only). Another kind, a negative budget, or a design made for the
+        other joint raises ConfigError."""
     @property
     def kind(self) -> ControllerKind:
         """The study's name of the controller."""
@@ -412,7 +428,8 @@ class Controller:
         measured at ``t`` (s since release): catflip's closed-loop command of the control step
         ``floor(t / period)``. It acts from ``t + delay`` until the next command; the motor is
         given ``clip(feedforward + correction + noise, qd)``. After the last control step the
-        last correction holds. GIL released; ConfigError for a bad ``t`` or state."""
+        last correction holds. GIL released; ConfigError for a bad ``t`` or state (a value
+        that is not finite, an attitude that is not a unit quaternion to 1 %)."""
     def reset(self) -> None:
         """Forgets the corrections sent (a new flight)."""
     def sensed(self, attitude: ArrayLike, q: ArrayLike, qd: ArrayLike, gyro: ArrayLike) -> F64:

@@ -60,6 +60,48 @@ fn err(e: catflip::Error) -> PyErr {
     }
 }
 
+/// Runs `work` on a thread of its own, with the GIL released, while this
+/// thread looks for Python's signals every 50 ms: Ctrl-C raises
+/// KeyboardInterrupt at once (after `on_interrupt`, which may ask the work to
+/// stop; work that cannot stop finishes in the background, its result dropped).
+fn interruptible<T: Send + 'static>(
+    py: Python<'_>,
+    on_interrupt: impl FnOnce(),
+    work: impl FnOnce() -> PyResult<T> + Send + 'static,
+) -> PyResult<T> {
+    use std::sync::mpsc::RecvTimeoutError;
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::Builder::new()
+        .name("catflip".into())
+        .spawn(move || {
+            let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work));
+            let _ = tx.send(r);
+        })
+        .map_err(|e| DesignError::new_err(format!("cannot start a thread: {e}")))?;
+    // (a receiver is not Sync; the lock lets the GIL-free wait borrow it)
+    let rx = Mutex::new(rx);
+    loop {
+        let wait = || {
+            rx.lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .recv_timeout(std::time::Duration::from_millis(50))
+        };
+        match py.detach(wait) {
+            Ok(Ok(r)) => return r,
+            Ok(Err(panic)) => std::panic::resume_unwind(panic),
+            Err(RecvTimeoutError::Timeout) => {
+                if let Err(e) = py.check_signals() {
+                    on_interrupt();
+                    return Err(e);
+                }
+            }
+            Err(RecvTimeoutError::Disconnected) => {
+                return Err(DesignError::new_err("the computation's thread ended without a result"));
+            }
+        }
+    }
+}
+
 fn json_loads<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
     py.import("json")?.call_method1("loads", (v.to_string(),))
 }
@@ -137,6 +179,24 @@ impl Config {
         })
     }
 
+    /// The config as `to_dict` and `to_toml` give it, and whether it has a
+    /// `[body]`: its robot file's path made absolute, so that its keys read
+    /// back from another folder. (With a `[body]` the `[cat]` cylinders are
+    /// its equivalent ones, which the keys leave out: the body gives them.)
+    fn portable(&self) -> (bool, Cfg) {
+        let (source, mut cfg) = self.snapshot();
+        if let Some(b) = cfg.body.as_mut() {
+            for p in [&mut b.urdf, &mut b.mjcf].into_iter().flatten() {
+                let joined = source.base.join(&*p);
+                *p = std::path::absolute(&joined)
+                    .unwrap_or(joined)
+                    .display()
+                    .to_string();
+            }
+        }
+        (cfg.body.is_some(), cfg)
+    }
+
     /// A consistent copy to compute with (the lock is not held during solves).
     fn snapshot(&self) -> (Source, Cfg) {
         let s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
@@ -144,8 +204,114 @@ impl Config {
     }
 }
 
+/// The `[cat]` keys a `[body]` replaces (`cat.joint` stays).
+const CYLINDER_KEYS: [&str; 4] = ["mass", "length", "radius", "front"];
+
+fn strip_cylinders(cat: Option<&mut serde_json::Map<String, serde_json::Value>>) {
+    if let Some(c) = cat {
+        for k in CYLINDER_KEYS {
+            c.remove(k);
+        }
+    }
+}
+
+/// A numpy array or scalar (anything with `tolist`, not a plain Python value)
+/// as the list or number it holds.
+fn plain<'py>(v: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
+    let python = v.is_instance_of::<PyBool>()
+        || v.is_instance_of::<PyInt>()
+        || v.is_instance_of::<PyFloat>()
+        || v.is_instance_of::<PyString>()
+        || v.is_instance_of::<PyList>()
+        || v.is_instance_of::<PyTuple>()
+        || v.is_instance_of::<PyDict>();
+    if !python && v.hasattr("tolist")? {
+        return Ok(Some(v.call_method0("tolist")?));
+    }
+    Ok(None)
+}
+
+/// A Python value as a TOML value (a config dict's): numbers, true/false,
+/// strings, lists, dicts and numpy arrays; `None` leaves the key out (an
+/// unset key, as `Config.to_dict` gives it). NaN and infinities pass, so the
+/// config's own check names the key.
+fn toml_value(v: &Bound<'_, PyAny>, key: &str) -> PyResult<Option<toml::Value>> {
+    if let Some(p) = plain(v)? {
+        return toml_value(&p, key);
+    }
+    if v.is_none() {
+        return Ok(None);
+    }
+    if v.is_instance_of::<PyBool>() {
+        return Ok(Some(toml::Value::Boolean(v.extract()?)));
+    }
+    if v.is_instance_of::<PyInt>() {
+        return Ok(Some(toml::Value::Integer(v.extract().map_err(|_| {
+            ConfigError::new_err(format!("{key}: {v} does not fit a 64-bit integer"))
+        })?)));
+    }
+    if v.is_instance_of::<PyFloat>() {
+        return Ok(Some(toml::Value::Float(v.extract()?)));
+    }
+    if v.is_instance_of::<PyString>() {
+        return Ok(Some(toml::Value::String(v.extract()?)));
+    }
+    if let Ok(d) = v.cast::<PyDict>() {
+        let mut t = toml::Table::new();
+        for (k, x) in d.iter() {
+            let k: String = k.extract().map_err(|_| {
+                PyTypeError::new_err(format!(
+                    "config dict: the keys of `{key}` are strings, not {k}"
+                ))
+            })?;
+            let name = if key.is_empty() { k.clone() } else { format!("{key}.{k}") };
+            if let Some(x) = toml_value(&x, &name)? {
+                t.insert(k, x);
+            }
+        }
+        return Ok(Some(toml::Value::Table(t)));
+    }
+    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
+        let mut items = Vec::new();
+        for x in v.try_iter()? {
+            let x = x?;
+            items.push(toml_value(&x, key)?.ok_or_else(|| {
+                ConfigError::new_err(format!("config dict: `{key}` holds None in a list"))
+            })?);
+        }
+        return Ok(Some(toml::Value::Array(items)));
+    }
+    Err(PyTypeError::new_err(format!(
+        "config dict: `{key}` is a number, true/false, a string, a list or a dict, not {}",
+        v.get_type().name()?
+    )))
+}
+
+/// `overrides`: one `"KEY=VALUE"` or a list of them.
+fn override_list(v: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
+    if let Ok(s) = v.extract::<String>() {
+        return Ok(vec![s]);
+    }
+    v.extract().map_err(|_| {
+        PyTypeError::new_err(format!(
+            "overrides is a list of \"KEY=VALUE\" strings (or one), not {}",
+            v.get_type().name().map_or_else(|_| "that".into(), |n| n.to_string())
+        ))
+    })
+}
+
+/// A count or index from Python: not negative.
+fn count(v: i64, what: &str) -> PyResult<usize> {
+    usize::try_from(v).map_err(|_| {
+        ConfigError::new_err(format!("{what} = {v}: give 0 or more"))
+    })
+}
+
 /// A Python value as the TOML text of a `--set KEY=VALUE`.
 fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
+    if let Some(p) = plain(v)? {
+        return toml_text(&p);
+    }
     if v.is_instance_of::<PyBool>() {
         return Ok(if v.extract::<bool>()? {
             "true"
@@ -200,8 +366,9 @@ impl Config {
     fn from_toml(
         py: Python<'_>,
         path: PathBuf,
-        overrides: Option<Vec<String>>,
+        overrides: Option<&Bound<'_, PyAny>>,
     ) -> PyResult<Config> {
+        let overrides = overrides.map(override_list).transpose()?;
         let text = std::fs::read_to_string(&path).map_err(|e| {
             err(catflip::Error::ConfigRead {
                 path: path.clone(),
@@ -237,17 +404,11 @@ impl Config {
         )
     }
 
-    /// Checks a config given as a dict of the TOML's tables (`{"name": ..., "cat": {...}, "fall": {...}}`).
+    /// Checks a config given as a dict of the TOML's tables (`{"name": ..., "cat": {...}, "fall": {...}}`);
+    /// a key whose value is None is left unset (as `to_dict` gives it), numpy arrays are lists.
     #[staticmethod]
     fn from_dict(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Config> {
-        let json: String = py.import("json")?.call_method1("dumps", (d,))?.extract()?;
-        let value: serde_json::Value =
-            serde_json::from_str(&json).map_err(|e| ConfigError::new_err(e.to_string()))?;
-        let table = toml::Value::try_from(value).map_err(|e| {
-            ConfigError::new_err(format!(
-                "config dict: {e} (leave an unset key out rather than giving None)"
-            ))
-        })?;
+        let table = toml_value(d.as_any(), "")?.unwrap_or(toml::Value::Table(Default::default()));
         let text = toml::to_string(&table).map_err(|e| ConfigError::new_err(e.to_string()))?;
         Config::from_source(
             py,
@@ -294,17 +455,65 @@ impl Config {
         }
     }
 
-    /// Every key with its value, defaults included, as nested dicts.
-    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
-        json_loads(
-            py,
-            &serde_json::to_value(self.snapshot().1).expect("a config serialises"),
-        )
+    fn __copy__(&self) -> Config {
+        self.copy()
     }
 
-    /// Every key with its value, defaults included, as TOML text.
+    fn __deepcopy__(&self, _memo: &Bound<'_, PyAny>) -> Config {
+        self.copy()
+    }
+
+    /// Pickled as its text, origin, overrides and folder: unpickling reads
+    /// and checks them again (the robot file too, from the same path).
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+        let (s, _) = self.snapshot();
+        let restore = py.import("catflip")?.getattr("_restore_config")?;
+        let args = (s.text, s.origin, s.overrides, s.base).into_pyobject(py)?;
+        Ok((restore, args))
+    }
+
+    /// The config `__reduce__` describes (for pickle).
+    #[staticmethod]
+    fn _from_state(
+        text: String,
+        origin: String,
+        overrides: Vec<String>,
+        base: PathBuf,
+    ) -> PyResult<Config> {
+        let source = Source {
+            text,
+            origin,
+            overrides,
+            base,
+        };
+        let cfg = source.load(None).map_err(err)?;
+        Ok(Config {
+            inner: Mutex::new(Snapshot { source, cfg }),
+        })
+    }
+
+    /// Every key with its value, defaults included, as nested dicts (None: unset);
+    /// `Config.from_dict` reads it back. A robot file's path (`body.urdf`) is absolute.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
+        let (body, cfg) = self.portable();
+        let mut v = serde_json::to_value(cfg).expect("a config serialises");
+        if body {
+            strip_cylinders(v.get_mut("cat").and_then(|c| c.as_object_mut()));
+        }
+        json_loads(py, &v)
+    }
+
+    /// Every key with its value, defaults included, as TOML text (`Config.from_text`
+    /// reads it back). A robot file's path (`body.urdf`) is absolute.
     fn to_toml(&self) -> String {
-        toml::to_string(&self.snapshot().1).expect("a config serialises")
+        let (body, cfg) = self.portable();
+        let mut v = toml::Table::try_from(cfg).expect("a config serialises");
+        if body && let Some(toml::Value::Table(cat)) = v.get_mut("cat") {
+            for k in CYLINDER_KEYS {
+                cat.remove(k);
+            }
+        }
+        toml::to_string(&v).expect("a config serialises")
     }
 
     /// The config's `name` (the CLI's output folder `output/<name>/`).
@@ -520,7 +729,7 @@ fn design(
         }
     };
     let seed = seed.map(String::from);
-    py.detach(move || run_design(cfg, source, method, seed.as_deref()))
+    interruptible(py, || {}, move || run_design(cfg, source, method, seed.as_deref()))
 }
 
 #[pymethods]
@@ -657,6 +866,13 @@ impl Design {
     fn schedule_json(&self) -> String {
         self.schedule.to_json()
     }
+    /// Immutable: a copy is the same object.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
     fn __repr__(&self) -> String {
         format!(
             "Design(method={:?}, status={:?}, verdict={:?}, peak={:.6} N m, {} rows)",
@@ -678,6 +894,22 @@ struct Simulation {
     report: SimReport,
     source: String,
     reason: Option<String>,
+}
+
+/// A design's torques are the joint's: a design made for the other joint
+/// (rotation-vector torques against two hinges) cannot be flown on `cfg`'s body.
+fn same_joint(cfg: &Cfg, d: &Design) -> PyResult<()> {
+    let (want, made) = (cfg.cat().joint, d.cfg.cat().joint);
+    if want != made {
+        return Err(ConfigError::new_err(format!(
+            "the {} design was made for the {} joint, but config `{}` has the {} joint; design one for this body",
+            d.method,
+            made.name(),
+            cfg.name,
+            want.name()
+        )));
+    }
+    Ok(())
 }
 
 /// What `simulate` runs: a design's plan, a schedule file, or the analytic plan.
@@ -732,6 +964,19 @@ fn simulate(
             }
         },
     };
+    if let Subject::Design(d) = &subject {
+        let d = d.get();
+        same_joint(&cfg, d)?;
+        let b = d.schedule.phase_bounds();
+        if let Some(why) =
+            catflip::verify::simulate::span_mismatch(&cfg.design_spec(), &cfg.name, b[0], b[3])
+        {
+            return Err(ConfigError::new_err(format!(
+                "the {} design: {why}; simulate it with the config it was made for (design.config, with any model error set on it), or design one for this fall",
+                d.method
+            )));
+        }
+    }
     py.detach(move || {
         let (source, report) = match &subject {
             Subject::Design(d) => {
@@ -895,6 +1140,13 @@ impl Simulation {
         }
         s
     }
+    /// Immutable: a copy is the same object.
+    fn __copy__(slf: Py<Self>) -> Py<Self> {
+        slf
+    }
+    fn __deepcopy__(slf: Py<Self>, _memo: &Bound<'_, PyAny>) -> Py<Self> {
+        slf
+    }
     fn __repr__(&self) -> String {
         format!(
             "Simulation(source={:?}, flip_deg={:.6}, tilt_deg={:.3e}, verdict={:?})",
@@ -1015,7 +1267,7 @@ impl LeastHeight {
 #[pyfunction]
 fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>> {
     let (_, cfg) = config.snapshot();
-    py.detach(move || {
+    interruptible(py, || {}, move || {
         let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
             .map_err(err)?;
         Ok(h.map(|h| LeastHeight {
@@ -1035,7 +1287,7 @@ fn sweep_columns<'py>(
     key: String,
     values: Vec<f64>,
     methods: Vec<String>,
-    threads: Option<usize>,
+    threads: Option<i64>,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let (source, _) = config.snapshot();
     let mut m = catflip::sweep::Methods {
@@ -1055,35 +1307,39 @@ fn sweep_columns<'py>(
             }
         }
     }
-    if threads == Some(0) {
-        return Err(ConfigError::new_err(
-            "threads=0: at least one point must be computed at a time; give 1 or more, or None for one per core",
-        ));
+    if let Some(t) = threads
+        && t < 1
+    {
+        return Err(ConfigError::new_err(format!(
+            "threads={t}: at least one point must be computed at a time; give 1 or more, or None for one per core"
+        )));
     }
+    let threads = threads.map(|t| t as usize);
     let threads =
         threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
-    let arg = format!(
-        "{key}=[{}]",
-        values
-            .iter()
-            .map(|v| v.to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let (points, csv) = py.detach(|| {
-        let points = catflip::sweep::sweep_values(
-            &key,
-            &arg,
-            &values,
-            |v| source.load(Some(&format!("{key}={v}"))),
-            m,
-            threads,
-            |_, _| {},
-        )
-        .map_err(err)?;
-        let csv = catflip::sweep::to_csv(&key, &points);
-        Ok::<_, PyErr>((points, csv))
-    })?;
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let asked = stop.clone();
+    let (points, csv) = interruptible(
+        py,
+        move || asked.store(true, std::sync::atomic::Ordering::SeqCst),
+        move || {
+            let points: Vec<_> = catflip::sweep::sweep_values(
+                &key,
+                &values,
+                |v| source.load(Some(&format!("{key}={v}"))),
+                m,
+                threads,
+                &stop,
+                |_, _| {},
+            )
+            .map_err(err)?
+            .into_iter()
+            .flatten()
+            .collect();
+            let csv = catflip::sweep::to_csv(&key, &points);
+            Ok((points, csv))
+        },
+    )?;
     let d = PyDict::new(py);
     let col = |f: &dyn Fn(&catflip::sweep::SweepPoint) -> Option<f64>| {
         points
@@ -1136,7 +1392,7 @@ struct Run {
 #[pyfunction]
 fn run(py: Python<'_>, config: &Config) -> PyResult<Run> {
     let (_, cfg) = config.snapshot();
-    py.detach(move || {
+    interruptible(py, || {}, move || {
         let r = catflip::run::run(&cfg, |_| {}).map_err(err)?;
         Ok(Run {
             summary: serde_json::to_value(&r.summary).expect("serialises"),
@@ -1374,6 +1630,18 @@ fn sim_state(state: Vec<f64>) -> PyResult<SimState> {
     })
 }
 
+/// An attitude quaternion `w x y z` must be a rotation: of unit norm (to 1 %;
+/// a simulator's is to rounding), not zero or a raw sum of noise.
+fn unit_attitude(a: &[f64]) -> PyResult<()> {
+    let norm = a.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if (norm - 1.0).abs() > 1e-2 {
+        return Err(ConfigError::new_err(format!(
+            "the attitude quaternion {a:?} has norm {norm:.6}; give the rear half's attitude as a unit quaternion w, x, y, z"
+        )));
+    }
+    Ok(())
+}
+
 fn pair(v: Vec<f64>, what: &str) -> PyResult<[f64; 2]> {
     v.try_into().map_err(|v: Vec<f64>| {
         ConfigError::new_err(format!("{what} has {} values; give 2", v.len()))
@@ -1450,6 +1718,12 @@ impl Controller {
         budget_s: Option<f64>,
     ) -> PyResult<Controller> {
         let kind = controller_kind(kind)?;
+        if budget_s.is_some() && kind != Kind::Replan {
+            return Err(ConfigError::new_err(format!(
+                "budget_s applies to kind=\"replan\" (a replan's wall-clock budget); leave it out for kind=\"{}\"",
+                kind.name()
+            )));
+        }
         if let Some(b) = budget_s
             && !(b.is_finite() && b >= 0.0)
         {
@@ -1458,7 +1732,10 @@ impl Controller {
             )));
         }
         let (_, cfg) = config.snapshot();
-        py.detach(move || {
+        if let Some(d) = &design {
+            same_joint(&cfg, d.get())?;
+        }
+        interruptible(py, || {}, move || {
             let plan = match design {
                 Some(d) => ControllerPlan::Design(d),
                 None => ControllerPlan::Study(std::sync::Arc::new(
@@ -1505,6 +1782,7 @@ impl Controller {
                 "state {s:?} has a value that is not finite"
             )));
         }
+        unit_attitude(&s[..4])?;
         let u = py.detach(|| {
             let mut o = self.lock();
             let k = o.step_at(t);
@@ -1535,7 +1813,14 @@ impl Controller {
         let g: [f64; 3] = gyro
             .try_into()
             .map_err(|_| ConfigError::new_err("gyro: give 3 values, rad/s"))?;
-        let s = self.lock().sensed(a, pair(q, "q")?, pair(qd, "qd")?, g);
+        let (q, qd) = (pair(q, "q")?, pair(qd, "qd")?);
+        if a.iter().chain(&g).chain(&q).chain(&qd).any(|v| !v.is_finite()) {
+            return Err(ConfigError::new_err(format!(
+                "a measurement is not finite: attitude {a:?}, q {q:?}, qd {qd:?}, gyro {g:?}"
+            )));
+        }
+        unit_attitude(&a)?;
+        let s = self.lock().sensed(a, q, qd, g);
         Ok(vector(py, s.to_vec()))
     }
 
@@ -1681,8 +1966,10 @@ impl Controller {
     /// (`trial=None`: the model, the config's start, no delay or noise), or trial `trial`
     /// of `catflip robustness --seed SEED` (its draws, delay and noises). GIL released.
     #[pyo3(signature = (trial = None, seed = 0))]
-    fn fly(&self, py: Python<'_>, trial: Option<usize>, seed: u64) -> Flight {
-        py.detach(|| {
+    fn fly(&self, py: Python<'_>, trial: Option<i64>, seed: i64) -> PyResult<Flight> {
+        let trial = trial.map(|t| count(t, "trial")).transpose()?;
+        let seed = count(seed, "seed")? as u64;
+        Ok(py.detach(|| {
             let o = self.lock().clone();
             let r = o.flight_reference();
             let (draw, flight) = match trial {
@@ -1718,7 +2005,7 @@ impl Controller {
                 correction: log.iter().map(|c| c.correction).collect(),
                 draw: draw.map(|d| serde_json::to_value(d).expect("serialises")),
             }
-        })
+        }))
     }
 
     fn __repr__(&self) -> String {

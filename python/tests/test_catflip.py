@@ -205,6 +205,57 @@ def test_from_dict_and_from_text_read_as_the_file():
         catflip.Config.from_dict({**tomllib.loads(seed.read_text()), "cat": {"masss": 1}})
 
 
+@pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.stem)
+def test_a_configs_keys_read_back_and_pickle(path, tmp_path, monkeypatch):
+    import copy
+    import pickle
+
+    a = catflip.Config.from_toml(path, "fall.height=7")
+    monkeypatch.chdir(tmp_path)  # a robot file's path must not depend on the folder
+    for b in (catflip.Config.from_dict(a.to_dict()), catflip.Config.from_text(a.to_toml()),
+              pickle.loads(pickle.dumps(a)), copy.deepcopy(a), copy.copy(a)):
+        assert b.to_dict() == a.to_dict()
+    assert pickle.loads(pickle.dumps(a)).overrides == a.overrides == ["fall.height=7"]
+
+
+def test_numpy_values_and_none_as_config_values():
+    c = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    c.set("start.angular_velocity", np.array([0.0, 0.0, 0.5]))
+    c.set("fall.height", np.float64(9.0))
+    d = c.to_dict()
+    assert d["start"]["angular_velocity"] == [0.0, 0.0, 0.5] and d["fall"]["height"] == 9.0
+    d["start"]["angular_velocity"] = np.array([0.1, 0.0, 0.0])
+    d["limits"]["max_torque"] = None  # unset, as to_dict gives it
+    assert catflip.Config.from_dict(d).to_dict()["start"]["angular_velocity"] == [0.1, 0.0, 0.0]
+    d["fall"]["height"] = float("nan")
+    with pytest.raises(catflip.ConfigError, match="fall.height` = NaN is invalid"):
+        catflip.Config.from_dict(d)
+
+
+def test_a_design_is_simulated_only_in_the_fall_it_lasts():
+    seed = ROOT / "configs" / "seed.toml"
+    d = catflip.design(catflip.Config.from_toml(seed), "phased")
+    for h in ("0.5", "40"):
+        with pytest.raises(catflip.ConfigError, match="the schedule runs from t = 0 s to"):
+            catflip.simulate(catflip.Config.from_toml(seed, [f"fall.height={h}"]), d)
+    # another body in the same fall is model error, and flies
+    heavier = catflip.Config.from_toml(seed, ["cat.mass=2.2"])
+    assert catflip.simulate(heavier, d).t[-1] == pytest.approx(d.duration)
+
+
+def test_ctrl_c_interrupts_a_long_call():
+    import signal
+
+    c = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    timer = threading.Timer(0.5, os.kill, (os.getpid(), signal.SIGINT))
+    start = time.monotonic()
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        catflip.sweep(c, "cat.radius", np.linspace(0.05, 0.2, 400), threads=1, frame=False)
+    # 400 points take minutes; the interrupt ends the call at the next look (50 ms)
+    assert time.monotonic() - start < 10
+
+
 def test_arrays_have_the_documented_shapes_and_dtypes():
     cfg = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
     cfg.set("simulate.samples_per_phase", 10)

@@ -180,6 +180,33 @@ def test_bad_arguments_raise_config_errors():
         c.torque(-1.0, c.nominal[0])
     with pytest.raises(catflip.ConfigError, match="not finite"):
         c.torque(0.0, [math.nan] * 11)
+    # an attitude that is no rotation, and counts below zero
+    with pytest.raises(catflip.ConfigError, match="unit quaternion"):
+        c.torque(0.0, np.zeros(11))
+    with pytest.raises(catflip.ConfigError, match="not finite"):
+        c.sensed([1, 0, 0, 0], [0, 0], [math.nan, 0], [0, 0, 0])
+    with pytest.raises(catflip.ConfigError, match="trial = -1"):
+        c.fly(trial=-1)
+    with pytest.raises(catflip.ConfigError, match="seed = -1"):
+        c.fly(trial=0, seed=-1)
+    with pytest.raises(catflip.ConfigError, match='budget_s applies to kind="replan"'):
+        catflip.Controller(config("seed"), kind="tvlqr", budget_s=0.01)
+
+
+def test_below_the_least_height_the_studys_design_names_it():
+    # as `run` answers: neither the phased nor the analytic start fits from 2 m
+    robot = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml")
+    with pytest.raises(catflip.ImpossibleError, match="the least drop height found is 3.4"):
+        catflip.Controller(robot)
+
+
+def test_a_design_for_the_other_joint_is_refused():
+    seed = catflip.design(config("seed"), "phased")
+    robot = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml", ["fall.height=20"])
+    with pytest.raises(catflip.ConfigError, match="made for the no-twist joint.*has the universal joint"):
+        catflip.Controller(robot, design=seed)
+    with pytest.raises(catflip.ConfigError, match="made for the no-twist joint.*has the universal joint"):
+        catflip.simulate(robot, seed)
 
 
 def test_controllers_release_the_gil_and_share_between_threads():

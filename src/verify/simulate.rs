@@ -582,29 +582,40 @@ pub fn read_schedule(spec: &DesignSpec, name: &str, text: &str, origin: &str) ->
         });
     }
     let b = s.phase_bounds();
-    let (start, end) = (b[0], b[3]);
-    let want = spec.available_time();
-    let tol = 1e-6 * (1.0 + want);
-    if start.abs() > tol || (end - want).abs() > tol {
-        // a schedule from 0 fits one height; one that starts later, none
-        let fits = if start.abs() <= tol {
-            format!(
-                "this one fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
-                0.5 * spec.fall.gravity * (end + spec.fall.margin).powi(2)
-            )
-        } else {
-            "this one does not start at 0, so no height fits it".into()
-        };
+    if let Some(why) = span_mismatch(spec, name, b[0], b[3]) {
         return Err(Error::Schedule {
             file: origin.into(),
             line: s.rows.len() + 1,
             message: format!(
-                "the schedule runs from t = {start} s to {end} s, but config `{}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then; replay it with the config it was designed for ({fits}), or design one for this fall with `catflip optimize`",
-                name,
-                spec.fall_time(),
-                spec.fall.margin,
+                "{why}; replay it with the config it was designed for, or design one for this fall with `catflip optimize`"
             ),
         });
     }
     Ok(s)
+}
+
+/// Why a schedule running from `start` to `end`, s, cannot be flown in the
+/// fall of config `name` (`spec`): it must start at release and end when the
+/// manoeuvre's time does, as every design made for that fall does. `None`
+/// when it fits.
+pub fn span_mismatch(spec: &DesignSpec, name: &str, start: f64, end: f64) -> Option<String> {
+    let want = spec.available_time();
+    let tol = 1e-6 * (1.0 + want);
+    if start.abs() <= tol && (end - want).abs() <= tol {
+        return None;
+    }
+    // a schedule from 0 fits one height; one that starts later, none
+    let fits = if start.abs() <= tol {
+        format!(
+            "it fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
+            0.5 * spec.fall.gravity * (end + spec.fall.margin).powi(2)
+        )
+    } else {
+        "it does not start at 0, so no height fits it".into()
+    };
+    Some(format!(
+        "the schedule runs from t = {start} s to {end} s, but config `{name}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then ({fits})",
+        spec.fall_time(),
+        spec.fall.margin,
+    ))
 }
