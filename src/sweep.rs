@@ -105,7 +105,14 @@ impl SweepSpec {
                 if i == self.count - 1 {
                     self.to
                 } else {
-                    self.from + step * i as f64
+                    // to 12 significant digits, a rounding's distance: a
+                    // decimal grid prints as typed (0.17, not 0.16999999999999998)
+                    let v = self.from + step * i as f64;
+                    if v == 0.0 {
+                        return v;
+                    }
+                    let e = 10f64.powi(11 - v.abs().log10().floor() as i32);
+                    (v * e).round() / e
                 }
             })
             .collect()
