@@ -371,7 +371,12 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
         })
     };
     let c = cfg.cat();
+    // with a [body] the cylinders are its equivalent ones, not typed keys
+    let typed = cfg.body.is_none();
     for (key, m) in [("cat.mass", c.rear.mass), ("cat.front.mass", c.front.mass)] {
+        if !typed {
+            break;
+        }
         if m > 200.0
             && (key == "cat.mass" || cfg.cat.front.as_ref().is_some_and(|f| f.mass.is_some()))
         {
@@ -385,8 +390,8 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
         }
     }
     for (key, h, set) in [
-        ("cat", &c.rear, true),
-        ("cat.front", &c.front, cfg.cat.front.is_some()),
+        ("cat", &c.rear, typed),
+        ("cat.front", &c.front, typed && cfg.cat.front.is_some()),
     ] {
         if !set {
             continue;
