@@ -711,6 +711,11 @@ fn design(
 ) -> PyResult<Design> {
     let (mut source, mut cfg) = config.snapshot();
     if let Some(o) = objective {
+        if !["peak-torque", "time", "energy"].contains(&o) {
+            return Err(ConfigError::new_err(format!(
+                "unknown objective `{o}`; use \"peak-torque\", \"time\" or \"energy\" (or None: design.objective)"
+            )));
+        }
         let arg = format!(
             "design.objective={}",
             serde_json::to_string(o).expect("serialises")

@@ -191,6 +191,8 @@ def test_set_and_objective_apply_like_the_cli(tmp_path):
         catflip.design(cfg, "phased", seed="analytic")
     with pytest.raises(catflip.ConfigError, match="unknown method"):
         catflip.design(cfg, "fast")
+    with pytest.raises(catflip.ConfigError, match='unknown objective `speed`; use "peak-torque"'):
+        catflip.design(cfg, objective="speed")
 
 
 def test_from_dict_and_from_text_read_as_the_file():
