@@ -2315,13 +2315,9 @@ fn continue_from(
 fn grid(spec: &DesignSpec, nodes: usize, mesh: Mesh) -> Transcription {
     let tr = Transcription::new(3, nodes);
     // (`uses_envelope` holds for every objective but the peak torque)
-    let torque_bound_alone = spec.objective == Objective::Time
-        && spec.motor.max_torque.is_some()
-        && spec.motor.no_load_speed.is_none()
-        && spec.motor.max_speed.is_none();
     if spec.free.torque_jumps
         && mesh == Mesh::Final
-        && (!spec.uses_envelope() || torque_bound_alone)
+        && !spec.uses_envelope()
         && Release::of(spec, 1.0).is_none()
     {
         tr.with_jumps()
