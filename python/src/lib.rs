@@ -1653,9 +1653,21 @@ fn pair(v: Vec<f64>, what: &str) -> PyResult<[f64; 2]> {
     })
 }
 
-/// One of the study's controllers along a design, for a simulation loop run
-/// outside catflip (MuJoCo, a robot): `torque(t, state)` is what catflip's own
-/// closed loop commands from that measurement.
+/// One of `catflip robustness`'s controllers along a design, for a simulation loop run
+/// outside catflip (MuJoCo, pyBullet, a robot): `torque(t, state)` is the correction
+/// catflip's own closed loop sends from that measurement (docs/control.md).
+///
+/// The state (11 floats) is the `<stem>.tvlqr.csv` convention: the rear half's attitude
+/// `W R` as a unit quaternion `w, x, y, z` in the simulators' world (gravity `-z`),
+/// `lambda` (3: the angular momentum about the common centre of mass in the rear half's
+/// frame, N m s), `q` (2) and `q_dot` (2): the hinge angles for the universal joint, the
+/// ball's rotation vector `(v1, v2)` and its rate for the no-twist joint. `sensed` builds
+/// it from a gyro. Torques are catflip's joint torques (hinge torques; rotation-vector
+/// torques for the no-twist joint).
+///
+/// The TVLQR predicts over its delay under the corrections it already sent, so the
+/// controller remembers them: a command at control step `k` forgets those from `k` on,
+/// and one at `t = 0` starts a new flight. Safe to share between threads (a lock).
 #[pyclass(frozen, module = "catflip")]
 struct Controller {
     online: Mutex<Online>,
@@ -1766,10 +1778,13 @@ impl Controller {
         self.lock().kind.name()
     }
 
-    /// The correction, N m (catflip's joint torques: hinge torques for the universal joint,
-    /// rotation-vector torques for the no-twist joint), on top of the feed-forward, from
-    /// the measured `state` at time `t`, s: what catflip's closed loop sends. It acts from
-    /// `t + delay` to the next control step. GIL released.
+    /// The correction, N m: shape (2,) (catflip's joint torques: hinge torques for the
+    /// universal joint, rotation-vector torques for the no-twist joint), on top of the
+    /// feed-forward, from the measured `state` at time `t`, s: catflip's closed-loop command
+    /// of the control step `floor(t / period)`. It acts from `t + delay` to the next
+    /// command. After the last control step (touchdown) the last correction holds; a
+    /// command at an earlier step forgets the later ones. GIL released; ConfigError for a
+    /// bad `t` or state (not finite, an attitude that is not a unit quaternion to 1 %).
     fn torque<'py>(
         &self,
         py: Python<'py>,
