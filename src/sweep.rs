@@ -100,19 +100,26 @@ impl SweepSpec {
         // first made 0:22:23's 16th point 14.999999999999998); the last
         // point is TO itself
         let step = (self.to - self.from) / (self.count - 1) as f64;
+        // the ends as typed; between them each point to 12 significant
+        // digits, a rounding's distance, so that a decimal grid prints as
+        // typed (0.17, not 0.16999999999999998) and crosses zero at 0; not
+        // where that would merge neighbours (a step below 1e-10 of a point)
+        let scale = self.from.abs().max(self.to.abs());
         (0..self.count)
             .map(|i| {
+                if i == 0 {
+                    return self.from;
+                }
                 if i == self.count - 1 {
-                    self.to
+                    return self.to;
+                }
+                let v = self.from + step * i as f64;
+                if v.abs() <= 1e-12 * scale {
+                    0.0
+                } else if step.abs() > 1e-10 * v.abs() {
+                    format!("{v:.11e}").parse().unwrap_or(v)
                 } else {
-                    // to 12 significant digits, a rounding's distance: a
-                    // decimal grid prints as typed (0.17, not 0.16999999999999998)
-                    let v = self.from + step * i as f64;
-                    if v == 0.0 {
-                        return v;
-                    }
-                    let e = 10f64.powi(11 - v.abs().log10().floor() as i32);
-                    (v * e).round() / e
+                    v
                 }
             })
             .collect()

@@ -230,8 +230,9 @@ def simulate(config: Config, design: Union[Design, str, os.PathLike[str], None] 
              start: Optional[Dict[str, Value]] = None) -> Simulation:
     """Simulates ``design`` (a Design, a schedule CSV path, or None for the analytic schedule)
     on ``config``'s cat, as ``catflip simulate [--schedule FILE]``, with the GIL released.
-    ``config`` may differ from the design's (model error), but not in its joint or in the
-    time its fall leaves for the manoeuvre (a Design is refused as a CSV of it would be);
+    ``config`` may differ from the design's (model error), but not in its joint, and its
+    fall must leave a Design its manoeuvre's time (a shorter manoeuvre, as a least-time
+    design's, flies);
     ``start`` sets its ``[start]`` keys
     (``{"angular_velocity": [0, 0, 0.5], "rotation_deg": [0, 30, 0]}``) for this simulation,
     with the CLI's checks. Raises ConfigError, DesignError."""

@@ -204,6 +204,12 @@ impl Config {
     }
 }
 
+/// A folder made absolute now, so that a config's relative paths (`body.urdf`)
+/// are read from where it was loaded, whatever the current folder later.
+fn folder(p: &std::path::Path) -> PathBuf {
+    std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf())
+}
+
 /// The `[cat]` keys a `[body]` replaces (`cat.joint` stays).
 const CYLINDER_KEYS: [&str; 4] = ["mass", "length", "radius", "front"];
 
@@ -381,10 +387,7 @@ impl Config {
                 text,
                 origin: path.display().to_string(),
                 overrides: overrides.unwrap_or_default(),
-                base: path
-                    .parent()
-                    .unwrap_or(std::path::Path::new("."))
-                    .to_path_buf(),
+                base: folder(path.parent().unwrap_or(std::path::Path::new("."))),
             },
         )
     }
@@ -399,7 +402,7 @@ impl Config {
                 text,
                 origin: origin.into(),
                 overrides: Vec::new(),
-                base: PathBuf::from("."),
+                base: folder(std::path::Path::new(".")),
             },
         )
     }
@@ -416,7 +419,7 @@ impl Config {
                 text,
                 origin: "dict".into(),
                 overrides: Vec::new(),
-                base: PathBuf::from("."),
+                base: folder(std::path::Path::new(".")),
             },
         )
     }
@@ -926,7 +929,9 @@ enum Subject {
 
 /// Simulates `design` (a Design, a schedule CSV path, or None for the analytic
 /// schedule) on `config`'s cat, as `catflip simulate [--schedule FILE]`, with the GIL released.
-/// `config` may differ from the design's (model error); `start` sets its `[start]` keys
+/// `config` may differ from the design's (model error), but not in its joint, and its fall
+/// must leave a Design its manoeuvre's time (a shorter one, as a least-time design's,
+/// flies); `start` sets its `[start]` keys
 /// (`{"angular_velocity": [0, 0, 0.5], "rotation_deg": [0, 30, 0]}`) for this simulation,
 /// with the CLI's checks. Raises ConfigError, DesignError.
 #[pyfunction]
@@ -972,15 +977,9 @@ fn simulate(
     if let Subject::Design(d) = &subject {
         let d = d.get();
         same_joint(&cfg, d)?;
-        let b = d.schedule.phase_bounds();
-        if let Some(why) =
-            catflip::verify::simulate::span_mismatch(&cfg.design_spec(), &cfg.name, b[0], b[3])
-        {
-            return Err(ConfigError::new_err(format!(
-                "the {} design: {why}; simulate it with the config it was made for (design.config, with any model error set on it), or design one for this fall",
-                d.method
-            )));
-        }
+        // as the controllers fly it: a manoeuvre longer than this fall
+        // cannot be flown in it (a shorter one, as a least-time design, can)
+        catflip::control::online::check_fits(&cfg, d.plan.as_ref()).map_err(err)?;
     }
     py.detach(move || {
         let (source, report) = match &subject {
@@ -1986,9 +1985,12 @@ impl Controller {
     /// (`trial=None`: the model, the config's start, no delay or noise), or trial `trial`
     /// of `catflip robustness --seed SEED` (its draws, delay and noises). GIL released.
     #[pyo3(signature = (trial = None, seed = 0))]
-    fn fly(&self, py: Python<'_>, trial: Option<i64>, seed: i64) -> PyResult<Flight> {
+    fn fly(&self, py: Python<'_>, trial: Option<i64>, seed: i128) -> PyResult<Flight> {
         let trial = trial.map(|t| count(t, "trial")).transpose()?;
-        let seed = count(seed, "seed")? as u64;
+        // the CLI's `--seed`: any 64-bit unsigned value
+        let seed = u64::try_from(seed).map_err(|_| {
+            ConfigError::new_err(format!("seed = {seed}: give 0 to 2**64 - 1"))
+        })?;
         Ok(py.detach(|| {
             let o = self.lock().clone();
             let r = o.flight_reference();

@@ -189,6 +189,7 @@ def test_bad_arguments_raise_config_errors():
         c.fly(trial=-1)
     with pytest.raises(catflip.ConfigError, match="seed = -1"):
         c.fly(trial=0, seed=-1)
+    assert c.fly(trial=0, seed=2**64 - 1).draw["trial"] == 0  # the CLI's --seed range
     with pytest.raises(catflip.ConfigError, match='budget_s applies to kind="replan"'):
         catflip.Controller(config("seed"), kind="tvlqr", budget_s=0.01)
 

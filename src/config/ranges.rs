@@ -371,15 +371,28 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
         })
     };
     let c = cfg.cat();
-    // with a [body] the cylinders are its equivalent ones, not typed keys
+    // with a [body] the cylinders are its equivalent ones, not typed keys:
+    // its own masses are
     let typed = cfg.body.is_none();
-    for (key, m) in [("cat.mass", c.rear.mass), ("cat.front.mass", c.front.mass)] {
-        if !typed {
-            break;
-        }
-        if m > 200.0
-            && (key == "cat.mass" || cfg.cat.front.as_ref().is_some_and(|f| f.mass.is_some()))
-        {
+    let body_mass =
+        |half: fn(&crate::import::BodyConfig) -> Option<&crate::import::RigidConfig>| {
+            cfg.body.as_ref().and_then(half).and_then(|r| r.mass)
+        };
+    let masses = if typed {
+        let front_typed = cfg.cat.front.as_ref().is_some_and(|f| f.mass.is_some());
+        [
+            ("cat.mass", Some(c.rear.mass)),
+            ("cat.front.mass", front_typed.then_some(c.front.mass)),
+        ]
+    } else {
+        [
+            ("body.rear.mass", body_mass(|b| b.rear.as_ref())),
+            ("body.front.mass", body_mass(|b| b.front.as_ref())),
+        ]
+    };
+    for (key, m) in masses {
+        let Some(m) = m else { continue };
+        if m > 200.0 {
             warn(
                 key,
                 format!(

@@ -219,7 +219,9 @@ fn stretched(
 /// into the envelope (1.88 s) crawled to 0.7559 s in 72 iterations.
 /// `observe` sees the stall-only start's coarse iterations, then the fine
 /// iterations of the start finished first. The stall-only least time is the
-/// answer's lower bound. Without `with_free`, the phased answer alone.
+/// answer's lower bound where the motor has a torque-speed line or a speed
+/// limit (under its stall torque alone it is the answer's own problem, and
+/// bounds nothing). Without `with_free`, the phased answer alone.
 pub fn heights(
     spec: &DesignSpec,
     with_free: bool,

@@ -187,6 +187,16 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["analyze", &seed, "--set", "cat.mass=350"],
         &["cat.mass", "grams", "0.35 kg"],
     );
+    // a robot body's own mass, under its own key
+    warns(
+        &[
+            "analyze",
+            &config("box-robot"),
+            "--set",
+            "body.rear.mass=500",
+        ],
+        &["body.rear.mass", "grams", "0.5 kg"],
+    );
     warns(
         &["analyze", &seed, "--set", "cat.length=23"],
         &["cat.length", "centimetres"],

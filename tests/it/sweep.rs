@@ -300,6 +300,8 @@ fn decimal_ends_and_steps_give_the_decimals_as_typed() {
         ("cat.length=0.18:0.24:7", 4),
         ("fall.height=0.5:10:20", 3),
         ("cat.radius=-0.3:0.3:13", 4),
+        ("cat.radius=-1.1:0.1:13", 4),
+        ("cat.radius=-0.9:0.3:5", 4),
     ] {
         let spec: catflip::sweep::SweepSpec = range.parse().unwrap();
         let (values, count) = (spec.values(), spec.count);
@@ -315,6 +317,34 @@ fn decimal_ends_and_steps_give_the_decimals_as_typed() {
                 "{range}: point {i} prints {v}"
             );
         }
+    }
+    // the ends as typed, and no rounding that merges, overflows or moves a
+    // point by more than a rounding, whatever the scale
+    for range in [
+        "cat.radius=1.0000000000001:2:3",
+        "cat.radius=1e-300:2e-300:3",
+        "cat.radius=-1e-300:1e-300:3",
+        "cat.radius=1:1.00000000001:11",
+        "cat.radius=1e300:2e300:3",
+        "cat.radius=123456789012345:223456789012345:3",
+    ] {
+        let spec: catflip::sweep::SweepSpec = range.parse().unwrap();
+        let values = spec.values();
+        let n = spec.count;
+        assert_eq!((values[0], values[n - 1]), (spec.from, spec.to), "{range}");
+        let step = (spec.to - spec.from) / (n - 1) as f64;
+        for (i, v) in values.iter().enumerate() {
+            let exact = spec.from + step * i as f64;
+            assert!(v.is_finite(), "{range}: {values:?}");
+            assert!(
+                (v - exact).abs() <= 1e-11 * exact.abs(),
+                "{range}: {v} vs {exact}"
+            );
+        }
+        assert!(
+            values.windows(2).all(|w| w[0] < w[1]),
+            "{range}: {values:?}"
+        );
     }
 }
 
