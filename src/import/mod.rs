@@ -188,10 +188,10 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
         .as_table_mut()
         .ok_or_else(|| invalid("cat", "not a table", "a table [cat]"))?;
     for key in ["mass", "length", "radius", "front"] {
-        if cat.contains_key(key) {
+        if let Some(v) = cat.get(key) {
             return Err(invalid(
                 &format!("cat.{key}"),
-                "given",
+                v,
                 "[body] gives the halves: remove cat.mass, cat.length, cat.radius and [cat.front] (cat.joint may stay)",
             ));
         }

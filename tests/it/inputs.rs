@@ -39,7 +39,8 @@ fn refused(args: &[&str], needles: &[&str]) {
 }
 
 /// A `--set` of the key a sweep or `size` sets itself would be overwritten
-/// at every point, yet name the output set: refused, naming both options.
+/// at every point, yet name the output set: refused, naming both options;
+/// so is a `[cat]` cylinder key beside the `[body]` that gives the halves.
 #[test]
 fn a_set_of_the_key_another_option_sets_is_refused() {
     let (seed, robot) = (config("seed"), config("robot-universal"));
@@ -57,6 +58,11 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
     refused(
         &["size", &robot, "--height", "1", "--set", "fall.height = 5"],
         &["--set fall.height = 5", "--height 1"],
+    );
+    // a [cat] cylinder key beside a [body], named with its value
+    refused(
+        &["analyze", &config("box-robot"), "--set", "cat.mass=1"],
+        &["`cat.mass` = 1 is invalid", "[body] gives the halves"],
     );
 }
 
