@@ -492,6 +492,9 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
     }
     let value: toml::Value = match toml::from_str::<toml::Table>(&format!("v = {raw}")) {
         Ok(mut t) => t.remove("v").expect("parsed key"),
+        // how Rust and Python print a NaN (TOML's is `nan`): the key's own
+        // check then names it
+        Err(_) if ["NaN", "+NaN", "-NaN"].contains(&raw.trim()) => toml::Value::Float(f64::NAN),
         Err(_) => toml::Value::String(raw.trim().to_string()),
     };
     let mut cur = table;

@@ -59,6 +59,11 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
         &["size", &robot, "--height", "1", "--set", "fall.height = 5"],
         &["--set fall.height = 5", "--height 1"],
     );
+    // NaN as Rust and Python print it reaches the key's own check
+    refused(
+        &["analyze", &seed, "--set", "fall.height=NaN"],
+        &["`fall.height` = NaN is invalid: must be > 0 m"],
+    );
     // a [cat] cylinder key beside a [body], named with its value
     refused(
         &["analyze", &config("box-robot"), "--set", "cat.mass=1"],
