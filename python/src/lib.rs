@@ -96,7 +96,9 @@ fn interruptible<T: Send + 'static>(
                 }
             }
             Err(RecvTimeoutError::Disconnected) => {
-                return Err(DesignError::new_err("the computation's thread ended without a result"));
+                return Err(DesignError::new_err(
+                    "the computation's thread ended without a result",
+                ));
             }
         }
     }
@@ -213,14 +215,6 @@ fn folder(p: &std::path::Path) -> PathBuf {
 /// The `[cat]` keys a `[body]` replaces (`cat.joint` stays).
 const CYLINDER_KEYS: [&str; 4] = ["mass", "length", "radius", "front"];
 
-fn strip_cylinders(cat: Option<&mut serde_json::Map<String, serde_json::Value>>) {
-    if let Some(c) = cat {
-        for k in CYLINDER_KEYS {
-            c.remove(k);
-        }
-    }
-}
-
 /// A numpy array or scalar (anything with `tolist`, not a plain Python value)
 /// as the list or number it holds.
 fn plain<'py>(v: &Bound<'py, PyAny>) -> PyResult<Option<Bound<'py, PyAny>>> {
@@ -256,11 +250,12 @@ fn toml_value(v: &Bound<'_, PyAny>, key: &str) -> PyResult<Option<toml::Value>> 
             ConfigError::new_err(format!("{key}: {v} does not fit a 64-bit integer"))
         })?)));
     }
-    if v.is_instance_of::<PyFloat>() {
-        return Ok(Some(toml::Value::Float(v.extract()?)));
-    }
     if v.is_instance_of::<PyString>() {
         return Ok(Some(toml::Value::String(v.extract()?)));
+    }
+    // a float, or anything that is one (`Decimal`, `Fraction`)
+    if v.is_instance_of::<PyFloat>() || v.hasattr("__float__")? {
+        return Ok(Some(toml::Value::Float(v.extract()?)));
     }
     if let Ok(d) = v.cast::<PyDict>() {
         let mut t = toml::Table::new();
@@ -270,7 +265,11 @@ fn toml_value(v: &Bound<'_, PyAny>, key: &str) -> PyResult<Option<toml::Value>> 
                     "config dict: the keys of `{key}` are strings, not {k}"
                 ))
             })?;
-            let name = if key.is_empty() { k.clone() } else { format!("{key}.{k}") };
+            let name = if key.is_empty() {
+                k.clone()
+            } else {
+                format!("{key}.{k}")
+            };
             if let Some(x) = toml_value(&x, &name)? {
                 t.insert(k, x);
             }
@@ -281,14 +280,15 @@ fn toml_value(v: &Bound<'_, PyAny>, key: &str) -> PyResult<Option<toml::Value>> 
         let mut items = Vec::new();
         for x in v.try_iter()? {
             let x = x?;
-            items.push(toml_value(&x, key)?.ok_or_else(|| {
-                ConfigError::new_err(format!("config dict: `{key}` holds None in a list"))
-            })?);
+            items
+                .push(toml_value(&x, key)?.ok_or_else(|| {
+                    ConfigError::new_err(format!("`{key}` holds None in a list"))
+                })?);
         }
         return Ok(Some(toml::Value::Array(items)));
     }
     Err(PyTypeError::new_err(format!(
-        "config dict: `{key}` is a number, true/false, a string, a list or a dict, not {}",
+        "`{key}`: a config value is a number, true/false, a string, a list or a dict, not {}",
         v.get_type().name()?
     )))
 }
@@ -301,44 +301,20 @@ fn override_list(v: &Bound<'_, PyAny>) -> PyResult<Vec<String>> {
     v.extract().map_err(|_| {
         PyTypeError::new_err(format!(
             "overrides is a list of \"KEY=VALUE\" strings (or one), not {}",
-            v.get_type().name().map_or_else(|_| "that".into(), |n| n.to_string())
+            v.get_type()
+                .name()
+                .map_or_else(|_| "that".into(), |n| n.to_string())
         ))
     })
 }
 
 /// A count or index from Python: not negative.
 fn count(v: i64, what: &str) -> PyResult<usize> {
-    usize::try_from(v).map_err(|_| {
-        ConfigError::new_err(format!("{what} = {v}: give 0 or more"))
-    })
+    usize::try_from(v).map_err(|_| ConfigError::new_err(format!("{what} = {v}: give 0 or more")))
 }
 
-/// A Python value as the TOML text of a `--set KEY=VALUE`.
-fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
-    if let Some(p) = plain(v)? {
-        return toml_text(&p);
-    }
-    if v.is_instance_of::<PyBool>() {
-        return Ok(if v.extract::<bool>()? {
-            "true"
-        } else {
-            "false"
-        }
-        .into());
-    }
-    if v.is_instance_of::<PyInt>() {
-        return Ok(v.extract::<i64>()?.to_string());
-    }
-    if v.is_instance_of::<PyFloat>() || v.hasattr("__float__")? && !v.is_instance_of::<PyString>() {
-        let x: f64 = v.extract()?;
-        return Ok(if x.is_nan() {
-            "nan".into()
-        } else if x.is_infinite() {
-            if x > 0.0 { "inf" } else { "-inf" }.into()
-        } else {
-            format!("{x:?}")
-        });
-    }
+/// A Python value (of key `key`) as the TOML text of a `--set KEY=VALUE`.
+fn toml_text(v: &Bound<'_, PyAny>, key: &str) -> PyResult<String> {
     if v.is_instance_of::<PyString>() {
         let s: String = v.extract()?;
         // as the user would type it after `--set KEY=` when the CLI reads it as
@@ -347,20 +323,31 @@ fn toml_text(v: &Bound<'_, PyAny>) -> PyResult<String> {
             && s.trim() == s
             && !s.is_empty()
             && !s.contains(['\n', '\r']);
-        return Ok(if plain {
-            s
-        } else {
-            serde_json::to_string(&s).expect("a string serialises")
-        });
+        if plain {
+            return Ok(s);
+        }
     }
-    if v.is_instance_of::<PyList>() || v.is_instance_of::<PyTuple>() {
-        let items: PyResult<Vec<String>> = v.try_iter()?.map(|x| toml_text(&x?)).collect();
-        return Ok(format!("[{}]", items?.join(", ")));
+    match toml_value(v, key)? {
+        Some(x) => Ok(text_of(&x)),
+        None => Err(PyTypeError::new_err(format!(
+            "`{key}`: a config value is a number, true/false, a string or a list, not None"
+        ))),
     }
-    Err(PyTypeError::new_err(format!(
-        "a config value is a number, true/false, a string or a list, not {}",
-        v.get_type().name()?
-    )))
+}
+
+/// A TOML value as typed after `--set KEY=` (a float as Rust writes it, so
+/// the recorded overrides read as the CLI's).
+fn text_of(x: &toml::Value) -> String {
+    match x {
+        toml::Value::Float(f) if f.is_nan() => "nan".into(),
+        toml::Value::Float(f) if f.is_infinite() => if *f > 0.0 { "inf" } else { "-inf" }.into(),
+        toml::Value::Float(f) => format!("{f:?}"),
+        toml::Value::String(s) => serde_json::to_string(s).expect("a string serialises"),
+        toml::Value::Array(a) => {
+            format!("[{}]", a.iter().map(text_of).collect::<Vec<_>>().join(", "))
+        }
+        other => other.to_string(),
+    }
 }
 
 #[pymethods]
@@ -427,7 +414,7 @@ impl Config {
     /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;
     /// on a ConfigError the config is left as it was.
     fn set(&self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let arg = format!("{key}={}", toml_text(value)?);
+        let arg = format!("{key}={}", toml_text(value, key)?);
         let cfg = {
             let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
             let cfg = s.source.load(Some(&arg)).map_err(err)?;
@@ -468,7 +455,10 @@ impl Config {
 
     /// Pickled as its text, origin, overrides and folder: unpickling reads
     /// and checks them again (the robot file too, from the same path).
-    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyTuple>)> {
         let (s, _) = self.snapshot();
         let restore = py.import("catflip")?.getattr("_restore_config")?;
         let args = (s.text, s.origin, s.overrides, s.base).into_pyobject(py)?;
@@ -500,8 +490,10 @@ impl Config {
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let (body, cfg) = self.portable();
         let mut v = serde_json::to_value(cfg).expect("a config serialises");
-        if body {
-            strip_cylinders(v.get_mut("cat").and_then(|c| c.as_object_mut()));
+        if body && let Some(cat) = v.get_mut("cat").and_then(|c| c.as_object_mut()) {
+            for k in CYLINDER_KEYS {
+                cat.remove(k);
+            }
         }
         json_loads(py, &v)
     }
@@ -737,7 +729,11 @@ fn design(
         }
     };
     let seed = seed.map(String::from);
-    interruptible(py, || {}, move || run_design(cfg, source, method, seed.as_deref()))
+    interruptible(
+        py,
+        || {},
+        move || run_design(cfg, source, method, seed.as_deref()),
+    )
 }
 
 #[pymethods]
@@ -946,11 +942,9 @@ fn simulate(
     if let Some(start) = start {
         // each `[start]` key as `--set start.KEY=VALUE`, the CLI's checks
         for (k, v) in start.iter() {
-            source.overrides.push(format!(
-                "start.{}={}",
-                k.extract::<String>()?,
-                toml_text(&v)?
-            ));
+            let key = format!("start.{}", k.extract::<String>()?);
+            let value = toml_text(&v, &key)?;
+            source.overrides.push(format!("{key}={value}"));
         }
         cfg = source.load(None).map_err(err)?;
     }
@@ -1271,14 +1265,18 @@ impl LeastHeight {
 #[pyfunction]
 fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>> {
     let (_, cfg) = config.snapshot();
-    interruptible(py, || {}, move || {
-        let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
-            .map_err(err)?;
-        Ok(h.map(|h| LeastHeight {
-            answer: h.answer,
-            phased_m: h.phased_m,
-        }))
-    })
+    interruptible(
+        py,
+        || {},
+        move || {
+            let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
+                .map_err(err)?;
+            Ok(h.map(|h| LeastHeight {
+                answer: h.answer,
+                phased_m: h.phased_m,
+            }))
+        },
+    )
 }
 
 /// Columns of a sweep: floats (NaN where a method gave none) and texts.
@@ -1396,19 +1394,23 @@ struct Run {
 #[pyfunction]
 fn run(py: Python<'_>, config: &Config) -> PyResult<Run> {
     let (_, cfg) = config.snapshot();
-    interruptible(py, || {}, move || {
-        let r = catflip::run::run(&cfg, |_| {}).map_err(err)?;
-        Ok(Run {
-            summary: serde_json::to_value(&r.summary).expect("serialises"),
-            files: r
-                .output
-                .files()
-                .map(|(n, c)| (n.to_string(), c.to_vec()))
-                .collect(),
-            partial: r.is_partial(),
-            impossible: r.is_impossible(),
-        })
-    })
+    interruptible(
+        py,
+        || {},
+        move || {
+            let r = catflip::run::run(&cfg, |_| {}).map_err(err)?;
+            Ok(Run {
+                summary: serde_json::to_value(&r.summary).expect("serialises"),
+                files: r
+                    .output
+                    .files()
+                    .map(|(n, c)| (n.to_string(), c.to_vec()))
+                    .collect(),
+                partial: r.is_partial(),
+                impossible: r.is_impossible(),
+            })
+        },
+    )
 }
 
 #[pymethods]
@@ -1751,24 +1753,28 @@ impl Controller {
         if let Some(d) = &design {
             same_joint(&cfg, d.get())?;
         }
-        interruptible(py, || {}, move || {
-            let plan = match design {
-                Some(d) => ControllerPlan::Design(d),
-                None => ControllerPlan::Study(std::sync::Arc::new(
-                    catflip::control::robustness::design(&cfg)
-                        .map_err(err)?
-                        .plan,
-                )),
-            };
-            catflip::control::online::check_fits(&cfg, plan.plan()).map_err(err)?;
-            let mut online = Online::new(&cfg, plan.shared(), kind);
-            online.replanning.budget_s = budget_s;
-            Ok(Controller {
-                online: Mutex::new(online),
-                cfg,
-                plan,
-            })
-        })
+        interruptible(
+            py,
+            || {},
+            move || {
+                let plan = match design {
+                    Some(d) => ControllerPlan::Design(d),
+                    None => ControllerPlan::Study(std::sync::Arc::new(
+                        catflip::control::robustness::design(&cfg)
+                            .map_err(err)?
+                            .plan,
+                    )),
+                };
+                catflip::control::online::check_fits(&cfg, plan.plan()).map_err(err)?;
+                let mut online = Online::new(&cfg, plan.shared(), kind);
+                online.replanning.budget_s = budget_s;
+                Ok(Controller {
+                    online: Mutex::new(online),
+                    cfg,
+                    plan,
+                })
+            },
+        )
     }
 
     /// `tvlqr`, `replan` or `open-loop`.
@@ -1833,7 +1839,12 @@ impl Controller {
             .try_into()
             .map_err(|_| ConfigError::new_err("gyro: give 3 values, rad/s"))?;
         let (q, qd) = (pair(q, "q")?, pair(qd, "qd")?);
-        if a.iter().chain(&g).chain(&q).chain(&qd).any(|v| !v.is_finite()) {
+        if a.iter()
+            .chain(&g)
+            .chain(&q)
+            .chain(&qd)
+            .any(|v| !v.is_finite())
+        {
             return Err(ConfigError::new_err(format!(
                 "a measurement is not finite: attitude {a:?}, q {q:?}, qd {qd:?}, gyro {g:?}"
             )));
@@ -1988,9 +1999,8 @@ impl Controller {
     fn fly(&self, py: Python<'_>, trial: Option<i64>, seed: i128) -> PyResult<Flight> {
         let trial = trial.map(|t| count(t, "trial")).transpose()?;
         // the CLI's `--seed`: any 64-bit unsigned value
-        let seed = u64::try_from(seed).map_err(|_| {
-            ConfigError::new_err(format!("seed = {seed}: give 0 to 2**64 - 1"))
-        })?;
+        let seed = u64::try_from(seed)
+            .map_err(|_| ConfigError::new_err(format!("seed = {seed}: give 0 to 2**64 - 1")))?;
         Ok(py.detach(|| {
             let o = self.lock().clone();
             let r = o.flight_reference();

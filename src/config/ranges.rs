@@ -374,21 +374,18 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
     // with a [body] the cylinders are its equivalent ones, not typed keys:
     // its own masses are
     let typed = cfg.body.is_none();
-    let body_mass =
-        |half: fn(&crate::import::BodyConfig) -> Option<&crate::import::RigidConfig>| {
-            cfg.body.as_ref().and_then(half).and_then(|r| r.mass)
-        };
-    let masses = if typed {
-        let front_typed = cfg.cat.front.as_ref().is_some_and(|f| f.mass.is_some());
-        [
-            ("cat.mass", Some(c.rear.mass)),
-            ("cat.front.mass", front_typed.then_some(c.front.mass)),
-        ]
-    } else {
-        [
-            ("body.rear.mass", body_mass(|b| b.rear.as_ref())),
-            ("body.front.mass", body_mass(|b| b.front.as_ref())),
-        ]
+    let masses = match &cfg.body {
+        None => [
+            ("cat.mass", Some(cfg.cat.mass)),
+            (
+                "cat.front.mass",
+                cfg.cat.front.as_ref().and_then(|f| f.mass),
+            ),
+        ],
+        Some(b) => [
+            ("body.rear.mass", b.rear.as_ref().and_then(|r| r.mass)),
+            ("body.front.mass", b.front.as_ref().and_then(|r| r.mass)),
+        ],
     };
     for (key, m) in masses {
         let Some(m) = m else { continue };
