@@ -158,6 +158,11 @@ pub struct GearAnswer {
     pub configured_possible: bool,
     /// Whether the best ratio flips the robot from `H`.
     pub possible: bool,
+    /// The ratios the search ended between, `[low, high]`: the optimum lies
+    /// there when the least height is unimodal in `log N` (a wide bracket
+    /// says the curve or the search was too coarse to place it; equal ends
+    /// when nothing was searched).
+    pub bracket: [f64; 2],
     /// Every ratio designed, in increasing order.
     pub evaluations: Vec<GearPoint>,
     /// The least heights the curve's designs predict for the ratios whose
@@ -410,6 +415,10 @@ fn gear_at(q: &Config, ratio: f64) -> Result<GearPoint> {
     })
 }
 
+/// A search bracket wider than this ratio of its ends does not place the
+/// best gear ratio (the defaults end within about 6 %).
+const GEAR_BRACKET_WIDE: f64 = 1.25;
+
 /// The best gear ratio: the curve's points predict the least time at
 /// `N = (u / u0)^(1/3)` (`t = N f(u) / w0`, `f(u) = t_H w0_point`); the search
 /// designs the configured ratio, then golden-section in `log N` between the
@@ -499,8 +508,16 @@ fn gear_search(
                 f2 = f(x2, &mut evals, &mut designs)?;
             }
         }
+        // the last comparison narrows the bracket once more
+        if f1 <= f2 {
+            b = x2;
+        } else {
+            a = x1;
+        }
     } else if budget == 1 {
         f(predicted[best].0, &mut evals, &mut designs)?;
+    } else {
+        (a, b) = (0.0, 0.0);
     }
     evals.sort_by(|a, b| a.gear_ratio.total_cmp(&b.gear_ratio));
     let top = *evals
@@ -519,6 +536,7 @@ fn gear_search(
             configured_least_height_m: configured.design.least_height_m,
             configured_possible: fits(configured.design.least_height_m),
             possible: fits(top.design.least_height_m),
+            bracket: [a.exp(), b.exp()],
             evaluations: evals,
             predicted: predictions,
         },
@@ -604,15 +622,23 @@ impl SizeAnswer {
                 self.height_m
             ),
             if g.evaluations.len() > 1 {
+                let [lo, hi] = g.bracket;
                 format!(
-                    "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m.",
+                    "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m. The search ended between N = {:.4} and {:.4}{}.",
                     g.best_ratio,
                     g.stall_torque_nm,
                     g.no_load_speed_rad_s,
                     g.least_height_m,
                     g.least_time_s,
                     can(g.possible),
-                    self.height_m
+                    self.height_m,
+                    lo,
+                    hi,
+                    if hi > GEAR_BRACKET_WIDE * lo {
+                        ": too coarse to place the optimum, which may need far less height (more --points or --gear-evaluations narrow it)"
+                    } else {
+                        ""
+                    }
                 )
             } else {
                 // no search (--gear-evaluations 0): only the configured ratio was designed

@@ -130,6 +130,22 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
         assert!((e.design.stall_torque_nm / e.gear_ratio / t0 - 1.0).abs() < 1e-12);
         assert!((e.design.no_load_speed_rad_s * e.gear_ratio / w0 - 1.0).abs() < 1e-12);
     }
+    // the search's bracket holds its best ratio (or the best is the
+    // configured one), and a bracket as wide as 4 points and 3 designs
+    // leave is called too coarse to place the optimum
+    let [lo, hi] = g.bracket;
+    assert!(lo < hi, "{lo} {hi}");
+    assert!(g.best_ratio == 1.0 || (lo..=hi).contains(&g.best_ratio));
+    let said = a.sentences().join(" ");
+    assert_eq!(
+        hi > 1.25 * lo,
+        said.contains("too coarse"),
+        "{lo} {hi}: {said}"
+    );
+    assert!(
+        said.contains(&format!("between N = {lo:.4} and {hi:.4}")),
+        "{said}"
+    );
     // the configured ratio (N = 1) is among them, and no better
     assert!(g.evaluations.iter().any(|e| e.gear_ratio == 1.0));
     assert!(g.least_height_m <= g.configured_least_height_m);
@@ -321,8 +337,10 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
     ] {
         assert!(json["gear"].get(key).is_some(), "gear has no {key}");
     }
-    // the configured ratio alone was designed: it is the best one
+    // the configured ratio alone was designed: it is the best one, and
+    // nothing was searched
     assert_eq!(json["gear"]["best_ratio"], 1.0);
+    assert_eq!(json["gear"]["bracket"], serde_json::json!([1.0, 1.0]));
     assert_eq!(
         json["gear"]["least_height_m"],
         json["gear"]["configured_least_height_m"]
