@@ -275,6 +275,13 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
         verdict: verdict.grade(),
         reason: verdict.reason(),
         beyond_the_motors: method == Method::Analytic && verdict.misses.iter().any(Miss::is_limit),
+        approximate_for_the_joint: method == Method::Analytic
+            && spec.cat.joint == crate::model::Joint::Universal
+            && !verdict.misses.is_empty()
+            && verdict
+                .misses
+                .iter()
+                .all(|m| matches!(m, Miss::Flip { .. } | Miss::Tilt { .. }) || m.is_limit()),
         result: Some(n),
     };
     Judged {
@@ -481,6 +488,11 @@ pub struct MethodSummary {
     /// does not make the run partial (present, `true`, only then).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub beyond_the_motors: bool,
+    /// Nor is it exact under the universal joint: there it misses the flip
+    /// and tilts (F4, MODEL.md); reported, but no reason for a partial run
+    /// (present, `true`, only when that is all it misses beside the limits).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub approximate_for_the_joint: bool,
     /// The numbers, absent when the method failed.
     #[serde(flatten)]
     pub result: Option<MethodNumbers>,
@@ -520,6 +532,7 @@ impl MethodSummary {
             verdict: Grade::Failed,
             reason: Some(e.to_string()),
             beyond_the_motors: false,
+            approximate_for_the_joint: false,
             result: None,
         }
     }
@@ -533,17 +546,29 @@ impl MethodSummary {
             verdict: Grade::Impossible,
             reason: Some(why.to_string()),
             beyond_the_motors: false,
+            approximate_for_the_joint: false,
             result: None,
         }
     }
 
     /// Whether this line makes a run partial: flagged or failed, unless it
-    /// is the reference beyond the motors.
+    /// is the reference beyond the motors or approximate for the joint.
     pub fn counts_against(&self) -> bool {
         match self.verdict {
             Grade::Ok => false,
-            Grade::Flagged => !self.beyond_the_motors,
+            Grade::Flagged => self.reference_note().is_none(),
             Grade::Failed | Grade::Impossible => true,
+        }
+    }
+
+    /// Why a flagged reference is not counted, in words (None for a design).
+    pub fn reference_note(&self) -> Option<&'static str> {
+        if self.beyond_the_motors {
+            Some("a reference beyond the motors, not counted")
+        } else if self.approximate_for_the_joint {
+            Some("the seed's closed form, approximate for the universal joint (F4), not counted")
+        } else {
+            None
         }
     }
 
@@ -637,17 +662,19 @@ mod tests {
     use super::*;
 
     /// Which lines make a run partial, over every grade and the reference
-    /// flag: flagged or failed or impossible, unless the flagged line is the
-    /// reference beyond the motors.
+    /// flags: flagged or failed or impossible, unless the flagged line is the
+    /// reference beyond the motors or approximate for the joint.
     #[test]
-    fn a_line_counts_against_the_run_unless_ok_or_the_reference_beyond_the_motors() {
-        for (grade, beyond, counts) in [
-            (Grade::Ok, false, false),
-            (Grade::Ok, true, false),
-            (Grade::Flagged, false, true),
-            (Grade::Flagged, true, false),
-            (Grade::Failed, false, true),
-            (Grade::Impossible, false, true),
+    fn a_line_counts_against_the_run_unless_ok_or_a_reference() {
+        for (grade, beyond, approximate, counts) in [
+            (Grade::Ok, false, false, false),
+            (Grade::Ok, true, false, false),
+            (Grade::Flagged, false, false, true),
+            (Grade::Flagged, true, false, false),
+            (Grade::Flagged, false, true, false),
+            (Grade::Flagged, true, true, false),
+            (Grade::Failed, false, false, true),
+            (Grade::Impossible, false, false, true),
         ] {
             let m = MethodSummary {
                 method: "analytic",
@@ -655,9 +682,15 @@ mod tests {
                 verdict: grade,
                 reason: None,
                 beyond_the_motors: beyond,
+                approximate_for_the_joint: approximate,
                 result: None,
             };
-            assert_eq!(m.counts_against(), counts, "{grade:?} beyond {beyond}");
+            assert_eq!(
+                m.counts_against(),
+                counts,
+                "{grade:?} beyond {beyond} approximate {approximate}"
+            );
+            assert_eq!(m.reference_note().is_some(), beyond || approximate);
         }
         let m = MethodSummary::impossible(Method::Phased, "needs 5 m");
         assert_eq!(

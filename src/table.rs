@@ -42,16 +42,12 @@ pub fn verdict_text(grade: Grade, reason: Option<&str>) -> String {
     }
 }
 
-/// What the seed's analytic schedule is when it breaks the motor limits.
-const REFERENCE: &str = "a reference beyond the motors, not counted";
-
-/// A method's verdict in words, the reference beyond the motors said to be one.
+/// A method's verdict in words, a reference not counted said to be one.
 fn method_verdict(m: &MethodSummary) -> String {
     let text = verdict_text(m.verdict, m.reason.as_deref());
-    if m.beyond_the_motors {
-        format!("{text} ({REFERENCE})")
-    } else {
-        text
+    match m.reference_note() {
+        Some(note) => format!("{text} ({note})"),
+        None => text,
     }
 }
 
@@ -121,10 +117,9 @@ pub fn free_design_text(
 /// A method's warning line (flagged or failed): its name and reasons.
 pub fn warning(m: &MethodSummary) -> Option<String> {
     let why = m.reason.as_ref()?;
-    Some(if m.beyond_the_motors {
-        format!("{}: {why} ({REFERENCE})", m.method)
-    } else {
-        format!("{}: {why}", m.method)
+    Some(match m.reference_note() {
+        Some(note) => format!("{}: {why} ({note})", m.method),
+        None => format!("{}: {why}", m.method),
     })
 }
 

@@ -646,6 +646,36 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     assert!(svg.contains("least-height"), "the torque figure draws it");
 }
 
+/// The seed under the universal joint: its analytic schedule misses the
+/// flip and tilts (F4) and is flagged, but as the seed's closed form, not a
+/// design, it does not make the run partial; under the pin joint the same
+/// schedule flips (F1) and carries no such note.
+#[test]
+fn under_the_universal_joint_the_analytic_reference_is_flagged_not_counted() {
+    use util::{method_line, run_summary};
+    let dir = temp_dir();
+    let (code, s, base, err) = run_summary("seed", &["cat.joint=universal"], dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(s["outcome"], "ok");
+    let an = method_line(&s, "analytic");
+    assert_eq!(an["verdict"], "flagged", "{an}");
+    assert!(an["flip_error_rad"].as_f64().unwrap() > 1e-2, "{an}");
+    assert_eq!(an["approximate_for_the_joint"], true, "{an}");
+    assert!(an.get("beyond_the_motors").is_none(), "{an}");
+    for m in ["phased", "free"] {
+        let l = method_line(&s, m);
+        assert_eq!(l["verdict"], "ok", "{l}");
+        assert!(l.get("approximate_for_the_joint").is_none(), "{l}");
+    }
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    assert!(html.contains("approximate for the universal joint (F4), not counted"));
+    let (code, s, _, err) = run_summary("seed", &[], dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    let an = method_line(&s, "analytic");
+    assert_eq!(an["verdict"], "ok", "{an}");
+    assert!(an.get("approximate_for_the_joint").is_none(), "{an}");
+}
+
 /// The robot from 6 m: possible, its designs sound; the seed's analytic
 /// schedule breaks the motors and is reported, but the run is not partial.
 #[test]
