@@ -34,23 +34,28 @@ pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 /// When neither design fits the motors in this fall, the error is `run`'s
 /// answer where that names the least drop height.
 pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
+    use crate::Error;
     use crate::design::free::{FreeDesign, Seed};
     let spec = cfg.design_spec().without_torque_jumps();
-    FreeDesign::new(&spec)
-        .solve()
-        .or_else(|_| FreeDesign::new(&spec).seed(Seed::Analytic).solve())
-        .map_err(|e| match e {
-            crate::Error::BeyondMotors { .. } => {
-                // `run`'s answer, from its own spec (its time design's
-                // torque may step where this design's does not)
-                crate::design::least_height::heights(&cfg.design_spec(), true, |_| {})
-                    .ok()
-                    .flatten()
-                    .and_then(|h| crate::pipeline::out_of_reach(&h.answer))
-                    .unwrap_or(e)
+    match FreeDesign::new(&spec).solve() {
+        Ok(r) => Ok(r),
+        Err(e) => {
+            // the phased seed cannot fit this fall: where `run`'s answer
+            // (from its own spec: its time design's torque may step where
+            // this design's does not) is that nothing found fits it, say
+            // so before the analytic seed's long and futile solve
+            if matches!(e, Error::SeedUnfit { .. } | Error::BeyondMotors { .. })
+                && let Some(beyond) =
+                    crate::design::least_height::heights(&cfg.design_spec(), true, |_| {})
+                        .ok()
+                        .flatten()
+                        .and_then(|h| crate::pipeline::out_of_reach(&h.answer))
+            {
+                return Err(beyond);
             }
-            e => e,
-        })
+            FreeDesign::new(&spec).seed(Seed::Analytic).solve()
+        }
+    }
 }
 
 /// One trial's draws.
