@@ -84,6 +84,26 @@ fn a_weaker_motor_never_needs_less_height() {
     );
 }
 
+/// A far stronger motor (1000 N m of stall torque, the servo's no-load
+/// speed) needs no more height than the servo: its torque time alone would
+/// make a reference drop of 7 cm, from which every free-form start failed
+/// and the answer was the phased design's 5.07 m (the servo's: 3.49 m);
+/// the reference is held to a tenth of the speed's time.
+#[test]
+fn a_far_stronger_motor_needs_no_more_height_than_the_servo() {
+    let servo = least(&robot(&[])).answer;
+    let cfg = robot(&["limits.max_torque=1000"]);
+    let strong = least(&cfg).answer;
+    assert!(reference(&cfg.design_spec()).fall.height > 0.5);
+    assert_eq!(strong.method, "free");
+    assert!(
+        strong.least_height_m <= servo.least_height_m * (1.0 + 1e-3),
+        "1000 N m: {} m, the servo: {} m",
+        strong.least_height_m,
+        servo.least_height_m
+    );
+}
+
 /// The slow-down of a schedule that leaves the envelope is the least one:
 /// the plan stretched by it is inside at every dense sample (the written
 /// rows among them), and 1e-6 less is not.
