@@ -635,7 +635,7 @@ impl SweepRun<'_> {
                 ),
             });
         }
-        let configs = checked_configs(&spec.key, &spec.arg(), &all, load)?;
+        let configs = checked_configs(&spec.key, &spec.arg(), "FROM and TO", &all, load)?;
         let never = std::sync::atomic::AtomicBool::new(false);
         let grid = Grid {
             values,
@@ -648,10 +648,12 @@ impl SweepRun<'_> {
 
 /// The configs at `values`, or the sweep's error before any work: a point
 /// whose config is invalid (outside the key's range) fails the whole sweep,
-/// over the whole grid so that every shard agrees.
+/// over the whole grid so that every shard agrees; the error asks to choose
+/// `what` (the range's `FROM and TO`, a caller's `the values`) inside it.
 fn checked_configs(
     key: &str,
     arg: &str,
+    what: &str,
     values: &[f64],
     load: impl Fn(f64) -> Result<Config>,
 ) -> Result<Vec<Result<Config>>> {
@@ -700,7 +702,7 @@ fn checked_configs(
                 format!("every point is invalid; {message}")
             } else {
                 format!(
-                    "{bad} of {} points are invalid, the first {message}; choose FROM and TO inside the key's range",
+                    "{bad} of {} points are invalid, the first {message}; choose {what} inside the key's range",
                     configs.len()
                 )
             },
@@ -732,7 +734,7 @@ pub fn sweep_values(
             .collect::<Vec<_>>()
             .join(", ")
     );
-    let configs = checked_configs(key, &arg, values, load)?;
+    let configs = checked_configs(key, &arg, "the values", values, load)?;
     let store = Mutex::new(Vec::new());
     let grid = Grid {
         values,

@@ -70,8 +70,9 @@ def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
 
     ``methods`` is a list, or one comma-separated string (``"phased,free"``).
     Each value is set on ``config`` as ``config.set(key, value)`` would (the
-    same checks: an invalid value is that point's ``error``, all invalid is a
-    ``ConfigError``), and every point is designed by each of ``methods``.
+    same checks, all before any point is computed: a value the key refuses is
+    a ``ConfigError`` naming how many are invalid and the first one), and
+    every point is designed by each of ``methods``.
     Neighbouring points continue from each other in chunks of 10, computed
     ``threads`` chunks at a time (default: one per core), with the GIL released.
 

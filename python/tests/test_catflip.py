@@ -371,6 +371,9 @@ def test_sweep_equals_the_cli(tmp_path):
     assert peaks[0] / peaks[2] == pytest.approx(3.0, rel=1e-9)
     with pytest.raises(catflip.ConfigError, match="every point is invalid"):
         catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, -2], frame=False)
+    # one invalid value refuses the whole sweep before any point, in Python's words
+    with pytest.raises(catflip.ConfigError, match="1 of 2 points are invalid.*choose the values"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, 2], frame=False)
     try:
         import pandas  # noqa: F401
     except ImportError:
