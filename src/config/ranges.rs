@@ -374,24 +374,36 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
     // with a [body] the cylinders are its equivalent ones, not typed keys:
     // its own masses are
     let typed = cfg.body.is_none();
-    let masses = match &cfg.body {
+    let masses: [(String, Option<f64>); 2] = match &cfg.body {
         None => [
-            ("cat.mass", Some(cfg.cat.mass)),
+            ("cat.mass".into(), Some(cfg.cat.mass)),
             (
-                "cat.front.mass",
+                "cat.front.mass".into(),
                 cfg.cat.front.as_ref().and_then(|f| f.mass),
             ),
         ],
-        Some(b) => [
-            ("body.rear.mass", b.rear.as_ref().and_then(|r| r.mass)),
-            ("body.front.mass", b.front.as_ref().and_then(|r| r.mass)),
-        ],
+        Some(b) => {
+            // a mass typed in [body.rear] / [body.front], else the file's
+            let file = b.urdf.as_ref().map_or("body.mjcf", |_| "body.urdf");
+            let resolved = b.halves.map(|h| [h.rear.mass, h.front.mass]);
+            let half = |i: usize, name: &str, typed: Option<f64>| match typed {
+                Some(m) => (format!("body.{name}.mass"), Some(m)),
+                None => (
+                    format!("{file} ({name} half's mass)"),
+                    resolved.map(|r| r[i]),
+                ),
+            };
+            [
+                half(0, "rear", b.rear.as_ref().and_then(|r| r.mass)),
+                half(1, "front", b.front.as_ref().and_then(|r| r.mass)),
+            ]
+        }
     };
     for (key, m) in masses {
         let Some(m) = m else { continue };
         if m > 200.0 {
             warn(
-                key,
+                &key,
                 format!(
                     "{m} kg a half is heavier than any cat or small robot: grams typed as kilograms? ({m} g = {} kg)",
                     m / 1000.0
@@ -498,12 +510,22 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
     }
     let theta = cfg.analytic.theta_deg.to_radians();
     if theta < closest_theta(cfg) {
+        let closest = closest_theta(cfg).to_degrees();
         warn(
             "analytic.theta_deg",
             format!(
-                "at {} deg between the halves they pass through each other (the end of the shorter half is within the radii); the closest this cat folds is {:.2} deg. The seed's schedule is still evaluated as the model's mathematics",
+                "the seed's analytic schedule folds to {} deg between the halves{}, where they pass through each other (the end of the shorter half is within the radii); the closest this {} folds is {closest:.2} deg. That schedule (the analytic row, a reference) is still evaluated as the model's mathematics; set analytic.theta_deg = {} or more for one this {} can fly (and limits.max_bend_deg for the designs)",
                 cfg.analytic.theta_deg,
-                closest_theta(cfg).to_degrees()
+                if cfg.analytic.theta_deg
+                    == crate::design::spec::AnalyticSettings::default().theta_deg
+                {
+                    " (analytic.theta_deg's default)"
+                } else {
+                    ""
+                },
+                if cfg.body.is_some() { "body" } else { "cat" },
+                closest.ceil(),
+                if cfg.body.is_some() { "body" } else { "cat" },
             ),
         );
     }

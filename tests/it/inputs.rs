@@ -208,6 +208,66 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         ],
         &["body.rear.mass", "grams", "0.5 kg"],
     );
+    // and a robot file's masses in grams, named by the file (the box
+    // robot's URDF with every link 1000 times heavier: the rear half 423 kg)
+    let grams = util::temp_dir();
+    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf")).unwrap();
+    let heavy: String = urdf
+        .split("<mass value=\"")
+        .enumerate()
+        .map(|(i, part)| {
+            if i == 0 {
+                return part.to_string();
+            }
+            let (value, rest) = part.split_once('"').unwrap();
+            let m: f64 = value.parse().unwrap();
+            format!("<mass value=\"{}\"{rest}", m * 1000.0)
+        })
+        .collect();
+    std::fs::write(grams.path().join("grams.urdf"), heavy).unwrap();
+    let toml = util::config_text("box-robot").replace("box-robot.urdf", "grams.urdf");
+    std::fs::write(grams.path().join("grams.toml"), toml).unwrap();
+    let path = grams.path().join("grams.toml");
+    warns(
+        &["analyze", path.to_str().unwrap()],
+        &["body.urdf (rear half's mass)", "grams", "0.423 kg"],
+    );
+    // the analytic reference folding a robot's halves through each other at
+    // the default angle says it is the default, and what to set instead
+    // (two boxes whose shorter half reaches the other at 48.33 deg)
+    let boxes = grams.path().join("boxes.toml");
+    std::fs::write(
+        &boxes,
+        r#"name = "boxes"
+[cat]
+joint = "universal"
+[body.rear]
+mass = 0.6
+com = [0, 0, 0]
+inertia = [[0.00212, 0, 0], [0, 0.00194, 0], [0, 0, 0.00082]]
+joint = [0, 0, 0.09]
+[body.front]
+mass = 0.4
+com = [0, 0, 0.07]
+inertia = [0.000987, 0.000867, 0.000547, 0, 0, 0]
+joint = [0, 0, 0]
+[fall]
+height = 2.0
+"#,
+    )
+    .unwrap();
+    let o = run(&["analyze", boxes.to_str().unwrap()], grams.path());
+    let err = stderr(&o);
+    let line = err
+        .lines()
+        .find(|l| l.starts_with("warning: analytic.theta_deg"))
+        .unwrap_or_else(|| panic!("{err}"));
+    assert!(
+        line.contains("(analytic.theta_deg's default)")
+            && line.contains("the closest this body folds")
+            && line.contains("set analytic.theta_deg = "),
+        "{line}"
+    );
     warns(
         &["analyze", &seed, "--set", "cat.length=23"],
         &["cat.length", "centimetres"],
