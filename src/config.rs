@@ -149,14 +149,30 @@ const TYPE_WORDS: &[(&str, &str, ValueKind)] = &[
     ),
 ];
 
-/// The parser's messages name Rust's types ("expected f64"); the user
-/// wrote TOML.
+/// The keys a config must give (every other has a default), by the field
+/// name the parser's "missing field `height`" gives without its table.
+const REQUIRED: [(&str, &str); 5] = [
+    ("name", "name"),
+    ("mass", "cat.mass"),
+    ("length", "cat.length"),
+    ("radius", "cat.radius"),
+    ("height", "fall.height"),
+];
+
+/// The parser's messages name Rust's types ("expected f64") and a missing
+/// field without its table; the user wrote TOML keys.
 fn plain_types(message: &str) -> String {
-    TYPE_WORDS
+    let m = TYPE_WORDS
         .iter()
         .fold(message.to_string(), |m, (rust, toml, _)| {
             m.replace(rust, toml)
-        })
+        });
+    REQUIRED.iter().fold(m, |m, (field, key)| {
+        m.replace(
+            &format!("missing field `{field}`"),
+            &format!("missing key `{key}` (required)"),
+        )
+    })
 }
 
 /// The kind of value the parser expected when a value's type was wrong
@@ -616,6 +632,18 @@ gravity = 9.8
             "limits.max_torque, limits.no_load_speed"
         );
         assert_eq!(with(&["limits.max_speed=3"]), "limits.max_speed");
+    }
+
+    #[test]
+    fn a_missing_required_key_is_named_with_its_table() {
+        let body = "name = \"b\"\n[body.rear]\nmass = 0.6\ncom = [0, 0, 0]\ninertia = [0.002, 0.002, 0.001, 0, 0, 0]\njoint = [0, 0, 0.09]\n[body.front]\nmass = 0.4\ncom = [0, 0, 0.07]\ninertia = [0.001, 0.001, 0.0005, 0, 0, 0]\njoint = [0, 0, 0]\n[fall]\nmargin = 0.1\n";
+        let e = Config::from_toml(body, "t", &[]).unwrap_err().to_string();
+        assert!(e.contains("missing key `fall.height`"), "{e}");
+        assert!(!e.contains("missing field"), "{e}");
+        let e = Config::from_toml(&SEED.replace("length = ", "# length = "), "t", &[])
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("missing key `cat.length`"), "{e}");
     }
 
     #[test]

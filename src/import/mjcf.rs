@@ -283,7 +283,8 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
                 .part
                 .mass
                 .min(group(next, &angles, from_geom, file)?.part.mass);
-            if cross.part.mass > CROSS_MAX_FRACTION * lighter {
+            // (a massless half is named as such when the halves are assembled)
+            if lighter > 0.0 && cross.part.mass > CROSS_MAX_FRACTION * lighter {
                 return Err(site(&child).error(file, format!(
                     "the universal joint's cross weighs {} kg, more than {CROSS_MAX_FRACTION:e} of a half: catflip's cross is massless (a third moving body it cannot model)",
                     cross.part.mass

@@ -292,7 +292,8 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
             };
             let lighter = links[&root].part.mass.min(links[&second.child].part.mass);
             let cm = links[cross].part.mass;
-            if cm > CROSS_MAX_FRACTION * lighter {
+            // (a massless half is named as such when the halves are assembled)
+            if lighter > 0.0 && cm > CROSS_MAX_FRACTION * lighter {
                 return Err(site(&links[cross].node).error(
                     file,
                     format!(

@@ -269,6 +269,19 @@ fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
             "without mass",
         ),
         (
+            // the cross is then not "heavier than a half": the half is massless
+            "massless half across a universal joint",
+            urdf_of(
+                &[("rear", 1.0), ("cross", 1e-9), ("front", 0.0)],
+                &format!(
+                    "{m1}{}",
+                    joint("m2", "revolute", "cross", "front", "0 0 0", "0 1 0")
+                ),
+            ),
+            "<link name=\"front\">",
+            "without mass",
+        ),
+        (
             "malformed",
             "<robot name=\"t\">\n  <link name=\"rear\">\n</robot>\n".to_string(),
             "the document",
