@@ -73,7 +73,8 @@ class Config:
     def copy(self) -> Config:
         """An independent copy (later ``set``s on either leave the other alone)."""
     def to_dict(self) -> Dict[str, Any]:
-        """Every key with its value, defaults included, as nested dicts (None: unset);
+        """Every key that has a value, defaults included, as nested dicts (an optional key
+        left unset is absent or None; None leaves a key unset in ``from_dict``);
         ``Config.from_dict`` reads it back. A robot file's path (``body.urdf``) is absolute."""
     def to_toml(self) -> str:
         """Every key with its value, defaults included, as TOML text (``Config.from_text``

@@ -485,7 +485,8 @@ impl Config {
         })
     }
 
-    /// Every key with its value, defaults included, as nested dicts (None: unset);
+    /// Every key that has a value, defaults included, as nested dicts (an optional key left
+    /// unset is absent or None; `None` leaves a key unset in `from_dict`);
     /// `Config.from_dict` reads it back. A robot file's path (`body.urdf`) is absolute.
     fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyAny>> {
         let (body, cfg) = self.portable();
