@@ -2206,13 +2206,14 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
         // the landing, not the motors: what the optimiser could not undo
         return crate::error::Error::Unreachable {
             reason: format!(
-                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height",
+                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}",
                 spec.fall.height,
                 solved.attitude_error.to_degrees(),
-                if spec.cat.joint == crate::model::Joint::NoTwist {
-                    "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine). "
+                if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() {
+                    // no height helps: the spine's tilt is out of its reach
+                    "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
                 } else {
-                    ""
+                    "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
                 }
             ),
         };

@@ -106,6 +106,9 @@ fn a_pitched_start_is_answered_as_unlandable() {
     let e = err.to_string();
     assert!(e.contains("cannot land belly-down from this start"), "{e}");
     assert!(e.contains("start.rotation_deg"), "{e}");
+    // and no height helps, so none is suggested: the joint or the start is
+    assert!(!e.contains("higher fall.height"), "{e}");
+    assert!(e.contains("cat.joint = \"universal\""), "{e}");
 }
 
 /// The default start keeps today's problem (full attitude `Rz(pi)`), bit for bit.
