@@ -65,7 +65,10 @@ impl StartConfig {
             "start.angular_velocity",
             w,
             w <= MAX_START_RATE,
-            &format!("must be at most {MAX_START_RATE} rad/s in magnitude (shown)"),
+            &format!(
+                "its magnitude (the number shown, rad/s, from {:?}) must be at most {MAX_START_RATE} rad/s",
+                self.angular_velocity
+            ),
         )?;
         Ok(())
     }
