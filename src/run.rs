@@ -90,6 +90,16 @@ pub struct RunSummary {
 }
 
 impl RunSummary {
+    /// Why a sound design's peak can be above the stall torque: a DC motor
+    /// driven against its speed brakes with more (`T + k |w|`, the torque-speed
+    /// line), which a table of peaks alone would read as a broken limit.
+    pub fn braking_note(&self) -> Option<String> {
+        above_stall(
+            self.max_torque_nm,
+            self.methods.iter().map(|m| (m.method, m.verdict, m.peak())),
+        )
+    }
+
     /// What makes the run partial: each method that counts against it and
     /// why, e.g. `phased not possible in this fall` (empty when none does).
     pub fn against(&self) -> Vec<String> {
@@ -595,6 +605,10 @@ fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
             }
         ),
     );
+    // a sound design above the stall torque: as the terminal says it
+    if let Some(n) = summary.braking_note() {
+        notes.insert(2, n);
+    }
     if summary.outcome == Outcome::Partial {
         notes.insert(
             0,
@@ -663,3 +677,61 @@ fn page(
 
 /// A method's summary line: see [`crate::pipeline`] (its table: [`crate::table`]).
 pub use crate::pipeline::{MethodNumbers, MethodSummary};
+
+/// [`RunSummary::braking_note`] on the stall torque and each method's name, verdict and
+/// peak: a note for the sound ones (verdict ok) above the stall torque.
+fn above_stall<'a>(
+    stall: Option<f64>,
+    methods: impl Iterator<Item = (&'a str, Grade, Option<f64>)>,
+) -> Option<String> {
+    let stall = stall?;
+    let above: Vec<&str> = methods
+        .filter(|(_, verdict, peak)| {
+            *verdict == Grade::Ok && peak.is_some_and(|p| p > stall * (1.0 + 1e-6))
+        })
+        .map(|(name, _, _)| name)
+        .collect();
+    (!above.is_empty()).then(|| {
+        format!(
+            "{}: peak above the {stall} N m stall torque while braking, which the motor's torque-speed line allows (T + k |w| against the speed; docs/model.md, section 5)",
+            above.join(", ")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Only a sound design above the stall torque gets the note: a flagged
+    /// one breaks its limit (its reason says so), and without a stall
+    /// torque there is nothing to be above.
+    #[test]
+    fn the_braking_note_names_the_sound_designs_above_the_stall_torque() {
+        let rows = [
+            ("analytic", Grade::Flagged, Some(3.0)),
+            ("free", Grade::Ok, Some(1.2)),
+            ("least-height", Grade::Ok, Some(2.0)),
+            ("phased", Grade::Impossible, None),
+        ];
+        let note = above_stall(Some(1.4), rows.into_iter()).expect("a note");
+        assert!(
+            note.starts_with("least-height: peak above the 1.4 N m"),
+            "{note}"
+        );
+        assert!(
+            !note.contains("analytic") && !note.contains("free"),
+            "{note}"
+        );
+        assert_eq!(above_stall(None, rows.into_iter()), None);
+        assert_eq!(above_stall(Some(3.5), rows.into_iter()), None);
+        // at the stall torque to rounding: no note
+        assert_eq!(
+            above_stall(
+                Some(2.0),
+                [("free", Grade::Ok, Some(2.0 * (1.0 + 1e-9)))].into_iter()
+            ),
+            None
+        );
+    }
+}

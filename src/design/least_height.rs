@@ -558,7 +558,7 @@ impl HeightAnswer {
         };
         let bound = self
             .least_height_lower_bound_m
-            .map(|b| format!(" (at least {b:.3} m)"))
+            .map(|b| format!(" (at least {b:.3} m within the stall torque)"))
             .unwrap_or_default();
         if !self.verified && self.from_start && self.possible {
             format!(

@@ -38,11 +38,20 @@ pub fn headline(a: &HeightAnswer) -> String {
     }
 }
 
-/// The least height found and, when known, its lower bound: `From 3.541 m
-/// (at least 3.200 m) they can`.
+/// The least height found and, when known, its lower bound and what the
+/// bound is: `... 3.541 m (at least 3.200 m) ...`.
 pub fn height_text(a: &HeightAnswer) -> String {
     let bound = lower_bound(a)
         .map(|b| format!(" (at least {b:.3} m)"))
+        .unwrap_or_default();
+    // the bound ignores the torque-speed line: said, lest a bound far below
+    // the answer read as a contradiction of "not possible"
+    let what = lower_bound(a)
+        .map(|b| {
+            format!(
+                " The bound, {b:.3} m, is the least height of a motor that never gives more than its stall torque and has no speed limit: no schedule within the stall torque needs less (the torque-speed line gives more while braking, T + k |w|, so it is not a proof for this motor). The answer is the best design found, a local optimum; where the two are far apart, the motors' speed, not their torque, is what holds the flip back."
+            )
+        })
         .unwrap_or_default();
     if !a.verified {
         // (only the phased design is ever unverified: the free-form ones
@@ -55,12 +64,12 @@ pub fn height_text(a: &HeightAnswer) -> String {
     if a.possible && a.least_height_m > a.height_m {
         // a design fits this fall although the least-height one needs more
         format!(
-            "A verified {} design fits this fall; the least-height design found needs {:.3} m{bound}.",
+            "A verified {} design fits this fall; the least-height design found needs {:.3} m{bound}.{what}",
             a.method, a.least_height_m
         )
     } else {
         format!(
-            "The least drop height they need: {:.3} m{bound} ({:.4} s of manoeuvre).",
+            "The least drop height found: {:.3} m{bound} ({:.4} s of manoeuvre).{what}",
             a.least_height_m, a.least_time_s
         )
     }

@@ -640,6 +640,13 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     assert!(lead < html.find("<table>").unwrap());
     assert!(html.contains("Not possible from 2 m with these motors."));
     assert!(html.contains(&format!("{least:.3} m")));
+    // the least-height design brakes above the stall torque: the page says
+    // why that is sound, as the terminal does
+    assert!(html.contains("least-height: peak above the 1.4 N m stall torque while braking"));
+    // the bound far below the answer says what it is, not a contradiction
+    assert!(
+        html.contains("is the least height of a motor that never gives more than its stall torque")
+    );
     assert!(!html.contains("FAILED"), "nothing errored");
     assert!(html.contains("<td>least-height</td>"));
     let svg = std::fs::read_to_string(base.join("torque.svg")).unwrap();

@@ -60,7 +60,8 @@ fn the_least_height_is_the_same_from_any_question_height() {
         let json = serde_json::to_value(a).unwrap();
         assert_eq!(json["least_height_lower_bound_m"].as_f64(), Some(bound));
         assert!(
-            a.sentence().contains(&format!("(at least {bound:.3} m)")),
+            a.sentence()
+                .contains(&format!("(at least {bound:.3} m within the stall torque)")),
             "{}",
             a.sentence()
         );
