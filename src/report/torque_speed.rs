@@ -29,7 +29,7 @@ pub fn caption(file: &str) -> Option<&'static str> {
             "Joint torque against time with the stall torque; with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
         }
         FILE => {
-            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed."
+            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed."
         }
         "flip.svg" => {
             "Rotation about the initial spine in the forward simulation (motor model applied)."
@@ -164,14 +164,23 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
     };
     if let Some(t) = motor.max_torque {
         // the band's lines beyond the closing speed: braking past no-load
+        // (cut to the plot: the chart clamps each end point on its own,
+        // which would tilt a line that leaves it)
         for s in [t, -t] {
-            c.draw_series(DashedLineSeries::new(
-                [(x.0, s - k * x.0), (x.1, s - k * x.1)],
-                4,
-                4,
-                grey.stroke_width(1),
-            ))
-            .map_err(perr)?;
+            let (mut w_lo, mut w_hi) = (x.0, x.1);
+            if k > 0.0 {
+                w_lo = w_lo.max((s - y.1) / k);
+                w_hi = w_hi.min((s - y.0) / k);
+            }
+            if w_lo < w_hi {
+                c.draw_series(DashedLineSeries::new(
+                    [(w_lo, s - k * w_lo), (w_hi, s - k * w_hi)],
+                    4,
+                    4,
+                    grey.stroke_width(1),
+                ))
+                .map_err(perr)?;
+            }
         }
         if let Some(poly) = &poly {
             c.draw_series(std::iter::once(Polygon::new(
