@@ -61,11 +61,64 @@ pub fn success_by_size(
     if series.is_empty() || results.is_empty() {
         return Ok(None);
     }
-    Ok(Some(crate::report::lines(
+    Ok(Some(crate::report::lines_styled(
         &format!("Landing within {max_tilt_deg} deg against each perturbation's size"),
         "size, fraction of its largest value in [robustness]",
         "success rate",
         &x,
         &series,
+        series_style,
     )?))
+}
+
+/// A series' style from its name `controller: perturbation`: the colour
+/// tells the controller, the dash and marker the perturbation (nine series:
+/// the report's four styles would repeat).
+fn series_style(name: &str, _: usize) -> crate::report::Style {
+    use crate::report::{Marker, Style};
+    use plotters::style::RGBColor;
+    let (controller, what) = name.split_once(": ").unwrap_or((name, ""));
+    let color = match controller {
+        "open-loop" => RGBColor(0x55, 0x55, 0x55),
+        "tvlqr" => RGBColor(0x1f, 0x77, 0xb4),
+        _ => RGBColor(0xd6, 0x27, 0x28),
+    };
+    let (dash, marker) = match what {
+        "spin" => (None, Marker::Circle),
+        "tilt" => (Some((10, 5)), Marker::Triangle),
+        _ => (Some((3, 3)), Marker::Square),
+    };
+    Style {
+        color,
+        dash,
+        marker,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The study's nine series are drawn nine ways: one colour a
+    /// controller, one dash and marker a perturbation.
+    #[test]
+    fn every_series_of_the_study_has_its_own_style() {
+        let mut seen = Vec::new();
+        for what in ["spin", "tilt", "inertia"] {
+            for c in CONTROLLERS {
+                let st = series_style(&format!("{c}: {what}"), 0);
+                let key = (
+                    (st.color.0, st.color.1, st.color.2),
+                    st.dash,
+                    format!("{:?}", st.marker),
+                );
+                assert!(!seen.contains(&key), "{c}: {what} repeats {key:?}");
+                seen.push(key);
+            }
+        }
+        // a controller keeps its colour across perturbations
+        let color = |n: &str| series_style(n, 0).color.0;
+        assert_eq!(color("tvlqr: spin"), color("tvlqr: inertia"));
+        assert_ne!(color("tvlqr: spin"), color("replan: spin"));
+    }
 }

@@ -744,6 +744,21 @@ pub fn lines(
     x: &[f64],
     series: &[(String, Vec<f64>)],
 ) -> Result<String> {
+    lines_styled(title, xdesc, ydesc, x, series, |name, i| {
+        style_of(name, i + 1)
+    })
+}
+
+/// [`lines`] with each series' style from `style_of(name, index)` (for more
+/// series than the methods' four styles tell apart).
+pub fn lines_styled(
+    title: &str,
+    xdesc: &str,
+    ydesc: &str,
+    x: &[f64],
+    series: &[(String, Vec<f64>)],
+    style_of: impl Fn(&str, usize) -> Style,
+) -> Result<String> {
     svg((1000, 560), |root| {
         let (plot, side) = with_legend(root);
         let xr = range(x.iter().copied());
@@ -767,7 +782,7 @@ pub fn lines(
                     .filter(|(_, y)| y.is_finite())
                     .map(|(a, b)| (*a, *b))
                     .collect();
-                (style_of(name, i + 1), pts)
+                (style_of(name, i), pts)
             })
             .collect();
         let keys: Vec<(String, Key)> = series
