@@ -579,9 +579,10 @@ fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
     notes.insert(
         0,
         format!(
-            "{} joint, peak norm {}; fall time {:.4} s, manoeuvre {:.4} s. {}{}Free-form design: {}.",
+            "{} joint, peak norm {}; dropped from {} m (fall.height): fall time {:.4} s, manoeuvre {:.4} s. {}{}Free-form design: {}.",
             summary.joint,
             cfg.norm().name(),
+            cfg.fall.height,
             summary.analytic.fall_time_s,
             summary.analytic.available_time_s,
             // (the ratios' own words start lower case: a sentence here)

@@ -370,8 +370,6 @@ fn with_legend<'b>(area: &Area<'b>) -> (Area<'b>, Area<'b>) {
     area.split_horizontally(w.saturating_sub(LEGEND_W))
 }
 
-/// Dotted vertical lines at the inner phase boundaries, one style for all
-/// methods, each topped with the method's marker.
 /// A thin dotted black vertical line at `x` (a boundary, [`Key::Boundary`]).
 fn boundary_line(c: &mut Chart, x: f64, y: (f64, f64)) -> Result<()> {
     c.draw_series(DashedLineSeries::new(
@@ -384,6 +382,8 @@ fn boundary_line(c: &mut Chart, x: f64, y: (f64, f64)) -> Result<()> {
     Ok(())
 }
 
+/// Dotted vertical lines at the inner phase boundaries, one style for all
+/// methods, each topped with the method's marker.
 fn phase_marks(c: &mut Chart, m: &MethodTrace, st: Style, y: (f64, f64)) -> Result<()> {
     for &b in &m.phase_bounds[1..m.phase_bounds.len() - 1] {
         boundary_line(c, b, y)?;
@@ -615,7 +615,7 @@ pub fn shape_path(methods: &[MethodTrace]) -> Result<String> {
     })
 }
 
-/// Where each finer mesh of the continuation starts (a dashed line).
+/// Where each finer mesh of the continuation starts (a dotted line).
 fn mesh_switches(
     c: &mut Chart,
     levels: &[crate::design::free::MeshLevel],

@@ -36,7 +36,7 @@ pub fn caption(file: &str) -> Option<&'static str> {
         }
         "shape_path.svg" => "The shape path in the (q1, q2) plane.",
         "convergence.svg" => {
-            "Free-form SCP convergence; a dashed line marks where a finer mesh starts (mesh continuation: from the coarser design when that converged or stopped at its iteration limit, and inside the motor envelope whenever its solve returned; else from the seed again)."
+            "Free-form SCP convergence; a dotted line marks where a finer mesh starts (mesh continuation: from the coarser design when that converged or stopped at its iteration limit, and inside the motor envelope whenever its solve returned; else from the seed again)."
         }
         _ => return None,
     })

@@ -676,6 +676,12 @@ fn under_the_universal_joint_the_analytic_reference_is_flagged_not_counted() {
     }
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     assert!(html.contains("approximate for the universal joint (F4), not counted"));
+    // without motor limits there is no answer block: the page still says
+    // from what height the cat was dropped
+    assert!(
+        html.contains("dropped from 10 m (fall.height)"),
+        "the drop height"
+    );
     let (code, s, _, err) = run_summary("seed", &[], dir.path());
     assert_eq!(code, Some(0), "{err}");
     let an = method_line(&s, "analytic");
