@@ -635,7 +635,7 @@ impl SizeAnswer {
                     lo,
                     hi,
                     if hi > GEAR_BRACKET_WIDE * lo {
-                        ": too coarse to place the optimum, which may need far less height (more --points or --gear-evaluations narrow it)"
+                        ": too coarse to place the optimum (more --points or --gear-evaluations narrow it)"
                     } else {
                         ""
                     }
