@@ -41,6 +41,17 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     (lo / 1.4, hi * 1.4)
 }
 
+/// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`: the
+/// chart's own log ticks left a 1.6-decade axis's ends without a number.
+fn log_ticks((lo, hi): (f64, f64)) -> Vec<f64> {
+    let first = lo.log10().floor() as i32;
+    let last = hi.log10().ceil() as i32;
+    (first..=last)
+        .flat_map(|d| [1.0, 2.0, 3.0, 5.0].map(|m| m * 10f64.powi(d)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect()
+}
+
 /// The curve figure (`size.svg`).
 pub fn curve(a: &SizeAnswer) -> Result<String> {
     svg((1000, 620), |root| {
@@ -81,7 +92,10 @@ pub fn curve(a: &SizeAnswer) -> Result<String> {
             .margin(12)
             .x_label_area_size(42)
             .y_label_area_size(70)
-            .build_cartesian_2d((xr.0..xr.1).log_scale(), (yr.0..yr.1).log_scale())
+            .build_cartesian_2d(
+                (xr.0..xr.1).log_scale().with_key_points(log_ticks(xr)),
+                (yr.0..yr.1).log_scale().with_key_points(log_ticks(yr)),
+            )
             .map_err(perr)?;
         c.configure_mesh()
             .x_desc("no-load speed w0 (rad/s), log scale")
