@@ -679,12 +679,14 @@ pub fn figures(lines: &[LineResult], grid: &Grid) -> Result<Vec<(String, String)
             .collect();
         figs.push((
             file.to_string(),
-            crate::report::lines(
+            // one style a release axis (the methods' four repeat past four)
+            crate::report::lines_styled(
                 &format!("Landing error against the {unit} at release, per axis"),
                 unit,
                 "landing error (deg)",
                 &x,
                 &series,
+                |_, i| crate::report::distinct_style(i),
             )?,
         ));
     }

@@ -91,6 +91,36 @@ pub fn style(i: usize) -> Style {
     STYLES[i % STYLES.len()]
 }
 
+/// The `i`-th of many series (more than the methods' four styles tell
+/// apart): eight colours, each with a dash and marker that turn with the
+/// index; the first 32 are distinct.
+pub fn distinct_style(i: usize) -> Style {
+    const COLORS: [RGBColor; 8] = [
+        RGBColor(0x1f, 0x77, 0xb4),
+        RGBColor(0xd6, 0x27, 0x28),
+        RGBColor(0x2c, 0xa0, 0x2c),
+        RGBColor(0x55, 0x55, 0x55),
+        RGBColor(0x94, 0x67, 0xbd),
+        RGBColor(0xff, 0x7f, 0x0e),
+        RGBColor(0x17, 0xbe, 0xcf),
+        RGBColor(0x8c, 0x56, 0x4b),
+    ];
+    const LOOKS: [(Option<(u32, u32)>, Marker); 4] = [
+        (None, Marker::Circle),
+        (Some((10, 5)), Marker::Triangle),
+        (Some((3, 3)), Marker::Square),
+        (Some((12, 3)), Marker::Cross),
+    ];
+    // the dash turns with each series too: two series on the same numbers
+    // (a recovery map's symmetric axes) show both colours through the gaps
+    let (dash, marker) = LOOKS[(i + i / COLORS.len()) % LOOKS.len()];
+    Style {
+        color: COLORS[i % COLORS.len()],
+        dash,
+        marker,
+    }
+}
+
 /// A method keeps its style across all figures; other series count from `i`.
 pub fn style_of(name: &str, i: usize) -> Style {
     match name {
@@ -924,6 +954,20 @@ pub fn index_html(page: &Page) -> String {
 mod tests {
     use super::*;
     use crate::design::objective::Objective;
+
+    /// Many series (a recovery map's release axes) are drawn as many ways.
+    #[test]
+    fn the_first_32_distinct_styles_differ() {
+        let key = |i: usize| {
+            let s = distinct_style(i);
+            (s.color.0, s.color.1, s.color.2, s.dash, s.marker)
+        };
+        for i in 0..32 {
+            for j in 0..i {
+                assert_ne!(key(i), key(j), "{i} and {j}");
+            }
+        }
+    }
 
     #[test]
     fn the_convergence_figure_names_the_objective_it_plots() {
