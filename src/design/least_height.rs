@@ -622,7 +622,7 @@ mod tests {
         a.verified = true;
         assert!(
             a.sentence()
-                .contains("from 62.514 m (at least 1.700 m) it is")
+                .contains("from 62.514 m (at least 1.700 m within the stall torque) it is")
         );
     }
 
