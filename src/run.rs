@@ -643,6 +643,12 @@ fn page(
     for t in &mut tracks {
         if let Some(m) = summary.methods.iter().find(|m| m.method == t.name) {
             t.status = track_status(m);
+            // its own drop, not the configured one
+            if m.method == Method::LeastHeight.name()
+                && let Some(a) = &summary.answer
+            {
+                t.status = format!("for a drop from {:.3} m; {}", a.least_height_m, t.status);
+            }
         }
     }
     tracks.retain(|t| t.frames.len() > 1);

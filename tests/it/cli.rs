@@ -643,6 +643,8 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     // the least-height design brakes above the stall torque: the page says
     // why that is sound, as the terminal does
     assert!(html.contains("least-height: peak above the 1.4 N m stall torque while braking"));
+    // its animated track says from what drop it is (not the 2 m asked)
+    assert!(html.contains(&format!("for a drop from {least:.3} m; ")));
     // the bound far below the answer says what it is, not a contradiction
     assert!(
         html.contains("is the least height of a motor that never gives more than its stall torque")
