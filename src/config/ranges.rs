@@ -508,13 +508,14 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             );
         }
     }
-    let theta = cfg.analytic.theta_deg.to_radians();
-    if theta < closest_theta(cfg) {
-        let closest = closest_theta(cfg).to_degrees();
+    let closest_rad = closest_theta(cfg);
+    if cfg.analytic.theta_deg.to_radians() < closest_rad {
+        let closest = closest_rad.to_degrees();
+        let what = if cfg.body.is_some() { "body" } else { "cat" };
         warn(
             "analytic.theta_deg",
             format!(
-                "the seed's analytic schedule folds to {} deg between the halves{}, where they pass through each other (the end of the shorter half is within the radii); the closest this {} folds is {closest:.2} deg. That schedule (the analytic row, a reference) is still evaluated as the model's mathematics; set analytic.theta_deg = {} or more for one this {} can fly (and limits.max_bend_deg for the designs)",
+                "the seed's analytic schedule folds to {} deg between the halves{}, where they pass through each other (the end of the shorter half is within the radii); the closest this {what} folds is {closest:.2} deg. That schedule (the analytic row, a reference) is still evaluated as the model's mathematics; set analytic.theta_deg = {} or more for one this {what} can fly (and limits.max_bend_deg for the designs)",
                 cfg.analytic.theta_deg,
                 if cfg.analytic.theta_deg
                     == crate::design::spec::AnalyticSettings::default().theta_deg
@@ -523,9 +524,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
                 } else {
                     ""
                 },
-                if cfg.body.is_some() { "body" } else { "cat" },
                 closest.ceil(),
-                if cfg.body.is_some() { "body" } else { "cat" },
             ),
         );
     }

@@ -73,25 +73,22 @@ pub fn success_by_size(
 
 /// A series' style from its name `controller: perturbation`: the colour
 /// tells the controller, the dash and marker the perturbation (nine series:
-/// the report's four styles would repeat).
+/// the report's four styles would repeat), both from
+/// [`crate::report::distinct_style`].
 fn series_style(name: &str, _: usize) -> crate::report::Style {
-    use crate::report::{Marker, Style};
-    use plotters::style::RGBColor;
+    use crate::report::distinct_style;
     let (controller, what) = name.split_once(": ").unwrap_or((name, ""));
-    let color = match controller {
-        "open-loop" => RGBColor(0x55, 0x55, 0x55),
-        "tvlqr" => RGBColor(0x1f, 0x77, 0xb4),
-        _ => RGBColor(0xd6, 0x27, 0x28),
-    };
-    let (dash, marker) = match what {
-        "spin" => (None, Marker::Circle),
-        "tilt" => (Some((10, 5)), Marker::Triangle),
-        _ => (Some((3, 3)), Marker::Square),
-    };
-    Style {
-        color,
-        dash,
-        marker,
+    let c = CONTROLLERS
+        .iter()
+        .position(|&n| n == controller)
+        .unwrap_or(0);
+    let p = ["spin", "tilt", "inertia"]
+        .iter()
+        .position(|&n| n == what)
+        .unwrap_or(0);
+    crate::report::Style {
+        color: distinct_style(c).color,
+        ..distinct_style(p)
     }
 }
 

@@ -41,12 +41,13 @@ pub fn headline(a: &HeightAnswer) -> String {
 /// The least height found and, when known, its lower bound and what the
 /// bound is: `... 3.541 m (at least 3.200 m) ...`.
 pub fn height_text(a: &HeightAnswer) -> String {
-    let bound = lower_bound(a)
+    let b = lower_bound(a);
+    let bound = b
         .map(|b| format!(" (at least {b:.3} m)"))
         .unwrap_or_default();
     // the bound ignores the torque-speed line: said, lest a bound far below
     // the answer read as a contradiction of "not possible"
-    let what = lower_bound(a)
+    let what = b
         .map(|b| {
             format!(
                 " The bound, {b:.3} m, is the least height of a motor that never gives more than its stall torque and has no speed limit: no schedule within the stall torque needs less (the torque-speed line gives more while braking, T + k |w|, so it is not a proof for this motor). The answer is the best design found, a local optimum; where the two are far apart, the motors' speed, not their torque, is what holds the flip back."
