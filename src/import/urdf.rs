@@ -345,11 +345,15 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
     })
 }
 
+/// A joint range's end in radians beyond which, up to 360, it reads as
+/// degrees: a full turn (catflip's own exports write +-pi).
+const DEGREES_SLIP: f64 = 2.0 * std::f64::consts::PI * (1.0 + 1e-9);
+
 /// The largest bend every joint range allows, rad: each revolute joint
 /// turns at least this far both ways (the disc inside their box, so a
 /// design within it is within every range); `None` without a range. A range
 /// that does not reach both sides of zero leaves no bend in one direction:
-/// refused, naming the joint.
+/// refused, naming the joint, and so is one typed in degrees.
 fn bend_limit(used: &[&JointData], file: &str) -> Result<Option<f64>> {
     let mut least: Option<f64> = None;
     for j in used {
@@ -361,6 +365,21 @@ fn bend_limit(used: &[&JointData], file: &str) -> Result<Option<f64>> {
                 file,
                 format!(
                     "the joint's range [{lower}, {upper}] rad does not reach both sides of the straight body: catflip's halves bend both ways (give lower < 0 < upper, or a continuous joint)"
+                ),
+            ));
+        }
+        // URDF gives radians; an end past a full turn but not past 360
+        // is a range typed in degrees, which would bound nothing (wider
+        // than any fold); further ends are the files' "no limit"
+        if let Some(end) = [lower, upper]
+            .into_iter()
+            .find(|e| (DEGREES_SLIP..=360.0).contains(&e.abs()))
+        {
+            return Err(site(&j.node).error(
+                file,
+                format!(
+                    "the joint's range [{lower}, {upper}] rad goes past a full turn: URDF limits are in radians, so degrees typed there bound nothing ({end} deg is {:.4} rad; give the range in radians, or a continuous joint for none)",
+                    end.to_radians()
                 ),
             ));
         }

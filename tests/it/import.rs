@@ -138,7 +138,8 @@ fn a_config_key_replaces_the_files_value_and_the_config_limits_win() {
 /// the disc inside their box: the smaller of `-lower` and `upper` over the
 /// joints), unless the config sets it; a range wider than the halves' own
 /// fold limit bounds nothing (catflip's exports write +-pi), and one that
-/// does not reach both sides of the straight body is refused with its line.
+/// does not reach both sides of the straight body is refused with its line,
+/// as is one typed in degrees.
 #[test]
 fn a_urdf_joint_range_bounds_the_bend_unless_the_config_sets_it() {
     let dir = temp_dir();
@@ -190,6 +191,23 @@ fn a_urdf_joint_range_bounds_the_bend_unless_the_config_sets_it() {
         .last()
         .unwrap();
     assert!(e.contains(&format!("line {at}, ")), "line {at}: {e}");
+    // a range typed in degrees is refused with its radians; a file's "no
+    // limit" far past a full turn bounds nothing
+    let degrees = ranged("lower=\"-90\" upper=\"90\"", "lower=\"-0.6\" upper=\"0.55\"");
+    let e = imported(dir.path(), "urdf", "r.urdf", &degrees)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("range [-90, 90] rad") && e.contains("in radians") && e.contains("1.5708 rad"),
+        "{e}"
+    );
+    let unlimited = ranged("lower=\"-1e9\" upper=\"1e9\"", "lower=\"-7\" upper=\"1e4\"");
+    let back = imported(dir.path(), "urdf", "r.urdf", &unlimited);
+    let e = back.unwrap_err().to_string();
+    assert!(e.contains("range [-7, 10000] rad"), "{e}");
+    let unlimited = ranged("lower=\"-1e9\" upper=\"1e9\"", "");
+    let back = imported(dir.path(), "urdf", "r.urdf", &unlimited).unwrap();
+    assert_eq!(back.limits.max_bend_deg, None);
 }
 
 /// A URDF of links and joints (a `<link>`'s inertial is `mass` kg, unit-ish inertia).
