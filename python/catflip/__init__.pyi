@@ -492,7 +492,7 @@ class Controller:
         """The gains as ``<stem>.tvlqr.csv`` text. GIL released."""
     def with_kind(self, kind: ControllerKind) -> Controller:
         """The same design's controller of another ``kind``, its gains reused (no new design)."""
-    def fly(self, trial: Optional[int] = None, seed: int = 0) -> Flight:
+    def fly(self, trial: Optional[int] = None, seed: int = 1) -> Flight:
         """A flight of catflip's closed-loop simulator under this controller: the nominal
         (``trial=None``) or trial ``trial`` of ``catflip robustness --seed SEED`` (its draws,
         delay and noises), with every command sent. GIL released."""

@@ -1996,7 +1996,7 @@ impl Controller {
     /// A flight of catflip's closed-loop simulator under this controller: the nominal
     /// (`trial=None`: the model, the config's start, no delay or noise), or trial `trial`
     /// of `catflip robustness --seed SEED` (its draws, delay and noises). GIL released.
-    #[pyo3(signature = (trial = None, seed = 0))]
+    #[pyo3(signature = (trial = None, seed = 1))]
     fn fly(&self, py: Python<'_>, trial: Option<i64>, seed: i128) -> PyResult<Flight> {
         let trial = trial.map(|t| count(t, "trial")).transpose()?;
         // the CLI's `--seed`: any 64-bit unsigned value

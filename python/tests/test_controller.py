@@ -142,6 +142,11 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
             f = c.fly(trial=int(row["trial"]), seed=5)
             assert f.landing_error_deg == pytest.approx(float(row[col]), rel=1e-12, abs=1e-12)
             assert f.draw["tilt_deg"] == float(row["tilt_deg"])
+    # without a seed, the CLI's default one
+    code, out, err = cli("robustness", SEED, "--trials", "1", "--json", out=tmp_path / "default")
+    assert code == 0, err
+    row = next(csv.DictReader(open(next((tmp_path / "default").rglob("robustness.csv")))))
+    assert controller("seed", "open-loop").fly(trial=0).draw["tilt_deg"] == float(row["tilt_deg"])
 
 
 def test_a_replan_over_its_budget_leaves_the_tvlqr_flying():
