@@ -26,7 +26,7 @@ pub fn caption(file: &str) -> Option<&'static str> {
     Some(match file {
         "angles.svg" => "Joint angles against time; dotted lines are the phase boundaries.",
         "torque.svg" => {
-            "Joint torque against time with the stall torque; with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
+            "Joint torque against time, each curve's peak circled; the least-height schedule, made for its own drop, on a panel of its own. With a stall torque, the torque limit is the black line (named in the key only, when far above the curves); with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
         }
         FILE => {
             "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed."

@@ -721,4 +721,14 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
     // summary and the page say
     assert_eq!(s["free_seed"], "phased");
     assert!(html.contains("Free-form design: from the phased design, "));
+    // the least-height schedule (2.0 N m for its 3.5 m drop) has its own
+    // torque axes, apart from the 6 m designs' (under 0.1 N m)
+    let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
+    for panel in [
+        "analytic schedule",
+        "optimised schedules",
+        "the least-height schedule (for its own drop height)",
+    ] {
+        assert_eq!(torque.matches(panel).count(), 1, "{panel}");
+    }
 }
