@@ -617,6 +617,22 @@ pub fn to_csv(lines: &[LineResult], header: bool) -> String {
     s
 }
 
+/// The index.html caption of a recovery figure, by file name.
+pub fn caption(file: &str) -> Option<&'static str> {
+    Some(match file {
+        "recovery-spin.svg" => {
+            "The largest spin at release from which the design still lands belly-down, against the spin axis's angle from the spine (+z), a line per plane of the rear half (y-z, x-z); bisected between the last spin of the grid that lands and the first that does not (a spin that landed at the grid's end is a lower bound: >= in the table)."
+        }
+        "recovery-landing-spin.svg" => {
+            "Landing error (the belly's angle from straight down at touchdown) against the spin at release, a line per spin axis; each start's free-form design continues from its neighbour's, and past the first start it misses from, the open-loop schedule for the start at rest is replayed."
+        }
+        "recovery-landing-tilt.svg" => {
+            "Landing error (the belly's angle from straight down at touchdown) against the tilt at release, a line per horizontal tilt axis (0 deg rolls about the spine, 90 deg pitches end over end); past the first tilt it misses from, the open-loop schedule for the start at rest is replayed."
+        }
+        _ => return None,
+    })
+}
+
 /// The figures: the largest recoverable spin against its axis, one series a
 /// plane, and the landing error against the magnitude, one series a line
 /// (spins and tilts apart).

@@ -212,5 +212,6 @@ fn report(cfg: &catflip::Config, s: &Summary, figures: &[String]) -> String {
         warnings: &[],
         animation: "",
         figures: &figs,
+        captions: catflip::recovery::caption,
     })
 }

@@ -679,6 +679,7 @@ fn page(
         warnings: &warnings,
         animation: &report::animation::section(&scene),
         figures: figure_names,
+        captions: report::caption,
     })
 }
 

@@ -892,6 +892,8 @@ pub struct Page<'a> {
     pub warnings: &'a [String],
     pub animation: &'a str,
     pub figures: &'a [&'a str],
+    /// Each figure's caption, by file name (the command's own).
+    pub captions: fn(&str) -> Option<&'static str>,
 }
 
 /// The report page: the answer when there is one ([`answer::lead`]), a
@@ -906,6 +908,7 @@ pub fn index_html(page: &Page) -> String {
         warnings,
         animation,
         figures,
+        captions,
     } = *page;
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>");
@@ -957,7 +960,7 @@ pub fn index_html(page: &Page) -> String {
     h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));
-        if let Some(c) = caption(f).or_else(|| size::caption(f)) {
+        if let Some(c) = captions(f) {
             h.push_str(&format!("<figcaption>{}</figcaption>", esc(c)));
         }
         h.push_str("</figure>\n");

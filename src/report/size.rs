@@ -309,5 +309,6 @@ pub fn page(a: &SizeAnswer) -> String {
         warnings: &a.failed,
         animation: "",
         figures: &[crate::size::files::CURVE_SVG, crate::size::files::GEAR_SVG],
+        captions: caption,
     })
 }

@@ -128,6 +128,10 @@ fn shards_concatenate_to_the_whole_map_and_the_figures_are_svg() {
         "recovery-landing-tilt.svg",
     ] {
         assert!(html.contains(&format!("src=\"{f}\"")), "{f} not linked");
+        // each figure says what it shows
+        let after = &html[html.find(&format!("src=\"{f}\"")).unwrap()..];
+        let figure = &after[..after.find("</figure>").unwrap()];
+        assert!(figure.contains("<figcaption>"), "{f} has no caption");
         let svg = std::fs::read_to_string(set.join(f)).unwrap();
         let doc = roxmltree::Document::parse(&svg).unwrap_or_else(|e| panic!("{f}: {e}"));
         assert_eq!(doc.root_element().tag_name().name(), "svg", "{f}");
