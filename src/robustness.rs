@@ -119,11 +119,27 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         format!("robustness{suffix}.timing.json"),
         serde_json::to_string_pretty(&timing)?,
     );
-    if !results.is_empty()
+    let figure = format!("robustness{suffix}.svg");
+    let drawn = if !results.is_empty()
         && let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
     {
-        out.add(format!("robustness{suffix}.svg"), svg);
-    }
+        out.add(figure.clone(), svg);
+        true
+    } else {
+        false
+    };
+    out.add(
+        "index.html",
+        page(
+            &cfg,
+            &summary,
+            &timing,
+            &range,
+            trials,
+            interrupted,
+            drawn.then_some(figure.as_str()),
+        ),
+    );
     out.add(
         StudyState::file_name(&suffix),
         serde_json::to_string_pretty(&state)?,
@@ -157,4 +173,90 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         ));
     }
     Ok(Status::Ok)
+}
+
+/// The study's page: each controller's line, what was drawn and how to fly
+/// a trial again, and the figure.
+fn page(
+    cfg: &catflip::Config,
+    s: &catflip::control::robustness::Summary,
+    timing: &catflip::control::robustness::ReplanTiming,
+    range: &std::ops::Range<usize>,
+    trials: usize,
+    interrupted: bool,
+    figure: Option<&str>,
+) -> String {
+    let rows: Vec<Vec<String>> = s
+        .controllers
+        .iter()
+        .map(|c| {
+            vec![
+                c.name.to_string(),
+                format!("{:.1} %", 100.0 * c.success_rate),
+                format!("{:.1} to {:.1} %", 100.0 * c.ci95[0], 100.0 * c.ci95[1]),
+                format!("{:.3}", c.landing_error_deg.p50),
+                format!("{:.3}", c.landing_error_deg.p99),
+                format!("{:.3}", c.landing_error_deg.max),
+                c.worst
+                    .iter()
+                    .map(|w| format!("{} ({:.1} deg)", w.trial, w.landing_error_deg))
+                    .collect::<Vec<_>>()
+                    .join(", "),
+            ]
+        })
+        .collect();
+    let p = &cfg.robustness;
+    let mut notes = vec![
+        format!(
+            "{}{} ({}..{} of {trials}), seed {}, dropped from {} m (fall.height): a trial succeeds when the belly lands within {} deg of straight down. Each trial draws its perturbations from the seed and its index alone: a spin at release up to [{}, {}, {}] rad/s about the rear half's axes, a tilt up to {} deg about a random horizontal axis, each half's mass, inertia and length off by up to {} %, {} % and {} %, {} ms of actuator delay, torque noise of {} % of the design's peak, attitude noise {} deg and rate noise {} rad/s, the open loop's PD gains off by up to {} % ([robustness]).",
+            if interrupted { "Partial study: " } else { "" },
+            catflip::console::count(s.trials, "trial"),
+            range.start,
+            range.end,
+            s.seed,
+            cfg.fall.height,
+            s.max_tilt_deg,
+            p.spin_rad_s[0],
+            p.spin_rad_s[1],
+            p.spin_rad_s[2],
+            p.tilt_deg,
+            100.0 * p.mass_error,
+            100.0 * p.inertia_error,
+            100.0 * p.length_error,
+            p.delay_ms,
+            100.0 * p.torque_noise,
+            p.attitude_noise_deg,
+            p.rate_noise_rad_s,
+            100.0 * p.pd_gain_error,
+        ),
+        format!(
+            "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}) (docs/control.md); robustness.csv has every trial's draws and landings.",
+            s.seed
+        ),
+    ];
+    notes.extend(catflip::console::robustness::replans(timing).map(|l| {
+        let mut l = l;
+        l[..1].make_ascii_uppercase();
+        format!("{l}.")
+    }));
+    let figures: Vec<&str> = figure.into_iter().collect();
+    catflip::report::index_html(&catflip::report::Page {
+        title: &format!("catflip robustness: {}", cfg.name),
+        lead: None,
+        header: &[
+            "controller",
+            "success",
+            "95 % interval",
+            "landing p50 deg",
+            "p99 deg",
+            "max deg",
+            "worst trials (landing)",
+        ],
+        rows: &rows,
+        notes: &notes,
+        warnings: &[],
+        animation: "",
+        figures: &figures,
+        captions: catflip::control::figure::caption,
+    })
 }

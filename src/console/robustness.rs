@@ -39,9 +39,20 @@ pub fn study(
             s.landing_error_deg.max
         ));
     }
-    if timing.replans > 0 {
-        lines.push(format!(
-            "  replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} over the {:.1} ms control period",
+    if let Some(line) = replans(timing) {
+        lines.push(format!("  {line}"));
+    }
+    for p in written {
+        lines.push(format!("  wrote {}", p.display()));
+    }
+    lines
+}
+
+/// The replans' counts and wall times, when there were any.
+pub fn replans(timing: &ReplanTiming) -> Option<String> {
+    (timing.replans > 0).then(|| {
+        format!(
+            "replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} over the {:.1} ms control period",
             timing.replans,
             timing.taken,
             timing.worse,
@@ -55,10 +66,6 @@ pub fn study(
             1e3 * timing.solve_max_s,
             timing.over_period,
             1e3 * timing.period_s
-        ));
-    }
-    for p in written {
-        lines.push(format!("  wrote {}", p.display()));
-    }
-    lines
+        )
+    })
 }

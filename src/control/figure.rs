@@ -9,6 +9,13 @@ use crate::error::Result;
 /// Bins along each perturbation's size.
 const BINS: usize = 5;
 
+/// The index.html caption of the study's figure (any shard's).
+pub fn caption(file: &str) -> Option<&'static str> {
+    (file.starts_with("robustness") && file.ends_with(".svg")).then_some(
+        "Each controller's success rate against the size of each perturbation (spin, tilt, inertia error), as a fraction of its largest value in [robustness]: the trials binned by that one perturbation, the others as they fell. A colour per controller, a dash and marker per perturbation; a bin without trials is left out.",
+    )
+}
+
 /// The SVG, or `None` when no perturbation varies.
 pub fn success_by_size(
     cfg: &Config,

@@ -193,7 +193,10 @@ fn a_urdf_joint_range_bounds_the_bend_unless_the_config_sets_it() {
     assert!(e.contains(&format!("line {at}, ")), "line {at}: {e}");
     // a range typed in degrees is refused with its radians; a file's "no
     // limit" far past a full turn bounds nothing
-    let degrees = ranged("lower=\"-90\" upper=\"90\"", "lower=\"-0.6\" upper=\"0.55\"");
+    let degrees = ranged(
+        "lower=\"-90\" upper=\"90\"",
+        "lower=\"-0.6\" upper=\"0.55\"",
+    );
     let e = imported(dir.path(), "urdf", "r.urdf", &degrees)
         .unwrap_err()
         .to_string();

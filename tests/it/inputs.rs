@@ -891,6 +891,23 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     assert!(o.status.success(), "{}", stderr(&o));
     let whole = read(set("whole").join("robustness.csv"));
     let whole_json = read(set("whole").join("robustness.json"));
+    // the study's page: each controller's rate and interval as the JSON has
+    // them, and the figure with its caption
+    let page = read(set("whole").join("index.html"));
+    let summary: serde_json::Value = serde_json::from_str(&whole_json).unwrap();
+    for c in summary["controllers"].as_array().unwrap() {
+        let pct = |x: &serde_json::Value| format!("{:.1}", 100.0 * x.as_f64().unwrap());
+        let row = format!(
+            "<td>{}</td><td>{} %</td><td>{} to {} %</td>",
+            c["name"].as_str().unwrap(),
+            pct(&c["success_rate"]),
+            pct(&c["ci95"][0]),
+            pct(&c["ci95"][1])
+        );
+        assert!(page.contains(&row), "{row}: {page}");
+    }
+    assert!(page.contains("<img src=\"robustness.svg\"") && page.contains("<figcaption>"));
+    assert!(!page.contains("Partial study"));
     // SIGINT once the progress shows 10 of the 40 trials (a line every 2),
     // twice at once, as GNU `timeout` sends it (to the command, then to its
     // process group): one request, the finished trials still published
@@ -910,6 +927,7 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     let json: serde_json::Value =
         serde_json::from_str(&read(set("part").join("robustness.json"))).unwrap();
     assert_eq!(json["status"], "partial");
+    assert!(read(set("part").join("index.html")).contains("Partial study: "));
     let state: serde_json::Value =
         serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
     assert_eq!(state["status"], "partial");
@@ -965,6 +983,11 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     );
     assert_eq!(read(set("part").join("robustness.csv")), whole);
     assert_eq!(read(set("part").join("robustness.json")), whole_json);
+    // (the page's table; its replans' wall times differ run to run)
+    let table = |page: &str| {
+        page[page.find("<table>").unwrap()..page.find("</table>").unwrap()].to_string()
+    };
+    assert_eq!(table(&read(set("part").join("index.html"))), table(&page));
     let state: serde_json::Value =
         serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
     assert_eq!(state["status"], "complete");
