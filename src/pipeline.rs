@@ -627,6 +627,20 @@ pub fn free_start(
 /// answer `a` says no schedule found fits (`run`'s line and `optimize`'s
 /// error).
 pub fn beyond_reach(a: &crate::design::least_height::HeightAnswer) -> String {
+    if a.beyond_longest_fall {
+        return format!(
+            "no schedule found fits the motors in the fall from {} m (fall.height), nor in any fall catflip designs (up to {} s): {} takes {:.4} s (a drop of {:.4e} m); raise the motors' limits (catflip size names the motors for a height)",
+            a.height_m,
+            crate::config::ranges::MAX_FALL_TIME_S,
+            if a.method == "analytic" {
+                "the seed's analytic schedule within these motors".to_string()
+            } else {
+                format!("the {} time-optimal design", a.method)
+            },
+            a.least_time_s,
+            a.least_height_m
+        );
+    }
     format!(
         "no schedule found fits the motors in the fall from {} m (fall.height); the least drop height found is {:.3} m (the {} time-optimal design)",
         a.height_m, a.least_height_m, a.method
@@ -636,6 +650,11 @@ pub fn beyond_reach(a: &crate::design::least_height::HeightAnswer) -> String {
 /// The error of a design made for this fall when the least-height answer
 /// `a` is that no schedule found fits it (verified), naming the height.
 pub fn out_of_reach(a: &crate::design::least_height::HeightAnswer) -> Option<Error> {
+    if a.beyond_longest_fall {
+        return Some(Error::BeyondMotors {
+            reason: beyond_reach(a),
+        });
+    }
     (!a.possible && a.verified).then(|| Error::BeyondMotors {
         reason: format!(
             "{}; `catflip run` writes its schedule as least-height.csv",

@@ -290,6 +290,9 @@ impl Question {
 
     /// Why the phased design is not attempted, if no phased schedule fits.
     fn phased_impossible(&self, spec: &DesignSpec) -> Option<String> {
+        if let Some(a) = self.answer.as_ref().filter(|a| a.beyond_longest_fall) {
+            return Some(crate::pipeline::beyond_reach(a));
+        }
         self.phased_short.map(|least| {
             format!(
                 "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
@@ -304,8 +307,15 @@ impl Question {
         // design is tried in the configured fall
         self.answer
             .as_ref()
-            .filter(|a| !a.possible && a.verified)
-            .map(|a| format!("{}, least-height.csv", crate::pipeline::beyond_reach(a)))
+            .filter(|a| !a.possible && (a.verified || a.beyond_longest_fall))
+            .map(|a| {
+                let written = if a.beyond_longest_fall {
+                    ""
+                } else {
+                    ", least-height.csv"
+                };
+                format!("{}{written}", crate::pipeline::beyond_reach(a))
+            })
     }
 
     /// After the designs: a verified free-form schedule inside the envelope
@@ -324,7 +334,8 @@ impl Question {
             a.possible = true;
             a.method = m.method;
         }
-        if let Some(a) = &self.answer {
+        // (beyond the longest fall there is no schedule to show)
+        if let Some(a) = self.answer.as_ref().filter(|a| !a.beyond_longest_fall) {
             let design = Design::LeastHeight(crate::pipeline::LeastHeightDesign::of(spec, a));
             done.add(spec, Method::LeastHeight, Ok((design, self.seconds)));
         }

@@ -293,7 +293,8 @@ impl HeightChain {
             _ => heights(spec, with_free, |_| {}),
         };
         match &h {
-            Ok(Some(h)) => {
+            // (a bend is known only where the phased design was made)
+            Ok(Some(h)) if h.phased_bend.is_finite() => {
                 self.bends.push(h.phased_bend);
                 if let Some(same) = self
                     .same_answer

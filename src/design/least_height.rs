@@ -56,6 +56,13 @@ pub struct HeightAnswer {
     /// lands answers; without one the numbers are the start at rest's and
     /// `possible` is false.
     pub from_start: bool,
+    /// Whether the shortest manoeuvre found needs a fall longer than any
+    /// catflip designs ([`crate::config::ranges::MAX_FALL_TIME_S`]): the
+    /// flip is then not possible from any height catflip answers for, and
+    /// there is no schedule (its simulations and simulator controls would
+    /// grow with that fall).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub beyond_longest_fall: bool,
     /// The least-height schedule.
     #[serde(skip)]
     pub schedule: Schedule,
@@ -68,7 +75,41 @@ pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
     if !spec.motor.is_limited() {
         return Ok(None);
     }
+    if let Some(far) = far_beyond(spec) {
+        return Ok(Some(far));
+    }
     answer_for(spec, &reference(spec), None).map(|(a, _)| Some(a))
+}
+
+/// How far past the longest fall the analytic schedule's least time under
+/// the motors may be before no design is tried: the seed's analytic
+/// schedule needs 65 times the free-form design's peak torque under a
+/// stall torque alone, 8 times its time (F7); the robot's 0.94 s against
+/// 0.74 s.
+const FAR: f64 = 20.0;
+
+/// The answer without a design when even a [`FAR`]th of the analytic
+/// schedule's least time under the motors ([`reference_time`]) needs a fall
+/// longer than catflip designs: a design made for such a fall would only
+/// show what the answer already says, at the cost of simulating it (a
+/// 1e-9 N m motor: a 37,000 s manoeuvre, 25 s of designs and a report that
+/// ran out of memory).
+fn far_beyond(spec: &DesignSpec) -> Option<HeightAnswer> {
+    let t = reference_time(spec)?;
+    (t / FAR + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S).then(|| HeightAnswer {
+        possible: false,
+        verified: false,
+        height_m: spec.fall.height,
+        least_height_m: crate::design::envelope::height_for(spec, t),
+        least_time_s: t,
+        method: "analytic",
+        status: Status::ClosedForm,
+        least_height_lower_bound_m: None,
+        flip_error_rad: f64::NAN,
+        from_start: true,
+        beyond_longest_fall: true,
+        schedule: Schedule { rows: Vec::new() },
+    })
 }
 
 /// [`answer`] with the phased `time` design made for `reference`, its bend
@@ -87,7 +128,7 @@ fn answer_for(
         spec.simulate.flip_tolerance,
     )
     .is_empty();
-    let answer = HeightAnswer {
+    let mut answer = HeightAnswer {
         possible: verified && fits(spec, least),
         verified,
         height_m: spec.fall.height,
@@ -98,8 +139,10 @@ fn answer_for(
         least_height_lower_bound_m: None,
         flip_error_rad: sim.flip_error_rad,
         from_start: spec.is_default_start(),
+        beyond_longest_fall: false,
         schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
     };
+    answer.bound(spec);
     Ok((answer, r.bend_deg.to_radians()))
 }
 
@@ -136,8 +179,25 @@ pub struct Heights {
 /// so the fall itself is part of the question: there the reference is the
 /// config's own drop.
 pub fn reference(spec: &DesignSpec) -> DesignSpec {
-    if !spec.is_default_start() {
+    let Some(least) = reference_time(spec) else {
         return spec.with_objective(Objective::Time);
+    };
+    // (a design for a fall catflip does not design would be simulated over it)
+    let longest = crate::config::ranges::MAX_FALL_TIME_S - spec.fall.margin;
+    let least = if least > longest {
+        round_down_to_digits(longest, 3)
+    } else {
+        least
+    };
+    spec.with_height(0.5 * spec.fall.gravity * (least + spec.fall.margin).powi(2))
+        .with_objective(Objective::Time)
+}
+
+/// The reference drop's manoeuvre time, s ([`reference`]); `None` from a
+/// start with momentum, where the reference is the config's own drop.
+fn reference_time(spec: &DesignSpec) -> Option<f64> {
+    if !spec.is_default_start() {
+        return None;
     }
     let plan = crate::design::analytic::analytic_plan(spec);
     let t0 = spec.available_time();
@@ -166,9 +226,7 @@ pub fn reference(spec: &DesignSpec) -> DesignSpec {
         (None, Some(s)) => s,
         (None, None) => t0,
     };
-    let least = round_to_digits(least.max(1e-3), 3);
-    spec.with_height(0.5 * spec.fall.gravity * (least + spec.fall.margin).powi(2))
-        .with_objective(Objective::Time)
+    Some(round_to_digits(least.max(1e-3), 3))
 }
 
 /// The least reference manoeuvre as a fraction of the analytic plan's time
@@ -180,6 +238,12 @@ const SPEED_FLOOR: f64 = 0.1;
 fn round_to_digits(x: f64, digits: i32) -> f64 {
     let e = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
     (x * e).round() / e
+}
+
+/// `x` (positive) rounded down to `digits` significant digits.
+fn round_down_to_digits(x: f64, digits: i32) -> f64 {
+    let e = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    (x * e).floor() / e
 }
 
 /// The least time with the stall torque alone (no torque-speed line, no
@@ -245,6 +309,15 @@ pub fn heights(
 ) -> Result<Option<Heights>> {
     if !spec.motor.is_limited() {
         return Ok(None);
+    }
+    if let Some(answer) = far_beyond(spec) {
+        return Ok(Some(Heights {
+            phased_m: answer.least_height_m,
+            phased_bend: f64::NAN,
+            phased_verified: false,
+            answer,
+            free: None,
+        }));
     }
     let reference = reference(spec);
     if !with_free {
@@ -544,6 +617,18 @@ impl HeightAnswer {
         self.flip_error_rad = sim.flip_error_rad;
         self.from_start = true;
         self.schedule = Schedule::sample(&spec.cat, &fr.plan, spec.simulate.samples_per_phase);
+        self.bound(spec);
+    }
+
+    /// The answer with [`HeightAnswer::beyond_longest_fall`] decided: a
+    /// manoeuvre longer than the longest fall is no answer catflip gives.
+    fn bound(&mut self, spec: &DesignSpec) {
+        self.beyond_longest_fall =
+            self.least_time_s + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S;
+        if self.beyond_longest_fall {
+            self.possible = false;
+            self.schedule = Schedule { rows: Vec::new() };
+        }
     }
 
     /// One plain sentence for the terminal and the report.
@@ -560,7 +645,23 @@ impl HeightAnswer {
             .least_height_lower_bound_m
             .map(|b| format!(" (at least {b:.3} m within the stall torque)"))
             .unwrap_or_default();
-        if !self.verified && self.from_start && self.possible {
+        if self.beyond_longest_fall {
+            format!(
+                "The flip is NOT possible from {} m with these motors, nor from any drop catflip designs (falls up to {} s): {} takes {:.4} s, a drop of {:.4e} m. Stronger or faster motors (catflip size names them for a height).",
+                self.height_m,
+                crate::config::ranges::MAX_FALL_TIME_S,
+                if self.method == "analytic" {
+                    "the seed's analytic schedule within these motors".to_string()
+                } else {
+                    format!(
+                        "the shortest manoeuvre found (the {} time design)",
+                        self.method
+                    )
+                },
+                self.least_time_s,
+                self.least_height_m
+            )
+        } else if !self.verified && self.from_start && self.possible {
             format!(
                 "The flip is possible from {} m: the {} design fits the motors in this fall; no verified least drop height was found (the phased time design fits them from {:.3} m but misses the flip; see the least-height row).",
                 self.height_m, self.method, self.least_height_m
@@ -614,6 +715,7 @@ mod tests {
             flip_error_rad: 5e-4,
             verified: false,
             from_start: true,
+            beyond_longest_fall: false,
             schedule: Schedule { rows: Vec::new() },
         };
         let s = a.sentence();

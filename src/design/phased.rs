@@ -254,10 +254,21 @@ pub fn check_limit(spec: &DesignSpec, unit_peak: f64, peak: f64, what: &str) -> 
     if let Some(lim) = spec.motor.max_torque
         && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
+        let t = (unit_peak / lim).sqrt() + spec.fall.margin;
+        let longest = crate::config::ranges::MAX_FALL_TIME_S;
+        let height = if t <= longest {
+            format!(
+                "drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
+                least_height(spec, unit_peak, lim)
+            )
+        } else {
+            format!(
+                "at this torque it needs a {t:.4e} s fall (F7), longer than any catflip designs ({longest} s): raise limits.max_torque"
+            )
+        };
         return Err(Error::BeyondMotors {
             reason: format!(
-                "the {what} needs {peak:.4} N m but limits.max_torque = {lim} N m; drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
-                least_height(spec, unit_peak, lim)
+                "the {what} needs {peak:.4} N m but limits.max_torque = {lim} N m; {height}"
             ),
         });
     }

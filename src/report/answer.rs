@@ -26,7 +26,12 @@ pub fn lower_bound(a: &HeightAnswer) -> Option<f64> {
 
 /// The headline: possible or not, from the configured height.
 pub fn headline(a: &HeightAnswer) -> String {
-    if !a.possible && !a.verified {
+    if a.beyond_longest_fall {
+        format!(
+            "Not possible from {} m with these motors, nor from any drop catflip designs.",
+            a.height_m
+        )
+    } else if !a.possible && !a.verified {
         format!(
             "No verified design flips it from {} m with these motors.",
             a.height_m
@@ -54,6 +59,9 @@ pub fn height_text(a: &HeightAnswer) -> String {
             )
         })
         .unwrap_or_default();
+    if a.beyond_longest_fall {
+        return a.sentence();
+    }
     if !a.verified {
         // (only the phased design is ever unverified: the free-form ones
         // that answer are flown first)
@@ -78,6 +86,9 @@ pub fn height_text(a: &HeightAnswer) -> String {
 
 /// What the least-height schedule is and where it is shown.
 fn shown_text(a: &HeightAnswer) -> String {
+    if a.beyond_longest_fall {
+        return "No least-height schedule is shown or written: its fall would be longer than any catflip simulates.".into();
+    }
     if !a.verified {
         return "Its schedule is the least-height row below (flagged), shown and written as least-height.csv so that it can be examined, not flown.".into();
     }

@@ -185,3 +185,72 @@ fn under_a_stall_torque_alone_the_answer_is_near_the_peak_optimum_scaled_and_has
         a.least_time_s
     );
 }
+
+/// A motor too weak for any fall catflip designs (30 s) is answered at
+/// once, with no schedule to simulate or export (a 1e-9 N m motor ran 25 s
+/// of designs for a 37,000 s manoeuvre, then ran out of memory writing its
+/// simulator controls); a manoeuvre that fits the longest fall is still the
+/// answer, with its schedule.
+#[test]
+fn a_motor_too_weak_for_any_fall_is_answered_without_a_schedule() {
+    use crate::util::{method_line, run_summary};
+    let dir = crate::util::temp_dir();
+    let (code, s, base, err) = run_summary("seed", &["limits.max_torque=1e-9"], dir.path());
+    assert_eq!(code, Some(4), "{err}");
+    let a = &s["answer"];
+    assert_eq!(a["beyond_longest_fall"], true, "{a}");
+    assert_eq!(a["possible"], false, "{a}");
+    // the analytic schedule within the motors, by F7: t = T0 sqrt(peak / limit)
+    let an = method_line(&s, "analytic");
+    let t0 = s["analytic"]["available_time_s"].as_f64().unwrap();
+    let t = t0 * (an["peak_torque_nm"].as_f64().unwrap() / 1e-9).sqrt();
+    let least = a["least_time_s"].as_f64().unwrap();
+    assert!(
+        (least / t - 1.0).abs() < 1e-2,
+        "{least} s against F7's {t} s"
+    );
+    assert!(
+        s["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .all(|m| m["method"] != "least-height"),
+        "{s}"
+    );
+    assert!(!base.join("least-height.csv").exists());
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    assert!(html.contains("nor from any drop catflip designs"), "{html}");
+    // optimize names no height beyond the longest fall either
+    let cfg = crate::util::config_arg("seed");
+    for mode in ["phased"] {
+        let (code, _, err) = crate::util::run(
+            &[
+                "optimize",
+                &cfg,
+                "--mode",
+                mode,
+                "--set",
+                "limits.max_torque=1e-9",
+                "--out",
+                ".",
+            ],
+            dir.path(),
+        );
+        assert_eq!(code, Some(4), "{mode}: {err}");
+        assert!(
+            err.contains("longer than any catflip designs")
+                || err.contains("nor in any fall catflip designs"),
+            "{mode}: {err}"
+        );
+        assert!(!err.contains("drop the cat from at least"), "{mode}: {err}");
+    }
+    // 1e-3 N m: the free-form design's 28.7 s manoeuvre fits the 30 s fall
+    // (the phased one, 37 s, does not): it answers, with its schedule
+    let (code, s, base, err) = run_summary("seed", &["limits.max_torque=1e-3"], dir.path());
+    assert_eq!(code, Some(4), "{err}");
+    let a = &s["answer"];
+    assert!(a.get("beyond_longest_fall").is_none(), "{a}");
+    assert!(a["least_time_s"].as_f64().unwrap() <= 30.0, "{a}");
+    assert_eq!(method_line(&s, "least-height")["verdict"], "ok");
+    assert!(base.join("least-height.csv").exists());
+}
