@@ -124,13 +124,13 @@ enum Command {
         /// Spin magnitudes per axis after zero (1 to 20; default 2).
         #[arg(long, allow_negative_numbers = true)]
         spins: Option<usize>,
-        /// Largest spin of the grid, rad/s (0 to 50; default 1).
+        /// Largest spin of the grid, rad/s (over 0, up to 50; default 1).
         #[arg(long = "max-spin", value_name = "W", allow_negative_numbers = true)]
         max_spin: Option<f64>,
         /// Tilt angles per axis after zero, 0 for none (0 to 20; default 2).
         #[arg(long, allow_negative_numbers = true)]
         tilts: Option<usize>,
-        /// Largest tilt of the grid, degrees (0 to 180; default 30).
+        /// Largest tilt of the grid, degrees (over 0, up to 180; default 30).
         #[arg(long = "max-tilt", value_name = "DEG", allow_negative_numbers = true)]
         max_tilt: Option<f64>,
         /// Bisection steps of the largest recoverable spin per axis (0 to 12; default 3).
@@ -697,6 +697,9 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
             .and_then(|s| s.to_str())
             .unwrap_or("schedule")
             .to_string();
+        // flown first, as `simulate` flies it: a schedule the model cannot
+        // follow gives no controls or gains (it wrote NaN gains)
+        catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &s)?;
         catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim);
     }
     for w in publisher.publish(out)? {

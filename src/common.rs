@@ -93,6 +93,16 @@ pub(crate) struct Common {
 
 /// Loads and checks the config; likely unit slips are warned about on stderr.
 pub(crate) fn load(c: &Common) -> Result<Config> {
+    // the last would win silently, yet both would name the output set
+    let key = |s: &String| s.split('=').next().map(|k| k.trim().to_string());
+    for (i, s) in c.set.iter().enumerate() {
+        if let Some(first) = c.set[..i].iter().find(|f| key(f) == key(s)) {
+            return Err(catflip::Error::Usage(format!(
+                "--set {s} gives the key of --set {first} again: give each key once"
+            ))
+            .into());
+        }
+    }
     let cfg = Config::load(&c.config, &c.set)?;
     for s in cfg.slips() {
         eprintln!("warning: {s}");

@@ -370,6 +370,21 @@ impl Config {
                 b > 0.0 && b < 180.0,
                 "must be in (0, 180) degrees",
             )?;
+            // every command designs the phased schedule or seeds from it
+            let from_file = if self.body.as_ref().is_some_and(|b| b.urdf.is_some()) {
+                " (with [body], it comes from body.urdf's joint ranges unless the config sets it)"
+            } else {
+                ""
+            };
+            check(
+                "limits.max_bend_deg",
+                b,
+                b > self.phased.bend_min_deg,
+                &format!(
+                    "must exceed phased.bend_min_deg = {} deg, the phased design's least bend: lower that key too for a tighter limit{from_file}",
+                    self.phased.bend_min_deg
+                ),
+            )?;
         }
         self.simulate.validate()?;
         self.phased.validate()?;

@@ -35,6 +35,14 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     let suffix = shard.suffix();
     let publisher = publisher(c, &cfg, &format!("robustness{suffix}"))?;
     let range = shard_range(trials, shard.index, shard.count);
+    if range.is_empty() {
+        eprintln!(
+            "warning: shard {}/{} holds no trials: the study has {}; use at most that many shards",
+            shard.index,
+            shard.count,
+            catflip::console::count(trials, "trial")
+        );
+    }
     let state = StudyState {
         status: SweepStatus::Partial,
         trials,

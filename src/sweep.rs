@@ -59,7 +59,7 @@ impl std::str::FromStr for SweepSpec {
         let count: usize = parts[2]
             .trim()
             .parse()
-            .map_err(|_| bad("COUNT must be a whole number"))?;
+            .map_err(|_| bad("COUNT must be a whole number of points, 1 or more"))?;
         if count < 1 || !from.is_finite() || !to.is_finite() || !(to - from).is_finite() {
             return Err(bad("COUNT must be at least 1 and the ends finite"));
         }

@@ -27,7 +27,10 @@ pub fn study(
             "controller", "success", "95 % CI", "p50 deg", "p99 deg", "max deg"
         ),
     ];
-    for s in &summary.controllers {
+    if trials == 0 {
+        lines.push("  (no trials in this shard: nothing to rate)".into());
+    }
+    for s in summary.controllers.iter().filter(|_| trials > 0) {
         lines.push(format!(
             "  {:<10} {:>8.1}% {:>7.1}%-{:>6.1}% {:>9.3} {:>9.3} {:>9.3}",
             s.name,

@@ -89,11 +89,6 @@ fn group<'a>(
     from_geom: bool,
     file: &str,
 ) -> Result<Group<'a>> {
-    for attr in ["class", "childclass"] {
-        if body.attribute(attr).is_some() {
-            return Err(site(&body).error(file, format!("`{attr}`: catflip does not read MJCF default classes; write the values on the elements")));
-        }
-    }
     let mut part = match body.children().find(|c| c.has_tag_name("inertial")) {
         Some(i) => {
             let pose = pose(&i, angles, file)?;
@@ -186,6 +181,27 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
         return Err(site(&inc).error(
             file,
             "<include>: catflip reads one file; paste the included model in",
+        ));
+    }
+    // defaults change elements that do not name them (a joint's type, a
+    // body's mass): read as written they would give another robot
+    if let Some(d) = root.descendants().find(|n| {
+        n.has_tag_name("default")
+            && n.children()
+                .any(|c| c.is_element() && !c.has_tag_name("default"))
+    }) {
+        return Err(site(&d).error(
+            file,
+            "<default>: catflip does not read MJCF defaults; write the values on the elements",
+        ));
+    }
+    if let Some(n) = root
+        .descendants()
+        .find(|n| n.attribute("class").is_some() || n.attribute("childclass").is_some())
+    {
+        return Err(site(&n).error(
+            file,
+            "`class`: catflip does not read MJCF default classes; write the values on the elements",
         ));
     }
     let compiler = root.children().find(|c| c.has_tag_name("compiler"));

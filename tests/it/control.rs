@@ -211,6 +211,36 @@ fn the_study_is_deterministic_and_its_shards_concatenate() {
     assert_ne!(whole, to_csv(&other.run(0..n, 2, |_, _| {}), true));
 }
 
+/// A shard that holds no trials says so, and rates nothing (it printed NaN).
+#[test]
+fn an_empty_shard_warns_and_rates_nothing() {
+    let dir = crate::util::temp_dir();
+    let seed = crate::util::config_arg("seed");
+    let out = crate::util::output(
+        &[
+            "robustness",
+            &seed,
+            "--trials",
+            "2",
+            "--shard",
+            "1/3",
+            "--out",
+            ".",
+        ],
+        dir.path(),
+    );
+    let (stdout, err) = crate::util::text(&out);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("warning: shard 1/3 holds no trials: the study has 2 trials"),
+        "{err}"
+    );
+    assert!(
+        stdout.contains("no trials in this shard") && !stdout.contains("NaN"),
+        "{stdout}"
+    );
+}
+
 /// Bad input is refused with the key, the value and the range; nothing is written.
 #[test]
 fn bad_input_is_refused_before_anything_is_written() {

@@ -370,6 +370,26 @@ fn mjcf_files_catflip_cannot_model_are_refused() {
             ),
             "no <inertial>",
         ),
+        // defaults would change elements that do not name them (a joint's
+        // type): refused, unclassed or by class, wherever the class is used
+        (
+            "default",
+            good.replacen(
+                "<worldbody>",
+                "<default><joint type=\"slide\"/></default>\n  <worldbody>",
+                1,
+            ),
+            "<default>: catflip does not read MJCF defaults",
+        ),
+        (
+            "class",
+            good.replacen(
+                "type=\"hinge\" axis=\"0 1 0\"",
+                "type=\"hinge\" class=\"s\" axis=\"0 1 0\"",
+                1,
+            ),
+            "`class`: catflip does not read MJCF default classes",
+        ),
     ] {
         let e = imported(dir.path(), "mjcf", "robot.xml", &text)
             .expect_err(what)

@@ -69,6 +69,27 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
         &["analyze", &config("box-robot"), "--set", "cat.mass=1"],
         &["`cat.mass` = 1 is invalid", "[body] gives the halves"],
     );
+    // a bend limit below the phased design's least bend: refused before any
+    // design, by `run` as by `optimize` (run wrote a report of FAILED rows)
+    refused(
+        &["run", &seed, "--set", "limits.max_bend_deg=1"],
+        &[
+            "`limits.max_bend_deg` = 1 is invalid",
+            "must exceed phased.bend_min_deg = 5 deg",
+        ],
+    );
+    // one key twice: the last would win silently, both would name the set
+    refused(
+        &[
+            "analyze",
+            &seed,
+            "--set",
+            "cat.mass=1",
+            "--set",
+            " cat.mass = 2",
+        ],
+        &["--set  cat.mass = 2 gives the key of --set cat.mass=1 again"],
+    );
 }
 
 #[test]

@@ -511,6 +511,24 @@ fn huge_torques_fail_naming_the_divergence_and_write_nothing() {
     let sim = dir.path().join("output/seed/simulate/simulation.csv");
     let rows = std::fs::read_to_string(sim).unwrap();
     assert!(!rows.contains("NaN"));
+    // export refuses it as simulate does (it wrote NaN gains and exited 0)
+    let p = dir.path().join("schedule.csv");
+    let c = seed_toml();
+    let (code, out, err) = run(
+        &[
+            "export",
+            "mjcf",
+            c.to_str().unwrap(),
+            "--schedule",
+            p.to_str().unwrap(),
+            "--out",
+            "exported",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(1), "{out}{err}");
+    assert!(err.contains("diverged") || err.contains("NaN"), "{err}");
+    assert!(!dir.path().join("exported").exists(), "export wrote files");
 }
 
 #[test]
@@ -567,15 +585,22 @@ fn a_schedule_for_another_fall_is_refused_naming_both_durations() {
     let (code, _, err) = simulate(dir.path(), &short, &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("0.45175") && err.contains("1.428571"), "{err}");
-    // the seed's own schedule stretched 100 times in time
+    // the seed's own schedule stretched twice in time fits a 40 m drop
+    // (g t^2 / 2 at 9.8 m/s^2 and 2.857 s); 100 times, no fall catflip
+    // designs (it named a 99,960 m drop, which the config refuses)
     let csv = analytic_csv(dir.path(), &[]);
+    let slow = map_rows(&csv, |x| x[0] *= 2.0);
+    let (code, _, err) = simulate(dir.path(), &slow, &[]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("`--set fall.height=40.0000000"), "{err}");
     let slow = map_rows(&csv, |x| x[0] *= 100.0);
     let (code, _, err) = simulate(dir.path(), &slow, &[]);
     assert_eq!(code, Some(2), "{err}");
     assert!(
-        err.contains("142.857") && err.contains("fall.height"),
+        err.contains("142.857") && err.contains("longer than any catflip designs (30 s)"),
         "{err}"
     );
+    assert!(!err.contains("--set fall.height"), "{err}");
     assert!(!dir.path().join("output/seed/simulate").exists());
 }
 
