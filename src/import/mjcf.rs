@@ -6,7 +6,7 @@
 //! derive it from geoms).
 
 use super::urdf::CROSS_MAX_FRACTION;
-use super::xml::{self, number, numbers, site, vec3};
+use super::xml::{self, numbers, site, vec3};
 use super::{Imported, Link, Part, Pose, Site, assemble};
 use crate::error::Result;
 use nalgebra::{Matrix3, Vector3};
@@ -42,10 +42,16 @@ fn orientation(n: &Node, angles: &Angles, file: &str) -> Result<Matrix3<f64>> {
         std::f64::consts::PI / 180.0
     };
     if n.attribute("quat").is_some() {
-        return Ok(xml::quat(&numbers(n, "quat", 4, None, file)?));
+        return Ok(xml::quat(&xml::direction(n, "quat", 4, None, file)?));
     }
     if n.attribute("axisangle").is_some() {
         let v = numbers(n, "axisangle", 4, None, file)?;
+        if v[..3].iter().all(|x| *x == 0.0) {
+            return Err(site(n).error(
+                file,
+                "attribute `axisangle` has an all-zero axis: it must give a direction",
+            ));
+        }
         return Ok(xml::axis_angle(&v[..3], v[3] * unit));
     }
     if n.attribute("euler").is_some() {
@@ -100,7 +106,7 @@ fn group<'a>(
                 Matrix3::from_diagonal(&vec3(&v))
             };
             Part {
-                mass: number(&i, "mass", None, file)?,
+                mass: xml::mass(&i, "mass", file)?,
                 com: Vector3::zeros(),
                 inertia,
             }
@@ -164,7 +170,13 @@ fn hinge_or_ball<'a>(body: &Node<'a, 'a>, file: &str) -> Result<Vec<BodyJoint<'a
             }
         }
         let pos = vec3(&numbers(&j, "pos", 3, Some(&[0.0; 3]), file)?);
-        let axis = vec3(&numbers(&j, "axis", 3, Some(&[0.0, 0.0, 1.0]), file)?);
+        let axis = vec3(&xml::direction(
+            &j,
+            "axis",
+            3,
+            Some(&[0.0, 0.0, 1.0]),
+            file,
+        )?);
         out.push((kind, pos, axis, j));
     }
     Ok(out)

@@ -435,7 +435,7 @@ pub(crate) fn assemble(
         if p.mass <= 0.0 {
             return Err(site.error(
                 file,
-                "a moving link without mass: catflip's halves need their mass and inertia (add an <inertial>)",
+                "a moving link without mass: catflip's halves need their mass and inertia (give it an <inertial> with a mass above 0)",
             ));
         }
     }

@@ -48,7 +48,7 @@ fn inertial(link: &Node, file: &str) -> Result<Part> {
     };
     let pose = origin(&i, file)?;
     let mass = match i.children().find(|c| c.has_tag_name("mass")) {
-        Some(m) => number(&m, "value", None, file)?,
+        Some(m) => xml::mass(&m, "value", file)?,
         None => 0.0,
     };
     let inertia = match i.children().find(|c| c.has_tag_name("inertia")) {
@@ -127,7 +127,7 @@ pub fn read(text: &str, file: &str) -> Result<Imported> {
             child: link_name(&n, "child", file)?,
             origin: origin(&n, file)?,
             axis: match n.children().find(|c| c.has_tag_name("axis")) {
-                Some(a) => vec3(&numbers(&a, "xyz", 3, Some(&[1.0, 0.0, 0.0]), file)?),
+                Some(a) => vec3(&xml::direction(&a, "xyz", 3, Some(&[1.0, 0.0, 0.0]), file)?),
                 None => nalgebra::Vector3::x(),
             },
             effort: limit

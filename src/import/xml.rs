@@ -35,9 +35,14 @@ pub fn numbers(
     default: Option<&[f64]>,
     file: &str,
 ) -> Result<Vec<f64>> {
+    let count = if n == 1 {
+        "a number".to_string()
+    } else {
+        format!("{n} numbers")
+    };
     let Some(raw) = node.attribute(attr) else {
         return default.map(|d| d.to_vec()).ok_or_else(|| {
-            site(node).error(file, format!("needs the attribute `{attr}` ({n} numbers)"))
+            site(node).error(file, format!("needs the attribute `{attr}` ({count})"))
         });
     };
     let v: std::result::Result<Vec<f64>, _> =
@@ -46,9 +51,39 @@ pub fn numbers(
         Ok(v) if v.len() == n && v.iter().all(|x| x.is_finite()) => Ok(v),
         _ => Err(site(node).error(
             file,
-            format!("attribute `{attr}` = \"{raw}\" must be {n} finite number(s)"),
+            format!("attribute `{attr}` = \"{raw}\" must be {count}, finite"),
         )),
     }
+}
+
+/// [`numbers`] that give a direction (an axis, a quaternion): not all zero.
+pub fn direction(
+    node: &Node,
+    attr: &str,
+    n: usize,
+    default: Option<&[f64]>,
+    file: &str,
+) -> Result<Vec<f64>> {
+    let v = numbers(node, attr, n, default, file)?;
+    if v.iter().all(|x| *x == 0.0) {
+        return Err(site(node).error(
+            file,
+            format!("attribute `{attr}` is all zeros: it must give a direction (a unit vector or quaternion; the tools normalise others)"),
+        ));
+    }
+    Ok(v)
+}
+
+/// A mass attribute, kg: not negative.
+pub fn mass(node: &Node, attr: &str, file: &str) -> Result<f64> {
+    let m = number(node, attr, None, file)?;
+    if m < 0.0 {
+        return Err(site(node).error(
+            file,
+            format!("{attr} = {m} kg is negative: give the body's mass in kg"),
+        ));
+    }
+    Ok(m)
 }
 
 pub fn number(node: &Node, attr: &str, default: Option<f64>, file: &str) -> Result<f64> {

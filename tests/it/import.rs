@@ -309,6 +309,31 @@ fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
             "not well-formed",
         ),
         (
+            // (it was blamed on the rear link: "a number is not finite")
+            "zero axis",
+            two(&format!(
+                "{m1}{}",
+                joint("m2", "revolute", "cross", "front", "0 0 0", "0 0 0")
+            ))
+            .replace(
+                "<axis xyz=\"0 0 0\"/>",
+                "<axis name=\"m2axis\" xyz=\"0 0 0\"/>",
+            ),
+            "<axis name=\"m2axis\">",
+            "`xyz` is all zeros",
+        ),
+        (
+            "negative mass",
+            urdf_of(
+                // (the front first: its <mass> is the first, whose line is checked)
+                &[("front", 0.2), ("rear", 1.0)],
+                &joint("ball", "spherical", "rear", "front", "0 0 0.1", "0 0 1"),
+            )
+            .replace("<mass value=\"0.2\"/>", "<mass value=\"-0.2\"/>"),
+            "<mass>",
+            "value = -0.2 kg is negative",
+        ),
+        (
             "negative motor limit",
             std::fs::read_to_string(util::configs().join("box-robot.urdf"))
                 .unwrap()
@@ -360,6 +385,16 @@ fn mjcf_files_catflip_cannot_model_are_refused() {
             "parallel",
             good.replace("axis=\"0 1 0\"", "axis=\"1 0 0\""),
             "parallel",
+        ),
+        (
+            "zero axis",
+            good.replace("axis=\"0 1 0\"", "axis=\"0 0 0\""),
+            "`axis` is all zeros",
+        ),
+        (
+            "negative mass",
+            good.replacen("mass=\"", "mass=\"-", 1),
+            "kg is negative",
         ),
         (
             "no inertial",
