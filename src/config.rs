@@ -184,6 +184,10 @@ fn expected_kind(message: &str) -> Option<ValueKind> {
         .map(|&(_, _, kind)| kind)
 }
 
+/// The longest `name`: the output folder's, with room for the set's
+/// overrides in its own name (file systems stop at 255 bytes).
+const MAX_NAME_LEN: usize = 100;
+
 impl Config {
     /// Reads, overrides and validates a config file.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Config> {
@@ -253,7 +257,21 @@ impl Config {
         if let Some(b) = cfg.body.as_mut() {
             b.halves = halves;
         }
-        cfg.validate()?;
+        cfg.validate().map_err(|e| match e {
+            // the user typed [body] keys or a file, not these
+            Error::Invalid {
+                key,
+                value,
+                expected,
+            } if cfg.body.is_some() && key.starts_with("cat.") => Error::Invalid {
+                expected: format!(
+                    "{expected} (with [body], `{key}` is a half's equivalent cylinder, computed from body.rear / body.front or the robot file: change those)"
+                ),
+                key,
+                value,
+            },
+            e => e,
+        })?;
         Ok(cfg)
     }
 
@@ -274,11 +292,14 @@ impl Config {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_' || c == '.')
             || self.name.starts_with('.')
+            || self.name.len() > MAX_NAME_LEN
         {
             return Err(Error::Invalid {
                 key: "name".into(),
                 value: format!("{:?}", self.name),
-                expected: "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (catflip keeps its sets in hidden folders)".into(),
+                expected: format!(
+                    "a non-empty folder name of letters, digits, '-', '_' or '.', not starting with '.' (catflip keeps its sets in hidden folders), at most {MAX_NAME_LEN} characters"
+                ),
             });
         }
         ranges::check_documented(self)?;

@@ -78,6 +78,26 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
             "must exceed phased.bend_min_deg = 5 deg",
         ],
     );
+    // a name too long for a folder (it blamed --out), and a [body] half's
+    // bad mass named as the [body] keys the user typed, not only [cat]'s
+    let long = format!("name={}", "n".repeat(101));
+    refused(
+        &["analyze", &seed, "--set", &long],
+        &["at most 100 characters"],
+    );
+    refused(
+        &[
+            "analyze",
+            &config("box-robot"),
+            "--set",
+            "body.rear.mass=1e9",
+        ],
+        &[
+            "`cat.mass` = 1e9 is invalid",
+            "with [body]",
+            "body.rear / body.front",
+        ],
+    );
     // one key twice: the last would win silently, both would name the set
     refused(
         &[
