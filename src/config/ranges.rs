@@ -231,13 +231,14 @@ pub fn check_documented(cfg: &Config) -> Result<()> {
 pub fn check_derived(cfg: &Config) -> Result<()> {
     let cat = cfg.cat();
     for (key, h) in [("cat.radius", &cat.rear), ("cat.front.radius", &cat.front)] {
-        if h.radius < 1e-3 * h.length {
+        // (h.length / 1000 as written: 1e-4 * 1e-3 rounds above 1e-7)
+        if h.radius < h.length / 1000.0 * (1.0 - 1e-12) {
             return Err(invalid(
                 key,
                 h.radius,
                 format!(
-                    "must be at least a thousandth of the half's length ({:e} m): a thinner half has no axial inertia to twist with",
-                    1e-3 * h.length
+                    "must be at least a thousandth of the half's length ({:.4e} m): a thinner half has no axial inertia to twist with",
+                    h.length / 1000.0
                 ),
             ));
         }
