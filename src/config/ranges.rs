@@ -531,3 +531,22 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    /// The radius's bound is the documented `length / 1000` to rounding:
+    /// exactly on it passes (1e-4 * 1e-3 rounds above 1e-7), just under fails.
+    #[test]
+    fn a_radius_of_a_thousandth_of_the_length_is_accepted() {
+        let at = |r: &str| {
+            let sets = ["cat.length=1e-4".to_string(), format!("cat.radius={r}")];
+            crate::config::Config::load(std::path::Path::new("configs/seed.toml"), &sets)
+        };
+        at("1e-7").expect("exactly a thousandth");
+        let e = at("0.99e-7").unwrap_err().to_string();
+        assert!(
+            e.contains("a thousandth of the half's length (1.0000e-7 m)"),
+            "{e}"
+        );
+    }
+}
