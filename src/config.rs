@@ -162,11 +162,18 @@ const REQUIRED: [(&str, &str); 5] = [
 /// The parser's messages name Rust's types ("expected f64") and a missing
 /// field without its table; the user wrote TOML keys.
 fn plain_types(message: &str) -> String {
-    let m = TYPE_WORDS
+    let mut m = TYPE_WORDS
         .iter()
         .fold(message.to_string(), |m, (rust, toml, _)| {
             m.replace(rust, toml)
         });
+    // a section given a value: "expected struct CatConfig" names Rust's type
+    if let Some(at) = m.find("expected struct ") {
+        let end = m[at + 16..]
+            .find(|c: char| !c.is_alphanumeric())
+            .map_or(m.len(), |e| at + 16 + e);
+        m.replace_range(at..end, "expected a table (a [section] of keys)");
+    }
     REQUIRED.iter().fold(m, |m, (field, key)| {
         m.replace(
             &format!("missing field `{field}`"),

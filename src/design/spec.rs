@@ -280,7 +280,7 @@ impl SimulateSettings {
             "simulate.samples_per_phase",
             n,
             (2.0..=30_000.0).contains(&n),
-            "must be in 2..=30000",
+            "must be a whole number in [2, 30000]",
         )?;
         Ok(())
     }
@@ -293,7 +293,7 @@ impl PhasedSettings {
             "phased.nodes",
             self.nodes as f64,
             (4..=2000).contains(&self.nodes),
-            "must be in 4..=2000",
+            "must be a whole number in [4, 2000]",
         )?;
         check(
             "phased.bend_min_deg",
@@ -311,7 +311,7 @@ impl PhasedSettings {
             "phased.scan_points",
             self.scan_points as f64,
             (3..=200).contains(&self.scan_points),
-            "must be in 3..=200",
+            "must be a whole number in [3, 200]",
         )?;
         check(
             "phased.bend_tol_deg",
@@ -330,7 +330,7 @@ impl FreeSettings {
             "free.nodes",
             self.nodes as f64,
             (4..=400).contains(&self.nodes),
-            "must be in 4..=400",
+            "must be a whole number in [4, 400]",
         )?;
         check(
             "free.max_iterations",

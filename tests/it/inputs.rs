@@ -98,6 +98,15 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
             "body.rear / body.front",
         ],
     );
+    // no Rust in the words: a section given a number, a whole-number range
+    refused(
+        &["analyze", &seed, "--set", "cat=1"],
+        &["--set cat=1", "expected a table (a [section] of keys)"],
+    );
+    refused(
+        &["analyze", &seed, "--set", "free.nodes=3"],
+        &["`free.nodes` = 3 is invalid: must be a whole number in [4, 400]"],
+    );
     // one key twice: the last would win silently, both would name the set
     refused(
         &[
