@@ -189,7 +189,16 @@ impl Publisher {
             path: path.to_path_buf(),
             message: e.to_string(),
         };
-        let created = create_dirs(dir).map_err(|(p, e)| oerr(&p, e))?;
+        let created = create_dirs(dir).map_err(|(p, e)| {
+            // a file where a folder must be: named, not the path below it
+            match p.ancestors().find(|a| a.is_file()) {
+                Some(file) => Error::OutputDir {
+                    path: file.to_path_buf(),
+                    message: "is a file, not a folder".into(),
+                },
+                None => oerr(&p, e),
+            }
+        })?;
         let (lock, id) = new_lock(dir, set).map_err(|e| {
             remove_created(&created);
             oerr(dir, e)
