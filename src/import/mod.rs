@@ -146,6 +146,15 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
             origin: origin.into(),
             message: format!("[body]: {}", e.message().trim()),
         })?;
+    for (key, path) in [("body.urdf", &body.urdf), ("body.mjcf", &body.mjcf)] {
+        if path.as_ref().is_some_and(|p| p.trim().is_empty()) {
+            return Err(invalid(
+                key,
+                "\"\"",
+                "an empty path: give the robot file's path, relative to the config file, or leave the key out",
+            ));
+        }
+    }
     let file = match (&body.urdf, &body.mjcf) {
         (Some(_), Some(m)) => {
             return Err(invalid(

@@ -98,6 +98,11 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
             "body.rear / body.front",
         ],
     );
+    // an empty robot file path (it read "Is a directory")
+    refused(
+        &["analyze", &config("box-robot"), "--set", "body.urdf=\"\""],
+        &["`body.urdf` = \"\" is invalid: an empty path"],
+    );
     // no Rust in the words: a section given a number, a whole-number range
     refused(
         &["analyze", &seed, "--set", "cat=1"],
