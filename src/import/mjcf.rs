@@ -26,6 +26,20 @@ struct Group<'a> {
 }
 
 fn orientation(n: &Node, angles: &Angles, file: &str) -> Result<Matrix3<f64>> {
+    let given: Vec<&str> = ["quat", "axisangle", "euler", "xyaxes", "zaxis"]
+        .into_iter()
+        .filter(|a| n.attribute(*a).is_some())
+        .collect();
+    if given.len() > 1 {
+        // (MuJoCo refuses it too: which one holds is not said)
+        return Err(site(n).error(
+            file,
+            format!(
+                "{} give its orientation twice: give one",
+                given.join(" and ")
+            ),
+        ));
+    }
     for bad in ["xyaxes", "zaxis"] {
         if n.attribute(bad).is_some() {
             return Err(site(n).error(
@@ -363,7 +377,18 @@ fn max_torque(root: &Node, used: &[Node], file: &str) -> Result<Option<f64>> {
     let Some(act) = root.children().find(|c| c.has_tag_name("actuator")) else {
         return Ok(None);
     };
+    let joints: Vec<&str> = root
+        .descendants()
+        .filter(|n| n.has_tag_name("joint"))
+        .filter_map(|j| j.attribute("name"))
+        .collect();
     for a in act.children().filter(|c| c.is_element()) {
+        // (MuJoCo refuses an actuator on a joint the model does not have)
+        if let Some(j) = a.attribute("joint")
+            && !joints.contains(&j)
+        {
+            return Err(site(&a).error(file, format!("joint=\"{j}\" names no joint of the model")));
+        }
         if !a.attribute("joint").is_some_and(|j| names.contains(&j)) {
             continue;
         }
@@ -372,6 +397,15 @@ fn max_torque(root: &Node, used: &[Node], file: &str) -> Result<Option<f64>> {
                 continue;
             }
             let v = numbers(&a, range, 2, None, file)?;
+            if v[0] > v[1] {
+                return Err(site(&a).error(
+                    file,
+                    format!(
+                        "{range} = \"{} {}\" has its lower bound above its upper one",
+                        v[0], v[1]
+                    ),
+                ));
+            }
             let b = v[0].abs().max(v[1].abs());
             best = Some(best.map_or(b, |x| x.min(b)));
         }

@@ -47,9 +47,15 @@ fn inertial(link: &Node, file: &str) -> Result<Part> {
         return Ok(Part::empty());
     };
     let pose = origin(&i, file)?;
+    // (URDF requires it; without it the link's inertia would have no mass)
     let mass = match i.children().find(|c| c.has_tag_name("mass")) {
         Some(m) => xml::mass(&m, "value", file)?,
-        None => 0.0,
+        None => {
+            return Err(site(&i).error(
+                file,
+                "an <inertial> without <mass>: give <mass value=\"...\"/> in kg",
+            ));
+        }
     };
     let inertia = match i.children().find(|c| c.has_tag_name("inertia")) {
         Some(t) => {

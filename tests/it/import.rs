@@ -334,6 +334,16 @@ fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
             "value = -0.2 kg is negative",
         ),
         (
+            "inertial without mass",
+            urdf_of(
+                &[("front", 0.2), ("rear", 1.0)],
+                &joint("ball", "spherical", "rear", "front", "0 0 0.1", "0 0 1"),
+            )
+            .replace("<mass value=\"0.2\"/>", ""),
+            "<inertial>",
+            "without <mass>",
+        ),
+        (
             "negative motor limit",
             std::fs::read_to_string(util::configs().join("box-robot.urdf"))
                 .unwrap()
@@ -395,6 +405,26 @@ fn mjcf_files_catflip_cannot_model_are_refused() {
             "negative mass",
             good.replacen("mass=\"", "mass=\"-", 1),
             "kg is negative",
+        ),
+        // what MuJoCo itself refuses is refused, not read some other way
+        (
+            "reversed ctrlrange",
+            good.replacen("ctrlrange=\"-1.4 1.4\"", "ctrlrange=\"1.4 -1.4\"", 1),
+            "lower bound above its upper one",
+        ),
+        (
+            "actuator on no joint",
+            good.replacen("joint=\"motor2\"", "joint=\"motorX\"", 1),
+            "joint=\"motorX\" names no joint of the model",
+        ),
+        (
+            "two orientations",
+            good.replacen(
+                "<body name=\"front\" pos=\"0 0 0.1\"",
+                "<body name=\"front\" pos=\"0 0 0.1\" quat=\"1 0 0 0\" euler=\"0 0 0\"",
+                1,
+            ),
+            "quat and euler give its orientation twice",
         ),
         (
             "no inertial",
