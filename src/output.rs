@@ -88,13 +88,22 @@ pub fn ensure_finite(v: &serde_json::Value, fields: &[&str]) -> Result<()> {
 /// The set a command publishes with `--set` overrides: `<base>@<overrides>`
 /// (e.g. `run@cat.joint=no-twist`), so that runs of one config with other
 /// overrides keep their own reports side by side; `<base>` without any.
-/// Characters other than letters, digits and `._=,+-` become `_`; a long
+/// Spaces around each key and value are dropped, other characters than
+/// letters, digits and `._=,+-` become `_`; a long
 /// name keeps its first 80 characters and a hash of the whole.
 pub fn set_name(base: &str, overrides: &[String]) -> String {
     if overrides.is_empty() {
         return base.to_string();
     }
-    let all = overrides.join(",");
+    // (`--set "k = v"` and `--set k=v` are one config: one set)
+    let all = overrides
+        .iter()
+        .map(|o| match o.split_once('=') {
+            Some((k, v)) => format!("{}={}", k.trim(), v.trim()),
+            None => o.trim().to_string(),
+        })
+        .collect::<Vec<_>>()
+        .join(",");
     let slug: String = all
         .chars()
         .map(|c| {
@@ -559,6 +568,21 @@ mod tests {
         let f = csv_field("a, \"b\", c");
         let back = f[1..f.len() - 1].replace("\"\"", "\"");
         assert_eq!(back, "a, \"b\", c");
+    }
+
+    /// One config, one set: the spaces a shell keeps around `=` do not
+    /// name another folder; other characters still become `_`.
+    #[test]
+    fn spaces_around_a_key_and_value_name_the_same_set() {
+        let set =
+            |o: &[&str]| set_name("run", &o.iter().map(|s| s.to_string()).collect::<Vec<_>>());
+        assert_eq!(
+            set(&["cat.mass = 2", " fall.height=3 "]),
+            "run@cat.mass=2,fall.height=3"
+        );
+        assert_eq!(set(&["cat.mass=2"]), set(&[" cat.mass =2"]));
+        assert_eq!(set(&["name=\"a b\""]), "run@name=_a_b_");
+        assert_eq!(set(&[]), "run");
     }
 
     fn hidden_sets(dir: &Path) -> Vec<String> {
