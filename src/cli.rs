@@ -479,6 +479,13 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             }
         })?),
         Optimizer::Free(seed) => {
+            // (from any seed the SCP would only fail at such a torque scale)
+            if let Some(e) = catflip::design::least_height::beyond_any_fall(&spec)
+                .as_ref()
+                .and_then(catflip::pipeline::out_of_reach)
+            {
+                return Err(e.into());
+            }
             let design = catflip::design::free::FreeDesign::new(&spec);
             let start;
             let design = match seed {

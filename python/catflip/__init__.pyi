@@ -252,6 +252,10 @@ class LeastHeight:
     def least_height_m(self) -> float:
         """The least drop height found, m (an upper bound on the true one)."""
     @property
+    def beyond_longest_fall(self) -> bool:
+        """Whether the motors need a fall longer than any catflip designs (30 s): then not
+        possible from any height, and the schedule is empty."""
+    @property
     def least_height_lower_bound_m(self) -> Optional[float]:
         """A lower bound on the least drop height, m, or None (the answer's
         ``least_height_lower_bound_m``: the stall-only design's)."""
@@ -262,8 +266,8 @@ class LeastHeight:
     def least_time_s(self) -> float:
         """The shortest manoeuvre found inside the motor envelope, s."""
     @property
-    def method(self) -> Literal["phased", "free"]:
-        """Which design settles the answer."""
+    def method(self) -> Literal["phased", "free", "analytic"]:
+        """Which design settles the answer (``analytic``: none made, the motors far beyond the longest fall)."""
     @property
     def status(self) -> str:
         """That design's solver status."""

@@ -1190,6 +1190,12 @@ impl LeastHeight {
     fn least_height_lower_bound_m(&self) -> Option<f64> {
         self.answer.least_height_lower_bound_m
     }
+    /// Whether the motors need a fall longer than any catflip designs (30 s):
+    /// then not possible from any height, and no schedule.
+    #[getter]
+    fn beyond_longest_fall(&self) -> bool {
+        self.answer.beyond_longest_fall
+    }
     /// The phased time design's least height, m.
     #[getter]
     fn phased_least_height_m(&self) -> f64 {
@@ -1200,7 +1206,8 @@ impl LeastHeight {
     fn least_time_s(&self) -> f64 {
         self.answer.least_time_s
     }
-    /// Which design settles the answer: `phased` or `free`.
+    /// Which design settles the answer: `phased` or `free` (`analytic` when the
+    /// motors are far beyond the longest fall and no design was made).
     #[getter]
     fn method(&self) -> &'static str {
         self.answer.method

@@ -351,6 +351,16 @@ def test_least_height_is_runs_answer():
     assert h.least_height_m == pytest.approx(g * (h.least_time_s + margin) ** 2 / 2, rel=1e-9)
     assert h.t.shape == (h.q.shape[0],) and h.tau.shape[1] == 2
     assert catflip.least_height(catflip.Config.from_toml(ROOT / "configs" / "seed.toml")) is None
+    assert not h.beyond_longest_fall
+
+
+def test_a_motor_too_weak_for_any_fall_has_no_schedule():
+    weak = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    weak.set("limits.max_torque", 1e-9)
+    h = catflip.least_height(weak)
+    assert h.beyond_longest_fall and not h.possible
+    assert h.least_time_s > 30 and h.t.shape == (0,)
+    assert "nor from any drop catflip designs" in h.sentence()
 
 
 def test_sweep_equals_the_cli(tmp_path):

@@ -94,6 +94,14 @@ const FAR: f64 = 20.0;
 /// show what the answer already says, at the cost of simulating it (a
 /// 1e-9 N m motor: a 37,000 s manoeuvre, 25 s of designs and a report that
 /// ran out of memory).
+pub fn beyond_any_fall(spec: &DesignSpec) -> Option<HeightAnswer> {
+    if !spec.motor.is_limited() {
+        return None;
+    }
+    far_beyond(spec)
+}
+
+/// [`beyond_any_fall`] for limited motors.
 fn far_beyond(spec: &DesignSpec) -> Option<HeightAnswer> {
     let t = reference_time(spec)?;
     (t / FAR + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S).then(|| HeightAnswer {

@@ -236,6 +236,19 @@ fn a_motor_too_weak_for_any_fall_is_answered_without_a_schedule() {
     assert_eq!(code, Some(4), "{err}");
     assert!(err.contains("longer than any catflip designs"), "{err}");
     assert!(!err.contains("drop the cat from at least"), "{err}");
+    // and the free-form design says the same from any seed, at once (its SCP
+    // failed numerically at this torque's scale)
+    for seed in [None, Some("analytic")] {
+        let mut args = vec!["optimize", &cfg, "--mode", "free"];
+        args.extend(seed.map(|s| ["--seed", s]).into_iter().flatten());
+        args.extend(["--set", "limits.max_torque=1e-9", "--out", "."]);
+        let (code, _, err) = crate::util::run(&args, dir.path());
+        assert_eq!(code, Some(4), "{seed:?}: {err}");
+        assert!(
+            err.contains("nor in any fall catflip designs"),
+            "{seed:?}: {err}"
+        );
+    }
     // 1e-3 N m: the free-form design's 28.7 s manoeuvre fits the 30 s fall
     // (the phased one, 37 s, does not): it answers, with its schedule
     let (code, s, base, err) = run_summary("seed", &["limits.max_torque=1e-3"], dir.path());
