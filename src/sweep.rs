@@ -843,6 +843,18 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
     s
 }
 
+/// The index.html caption of a sweep's figure, by file name.
+pub fn caption(file: &str) -> Option<&'static str> {
+    if !file.starts_with("sweep-") || !file.ends_with(".svg") {
+        return None;
+    }
+    Some(if file.ends_with("-least-height.svg") {
+        "The least drop height within the motor limits against the swept key: the phased and the free-form time designs' (the answer is the lower of the two that verify); a gap is a point without one."
+    } else {
+        "Each method's peak joint torque (in the configured norm) against the swept key; a gap is a point where the method failed (its error is in the table)."
+    })
+}
+
 /// Peak against the swept value, one line per method; and, with a torque
 /// limit, the least drop height.
 /// `file_key` names the files, `key` labels the axes.

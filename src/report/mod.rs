@@ -842,12 +842,19 @@ pub fn lines_styled(
                 .margin(12)
                 .x_label_area_size(42)
                 .y_label_area_size(70)
-                .build_cartesian_2d(xr.0..xr.1, (lo / 1.3..hi * 1.3).log_scale())
+                .build_cartesian_2d(
+                    xr.0..xr.1,
+                    (lo / 1.3..hi * 1.3)
+                        .log_scale()
+                        .with_key_points(log_ticks((lo / 1.3, hi * 1.3))),
+                )
                 .map_err(perr)?;
             let ydesc = format!("{ydesc}, log scale");
             c.configure_mesh()
                 .x_desc(xdesc)
                 .y_desc(ydesc)
+                .y_label_formatter(&tick)
+                .y_labels(12)
                 .label_style((FONT, 13))
                 .axis_desc_style((FONT, 15))
                 .light_line_style(WHITE.mix(0.0))
@@ -872,6 +879,25 @@ pub fn lines_styled(
         }
         legend(&side, &keys)
     })
+}
+
+/// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`: the
+/// chart's own log ticks left a 1.6-decade axis's ends without a number.
+pub(crate) fn log_ticks((lo, hi): (f64, f64)) -> Vec<f64> {
+    let first = lo.log10().floor() as i32;
+    let last = hi.log10().ceil() as i32;
+    (first..=last)
+        .flat_map(|d| [1.0, 2.0, 3.0, 5.0].map(|m| m * 10f64.powi(d)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect()
+}
+
+/// A log axis's label: the number without float noise (`0.3`, not
+/// `0.30000000000000004`).
+pub(crate) fn tick(v: &f64) -> String {
+    let s = format!("{:.6}", v);
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    s.to_string()
 }
 
 /// Escapes text for HTML.
@@ -973,6 +999,27 @@ pub fn index_html(page: &Page) -> String {
 mod tests {
     use super::*;
     use crate::design::objective::Objective;
+
+    /// A log axis (a sweep's peaks over two decades) labels 1, 2, 3 and 5
+    /// times each power of ten, without float noise (it printed
+    /// 0.30000000000000001).
+    #[test]
+    fn a_log_axis_labels_round_numbers() {
+        let x = [0.18, 0.2, 0.22, 0.24];
+        let series = [
+            ("analytic".to_string(), vec![1.5, 1.8, 2.0, 2.3]),
+            ("free".to_string(), vec![0.05, 0.053, 0.056, 0.06]),
+        ];
+        let svg = lines("t", "x", "y", &x, &series).unwrap();
+        let labels: Vec<&str> = svg
+            .split("</text>")
+            .filter_map(|t| t.rsplit('>').next().map(str::trim))
+            .collect();
+        for want in ["0.05", "0.1", "0.2", "0.3", "0.5", "1", "2"] {
+            assert!(labels.contains(&want), "{want} in {labels:?}");
+        }
+        assert!(labels.iter().all(|l| !l.contains("0000")), "{labels:?}");
+    }
 
     /// Many series (a recovery map's release axes) are drawn as many ways.
     #[test]

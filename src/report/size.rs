@@ -3,7 +3,7 @@
 //! asymptotes, the configured motor and its gear line), and the least height
 //! against the gear ratio.
 
-use super::{FONT, Key, legend, line, marker, perr, style, svg, with_legend};
+use super::{FONT, Key, legend, line, log_ticks, marker, perr, style, svg, tick, with_legend};
 use crate::error::Result;
 use crate::report::Marker;
 use crate::size::SizeAnswer;
@@ -23,11 +23,6 @@ pub fn caption(file: &str) -> Option<&'static str> {
 }
 
 /// A tick label without float noise (`0.6`, not `0.6000000000000001`).
-fn tick(v: &f64) -> String {
-    let s = format!("{:.6}", v);
-    let s = s.trim_end_matches('0').trim_end_matches('.');
-    s.to_string()
-}
 
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
@@ -39,17 +34,6 @@ fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
         return (0.1, 10.0);
     }
     (lo / 1.4, hi * 1.4)
-}
-
-/// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`: the
-/// chart's own log ticks left a 1.6-decade axis's ends without a number.
-fn log_ticks((lo, hi): (f64, f64)) -> Vec<f64> {
-    let first = lo.log10().floor() as i32;
-    let last = hi.log10().ceil() as i32;
-    (first..=last)
-        .flat_map(|d| [1.0, 2.0, 3.0, 5.0].map(|m| m * 10f64.powi(d)))
-        .filter(|v| (lo..=hi).contains(v))
-        .collect()
 }
 
 /// The curve figure (`size.svg`).

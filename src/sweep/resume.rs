@@ -156,12 +156,79 @@ impl SweepState {
         let mut out = crate::output::Output::default();
         out.add(format!("sweep-{file_key}.csv"), super::to_csv(key, &points));
         if !(interrupted && points.is_empty()) {
+            let mut names = Vec::new();
             for (name, svg) in super::figures(file_key, key, &points, limit)? {
+                names.push(name.clone());
                 out.add(name, svg);
             }
+            out.add("index.html", self.page(file_key, key, &points, &names));
         }
         out.add(Self::file_name(file_key), self.to_json());
         Ok(out)
+    }
+
+    /// The sweep's page: a row a finished point, and the figures.
+    fn page(&self, file_key: &str, key: &str, points: &[SweepPoint], figures: &[String]) -> String {
+        let cell =
+            |x: Option<f64>, digits: usize| x.map_or(String::new(), |x| format!("{x:.digits$}"));
+        let rows: Vec<Vec<String>> = points
+            .iter()
+            .map(|p| {
+                vec![
+                    format!("{}", p.value),
+                    cell(p.analytic_peak_nm, 5),
+                    cell(p.phased_peak_nm, 5),
+                    cell(p.free_peak_nm, 5),
+                    cell(p.least_height_phased_m, 3),
+                    cell(p.least_height_free_m, 3),
+                    p.free_status
+                        .map_or("", crate::verdict::Status::name)
+                        .to_string(),
+                    p.error.clone().unwrap_or_default(),
+                ]
+            })
+            .collect();
+        let name = self.config["name"].as_str().unwrap_or("config");
+        let mut notes = vec![format!(
+            "{}{} of {key} ({}, shard {}), methods {}: each point designed by each method as `catflip run` designs it; where motors are limited, the least drop heights of the phased and free-form time designs (a row's error names what failed there). sweep-{file_key}.csv has every number; docs/outputs.md the columns.",
+            if self.status == SweepStatus::Partial {
+                "Partial sweep: "
+            } else {
+                ""
+            },
+            if points.len() == 1 {
+                "1 point".to_string()
+            } else {
+                format!("{} points", points.len())
+            },
+            self.range,
+            self.shard,
+            self.methods.join(", "),
+        )];
+        if points.iter().any(|p| p.error.is_some()) {
+            notes.push("A point whose method failed keeps the other methods' numbers.".into());
+        }
+        let figs: Vec<&str> = figures.iter().map(String::as_str).collect();
+        crate::report::index_html(&crate::report::Page {
+            title: &format!("catflip sweep: {name}, {key}"),
+            lead: None,
+            header: &[
+                key,
+                "analytic peak N m",
+                "phased peak N m",
+                "free peak N m",
+                "least height, phased, m",
+                "least height, free, m",
+                "free status",
+                "error",
+            ],
+            rows: &rows,
+            notes: &notes,
+            warnings: &[],
+            animation: "",
+            figures: &figs,
+            captions: super::caption,
+        })
     }
 
     pub fn to_json(&self) -> String {

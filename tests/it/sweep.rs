@@ -70,6 +70,21 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
     )
     .unwrap();
     assert_eq!(full.lines().count(), 12);
+    // the sweep's page: a row a point, its value first, and the figure captioned
+    let page = std::fs::read_to_string(
+        dir.path()
+            .join("full/seed/sweep-cat_radius@free.nodes=10,phased.nodes=12/index.html"),
+    )
+    .unwrap();
+    assert_eq!(page.matches("<tr><td>").count(), 11, "{page}");
+    for line in full.lines().skip(1) {
+        let value = line.split(',').next().unwrap();
+        assert!(
+            page.contains(&format!("<tr><td>{value}</td>")),
+            "{value}: {page}"
+        );
+    }
+    assert!(page.contains("<img src=\"sweep-cat_radius.svg\"") && page.contains("<figcaption>"));
     let mut joined = String::new();
     for k in 1..=3 {
         let mut args = common.to_vec();
