@@ -22,8 +22,6 @@ pub fn caption(file: &str) -> Option<&'static str> {
     })
 }
 
-/// A tick label without float noise (`0.6`, not `0.6000000000000001`).
-
 fn log_range(values: impl Iterator<Item = f64>) -> (f64, f64) {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
