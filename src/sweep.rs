@@ -843,15 +843,18 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
     s
 }
 
+/// The least-height figure's line of the configured drop.
+const FALL_HEIGHT_SERIES: &str = "fall.height (the drop asked)";
+
 /// The index.html caption of a sweep's figure, by file name.
 pub fn caption(file: &str) -> Option<&'static str> {
     if !file.starts_with("sweep-") || !file.ends_with(".svg") {
         return None;
     }
     Some(if file.ends_with("-least-height.svg") {
-        "The least drop height within the motor limits against the swept key: the phased and the free-form time designs' (the answer is the lower of the two that verify); a gap is a point without one."
+        "The least drop height within the motor limits against the swept key: the phased and the free-form time designs' (the answer is the lower of the two that verify); a gap is a point without one. The grey dashed line is the configured drop (fall.height): where the answer is below it, the flip is possible."
     } else {
-        "Each method's peak joint torque (in the configured norm) against the swept key; a gap is a point where the method failed (its error is in the table)."
+        "Each method's peak joint torque (in the configured norm) against the swept key, without the motor limits (with them, the least drop heights below say what the motors can do); a gap is a point where the method failed (its error is in the table)."
     })
 }
 
@@ -863,6 +866,7 @@ pub fn figures(
     key: &str,
     points: &[SweepPoint],
     limit: Option<f64>,
+    fall_height: f64,
 ) -> Result<Vec<(String, String)>> {
     let x: Vec<f64> = points.iter().map(|p| p.value).collect();
     let col = |f: &dyn Fn(&SweepPoint) -> Option<f64>| {
@@ -910,9 +914,17 @@ pub fn figures(
                 hs.push((name.to_string(), ys));
             }
         }
+        // the question's own height: below it the flip is possible (a sweep
+        // of the height itself: the diagonal)
+        let asked: Vec<f64> = if key == "fall.height" {
+            x.clone()
+        } else {
+            vec![fall_height; x.len()]
+        };
+        hs.push((FALL_HEIGHT_SERIES.to_string(), asked));
         figs.push((
             format!("sweep-{file_key}-least-height.svg"),
-            crate::report::lines(
+            crate::report::lines_styled(
                 &format!(
                     "Least drop height within the motor limits (stall torque {l} N m) against {key}"
                 ),
@@ -920,6 +932,13 @@ pub fn figures(
                 "least drop height (m)",
                 &x,
                 &hs,
+                |name, i| {
+                    if name == FALL_HEIGHT_SERIES {
+                        crate::report::style_of("analytic", i)
+                    } else {
+                        crate::report::style_of(name, i)
+                    }
+                },
             )?,
         ));
     }
@@ -929,6 +948,65 @@ pub fn figures(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The least-height figure draws the question's height: a level line
+    /// at the configured drop, the diagonal in a sweep of the drop itself;
+    /// without a motor limit there is no such figure.
+    #[test]
+    fn the_least_height_figure_draws_the_questions_height() {
+        let points: Vec<SweepPoint> = [2.0, 3.0, 4.0]
+            .iter()
+            .map(|&v| SweepPoint {
+                value: v,
+                least_height_free_m: Some(3.0),
+                ..Default::default()
+            })
+            .collect();
+        // the level line's y in pixels equals across the points; the diagonal's rises
+        let line_ys = |key: &str| -> Vec<f64> {
+            let figs = figures("k", key, &points, Some(1.4), 2.5).unwrap();
+            let svg = &figs[1].1;
+            assert!(svg.contains(FALL_HEIGHT_SERIES), "{key}");
+            // the line's dashes, in its style's colour (the legend's sample last)
+            let colour = format!(
+                "stroke=\"#{:02X}{:02X}{:02X}\" stroke-width=\"2\"",
+                crate::report::style_of("analytic", 0).color.0,
+                crate::report::style_of("analytic", 0).color.1,
+                crate::report::style_of("analytic", 0).color.2
+            );
+            svg.split("<polyline")
+                .filter(|p| p.contains(&colour))
+                .flat_map(|p| {
+                    let pts = p
+                        .split("points=\"")
+                        .nth(1)
+                        .unwrap()
+                        .split('"')
+                        .next()
+                        .unwrap();
+                    pts.split_whitespace()
+                        .map(|p| p.split(',').nth(1).unwrap().parse::<f64>().unwrap())
+                        .collect::<Vec<_>>()
+                })
+                .collect()
+        };
+        let level = line_ys("cat.length");
+        assert!(level.len() > 4, "the line is drawn: {level:?}");
+        let mut ys = level.clone();
+        ys.dedup();
+        assert!(ys.len() <= 2, "a level line and its legend sample: {ys:?}");
+        let diagonal = line_ys("fall.height");
+        let (lo, hi) = diagonal
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(*y), b.max(*y)));
+        assert!(hi - lo > 100.0, "the diagonal spans the plot: {diagonal:?}");
+        assert_eq!(
+            figures("k", "cat.length", &points, None, 2.5)
+                .unwrap()
+                .len(),
+            1
+        );
+    }
 
     /// A point's error sentence holds commas, quotes and a line break: the
     /// row still has the header's columns, and the sentence reads back whole.

@@ -157,7 +157,8 @@ impl SweepState {
         out.add(format!("sweep-{file_key}.csv"), super::to_csv(key, &points));
         if !(interrupted && points.is_empty()) {
             let mut names = Vec::new();
-            for (name, svg) in super::figures(file_key, key, &points, limit)? {
+            let height = self.config["fall"]["height"].as_f64().unwrap_or(f64::NAN);
+            for (name, svg) in super::figures(file_key, key, &points, limit, height)? {
                 names.push(name.clone());
                 out.add(name, svg);
             }
@@ -189,8 +190,19 @@ impl SweepState {
             })
             .collect();
         let name = self.config["name"].as_str().unwrap_or("config");
+        let limited = self.config["limits"]["max_torque"].is_number();
+        let height = self.config["fall"]["height"].as_f64();
+        let what = if limited {
+            format!(
+                "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: below the configured {} m (fall.height) the flip is possible there. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)",
+                height.map_or("?".into(), |h| h.to_string())
+            )
+        } else {
+            "each point designed by each method as `catflip run` designs it (no motor limits)"
+                .to_string()
+        };
         let mut notes = vec![format!(
-            "{}{} of {key} ({}, shard {}), methods {}: each point designed by each method as `catflip run` designs it; where motors are limited, the least drop heights of the phased and free-form time designs (a row's error names what failed there). sweep-{file_key}.csv has every number; docs/outputs.md the columns.",
+            "{}{} of {key} ({}, shard {}), methods {}: {what}. A row's error names what failed there. sweep-{file_key}.csv has every number; docs/outputs.md the columns.",
             if self.status == SweepStatus::Partial {
                 "Partial sweep: "
             } else {
