@@ -690,7 +690,11 @@ fn page(
         warnings: &warnings,
         animation: &report::animation::section(&scene),
         figures: figure_names,
-        captions: report::caption,
+        captions: if cfg.motor().is_limited() {
+            report::caption
+        } else {
+            report::caption_without_limits
+        },
     })
 }
 

@@ -11,7 +11,9 @@ pub mod answer;
 pub mod size;
 mod torque_speed;
 
-pub use torque_speed::{FILE as TORQUE_SPEED_SVG, caption, envelope, torque_speed};
+pub use torque_speed::{
+    FILE as TORQUE_SPEED_SVG, caption, caption_without_limits, envelope, torque_speed,
+};
 
 use crate::design::scp::ScpIteration;
 use crate::error::{Error, Result};
@@ -576,15 +578,27 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
                         BLACK.stroke_width(1),
                     ))
                     .map_err(perr)?;
-                    keys.push((format!("torque limit {l} N m"), Key::Level));
+                    keys.push((limit_name(l, motor), Key::Level));
                 }
-                (Some(l), None) => keys.push((format!("torque limit {l} N m (above)"), Key::Level)),
+                (Some(l), None) => {
+                    keys.push((format!("{} (above)", limit_name(l, motor)), Key::Level))
+                }
                 _ => {}
             }
             legend(&side, &keys)?;
         }
         Ok(())
     })
+}
+
+/// The torque figure's limit line: a torque limit, or with a torque-speed
+/// line the stall torque, which a braking joint may pass.
+fn limit_name(l: f64, motor: &Motor) -> String {
+    if motor.slope() > 0.0 {
+        format!("stall torque {l} N m (more while braking)")
+    } else {
+        format!("torque limit {l} N m")
+    }
 }
 
 /// Rotation about the initial spine against time (forward simulation).

@@ -42,6 +42,20 @@ pub fn caption(file: &str) -> Option<&'static str> {
     })
 }
 
+/// [`caption`] for a run without motor limits: no envelope, limit or
+/// least-height schedule is drawn, so none is described.
+pub fn caption_without_limits(file: &str) -> Option<&'static str> {
+    match file {
+        "torque.svg" => Some(
+            "Joint torque against time, each curve's peak circled (no motor limits are configured).",
+        ),
+        FILE => Some(
+            "Torque-speed plane, the figure a motor is sized with: each method's trajectory from its schedule (no motor limits are configured, so no envelope is drawn). Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed.",
+        ),
+        _ => caption(file),
+    }
+}
+
 /// One panel's samples: `(speed, torque)` per method.
 struct Panel {
     title: String,

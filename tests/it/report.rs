@@ -67,6 +67,16 @@ fn run_writes_a_complete_consistent_report() {
         }
     }
     assert!(base.join("seed.mjcf.xml").exists() && base.join("seed.urdf").exists());
+    // without motor limits the captions describe no envelope, limit line or
+    // least-height panel (none is drawn)
+    assert!(html.contains("no motor limits are configured, so no envelope is drawn"));
+    for absent in [
+        "grey band",
+        "least-height",
+        "torque limit is the black line",
+    ] {
+        assert!(!html.contains(absent), "{absent}");
+    }
     let peaks: Vec<f64> = methods
         .iter()
         .map(|m| m["peak_torque_nm"].as_f64().unwrap())

@@ -85,6 +85,8 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     assert!(html.contains("<img src=\"torque_speed.svg\""));
     assert!(html.contains("<figcaption>Torque-speed plane"));
+    assert!(html.contains("the grey band is the DC-motor envelope"));
+    assert!(html.contains("the least-height schedule, made for its own drop"));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(base.join("summary.json")).unwrap()).unwrap();
     // the config: XL430 stall torque and no-load speed, per motor, no max_speed
@@ -93,7 +95,10 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     assert!(svg.contains("stall T = 1.4 N m") && svg.contains("no-load w0 = 5.969 rad/s"));
     // the torque figure draws the limits: the stall torque and T - k|w| along each method
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
-    assert!(torque.contains("torque limit 1.4 N m") && torque.contains("T - k|w|"));
+    // (with a torque-speed line the limit line is the stall torque, which braking passes)
+    assert!(
+        torque.contains("stall torque 1.4 N m (more while braking)") && torque.contains("T - k|w|")
+    );
 
     let polys = elements(&svg, "polygon", &["fill=\"#BBBBBB\""]);
     assert_eq!(polys.len(), 2, "one envelope per motor");
