@@ -563,7 +563,11 @@ impl MethodSummary {
 
     /// Why a flagged reference is not counted, in words (None for a design).
     pub fn reference_note(&self) -> Option<&'static str> {
-        if self.beyond_the_motors {
+        if self.beyond_the_motors && self.approximate_for_the_joint {
+            Some(
+                "a reference beyond the motors, and the seed's closed form, approximate for the universal joint (F4): not counted",
+            )
+        } else if self.beyond_the_motors {
             Some("a reference beyond the motors, not counted")
         } else if self.approximate_for_the_joint {
             Some("the seed's closed form, approximate for the universal joint (F4), not counted")

@@ -716,7 +716,12 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
         .expect("the answer");
     assert!(lead < html.find("<table>").unwrap());
     assert!(html.contains("Possible from 6 m with these motors."));
-    assert!(html.contains("a reference beyond the motors, not counted"));
+    // both reasons the universal joint's analytic row is a reference (it
+    // named the first alone)
+    assert_eq!(an["approximate_for_the_joint"], true, "{an}");
+    assert!(html.contains(
+        "a reference beyond the motors, and the seed's closed form, approximate for the universal joint (F4): not counted"
+    ));
     // the phased design fits this fall: it seeds the free-form one, as the
     // summary and the page say
     assert_eq!(s["free_seed"], "phased");
