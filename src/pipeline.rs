@@ -633,16 +633,10 @@ pub fn free_start(
 pub fn beyond_reach(a: &crate::design::least_height::HeightAnswer) -> String {
     if a.beyond_longest_fall {
         return format!(
-            "no schedule found fits the motors in the fall from {} m (fall.height), nor in any fall catflip designs (up to {} s): {} takes {:.4} s (a drop of {:.4e} m); raise the motors' limits (catflip size names the motors for a height)",
+            "no schedule found fits the motors in the fall from {} m (fall.height), nor in any fall catflip designs (up to {} s): {}",
             a.height_m,
             crate::config::ranges::MAX_FALL_TIME_S,
-            if a.method == "analytic" {
-                "the seed's analytic schedule within these motors".to_string()
-            } else {
-                format!("the {} time-optimal design", a.method)
-            },
-            a.least_time_s,
-            a.least_height_m
+            a.beyond_text().trim_end_matches('.')
         );
     }
     format!(

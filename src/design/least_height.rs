@@ -639,6 +639,27 @@ impl HeightAnswer {
         }
     }
 
+    /// What a manoeuvre beyond the longest fall takes, and what to change.
+    pub fn beyond_text(&self) -> String {
+        let seconds = if self.least_time_s < 1e4 {
+            format!("{:.4} s", self.least_time_s)
+        } else {
+            format!("{:.3e} s", self.least_time_s)
+        };
+        format!(
+            "{} takes {seconds}, a drop of {:.3e} m; stronger or faster motors would do (catflip size names them for a height).",
+            if self.method == "analytic" {
+                "the seed's analytic schedule within these motors".to_string()
+            } else {
+                format!(
+                    "the shortest manoeuvre found (the {} time design)",
+                    self.method
+                )
+            },
+            self.least_height_m
+        )
+    }
+
     /// One plain sentence for the terminal and the report.
     pub fn sentence(&self) -> String {
         let what = if self.status.is_proven() {
@@ -655,19 +676,10 @@ impl HeightAnswer {
             .unwrap_or_default();
         if self.beyond_longest_fall {
             format!(
-                "The flip is NOT possible from {} m with these motors, nor from any drop catflip designs (falls up to {} s): {} takes {:.4} s, a drop of {:.4e} m. Stronger or faster motors (catflip size names them for a height).",
+                "The flip is NOT possible from {} m with these motors, nor from any drop catflip designs (falls up to {} s): {}",
                 self.height_m,
                 crate::config::ranges::MAX_FALL_TIME_S,
-                if self.method == "analytic" {
-                    "the seed's analytic schedule within these motors".to_string()
-                } else {
-                    format!(
-                        "the shortest manoeuvre found (the {} time design)",
-                        self.method
-                    )
-                },
-                self.least_time_s,
-                self.least_height_m
+                self.beyond_text()
             )
         } else if !self.verified && self.from_start && self.possible {
             format!(

@@ -60,7 +60,8 @@ pub fn height_text(a: &HeightAnswer) -> String {
         })
         .unwrap_or_default();
     if a.beyond_longest_fall {
-        return a.sentence();
+        let t = a.beyond_text();
+        return t[..1].to_uppercase() + &t[1..];
     }
     if !a.verified {
         // (only the phased design is ever unverified: the free-form ones
