@@ -189,7 +189,7 @@ fn report(cfg: &catflip::Config, s: &Summary, figures: &[String]) -> String {
         })
         .collect();
     let notes = vec![format!(
-        "{} of {} starts land within {:.4} deg of belly-down from {} m (recovery{}.csv has every start; {} lines of {}).",
+        "{} of {} starts land within {:.4} deg of belly-down (land.max_tilt_deg; unless set, simulate.flip_tolerance in degrees) from {} m (recovery{}.csv has every start; {} of the map's {} lines of starts, a spin or tilt axis each, finished).",
         s.starts_landing,
         s.starts,
         s.landing_tolerance_deg,

@@ -216,11 +216,11 @@ fn page(
     let p = &cfg.robustness;
     let mut notes = vec![
         format!(
-            "{}{} ({}..{} of {trials}), seed {}, dropped from {} m (fall.height): a trial succeeds when the belly lands within {} deg of straight down. Each trial draws its perturbations from the seed and its index alone: a spin at release up to [{}, {}, {}] rad/s about the rear half's axes, a tilt up to {} deg about a random horizontal axis, each half's mass, inertia and length off by up to {} %, {} % and {} %, {} ms of actuator delay, torque noise of {} % of the design's peak, attitude noise {} deg and rate noise {} rad/s, the open loop's PD gains off by up to {} % ([robustness]).",
+            "{}{} (numbers {} to {} of the study's {trials}), seed {}, dropped from {} m (fall.height): a trial succeeds when the belly lands within {} deg of straight down (land.max_tilt_deg; 10 deg unless set). Each trial draws its perturbations from the seed and its index alone: a spin at release up to [{}, {}, {}] rad/s about the rear half's axes, a tilt up to {} deg about a random horizontal axis, each half's mass, inertia and length off by up to {} %, {} % and {} %, {} ms of actuator delay, torque noise of {} % of the design's peak, attitude noise {} deg and rate noise {} rad/s, the open loop's PD gains off by up to {} % ([robustness]).",
             if interrupted { "Partial study: " } else { "" },
             catflip::console::count(s.trials, "trial"),
             range.start,
-            range.end,
+            range.end.saturating_sub(1),
             s.seed,
             cfg.fall.height,
             s.max_tilt_deg,

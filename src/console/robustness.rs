@@ -55,7 +55,7 @@ pub fn study(
 pub fn replans(timing: &ReplanTiming) -> Option<String> {
     (timing.replans > 0).then(|| {
         format!(
-            "replans: {} ({} taken, {} worse than the plan in use, {} failed, {} late); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} over the {:.1} ms control period",
+            "replans: {} ({} taken, {} worse than the plan in use, {} failed, {} dropped over their budget); wall time median {:.2} ms, p99 {:.2} ms, worst {:.2} ms (the solve: {:.2}, {:.2}, {:.2} ms); {} took longer than the {:.1} ms control period",
             timing.replans,
             timing.taken,
             timing.worse,
