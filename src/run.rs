@@ -609,14 +609,42 @@ fn page_notes(cfg: &Config, summary: &RunSummary, notes: &mut Vec<String>) {
     notes.insert(
         1,
         format!(
-            "Flip and tilt come from the dynamic forward simulation of each schedule ({}, torque clipped to the motor envelope).",
+            "Flip and tilt come from the dynamic forward simulation of each schedule ({}{}).",
             if cfg.simulate.pd {
                 "feed-forward torque plus PD tracking"
             } else {
                 "feed-forward torque only, simulate.pd = false"
+            },
+            if cfg.motor().is_limited() {
+                ", torque clipped to the motor envelope"
+            } else {
+                "; no motor limits are configured"
             }
         ),
     );
+    // the answer says from what height; this says what to fly from this one
+    if let Some(a) = summary.answer.as_ref().filter(|a| a.possible)
+        && let Some((m, peak)) = ["free", "phased"].into_iter().find_map(|name| {
+            summary
+                .methods
+                .iter()
+                .find(|m| m.method == name && m.verdict == Grade::Ok)
+                .and_then(|m| m.peak().map(|p| (m.method, p)))
+        })
+    {
+        // the free-form design is the optimum of the objective; the phased
+        // one the certified family's
+        notes.insert(
+            0,
+            format!(
+                "To fly from {} m: {m}.csv ({m}.mujoco.csv and {m}.pybullet.csv for the simulators), the {} design for design.objective = {} (peak {peak:.4} N m); least-height.csv is made for its own {:.3} m drop.",
+                a.height_m,
+                if m == "free" { "free-form" } else { "phased" },
+                cfg.design.objective.name(),
+                a.least_height_m
+            ),
+        );
+    }
     // a sound design above the stall torque: as the terminal says it
     if let Some(n) = summary.braking_note() {
         notes.insert(2, n);

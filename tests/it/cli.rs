@@ -726,6 +726,11 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
     // summary and the page say
     assert_eq!(s["free_seed"], "phased");
     assert!(html.contains("Free-form design: from the phased design, "));
+    // what to fly from 6 m, and that least-height.csv is not it
+    let free = method_line(&s, "free")["peak_torque_nm"].as_f64().unwrap();
+    assert!(html.contains(&format!(
+        "To fly from 6 m: free.csv (free.mujoco.csv and free.pybullet.csv for the simulators), the free-form design for design.objective = peak-torque (peak {free:.4} N m); least-height.csv is made for its own"
+    )), "{html}");
     // the least-height schedule (2.0 N m for its 3.5 m drop) has its own
     // torque axes, apart from the 6 m designs' (under 0.1 N m)
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
