@@ -624,8 +624,20 @@ impl SizeAnswer {
             if g.evaluations.len() > 1 {
                 let [lo, hi] = g.bracket;
                 format!(
-                    "Its best gear ratio is N = {:.4} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m. The search ended between N = {:.4} and {:.4}{}.",
+                    "Its best gear ratio is N = {:.4}{} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m. The search ended between N = {:.4} and {:.4}{}.",
                     g.best_ratio,
+                    // (N < 1: the speed is what the flip lacks)
+                    if g.best_ratio < 1.0 {
+                        format!(
+                            ", a speed-up of {:.2} times the configured gearing",
+                            1.0 / g.best_ratio
+                        )
+                    } else {
+                        format!(
+                            ", a reduction of {:.2} times the configured gearing",
+                            g.best_ratio
+                        )
+                    },
                     g.stall_torque_nm,
                     g.no_load_speed_rad_s,
                     g.least_height_m,

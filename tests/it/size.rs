@@ -146,6 +146,13 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
         said.contains(&format!("between N = {lo:.4} and {hi:.4}")),
         "{said}"
     );
+    // which way the gearing goes, in words (N < 1 is a speed-up)
+    let way = if g.best_ratio < 1.0 {
+        format!("a speed-up of {:.2} times", 1.0 / g.best_ratio)
+    } else {
+        format!("a reduction of {:.2} times", g.best_ratio)
+    };
+    assert!(said.contains(&way), "{way}: {said}");
     // the configured ratio (N = 1) is among them, and no better
     assert!(g.evaluations.iter().any(|e| e.gear_ratio == 1.0));
     assert!(g.least_height_m <= g.configured_least_height_m);
