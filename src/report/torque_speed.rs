@@ -245,11 +245,14 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
                 BLACK.stroke_width(1),
             ))
             .map_err(perr)?;
+            // the two ends' labels at the top and the bottom: side by side
+            // they overlapped at a small max_speed
+            let (at_y, dy) = if w < 0.0 { (y.0, -18) } else { (y.1, 4) };
             c.draw_series(std::iter::once(text(
                 format!("max_speed {w} rad/s"),
-                (w, y.1),
+                (w, at_y),
                 4,
-                4,
+                dy,
             )))
             .map_err(perr)?;
         }
