@@ -699,9 +699,11 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
             &text,
             &p.display().to_string(),
         )?;
+        // `free.schedule.json` names the same schedule as `free.csv`
         let stem = p
             .file_stem()
             .and_then(|s| s.to_str())
+            .map(|s| s.strip_suffix(".schedule").unwrap_or(s))
             .unwrap_or("schedule")
             .to_string();
         // flown first, as `simulate` flies it: a schedule the model cannot

@@ -247,6 +247,33 @@ fn held_torques_carry_the_schedules_impulse() {
     );
     assert!(ok, "{err}");
     assert!(out.contains("analytic.mujoco.csv"), "{out}");
+    let written = std::fs::read_to_string(base.join("analytic.mujoco.csv")).unwrap();
+    // its schedule JSON names the same files, with the same controls
+    let json = sched.with_file_name("analytic.schedule.json");
+    let (ok, out, err) = run_ok(
+        &[
+            "export",
+            "mjcf",
+            c,
+            "--schedule",
+            json.to_str().unwrap(),
+            "--out",
+            "json",
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("analytic.mujoco.csv") && !out.contains("analytic.schedule."),
+        "{out}"
+    );
+    // (the same rows: the JSON's numbers carry more digits than the CSV's)
+    let again = std::fs::read_to_string(
+        dir.path()
+            .join("json/robot-universal/export-mjcf/analytic.mujoco.csv"),
+    )
+    .unwrap();
+    assert_eq!(again.lines().count(), written.lines().count());
     let (meta, cols, rows) =
         read_controls(&std::fs::read_to_string(base.join("analytic.mujoco.csv")).unwrap());
     let dt = num(&meta["dt_s"]);
