@@ -146,8 +146,12 @@
     view.drawnLegs = bodies.flatMap(b => b.legs.map(([, q]) => proj(q).slice(0, 2)));
     const lim = scene.max_torque_nm;
     const over = lim != null && s.tau >= lim * (1 - 1e-6); // the simulation clips at the limit
-    view.readout.innerHTML = `t = ${t.toFixed(3)} s<br>flip ${s.flip.toFixed(1)} deg<br>bend ${s.bend.toFixed(1)} deg<br>` +
-      `torque ${s.tau.toPrecision(4)} N m (${scene.norm})` + (lim != null ? ` / limit ${lim}` : '') + (over ? ' <b>at the limit</b>' : '');
+    // past a track's touchdown (a shorter drop's) its last torque is not held
+    const end = view.track.frames[view.track.frames.length - 1].t;
+    const torque = t > end + 1e-9
+      ? `landed at t = ${end.toFixed(3)} s`
+      : `torque ${s.tau.toPrecision(4)} N m (${scene.norm})` + (lim != null ? ` / limit ${lim}` : '') + (over ? ' <b>at the limit</b>' : '');
+    view.readout.innerHTML = `t = ${t.toFixed(3)} s<br>flip ${s.flip.toFixed(1)} deg<br>bend ${s.bend.toFixed(1)} deg<br>` + torque;
     return s;
   }
 
@@ -242,6 +246,9 @@
     setTime(0); const start = legs();
     setTime(tEnd / 2); const mid = legs();
     setTime(tEnd);
+    // each view's readout at the end, and its track's own last instant
+    out.readout_end = views.map(v => v.readout.textContent);
+    out.track_end_s = tracks.map(tr => tr.frames[tr.frames.length - 1].t);
     // largest on-screen move of a belly stub between the two instants, px
     out.leg_move_px = views.map((v, i) => Math.max(...mid[i].map((p, k) => Math.hypot(p[0] - start[i][k][0], p[1] - start[i][k][1]))));
     // world x of body A's belly at the end: cos(flip) for a straight, untilted cat

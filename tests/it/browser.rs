@@ -147,4 +147,19 @@ fn the_robots_comparison_table_fits_a_1300_px_window() {
         st["table_scrolls"], false,
         "the table scrolls in its frame: {st}"
     );
+    // at the end, a track that landed earlier (the 2 m drop against the
+    // least-height one's) says so instead of holding its last torque
+    let t_end = st["t_end"].as_f64().unwrap();
+    let ends = st["track_end_s"].as_array().unwrap();
+    let readouts = st["readout_end"].as_array().unwrap();
+    assert!(
+        ends.iter().any(|e| e.as_f64().unwrap() < t_end - 1e-6),
+        "{st}"
+    );
+    for (e, r) in ends.iter().zip(readouts) {
+        let (e, r) = (e.as_f64().unwrap(), r.as_str().unwrap());
+        let landed = r.contains(&format!("landed at t = {e:.3} s"));
+        assert_eq!(landed, e < t_end - 1e-6, "{e} s: {r}");
+        assert_eq!(r.contains("torque "), !landed, "{r}");
+    }
 }
