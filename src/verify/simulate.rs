@@ -152,6 +152,12 @@ fn failure(
         OdeStatus::NonFinite | OdeStatus::Stopped => format!(
             "the motion diverged: the state became NaN or infinite at t = {at:.6} s (applied torque up to {peak:.4e} N m); {cause}"
         ),
+        // with next to no torque the schedule is not what the integrator
+        // cannot follow: the body is (halves of 1e4 and 1e-6 kg)
+        OdeStatus::StepBudget if peak <= f64::MIN_POSITIVE.sqrt() => format!(
+            "the integrator used its {} steps per phase by t = {at:.6} s with next to no torque applied ({peak:.4e} N m): the body itself is too stiff to integrate at simulate.rtol = {:e} (halves of very different masses, lengths or radii?); check the cat's keys, or try simulate.rtol = 1e-8",
+            ode.max_steps, ode.rtol
+        ),
         OdeStatus::StepBudget => format!(
             "the integrator used its {} steps per phase by t = {at:.6} s (applied torque up to {peak:.4e} N m): the motion is too fast or too rough for simulate.rtol = {:e}; a schedule with very many rows or huge torques is the usual cause, and simulate.rtol = 1e-8 may help",
             ode.max_steps, ode.rtol

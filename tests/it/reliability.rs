@@ -538,6 +538,31 @@ fn huge_torques_fail_naming_the_divergence_and_write_nothing() {
     assert!(!dir.path().join("exported").exists(), "export wrote files");
 }
 
+/// A body the integrator cannot follow with next to no torque applied
+/// (halves of 1e4 and 1e-6 kg) is named as the cause, not huge torques.
+#[test]
+fn a_stiff_body_is_blamed_not_the_torques() {
+    let dir = temp_dir();
+    let c = seed_toml();
+    let (code, _, err) = run(
+        &[
+            "optimize",
+            c.to_str().unwrap(),
+            "--set",
+            "cat.mass=1e4",
+            "--set",
+            "cat.front.mass=1e-6",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("with next to no torque applied") && err.contains("the body itself"),
+        "{err}"
+    );
+    assert!(!err.contains("huge torques"), "{err}");
+}
+
 #[test]
 fn a_million_row_resampling_is_refused_at_once_with_the_bound() {
     let dir = temp_dir();
