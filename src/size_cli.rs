@@ -9,6 +9,9 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
     // `--height` replaces `fall.height` before the config is checked: the
     // configured drop is not used, and the margin is judged against this one
     crate::cli::refuse_set_of(c, "fall.height", &format!("--height {height}"))?;
+    // (it designs least-time schedules: another objective would be ignored,
+    // yet name the set)
+    crate::cli::refuse_set_of(c, "design.objective", "`catflip size`")?;
     let with_height = Common {
         set: [c.set.clone(), vec![format!("fall.height={height}")]].concat(),
         ..c.clone()

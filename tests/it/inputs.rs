@@ -59,6 +59,19 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
         &["size", &robot, "--height", "1", "--set", "fall.height = 5"],
         &["--set fall.height = 5", "--height 1"],
     );
+    refused(
+        &[
+            "size",
+            &robot,
+            "--height",
+            "1",
+            "--set",
+            "design.objective=energy",
+        ],
+        &[
+            "--set design.objective=energy conflicts with `catflip size`, which sets design.objective itself",
+        ],
+    );
     // NaN as Rust and Python print it reaches the key's own check
     refused(
         &["analyze", &seed, "--set", "fall.height=NaN"],
