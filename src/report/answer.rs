@@ -79,7 +79,7 @@ pub fn height_text(a: &HeightAnswer) -> String {
         )
     } else {
         format!(
-            "The least drop height found: {:.3} m{bound} ({:.4} s of manoeuvre).{what}",
+            "The least drop height found: {:.3} m{bound}, for a {:.4} s manoeuvre.{what}",
             a.least_height_m, a.least_time_s
         )
     }
