@@ -229,11 +229,7 @@ fn thread_count(s: &str) -> Result<u32, String> {
 /// A `--set` of the key that another option sets (a sweep's key, the size's
 /// height) would be overwritten silently, yet name the output set: refused.
 pub(crate) fn refuse_set_of(c: &Common, key: &str, by: &str) -> Result<()> {
-    if let Some(s) = c
-        .set
-        .iter()
-        .find(|s| s.split('=').next().map(str::trim) == Some(key))
-    {
+    if let Some(s) = c.set.iter().find(|s| crate::common::set_key(s) == key) {
         return Err(catflip::Error::Usage(format!(
             "--set {s} conflicts with {by}, which sets {key} itself; leave the --set out"
         ))

@@ -91,12 +91,16 @@ pub(crate) struct Common {
     pub(crate) out: PathBuf,
 }
 
+/// The key of a `--set KEY=VALUE`, as the config reads it (spaces dropped).
+pub(crate) fn set_key(arg: &str) -> &str {
+    arg.split('=').next().unwrap_or(arg).trim()
+}
+
 /// Loads and checks the config; likely unit slips are warned about on stderr.
 pub(crate) fn load(c: &Common) -> Result<Config> {
     // the last would win silently, yet both would name the output set
-    let key = |s: &String| s.split('=').next().map(|k| k.trim().to_string());
     for (i, s) in c.set.iter().enumerate() {
-        if let Some(first) = c.set[..i].iter().find(|f| key(f) == key(s)) {
+        if let Some(first) = c.set[..i].iter().find(|f| set_key(f) == set_key(s)) {
             return Err(catflip::Error::Usage(format!(
                 "--set {s} gives the key of --set {first} again: give each key once"
             ))

@@ -22,6 +22,12 @@ use std::f64::consts::PI;
 /// beyond the model's own reach (it has no air drag, and a cat falls at its
 /// terminal speed after a few seconds).
 pub const MAX_FALL_TIME_S: f64 = 30.0;
+/// Whether a fall of `fall_time_s` (manoeuvre plus margin) is longer than
+/// any catflip designs (a NaN one too: no fall has it).
+pub fn beyond_longest_fall(fall_time_s: f64) -> bool {
+    fall_time_s.is_nan() || fall_time_s > MAX_FALL_TIME_S
+}
+
 /// Shortest fall, s: below it the torques (which grow as `1 / T^2`) leave
 /// the range where the solvers' tolerances mean anything.
 pub const MIN_FALL_TIME_S: f64 = 1e-3;

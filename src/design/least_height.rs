@@ -75,7 +75,7 @@ pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
     if !spec.motor.is_limited() {
         return Ok(None);
     }
-    if let Some(far) = far_beyond(spec) {
+    if let Some(far) = beyond_any_fall(spec) {
         return Ok(Some(far));
     }
     answer_for(spec, &reference(spec), None).map(|(a, _)| Some(a))
@@ -98,13 +98,8 @@ pub fn beyond_any_fall(spec: &DesignSpec) -> Option<HeightAnswer> {
     if !spec.motor.is_limited() {
         return None;
     }
-    far_beyond(spec)
-}
-
-/// [`beyond_any_fall`] for limited motors.
-fn far_beyond(spec: &DesignSpec) -> Option<HeightAnswer> {
     let t = reference_time(spec)?;
-    (t / FAR + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S).then(|| HeightAnswer {
+    crate::config::ranges::beyond_longest_fall(t / FAR + spec.fall.margin).then(|| HeightAnswer {
         possible: false,
         verified: false,
         height_m: spec.fall.height,
@@ -318,7 +313,7 @@ pub fn heights(
     if !spec.motor.is_limited() {
         return Ok(None);
     }
-    if let Some(answer) = far_beyond(spec) {
+    if let Some(answer) = beyond_any_fall(spec) {
         return Ok(Some(Heights {
             phased_m: answer.least_height_m,
             phased_bend: f64::NAN,
@@ -632,7 +627,7 @@ impl HeightAnswer {
     /// manoeuvre longer than the longest fall is no answer catflip gives.
     fn bound(&mut self, spec: &DesignSpec) {
         self.beyond_longest_fall =
-            self.least_time_s + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S;
+            crate::config::ranges::beyond_longest_fall(self.least_time_s + spec.fall.margin);
         if self.beyond_longest_fall {
             self.possible = false;
             self.schedule = Schedule { rows: Vec::new() };

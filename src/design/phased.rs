@@ -255,15 +255,15 @@ pub fn check_limit(spec: &DesignSpec, unit_peak: f64, peak: f64, what: &str) -> 
         && peak > lim * (1.0 + crate::verdict::tolerance::LIMIT)
     {
         let t = (unit_peak / lim).sqrt() + spec.fall.margin;
-        let longest = crate::config::ranges::MAX_FALL_TIME_S;
-        let height = if t <= longest {
+        let height = if crate::config::ranges::beyond_longest_fall(t) {
             format!(
-                "drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
-                least_height(spec, unit_peak, lim)
+                "at this torque it needs a {t:.4e} s fall (F7), longer than any catflip designs ({} s): raise limits.max_torque",
+                crate::config::ranges::MAX_FALL_TIME_S
             )
         } else {
             format!(
-                "at this torque it needs a {t:.4e} s fall (F7), longer than any catflip designs ({longest} s): raise limits.max_torque"
+                "drop the cat from at least {:.3} m (fall.height, F7) or raise limits.max_torque",
+                least_height(spec, unit_peak, lim)
             )
         };
         return Err(Error::BeyondMotors {

@@ -46,6 +46,10 @@ pub fn headline(a: &HeightAnswer) -> String {
 /// The least height found and, when known, its lower bound and what the
 /// bound is: `... 3.541 m (at least 3.200 m) ...`.
 pub fn height_text(a: &HeightAnswer) -> String {
+    if a.beyond_longest_fall {
+        let t = a.beyond_text();
+        return t[..1].to_uppercase() + &t[1..];
+    }
     let b = lower_bound(a);
     let bound = b
         .map(|b| format!(" (at least {b:.3} m)"))
@@ -59,10 +63,6 @@ pub fn height_text(a: &HeightAnswer) -> String {
             )
         })
         .unwrap_or_default();
-    if a.beyond_longest_fall {
-        let t = a.beyond_text();
-        return t[..1].to_uppercase() + &t[1..];
-    }
     if !a.verified {
         // (only the phased design is ever unverified: the free-form ones
         // that answer are flown first)

@@ -162,14 +162,24 @@ impl SweepState {
                 names.push(name.clone());
                 out.add(name, svg);
             }
-            out.add("index.html", self.page(file_key, key, &points, &names));
+            out.add(
+                "index.html",
+                self.page(file_key, key, &points, &names, height),
+            );
         }
         out.add(Self::file_name(file_key), self.to_json());
         Ok(out)
     }
 
     /// The sweep's page: a row a finished point, and the figures.
-    fn page(&self, file_key: &str, key: &str, points: &[SweepPoint], figures: &[String]) -> String {
+    fn page(
+        &self,
+        file_key: &str,
+        key: &str,
+        points: &[SweepPoint],
+        figures: &[String],
+        height: f64,
+    ) -> String {
         let cell =
             |x: Option<f64>, digits: usize| x.map_or(String::new(), |x| format!("{x:.digits$}"));
         let rows: Vec<Vec<String>> = points
@@ -191,11 +201,9 @@ impl SweepState {
             .collect();
         let name = self.config["name"].as_str().unwrap_or("config");
         let limited = self.config["limits"]["max_torque"].is_number();
-        let height = self.config["fall"]["height"].as_f64();
         let what = if limited {
             format!(
-                "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: below the configured {} m (fall.height) the flip is possible there. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)",
-                height.map_or("?".into(), |h| h.to_string())
+                "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: below the configured {height} m (fall.height) the flip is possible there. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)"
             )
         } else {
             "each point designed by each method as `catflip run` designs it (no motor limits)"

@@ -611,21 +611,20 @@ pub fn span_mismatch(spec: &DesignSpec, name: &str, start: f64, end: f64) -> Opt
         return None;
     }
     // a schedule from 0 fits one height; one that starts later, none
-    let fits =
-        if start.abs() <= tol && end + spec.fall.margin > crate::config::ranges::MAX_FALL_TIME_S {
-            format!(
-                "it would need a {:.4} s fall, longer than any catflip designs ({} s)",
-                end + spec.fall.margin,
-                crate::config::ranges::MAX_FALL_TIME_S
-            )
-        } else if start.abs() <= tol {
-            format!(
-                "it fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
-                0.5 * spec.fall.gravity * (end + spec.fall.margin).powi(2)
-            )
-        } else {
-            "it does not start at 0, so no height fits it".into()
-        };
+    let fall = end + spec.fall.margin;
+    let fits = if start.abs() > tol {
+        "it does not start at 0, so no height fits it".into()
+    } else if crate::config::ranges::beyond_longest_fall(fall) {
+        format!(
+            "it would need a {fall:.4} s fall, longer than any catflip designs ({} s)",
+            crate::config::ranges::MAX_FALL_TIME_S
+        )
+    } else {
+        format!(
+            "it fits `--set fall.height={:.9}` at this fall.gravity and fall.margin",
+            0.5 * spec.fall.gravity * fall.powi(2)
+        )
+    };
     Some(format!(
         "the schedule runs from t = {start} s to {end} s, but config `{name}` leaves {want:.6} s for the manoeuvre (fall time {:.6} s minus fall.margin {} s) and a schedule must start at 0 and end then ({fits})",
         spec.fall_time(),
