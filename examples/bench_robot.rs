@@ -61,8 +61,12 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
         }
         ["height", name] => {
             let cfg = config(name, &[], extra)?;
-            let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})?
-                .ok_or_else(|| anyhow::anyhow!("{name}: no motor limits"))?;
+            let h = catflip::design::least_height::heights(
+                &cfg.design_spec(),
+                catflip::design::least_height::Families::Both,
+                |_| {},
+            )?
+            .ok_or_else(|| anyhow::anyhow!("{name}: no motor limits"))?;
             format!(
                 "least height {:.4} m ({} {:.5} s), phased {:.4} m",
                 h.answer.least_height_m, h.answer.method, h.answer.least_time_s, h.phased_m

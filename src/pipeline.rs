@@ -610,7 +610,11 @@ pub fn free_start(
         "no phased schedule fits the motors in this fall: finding the least drop height first, as `catflip run` does",
     );
     // (the least height failing leaves the analytic seed, as in `run`)
-    if let Ok(Some(h)) = crate::design::least_height::heights(spec, true, |_| {}) {
+    if let Ok(Some(h)) = crate::design::least_height::heights(
+        spec,
+        crate::design::least_height::Families::Both,
+        |_| {},
+    ) {
         if let Some(e) = out_of_reach(&h.answer) {
             return Err(e);
         }

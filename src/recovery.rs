@@ -522,7 +522,11 @@ fn flight(cfg: &Config, fr: &FreeResult) -> Result<(SimReport, bool)> {
 /// free-form `time` design inside the motor envelope (from the start at
 /// rest the phased one counts too); `None` when none verifies.
 fn least_height(cfg: &Config) -> Option<f64> {
-    match crate::design::least_height::heights(&cfg.design_spec(), true, |_| {}) {
+    match crate::design::least_height::heights(
+        &cfg.design_spec(),
+        crate::design::least_height::Families::Both,
+        |_| {},
+    ) {
         Ok(Some(h)) if h.free.is_some() || cfg.start.is_default() => Some(h.answer.least_height_m),
         _ => None,
     }

@@ -265,8 +265,11 @@ impl Question {
         let clock =
             stages.begin("least drop height (shortest manoeuvre inside the motor envelope)");
         let progress = &mut stages.progress;
-        let heights =
-            crate::design::least_height::heights(spec, true, |it| progress(Progress::Scp(it)));
+        let heights = crate::design::least_height::heights(
+            spec,
+            crate::design::least_height::Families::Both,
+            |it| progress(Progress::Scp(it)),
+        );
         let mut q = Question {
             seconds: clock.elapsed().as_secs_f64(),
             ..Question::default()

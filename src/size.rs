@@ -32,7 +32,7 @@
 
 use crate::config::Config;
 use crate::design::free::FreeDesign;
-use crate::design::least_height::heights;
+use crate::design::least_height::{Families, heights};
 use crate::design::objective::Objective;
 use crate::design::spec::DesignSpec;
 use crate::error::{Error, Result};
@@ -297,7 +297,7 @@ fn speed_ratio(q: &Config) -> Option<f64> {
 pub fn design_motor(q: &Config, torque: f64, no_load: f64) -> Result<MotorDesign> {
     let speed = speed_ratio(q).map(|r| r * no_load);
     let spec = with_motor(q, Some(torque), Some(no_load), speed);
-    let h = heights(&spec, true, |_| {})?.expect("a limited motor has an answer");
+    let h = heights(&spec, Families::Both, |_| {})?.expect("a limited motor has an answer");
     let a = &h.answer;
     if !a.from_start {
         // a tilted release: only a free-form design from the start answers
@@ -332,7 +332,7 @@ fn asymptotes(q: &Config) -> Result<(f64, f64)> {
     let w0 = q.limits.no_load_speed.expect("checked by question");
     let w = w0 * speed_ratio(q).unwrap_or(1.0).min(1.0);
     let speed = with_motor(q, None, None, Some(w));
-    let h = heights(&speed, true, |_| {})?.expect("a speed limit has an answer");
+    let h = heights(&speed, Families::Both, |_| {})?.expect("a speed limit has an answer");
     let speed = w0 * h.answer.least_time_s / q.available_time();
     Ok((torque, speed))
 }

@@ -15,7 +15,7 @@
 use crate::config::Config;
 use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
-use crate::design::least_height::{Heights, heights, heights_near};
+use crate::design::least_height::{Families, Heights, heights, heights_near};
 use crate::design::phased::BendHint;
 use crate::design::phased::least_height;
 use crate::design::spec::DesignSpec;
@@ -278,33 +278,30 @@ impl HeightChain {
     /// The least heights at this point: continued from the chunk's last
     /// least-height design when there is one, else the cold stage (so the
     /// chunk's first point answers as `run` does).
-    fn heights(&mut self, spec: &DesignSpec, with_free: bool) -> Result<Option<Heights>> {
+    fn heights(&mut self, spec: &DesignSpec, families: Families) -> Result<Option<Heights>> {
         if let Some(Some(h)) = &self.same_answer {
             return Ok(Some(h.clone()));
         }
         let d = &self.designs;
-        let h = match (&d.warm, with_free) {
+        let h = match (&d.warm, families.free()) {
             (Some(prev), true) => heights_near(
                 spec,
                 prev,
                 d.before.as_ref(),
                 BendHint::from_chain(&self.bends),
+                families,
             ),
-            _ => heights(spec, with_free, |_| {}),
+            _ => heights(spec, families, |_| {}),
         };
+        // (a bend is known only where the phased design was made)
         match &h {
-            // (a bend is known only where the phased design was made)
-            Ok(Some(h)) if h.phased_bend.is_finite() => {
-                self.bends.push(h.phased_bend);
-                if let Some(same) = self
-                    .same_answer
-                    .as_mut()
-                    .filter(|_| spec.is_default_start())
-                {
-                    *same = Some(h.clone());
-                }
-            }
+            Ok(Some(h)) if h.phased_bend.is_finite() => self.bends.push(h.phased_bend),
             _ => self.bends.clear(),
+        }
+        if let (Ok(Some(h)), Some(same)) = (&h, self.same_answer.as_mut())
+            && spec.is_default_start()
+        {
+            *same = Some(h.clone());
         }
         self.designs.advance(
             h.as_ref()
@@ -499,7 +496,14 @@ fn point(
     }
     if envelope && (methods.phased || methods.free) {
         let limited = limited_cfg.design_spec();
-        match height.heights(&limited, methods.free) {
+        // (without the phased column its design is made only where no
+        // free-form design verifies)
+        let families = match (methods.phased, methods.free) {
+            (true, true) => Families::Both,
+            (true, false) => Families::Phased,
+            _ => Families::Free,
+        };
+        match height.heights(&limited, families) {
             Ok(Some(h)) => {
                 if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);

@@ -1277,7 +1277,7 @@ fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>
         py,
         || {},
         move || {
-            let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
+            let h = catflip::design::least_height::heights(&cfg.design_spec(), catflip::design::least_height::Families::Both, |_| {})
                 .map_err(err)?;
             Ok(h.map(|h| LeastHeight {
                 answer: h.answer,

@@ -45,11 +45,14 @@ pub fn design(cfg: &Config) -> crate::Result<crate::design::free::FreeResult> {
             // this design's does not) is that nothing found fits it, say
             // so before the analytic seed's long and futile solve
             if matches!(e, Error::SeedUnfit { .. } | Error::BeyondMotors { .. })
-                && let Some(beyond) =
-                    crate::design::least_height::heights(&cfg.design_spec(), true, |_| {})
-                        .ok()
-                        .flatten()
-                        .and_then(|h| crate::pipeline::out_of_reach(&h.answer))
+                && let Some(beyond) = crate::design::least_height::heights(
+                    &cfg.design_spec(),
+                    crate::design::least_height::Families::Both,
+                    |_| {},
+                )
+                .ok()
+                .flatten()
+                .and_then(|h| crate::pipeline::out_of_reach(&h.answer))
             {
                 return Err(beyond);
             }

@@ -291,6 +291,31 @@ fn stretched(
     p
 }
 
+/// Which design families answer the least height ([`heights`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Families {
+    /// The phased `time` design alone.
+    Phased,
+    /// The free-form `time` designs; the phased design only when none of
+    /// them verifies (a sweep without the phased column: its least height
+    /// is the free-form design's whichever answers).
+    Free,
+    /// Both: the answer is the better one.
+    Both,
+}
+
+impl Families {
+    /// Whether the phased design is made whatever the free-form ones do.
+    pub fn phased(self) -> bool {
+        self != Families::Free
+    }
+
+    /// Whether the free-form designs are made.
+    pub fn free(self) -> bool {
+        self != Families::Phased
+    }
+}
+
 /// [`answer`], improved by the free-form time designs from two starts, both
 /// made for the [`reference`] drop so that neither depends on
 /// `fall.height`: the stall-only design ([`stall_only`]) at the stall-only
@@ -304,10 +329,10 @@ fn stretched(
 /// iterations of the start finished first. The stall-only least time is the
 /// answer's lower bound where the motor has a torque-speed line or a speed
 /// limit (under its stall torque alone it is the answer's own problem, and
-/// bounds nothing). Without `with_free`, the phased answer alone.
+/// bounds nothing). `families` says which designs are made.
 pub fn heights(
     spec: &DesignSpec,
-    with_free: bool,
+    families: Families,
     mut observe: impl FnMut(&ScpIteration),
 ) -> Result<Option<Heights>> {
     if !spec.motor.is_limited() {
@@ -323,7 +348,7 @@ pub fn heights(
         }));
     }
     let reference = reference(spec);
-    if !with_free {
+    if !families.free() {
         let (answer, phased_bend) = answer_for(spec, &reference, None)?;
         return Ok(Some(Heights {
             phased_m: answer.least_height_m,
@@ -345,7 +370,7 @@ pub fn heights(
                 .coarse_stage();
             // (the receiver waits for it: it is never gone before this)
             let _ = sent.send(staged);
-            answer_for(spec, reference, None)
+            families.phased().then(|| answer_for(spec, reference, None))
         });
         let (bound, from_stall) = match stall_only(reference) {
             Ok(Some((least, sr))) => {
@@ -375,7 +400,10 @@ pub fn heights(
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (phased, bound, candidates)
     });
-    let (mut answer, phased_bend) = phased?;
+    let (mut answer, phased_bend) = match phased {
+        Some(phased) => phased?,
+        None => unless_verified(spec, &reference, &candidates)?,
+    };
     // (the stall-only design's time scaling, F3, holds at zero momentum only:
     // F9; under the stall torque alone it is the answer's own problem, whose
     // local optimum bounds nothing)
@@ -492,23 +520,56 @@ pub fn heights_near(
     prev: &FreeResult,
     before: Option<&FreeResult>,
     hint: Option<BendHint>,
+    families: Families,
 ) -> Result<Option<Heights>> {
     if !spec.motor.is_limited() {
         return Ok(None);
     }
     let reference = reference(spec);
-    let answer = answer_for(spec, &reference, hint)?;
-    let continued = free::FreeDesign::new(&reference)
+    let continued: Vec<Candidate> = free::FreeDesign::new(&reference)
         .warm(prev, before)
         .solve()
         .ok()
-        .map(|fr| flown(&reference, fr));
-    let h = concluded(spec, answer, continued);
-    if h.free.is_some() {
-        Ok(Some(h))
-    } else {
-        heights(spec, true, |_| {})
+        .map(|fr| flown(&reference, fr))
+        .into_iter()
+        .collect();
+    if !continued.iter().any(|c| c.1.is_some()) {
+        return heights(spec, families, |_| {});
     }
+    let answer = if families.phased() {
+        answer_for(spec, &reference, hint)?
+    } else {
+        unless_verified(spec, &reference, &continued)?
+    };
+    Ok(Some(concluded(spec, answer, continued)))
+}
+
+/// The phased answer ([`answer_for`]) when no free-form design in
+/// `candidates` verifies; otherwise a blank one that the fastest of them
+/// settles ([`concluded`]), its phased numbers NaN.
+fn unless_verified(
+    spec: &DesignSpec,
+    reference: &DesignSpec,
+    candidates: &[Candidate],
+) -> Result<(HeightAnswer, f64)> {
+    if !candidates.iter().any(|c| c.1.is_some()) {
+        return answer_for(spec, reference, None);
+    }
+    let blank = HeightAnswer {
+        possible: false,
+        verified: false,
+        height_m: spec.fall.height,
+        least_height_m: f64::NAN,
+        least_time_s: f64::INFINITY,
+        method: "free",
+        status: Status::Converged,
+        least_height_lower_bound_m: None,
+        flip_error_rad: f64::NAN,
+        from_start: spec.is_default_start(),
+        beyond_longest_fall: false,
+        schedule: Schedule { rows: Vec::new() },
+    };
+    Ok((blank, f64::NAN))
 }
 
 /// The answer from the phased one (`answer`) and the free-form `time`

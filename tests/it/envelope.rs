@@ -197,9 +197,13 @@ fn a_servo_that_cannot_bind_in_a_long_fall_leaves_each_design_where_the_stall_to
 #[test]
 fn the_phased_design_fits_a_fall_just_longer_than_the_phased_least_height() {
     let cfg = util::config("box-robot", &[]);
-    let h = catflip::design::least_height::heights(&cfg.design_spec(), false, |_| {})
-        .unwrap()
-        .expect("the box robot has motor limits");
+    let h = catflip::design::least_height::heights(
+        &cfg.design_spec(),
+        catflip::design::least_height::Families::Phased,
+        |_| {},
+    )
+    .unwrap()
+    .expect("the box robot has motor limits");
     for k in [1.02, 1.06] {
         let spec = cfg.design_spec().with_height(k * h.phased_m);
         let r = optimize(&spec, |_| {}).unwrap_or_else(|e| {

@@ -3,14 +3,14 @@
 //! needs less, and the lower bound beside it is below it.
 use catflip::Config;
 use catflip::design::envelope::{least_stretch, usage_of};
-use catflip::design::least_height::{Heights, heights, reference};
+use catflip::design::least_height::{Families, Heights, heights, reference};
 
 fn robot(set: &[&str]) -> Config {
     crate::util::config("robot-universal", set)
 }
 
 fn least(cfg: &Config) -> Heights {
-    heights(&cfg.design_spec(), true, |_| {})
+    heights(&cfg.design_spec(), Families::Both, |_| {})
         .unwrap()
         .expect("the robot has motor limits")
 }

@@ -201,11 +201,16 @@ fn a_cat_sweep_starts_each_bend_search_at_the_neighbours_and_finds_the_scans_opt
 /// with the phased and free-form methods, whose least heights the sweep
 /// gives, in one chunk (one thread: every point after the first continues).
 fn robot_least_heights(range: &str) -> (std::path::PathBuf, Vec<catflip::sweep::SweepPoint>) {
+    robot_sweep(range, true)
+}
+
+/// [`robot_least_heights`], with the phased method or without it.
+fn robot_sweep(range: &str, phased: bool) -> (std::path::PathBuf, Vec<catflip::sweep::SweepPoint>) {
     let path = configs().join("robot-universal.toml");
     let spec: catflip::sweep::SweepSpec = range.parse().unwrap();
     let methods = catflip::sweep::Methods {
         analytic: false,
-        phased: true,
+        phased,
         free: true,
     };
     let points = catflip::sweep::sweep(&path, &[], &spec, methods, 1, |_, _| {}).unwrap();
@@ -273,9 +278,13 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
 fn a_sweep_of_the_fall_height_gives_one_least_height_at_every_point() {
     let (path, points) = robot_least_heights("fall.height=4:8:3");
     let cfg = catflip::Config::load(&path, &[]).unwrap();
-    let h = catflip::design::least_height::heights(&cfg.design_spec(), true, |_| {})
-        .unwrap()
-        .unwrap();
+    let h = catflip::design::least_height::heights(
+        &cfg.design_spec(),
+        catflip::design::least_height::Families::Both,
+        |_| {},
+    )
+    .unwrap()
+    .unwrap();
     let free = catflip::design::envelope::height_for(
         &cfg.design_spec(),
         h.free.as_ref().unwrap().manoeuvre_time_s,
@@ -284,6 +293,25 @@ fn a_sweep_of_the_fall_height_gives_one_least_height_at_every_point() {
     for p in &points {
         assert_eq!(p.least_height_phased_m, Some(h.phased_m), "{}", p.value);
         assert_eq!(p.least_height_free_m, Some(free), "{}", p.value);
+    }
+}
+
+/// Without the phased column a sweep makes no phased least-height design
+/// where a free-form one verifies (a third of a continued point's work):
+/// its free-form least heights are the ones of the sweep with both
+/// methods, to the bit, at the chunk's cold first point and the continued
+/// points after it.
+#[test]
+fn a_sweep_without_the_phased_method_gives_the_same_free_least_heights() {
+    let (_, both) = robot_sweep("limits.no_load_speed=6.1:5.9:3", true);
+    let (_, free) = robot_sweep("limits.no_load_speed=6.1:5.9:3", false);
+    assert_eq!(free.len(), 3);
+    for (b, f) in both.iter().zip(&free) {
+        assert!(f.least_height_free_m.is_some(), "{f:?}");
+        assert_eq!(f.least_height_free_m, b.least_height_free_m, "{}", f.value);
+        assert_eq!(f.free_peak_nm, b.free_peak_nm, "{}", f.value);
+        assert_eq!(f.least_height_phased_m, None);
+        assert_eq!(f.error, None);
     }
 }
 
