@@ -161,7 +161,7 @@ def test_impossible_from_this_height(tmp_path):
 
 
 def test_a_named_phased_seed_that_does_not_fit_is_no_impossibility(tmp_path):
-    # from 4 m the robot flips (the least height is 3.487 m), but no phased schedule fits:
+    # from 4 m the robot flips (the least height is 3.483 m), but no phased schedule fits:
     # the named phased seed fails as the CLI's exit 1, not as the motors' impossibility
     robot = ROOT / "configs" / "robot-universal.toml"
     status, _, stderr = cli("optimize", robot, "--mode", "free", "--seed", "phased",
