@@ -495,13 +495,7 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
     assert!(a.sentence().starts_with("No verified design found"));
     // `run`'s answer: a verified free-form design, shorter; from its 2 m the
     // robot cannot, from 1.01 times the least height it can
-    let h = catflip::design::least_height::heights(
-        &cfg.design_spec(),
-        catflip::design::least_height::Families::Both,
-        |_| {},
-    )
-    .unwrap()
-    .unwrap();
+    let h = crate::util::least(&cfg);
     let f = &h.answer;
     assert!(f.verified && f.method == "free", "{}", f.sentence());
     // (and a sweep says its phased column is not a verified height)

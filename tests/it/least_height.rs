@@ -1,18 +1,13 @@
 //! The robot builder's answer is one answer: the least drop height does not
 //! depend on the height the question is asked from, a weaker motor never
 //! needs less, and the lower bound beside it is below it.
+use crate::util::least;
 use catflip::Config;
 use catflip::design::envelope::{least_stretch, usage_of};
-use catflip::design::least_height::{Families, Heights, heights, reference};
+use catflip::design::least_height::{Heights, reference};
 
 fn robot(set: &[&str]) -> Config {
     crate::util::config("robot-universal", set)
-}
-
-fn least(cfg: &Config) -> Heights {
-    heights(&cfg.design_spec(), Families::Both, |_| {})
-        .unwrap()
-        .expect("the robot has motor limits")
 }
 
 /// The answers from 1, 2, 6 and 10 m agree: every design of the answer is

@@ -278,13 +278,7 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
 fn a_sweep_of_the_fall_height_gives_one_least_height_at_every_point() {
     let (path, points) = robot_least_heights("fall.height=4:8:3");
     let cfg = catflip::Config::load(&path, &[]).unwrap();
-    let h = catflip::design::least_height::heights(
-        &cfg.design_spec(),
-        catflip::design::least_height::Families::Both,
-        |_| {},
-    )
-    .unwrap()
-    .unwrap();
+    let h = crate::util::least(&cfg);
     let free = catflip::design::envelope::height_for(
         &cfg.design_spec(),
         h.free.as_ref().unwrap().manoeuvre_time_s,

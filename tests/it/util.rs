@@ -218,3 +218,15 @@ pub fn number_after(text: &str, phrase: &str) -> f64 {
         .and_then(|t| t.parse().ok())
         .unwrap_or_else(|| panic!("no number after `{phrase}` in {text}"))
 }
+
+/// The least-height stage's answer for `cfg` (both design families), as
+/// `run` makes it; `cfg` must limit its motors.
+pub fn least(cfg: &Config) -> catflip::design::least_height::Heights {
+    catflip::design::least_height::heights(
+        &cfg.design_spec(),
+        catflip::design::least_height::Families::Both,
+        |_| {},
+    )
+    .unwrap()
+    .expect("a config with motor limits")
+}
