@@ -133,10 +133,44 @@ fn scan_best<D: Scored>(
 pub fn scan_then_brent<D: Scored>(
     mut scan: Vec<f64>,
     tol: f64,
-    mut eval: impl FnMut(f64) -> Result<D>,
+    eval: impl FnMut(f64) -> Result<D>,
 ) -> Result<D> {
+    let mut failed = None;
+    let mut eval = tolerant(eval, &mut failed);
     let (a, x, b, best_d) = scan_best(&mut scan, &mut eval)?;
-    brent(a, x, b, best_d, tol, eval)
+    let best = brent(a, x, b, best_d, tol, eval)?;
+    best.0
+        .ok_or_else(|| failed.expect("a bend the solver could not finish"))
+}
+
+/// A bend's design, or none where the solver could not finish its conic
+/// program: an impossible bend (infinite score), as one where no timing
+/// fits. A bend of a hundredth of a degree needs thousands of twist turns,
+/// and its program ends in numerical trouble: the search goes on without it
+/// (it used to end there, however good the other bends).
+struct Tried<D>(Option<D>);
+
+impl<D: Scored> Scored for Tried<D> {
+    fn score(&self) -> f64 {
+        self.0.as_ref().map_or(f64::INFINITY, Scored::score)
+    }
+}
+
+/// `eval` with a solver's failure at a bend taken as an impossible bend
+/// ([`Tried`]), the first such error kept in `failed`; other errors end the
+/// search.
+fn tolerant<'a, D>(
+    mut eval: impl FnMut(f64) -> Result<D> + 'a,
+    failed: &'a mut Option<Error>,
+) -> impl FnMut(f64) -> Result<Tried<D>> + 'a {
+    move |x| match eval(x) {
+        Ok(d) => Ok(Tried(Some(d))),
+        Err(e @ Error::Solver { .. }) => {
+            failed.get_or_insert(e);
+            Ok(Tried(None))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// A local search for a sweep, where the neighbouring point's best bend
@@ -146,6 +180,19 @@ pub fn scan_then_brent<D: Scored>(
 /// `None` when no bend of the bracket is possible (the caller scans the
 /// whole range instead).
 pub fn bracket_then_brent<D: Scored>(
+    center: f64,
+    step: f64,
+    range: (f64, f64),
+    tol: f64,
+    eval: impl FnMut(f64) -> Result<D>,
+) -> Result<Option<D>> {
+    let mut failed = None;
+    let found = bracket_then_brent_tried(center, step, range, tol, tolerant(eval, &mut failed))?;
+    Ok(found.and_then(|t| t.0))
+}
+
+/// [`bracket_then_brent`] on any scored design.
+fn bracket_then_brent_tried<D: Scored>(
     center: f64,
     step: f64,
     (lo, hi): (f64, f64),
@@ -344,6 +391,43 @@ mod tests {
         assert!((best.0 - 0.83).abs() < 2e-6, "{}", best.0);
         let best = scan_then_brent(scan, 1e-6, f).unwrap();
         assert!((best.0 - 0.83).abs() < 2e-6, "{}", best.0);
+    }
+
+    #[test]
+    fn a_bend_the_solver_cannot_finish_is_skipped_and_all_failing_is_the_error() {
+        let fail = || Error::Solver {
+            what: "path-timing SOCP".into(),
+            status: "NumericalError".into(),
+            hint: String::new(),
+        };
+        // (x - 0.83)^2 + 0.1, the solver failing below 0.3 and at 1.1
+        let f = |x: f64| {
+            if x < 0.3 || (x - 1.1).abs() < 1e-12 {
+                Err(fail())
+            } else {
+                Ok(S(x, (x - 0.83).powi(2) + 0.1))
+            }
+        };
+        let scan: Vec<f64> = (0..12).map(|i| 0.1 + 2.9 * i as f64 / 11.0).collect();
+        let best = scan_then_brent(scan.clone(), 1e-6, f).unwrap();
+        assert!((best.0 - 0.83).abs() < 2e-6, "{}", best.0);
+        let near = bracket_then_brent(0.25, 0.05, (0.1, 3.0), 1e-6, f)
+            .unwrap()
+            .unwrap();
+        assert!((near.0 - 0.83).abs() < 2e-6, "{}", near.0);
+        // every bend failing: the solver's error, not a design
+        let all = scan_then_brent(scan, 1e-6, |_| Err::<S, _>(fail()));
+        assert!(matches!(all, Err(Error::Solver { .. })));
+        assert!(
+            bracket_then_brent(1.0, 0.1, (0.1, 3.0), 1e-6, |_| Err::<S, _>(fail()))
+                .unwrap()
+                .is_none()
+        );
+        // an error that is not the solver's still ends the search
+        let usage = scan_then_brent(vec![0.5, 1.0], 1e-6, |_| {
+            Err::<S, _>(Error::Usage("interrupted".into()))
+        });
+        assert!(matches!(usage, Err(Error::Usage(_))));
     }
 
     #[test]

@@ -289,8 +289,19 @@ impl PhaseSocp {
     /// Solves the phase along `path` in unit time with the solver in `slot`.
     fn solve(&self, slot: &mut Option<ConicSolver>, cat: &Cat, path: &Path) -> Result<PhaseTiming> {
         let data = self.build(cat, path);
-        let (status, x, _) = solve_reusing_with(slot, &data, self.settings)?;
+        let reused = slot.is_some();
+        let (mut status, mut x, _) = solve_reusing_with(slot, &data, self.settings)?;
+        if !status.ok() && reused {
+            // a reused solver keeps the scaling of the program it was set up
+            // for: after a bend far from this one (a tenth of a degree, whose
+            // peak is a million times the optimum's) that scaling failed
+            // the bends after it; a solver set up for this program
+            *slot = None;
+            (status, x, _) = solve_reusing_with(slot, &data, self.settings)?;
+        }
         if !status.ok() {
+            // (nor is a failed program's scaling one to keep)
+            *slot = None;
             return Err(Error::Solver {
                 what: format!("path-timing SOCP ({} intervals)", self.k),
                 status: format!("{status:?}"),

@@ -209,6 +209,33 @@ fn a_broken_phase_problem_surfaces_as_a_solver_status() {
     let _ = ShapePlan::duration(&cosine_plan(1.0, 1.0, [1.0; 3]));
 }
 
+/// A bend search from a bend of almost nothing (whose program needs
+/// thousands of twist turns and fails, or succeeds at a million times the
+/// optimum's peak) finds the design the default range finds: the failed
+/// bends are passed over, and the solver set up for that extreme program
+/// does not carry its scaling to the next (every bend after it failed:
+/// NumericalError for `phased.bend_min_deg = 0.1` and below).
+#[test]
+fn a_bend_range_from_almost_nothing_finds_the_default_ranges_design() {
+    let optimum = optimize(&cfg("seed", &[]).design_spec(), |_| {}).unwrap();
+    for low in ["1e-300", "1e-4", "0.01", "0.1"] {
+        let c = cfg("seed", &[&format!("phased.bend_min_deg={low}")]);
+        let r = optimize(&c.design_spec(), |_| {}).unwrap_or_else(|e| panic!("{low}: {e}"));
+        assert!(
+            (r.peak_torque_nm / optimum.peak_torque_nm - 1.0).abs() < 1e-5,
+            "{low}: {} against {} N m at {} deg",
+            r.peak_torque_nm,
+            optimum.peak_torque_nm,
+            r.bend_deg
+        );
+        assert!(
+            (r.bend_deg - optimum.bend_deg).abs() < 0.1,
+            "{low}: {} deg",
+            r.bend_deg
+        );
+    }
+}
+
 #[test]
 fn the_fold_solved_alongside_the_twist_root_find_is_the_same_design() {
     // the robot (universal joint): its fold is solved on its own thread
