@@ -21,13 +21,23 @@ pub const TABLE_HEADER: [&str; 12] = [
     "verdict",
 ];
 
-/// A small number in the table: `0` for exact zero, else 3 significant digits.
-fn small(x: f64) -> String {
+/// A number in the table to 3 significant digits: `0` for exact zero,
+/// plain from a thousandth to a thousand (a landing 154 deg off read
+/// `1.54e2`), otherwise in scientific notation (`-1.75e-4`).
+pub fn three_digits(x: f64) -> String {
     if x == 0.0 {
-        "0".into()
-    } else {
-        format!("{x:.2e}")
+        return "0".into();
     }
+    let a = x.abs();
+    if !(1e-3..999.5).contains(&a) {
+        return format!("{x:.2e}");
+    }
+    // digits after the point for 3 significant ones, from the rounded value
+    let magnitude = format!("{a:.2e}")
+        .split_once('e')
+        .and_then(|(_, e)| e.parse::<i32>().ok())
+        .unwrap_or(0);
+    format!("{x:.*}", (2 - magnitude).max(0) as usize)
 }
 
 /// A verdict as the table words it: `ok`, `FLAGGED: <why>`, `FAILED: <why>`,
@@ -62,9 +72,9 @@ pub fn table_row(m: &MethodSummary) -> Vec<String> {
                 format!("{:.4e}", n.energy_n2m2s),
                 format!("{:.2}", n.bend_deg),
                 format!("{:.3}/{:.3}/{:.3}", d[0], d[1], d[2]),
-                small(n.flight.flip_error_rad),
-                small(n.flight.tilt_deg),
-                small(n.flight.landing_error_deg),
+                three_digits(n.flight.flip_error_rad),
+                three_digits(n.flight.tilt_deg),
+                three_digits(n.flight.landing_error_deg),
                 format!("{:.5}", n.flight.sim_peak_torque_nm),
                 format!("{:.3}", n.solve_time_s),
             ]);
@@ -131,6 +141,29 @@ pub fn track_status(m: &MethodSummary) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Three significant digits, plain where a reader reads them plainly.
+    #[test]
+    fn table_numbers_are_plain_from_a_thousandth_to_a_thousand() {
+        let cases = [
+            (0.0, "0"),
+            (154.2, "154"),
+            (-2.695, "-2.69"),
+            (2.7, "2.70"),
+            (0.0923, "0.0923"),
+            (0.00649, "0.00649"),
+            (0.01, "0.0100"),
+            (9.996, "10.0"),
+            (0.0009996, "1.00e-3"),
+            (-1.75e-4, "-1.75e-4"),
+            (999.4, "999"),
+            (999.6, "1.00e3"),
+            (12345.0, "1.23e4"),
+        ];
+        for (x, text) in cases {
+            assert_eq!(three_digits(x), text, "{x}");
+        }
+    }
 
     /// The ratios that exist are named, the missing ones left out.
     #[test]

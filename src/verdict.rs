@@ -284,15 +284,16 @@ impl fmt::Display for Miss {
                 tolerance,
             } => write!(
                 f,
-                "misses the flip by {error_rad:.3e} rad (simulate.flip_tolerance = {tolerance:e} rad)"
+                "misses the flip by {} rad (simulate.flip_tolerance = {tolerance:e} rad)",
+                crate::table::three_digits(*error_rad)
             ),
             Miss::Tilt {
                 tilt_deg,
                 tolerance,
             } => write!(
                 f,
-                "tilts the spine by {tilt_deg:.3} deg = {:.3e} rad (simulate.flip_tolerance = {tolerance:e} rad)",
-                tilt_deg.to_radians()
+                "tilts the spine by {tilt_deg:.3} deg = {} rad (simulate.flip_tolerance = {tolerance:e} rad)",
+                crate::table::three_digits(tilt_deg.to_radians())
             ),
             Miss::Torque { peak_nm, limit } => write!(
                 f,
