@@ -713,7 +713,11 @@ fn page(
         .collect();
     let lead = summary.answer.as_ref().map(report::answer::lead);
     report::index_html(&report::Page {
-        title: &format!("catflip report: {}", cfg.name),
+        // (the height tells apart the pages of one body asked from two)
+        title: &format!(
+            "catflip report: {}, dropped from {} m",
+            cfg.name, cfg.fall.height
+        ),
         lead: lead.as_deref(),
         header: &TABLE_HEADER,
         rows: &rows,

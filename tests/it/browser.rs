@@ -77,7 +77,10 @@ fn report_page_renders_runs_and_animates_in_chromium() {
     let base = dir.path().join("output/seed/run");
     let (dom, st) = open_selftest(&base.join("index.html"), 1300);
     // the page rendered and the player built one view per method
-    assert!(dom.contains("<h1>catflip report: seed</h1>"), "{dom}");
+    assert!(
+        dom.contains("<h1>catflip report: seed, dropped from 10 m</h1>"),
+        "{dom}"
+    );
     assert_eq!(dom.matches("<canvas").count(), 3, "one canvas per method");
     // no script error reached window.onerror
     assert_eq!(pre(&dom, "errors"), Some(""), "script errors");

@@ -20,6 +20,13 @@ fn run_writes_a_complete_consistent_report() {
     let methods = summary["methods"].as_array().unwrap();
     assert_eq!(methods.len(), 3);
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    // the heading names the height the question is asked from (the pages of
+    // one body from 2 and 6 m shared one)
+    assert!(
+        html.contains("<h1>catflip report: seed, dropped from 10 m</h1>"),
+        "{}",
+        &html[..html.len().min(2000)]
+    );
     for m in methods {
         let name = m["method"].as_str().unwrap();
         let peak = m["peak_torque_nm"].as_f64().unwrap();
