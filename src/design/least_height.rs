@@ -100,18 +100,13 @@ pub fn beyond_any_fall(spec: &DesignSpec) -> Option<HeightAnswer> {
     }
     let t = reference_time(spec)?;
     crate::config::ranges::beyond_longest_fall(t / FAR + spec.fall.margin).then(|| HeightAnswer {
-        possible: false,
-        verified: false,
-        height_m: spec.fall.height,
         least_height_m: crate::design::envelope::height_for(spec, t),
         least_time_s: t,
         method: "analytic",
         status: Status::ClosedForm,
-        least_height_lower_bound_m: None,
-        flip_error_rad: f64::NAN,
         from_start: true,
         beyond_longest_fall: true,
-        schedule: Schedule { rows: Vec::new() },
+        ..HeightAnswer::blank(spec)
     })
 }
 
@@ -553,14 +548,14 @@ pub fn heights_near(
     let answer = if families.phased() {
         answer_for(spec, &reference, hint)?
     } else {
-        unless_verified(spec, &reference, &continued)?
+        (HeightAnswer::blank(spec), f64::NAN)
     };
     Ok(Some(concluded(spec, answer, continued)))
 }
 
 /// The phased answer ([`answer_for`]) when no free-form design in
-/// `candidates` verifies; otherwise a blank one that the fastest of them
-/// settles ([`concluded`]), its phased numbers NaN.
+/// `candidates` verifies; otherwise a blank one ([`HeightAnswer::blank`])
+/// that the fastest of them settles ([`concluded`]), its bend NaN.
 fn unless_verified(
     spec: &DesignSpec,
     reference: &DesignSpec,
@@ -569,21 +564,7 @@ fn unless_verified(
     if !candidates.iter().any(|c| c.1.is_some()) {
         return answer_for(spec, reference, None);
     }
-    let blank = HeightAnswer {
-        possible: false,
-        verified: false,
-        height_m: spec.fall.height,
-        least_height_m: f64::NAN,
-        least_time_s: f64::INFINITY,
-        method: "free",
-        status: Status::Converged,
-        least_height_lower_bound_m: None,
-        flip_error_rad: f64::NAN,
-        from_start: spec.is_default_start(),
-        beyond_longest_fall: false,
-        schedule: Schedule { rows: Vec::new() },
-    };
-    Ok((blank, f64::NAN))
+    Ok((HeightAnswer::blank(spec), f64::NAN))
 }
 
 /// The answer from the phased one (`answer`) and the free-form `time`
@@ -679,6 +660,26 @@ pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
 }
 
 impl HeightAnswer {
+    /// No answer yet: not verified, no design, an infinite least time (so
+    /// that any verified free-form design improves it,
+    /// [`HeightAnswer::improve_with`]).
+    fn blank(spec: &DesignSpec) -> HeightAnswer {
+        HeightAnswer {
+            possible: false,
+            verified: false,
+            height_m: spec.fall.height,
+            least_height_m: f64::NAN,
+            least_time_s: f64::INFINITY,
+            method: "free",
+            status: Status::Converged,
+            least_height_lower_bound_m: None,
+            flip_error_rad: f64::NAN,
+            from_start: spec.is_default_start(),
+            beyond_longest_fall: false,
+            schedule: Schedule { rows: Vec::new() },
+        }
+    }
+
     /// Takes a verified free-form `time` design (`fr`, flown as `sim`:
     /// inside the envelope and flipping; designs that stopped at the
     /// iteration limit count too) when it is shorter than the answer's.
