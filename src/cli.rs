@@ -483,13 +483,17 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
                 return Err(e.into());
             }
             let design = catflip::design::free::FreeDesign::new(&spec);
-            let start;
-            let design = match seed {
-                Some(seed) => design.seed(seed),
-                None => {
-                    start = catflip::pipeline::free_start(&spec, |n| eprintln!("note: {n}"))?;
-                    design.from_plan(start.0.as_ref(), start.1)
-                }
+            // without --seed, the start `run` takes
+            let start = seed
+                .is_none()
+                .then(|| catflip::pipeline::free_start(&spec, |n| eprintln!("note: {n}")))
+                .transpose()?;
+            let design = match &start {
+                Some(s) => design.from_plan(s.plan.as_ref(), s.name),
+                None => match seed {
+                    Some(seed) => design.seed(seed),
+                    None => design,
+                },
             };
             if verbose {
                 eprintln!(
@@ -500,8 +504,12 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             let r = design
                 .check_mesh()
                 .observe(&mut console::progress::IterationTable { verbose })
-                .solve()?;
-            Design::Free(r)
+                .solve();
+            let r = match &start {
+                Some(s) => s.judged(&spec, r),
+                None => r,
+            };
+            Design::Free(r?)
         }
     };
     // the same stage as `run`: schedule, verdict, files

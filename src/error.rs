@@ -56,6 +56,18 @@ pub enum Error {
     /// reason names the drop height, or the motor, that would do.
     #[error("not possible with these motors in this fall: {reason}")]
     BeyondMotors { reason: String },
+    /// A design that found no schedule inside the motor limits in a fall the
+    /// least-height answer says the motors can do (its own design does it):
+    /// this design's failure, not the motors' (exit status 1, not 4).
+    #[error(
+        "the {what} design, started from the least-height design, found no schedule inside the motor limits in the fall from {height_m} m, {:.1} % above the least drop height found ({least_height_m:.3} m): the flip is possible, the least-height schedule does it (`catflip run` writes it as least-height.csv); a higher fall.height leaves this design more room",
+        100.0 * (height_m / least_height_m - 1.0)
+    )]
+    ShortOfAnswer {
+        what: String,
+        height_m: f64,
+        least_height_m: f64,
+    },
     /// The phased seed of a free-form design is impossible where the
     /// free-form design may not be.
     #[error(

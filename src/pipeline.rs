@@ -595,13 +595,15 @@ impl MethodSummary {
 /// ([`crate::design::phased::seed_plan`]): the free-form design meets the
 /// limit or says from what height it would (F7). `note` is told, in words,
 /// when the least height is sought and which start was taken.
-pub fn free_start(
-    spec: &DesignSpec,
-    mut note: impl FnMut(&str),
-) -> Result<(Box<dyn ShapePlan>, &'static str)> {
+pub fn free_start(spec: &DesignSpec, mut note: impl FnMut(&str)) -> Result<FreeStart> {
     use crate::design::free::Seed;
+    let start = |plan, name| FreeStart {
+        plan,
+        name,
+        least_height_m: None,
+    };
     match Seed::Phased.plan(spec) {
-        Ok(plan) => return Ok((plan, Seed::Phased.name())),
+        Ok(plan) => return Ok(start(plan, Seed::Phased.name())),
         Err(Error::BeyondMotors { .. }) => {}
         Err(Error::Unreachable { reason }) => return Err(Error::SeedUnfit { reason }),
         Err(e) => return Err(e),
@@ -624,11 +626,58 @@ pub fn free_start(
                 "the least drop height found is {:.3} m; the free-form design starts from the shortest free-form manoeuvre found ({:.4} s)",
                 a.least_height_m, fr.manoeuvre_time_s
             ));
-            return Ok((Box::new(fr.plan), FREE_LEAST_TIME));
+            return Ok(FreeStart {
+                plan: Box::new(fr.plan),
+                name: FREE_LEAST_TIME,
+                least_height_m: a.possible.then_some(a.least_height_m),
+            });
         }
     }
     note("the free-form design starts from the analytic schedule");
-    Ok((Seed::Analytic.plan(spec)?, Seed::Analytic.name()))
+    Ok(start(Seed::Analytic.plan(spec)?, Seed::Analytic.name()))
+}
+
+/// Where a free-form design starts ([`free_start`]).
+pub struct FreeStart {
+    pub plan: Box<dyn ShapePlan>,
+    /// The start's name in the result ([`FREE_LEAST_TIME`] for the
+    /// least-height design).
+    pub name: &'static str,
+    /// The least drop height found, m, when the start is that answer's
+    /// design and the flip is possible in this fall ([`short_of_answer`]).
+    pub least_height_m: Option<f64>,
+}
+
+impl FreeStart {
+    /// `r`, the design from this start, its failure restated where the
+    /// start is the least-height design in a fall it does
+    /// ([`short_of_answer`]).
+    pub fn judged(&self, spec: &DesignSpec, r: Result<FreeResult>) -> Result<FreeResult> {
+        short_of_answer(spec, self.least_height_m, r)
+    }
+}
+
+/// `r`, a free-form design's outcome; where it started from the least-height
+/// design in a fall the answer says the motors can do (`least_height_m`,
+/// the least drop height found), a design that found no schedule inside
+/// the motor limits failed on its own ([`Error::ShortOfAnswer`]): the
+/// motors' answer stays "possible" (the least-height schedule does it),
+/// not exit status 4. Near the least height the feasible schedules are
+/// few: the robot's peak-torque design from 3.5 and 3.52 m (3.483 m found)
+/// ends locally infeasible.
+pub fn short_of_answer(
+    spec: &DesignSpec,
+    least_height_m: Option<f64>,
+    r: Result<FreeResult>,
+) -> Result<FreeResult> {
+    match (r, least_height_m) {
+        (Err(Error::BeyondMotors { .. }), Some(least)) => Err(Error::ShortOfAnswer {
+            what: format!("free-form {}", spec.objective.name()),
+            height_m: spec.fall.height,
+            least_height_m: least,
+        }),
+        (r, _) => r,
+    }
 }
 
 /// Why no free-form design is attempted in this fall: the least-height
@@ -681,6 +730,49 @@ pub fn least_height_of_time_design(spec: &DesignSpec, manoeuvre: f64) -> Option<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A design from the least-height design that cannot fit the motors, in
+    /// a fall the answer says they can do, is this design's failure (exit
+    /// status 1), naming how far above the least height the fall is; with
+    /// no such answer, or another failure, the outcome is unchanged.
+    #[test]
+    fn a_failure_from_the_least_height_design_in_a_possible_fall_is_not_the_motors_answer() {
+        let spec = crate::test_support::spec_of(
+            include_str!("../configs/robot-universal.toml"),
+            "robot",
+            &["fall.height=3.5".into()],
+        );
+        let beyond = || {
+            Err(Error::BeyondMotors {
+                reason: "cannot keep inside".into(),
+            })
+        };
+        let e = short_of_answer(&spec, Some(3.4832), beyond()).unwrap_err();
+        assert!(!e.is_beyond_motors() && !e.is_bad_input(), "{e:?}");
+        let text = e.to_string();
+        for words in [
+            "free-form peak-torque design",
+            "from 3.5 m, 0.5 % above the least drop height found (3.483 m)",
+            "the flip is possible",
+            "least-height.csv",
+        ] {
+            assert!(text.contains(words), "{words:?} not in {text}");
+        }
+        assert!(
+            short_of_answer(&spec, None, beyond())
+                .unwrap_err()
+                .is_beyond_motors()
+        );
+        let solver = Err(Error::Solver {
+            what: "SCP".into(),
+            status: "NumericalError".into(),
+            hint: String::new(),
+        });
+        assert!(matches!(
+            short_of_answer(&spec, Some(3.4832), solver),
+            Err(Error::Solver { .. })
+        ));
+    }
 
     /// Which lines make a run partial, over every grade and the reference
     /// flags: flagged or failed or impossible, unless the flagged line is the

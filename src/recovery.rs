@@ -350,10 +350,11 @@ impl Origin {
         let mut at_rest = cfg.clone();
         at_rest.start = Default::default();
         let spec = at_rest.design_spec();
-        let (plan, seed) = crate::pipeline::free_start(&spec, |_| {})?;
+        let start = crate::pipeline::free_start(&spec, |_| {})?;
         let design = FreeDesign::new(&spec)
-            .from_plan(plan.as_ref(), seed)
-            .solve()?;
+            .from_plan(start.plan.as_ref(), start.name)
+            .solve();
+        let design = start.judged(&spec, design)?;
         Ok(Origin {
             cfg: at_rest,
             grid: grid.clone(),

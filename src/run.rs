@@ -449,22 +449,12 @@ impl Methods {
             .solve();
         // from the least-height design, in a fall the answer says it does:
         // the failure is this design's, and the user's schedule is that one
-        let free = match (free, &q.answer) {
-            (Err(Error::BeyondMotors { .. }), Some(a))
-                if seed_name == crate::pipeline::FREE_LEAST_TIME && a.possible =>
-            {
-                Err(Error::BeyondMotors {
-                    reason: format!(
-                        "the free-form {} design, started from the least-height design, found no schedule inside the motor limits in the fall from {} m, {:.1} % above the least drop height found ({:.3} m); the least-height schedule does it (its row, least-height.csv)",
-                        spec.objective.name(),
-                        spec.fall.height,
-                        100.0 * (spec.fall.height / a.least_height_m - 1.0),
-                        a.least_height_m
-                    ),
-                })
-            }
-            (free, _) => free,
-        };
+        let least = q
+            .answer
+            .as_ref()
+            .filter(|a| seed_name == crate::pipeline::FREE_LEAST_TIME && a.possible)
+            .map(|a| a.least_height_m);
+        let free = crate::pipeline::short_of_answer(spec, least, free);
         let design = free.map(|fr| {
             let t = fr.solve_time_s;
             (Design::Free(fr), t)

@@ -628,22 +628,29 @@ fn run_design(
         match method {
             "free" => {
                 let design = catflip::design::free::FreeDesign::new(&spec);
-                let start;
-                let design = match seed {
-                    None => {
-                        start = catflip::pipeline::free_start(&spec, |_| {}).map_err(err)?;
-                        design.from_plan(start.0.as_ref(), start.1)
-                    }
-                    Some("phased") => design.seed(catflip::design::free::Seed::Phased),
-                    Some("analytic") => design.seed(catflip::design::free::Seed::Analytic),
-                    Some(other) => {
+                // without a seed, the start `run` takes
+                let start = seed
+                    .is_none()
+                    .then(|| catflip::pipeline::free_start(&spec, |_| {}))
+                    .transpose()
+                    .map_err(err)?;
+                let design = match (&start, seed) {
+                    (Some(s), _) => design.from_plan(s.plan.as_ref(), s.name),
+                    (None, Some("phased")) => design.seed(catflip::design::free::Seed::Phased),
+                    (None, Some("analytic")) => design.seed(catflip::design::free::Seed::Analytic),
+                    (None, other) => {
                         return Err(ConfigError::new_err(format!(
-                            "unknown seed `{other}`; use \"phased\" or \"analytic\""
+                            "unknown seed `{}`; use \"phased\" or \"analytic\"",
+                            other.unwrap_or_default()
                         )));
                     }
                 };
-                let r = design.check_mesh().solve().map_err(err)?;
-                staged(&spec, catflip::pipeline::Design::Free(r))?
+                let r = design.check_mesh().solve();
+                let r = match &start {
+                    Some(s) => s.judged(&spec, r),
+                    None => r,
+                };
+                staged(&spec, catflip::pipeline::Design::Free(r.map_err(err)?))?
             }
             "phased" => {
                 if seed.is_some() {
