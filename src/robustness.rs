@@ -128,6 +128,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         serde_json::to_string_pretty(&timing)?,
     );
     let figure = format!("robustness{suffix}.svg");
+    let bins = catflip::control::figure::bins(&cfg, &results, max_tilt_deg);
     let drawn = if !results.is_empty()
         && let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
     {
@@ -145,7 +146,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             &range,
             trials,
             interrupted,
-            drawn.then_some(figure.as_str()),
+            drawn.then_some((figure.as_str(), bins.as_slice())),
         ),
     );
     out.add(
@@ -184,7 +185,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
 }
 
 /// The study's page: each controller's line, what was drawn and how to fly
-/// a trial again, and the figure.
+/// a trial again, and the figure with its bins' trials.
 fn page(
     cfg: &catflip::Config,
     s: &catflip::control::robustness::Summary,
@@ -192,7 +193,7 @@ fn page(
     range: &std::ops::Range<usize>,
     trials: usize,
     interrupted: bool,
-    figure: Option<&str>,
+    figure: Option<(&str, &[catflip::control::figure::Bins])>,
 ) -> String {
     let rows: Vec<Vec<String>> = s
         .controllers
@@ -242,12 +243,15 @@ fn page(
             s.seed
         ),
     ];
+    if let Some((_, bins)) = figure {
+        notes.extend(catflip::control::figure::bins_note(bins));
+    }
     notes.extend(catflip::console::robustness::replans(timing).map(|l| {
         let mut l = l;
         l[..1].make_ascii_uppercase();
         format!("{l}.")
     }));
-    let figures: Vec<&str> = figure.into_iter().collect();
+    let figures: Vec<&str> = figure.into_iter().map(|f| f.0).collect();
     catflip::report::index_html(&catflip::report::Page {
         title: &format!("catflip robustness: {}", cfg.name),
         lead: None,

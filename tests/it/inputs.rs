@@ -976,6 +976,26 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     }
     assert!(page.contains("<img src=\"robustness.svg\"") && page.contains("<figcaption>"));
     assert!(!page.contains("Partial study"));
+    // each perturbation's bins, with the trials each holds: all 40 of them
+    let bins = page
+        .split("hold these trials: ")
+        .nth(1)
+        .and_then(|t| t.split('.').next())
+        .unwrap_or_else(|| panic!("no bins' trials on the page: {page}"));
+    let counted: Vec<(&str, usize)> = bins
+        .split("; ")
+        .map(|b| {
+            let (what, n) = b.split_once(' ').unwrap();
+            let n: Vec<usize> = n.split(", ").map(|k| k.parse().unwrap()).collect();
+            assert_eq!(n.len(), 5, "{b}");
+            (what, n.iter().sum())
+        })
+        .collect();
+    assert_eq!(
+        counted,
+        [("spin", 40), ("tilt", 40), ("inertia", 40)],
+        "{bins}"
+    );
     // SIGINT once the progress shows 10 of the 40 trials (a line every 2),
     // twice at once, as GNU `timeout` sends it (to the command, then to its
     // process group): one request, the finished trials still published
