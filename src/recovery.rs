@@ -626,7 +626,7 @@ pub fn to_csv(lines: &[LineResult], header: bool) -> String {
 pub fn caption(file: &str) -> Option<&'static str> {
     Some(match file {
         "recovery-spin.svg" => {
-            "The largest spin at release from which the design still lands belly-down, against the spin axis's angle from the spine (+z), a line per plane of the rear half (y-z, x-z); bisected between the last spin of the grid that lands and the first that does not (a spin that landed at the grid's end is a lower bound: >= in the table)."
+            "The largest spin at release from which the design still lands belly-down, about each axis of the map (its angle from the spine +z; a marker per plane of the rear half, y-z and x-z; nothing is known between the axes, so they are not joined): the marker is the largest spin found to land, the cross above it the smallest found to miss, bisected between them; where every spin of the grid landed, the bar is dashed upwards past the grid's largest spin (a lower bound: >= in the table)."
         }
         "recovery-landing-spin.svg" => {
             "Landing error (the belly's angle from straight down at touchdown) against the spin at release, a line per spin axis; each start's free-form design continues from its neighbour's, and past the first start it misses from, the open-loop schedule for the start at rest is replayed."
@@ -645,38 +645,42 @@ pub fn figures(lines: &[LineResult], grid: &Grid) -> Result<Vec<(String, String)
     let mut figs = Vec::new();
     let bounds: Vec<&Bound> = lines.iter().filter_map(|l| l.bound.as_ref()).collect();
     if !bounds.is_empty() {
-        let mut x: Vec<f64> = bounds.iter().map(|b| b.axis_deg).collect();
-        x.sort_by(f64::total_cmp);
-        x.dedup();
-        let series: Vec<(String, Vec<f64>)> = [Plane::Yz, Plane::Xz]
+        // each axis once (one along the spine is listed in the yz plane)
+        let series: Vec<(String, Vec<crate::report::Bracket>)> = [Plane::Yz, Plane::Xz]
             .iter()
             .map(|&plane| {
-                let ys = x
+                let of: Vec<_> = bounds
                     .iter()
-                    .map(|&a| {
-                        bounds
-                            .iter()
-                            .find(|b| {
-                                b.axis_deg == a && (b.plane == plane || b.axis_deg % 180.0 == 0.0)
-                            })
-                            .map_or(f64::NAN, |b| b.largest_spin_rad_s)
+                    .filter(|b| b.plane == plane)
+                    .map(|b| crate::report::Bracket {
+                        x: b.axis_deg,
+                        lo: b.largest_spin_rad_s,
+                        hi: b.first_miss_rad_s,
                     })
-                    .collect::<Vec<_>>();
-                (format!("axis in the {} plane", plane.name()), ys)
+                    .collect();
+                (format!("axis in the {} plane", plane.name()), of)
             })
-            .filter(|s| s.1.iter().any(|y| y.is_finite()))
+            .filter(|s| !s.1.is_empty())
             .collect();
         figs.push((
             "recovery-spin.svg".to_string(),
-            crate::report::lines(
+            crate::report::brackets(
                 &format!(
-                    "Largest recoverable spin against its axis (grid up to {} rad/s)",
+                    "Largest recoverable spin about each axis (grid up to {} rad/s)",
                     grid.max_spin
                 ),
-                "axis angle from the spine +z (deg)",
-                "largest recoverable spin (rad/s)",
-                &x,
+                (
+                    "axis angle from the spine +z (deg)",
+                    "spin at release (rad/s)",
+                ),
                 &series,
+                grid.max_spin,
+                [
+                    "the largest spin that landed",
+                    "the smallest that missed",
+                    "every spin tried landed",
+                    "the grid's largest spin",
+                ],
             )?,
         ));
     }

@@ -895,6 +895,77 @@ pub fn lines_styled(
     })
 }
 
+/// A quantity known only to lie in `[lo, hi)`: the largest value found to
+/// hold and the smallest found not to (`hi` `None`: every value tried held,
+/// up to the figure's `top`, so it is at least `lo`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bracket {
+    pub x: f64,
+    pub lo: f64,
+    pub hi: Option<f64>,
+}
+
+/// Brackets ([`Bracket`]) against separate cases `x` (not joined: nothing
+/// is known between them), a style per series, nudged apart where they
+/// share an `x`: a marker at `lo`, a cross at `hi` with a bar between them,
+/// or a dashed bar up past `top` (the largest value tried, a thin level)
+/// where every value held. `legend` names, in words of the quantity, the
+/// marker, the cross, the dashed bar and the level.
+pub fn brackets(
+    title: &str,
+    desc: (&str, &str),
+    series: &[(String, Vec<Bracket>)],
+    top: f64,
+    legend_words: [&str; 4],
+) -> Result<String> {
+    svg((1000, 560), |root| {
+        let (plot, side) = with_legend(root);
+        let xs = || series.iter().flat_map(|s| s.1.iter().map(|b| b.x));
+        let (x0, x1) = xs().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+            (a.min(x), b.max(x))
+        });
+        let pad = (0.08 * (x1 - x0)).max(5.0);
+        let y1 = 1.12 * top;
+        let mut c = chart(&plot, title, (x0 - pad, x1 + pad), (0.0, y1), desc, false)?;
+        c.draw_series(LineSeries::new(
+            [(x0 - pad, top), (x1 + pad, top)],
+            BLACK.stroke_width(1),
+        ))
+        .map_err(perr)?;
+        let nudge = 0.012 * (x1 - x0 + 2.0 * pad);
+        let mut keys = Vec::new();
+        for (k, (name, bs)) in series.iter().enumerate() {
+            let st = distinct_style(k);
+            let dx = (k as f64 - 0.5 * (series.len() as f64 - 1.0)) * nudge;
+            let stroke = st.color.stroke_width(2);
+            for b in bs {
+                let x = b.x + dx;
+                match b.hi {
+                    Some(hi) => {
+                        c.draw_series(LineSeries::new([(x, b.lo), (x, hi)], stroke))
+                            .map_err(perr)?;
+                        c.draw_series(std::iter::once(marker((x, hi), Marker::Cross, st.color)))
+                            .map_err(perr)?;
+                    }
+                    None => {
+                        c.draw_series(DashedLineSeries::new([(x, b.lo), (x, y1)], 5, 4, stroke))
+                            .map_err(perr)?;
+                    }
+                }
+                c.draw_series(std::iter::once(marker((x, b.lo), st.marker, st.color)))
+                    .map_err(perr)?;
+            }
+            keys.push((name.clone(), Key::Mark(st)));
+        }
+        let [lo, hi, open, level] = legend_words;
+        keys.push((format!("marker: {lo}"), Key::Note));
+        keys.push((format!("cross: {hi}"), Key::Note));
+        keys.push((format!("dashed: {open}"), Key::Note));
+        keys.push((level.to_string(), Key::Level));
+        legend(&side, &keys)
+    })
+}
+
 /// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`: the
 /// chart's own log ticks left a 1.6-decade axis's ends without a number.
 pub(crate) fn log_ticks((lo, hi): (f64, f64)) -> Vec<f64> {
@@ -1013,6 +1084,83 @@ pub fn index_html(page: &Page) -> String {
 mod tests {
     use super::*;
     use crate::design::objective::Objective;
+
+    /// Separate cases are drawn apart: every line of the figure is vertical
+    /// (a bracket, a grid line) or horizontal (the level, a grid line), none
+    /// joins two cases; an open bracket rises above the largest value tried,
+    /// a closed one stops at its cross.
+    #[test]
+    fn brackets_are_never_joined_and_an_open_one_rises_past_the_top() {
+        let b = |x, lo, hi| Bracket { x, lo, hi };
+        let series = [
+            (
+                "yz".to_string(),
+                vec![
+                    b(0.0, 1.0, None),
+                    b(90.0, 0.0, Some(0.0625)),
+                    b(180.0, 0.5, Some(0.75)),
+                ],
+            ),
+            (
+                "xz".to_string(),
+                vec![b(90.0, 1.0, None), b(270.0, 0.25, Some(0.5))],
+            ),
+        ];
+        let svg = brackets("t", ("x", "y"), &series, 1.0, ["a", "b", "c", "d"]).unwrap();
+        let doc = roxmltree::Document::parse(&svg).unwrap();
+        // (stroke, points) of every line drawn
+        let lines: Vec<(&str, Vec<(f64, f64)>)> = doc
+            .descendants()
+            .filter(|e| e.has_tag_name("polyline"))
+            .map(|e| {
+                let pts = e
+                    .attribute("points")
+                    .unwrap()
+                    .split_whitespace()
+                    .map(|p| {
+                        let (x, y) = p.split_once(',').unwrap();
+                        (x.parse().unwrap(), y.parse().unwrap())
+                    })
+                    .collect();
+                (e.attribute("stroke").unwrap(), pts)
+            })
+            .collect();
+        let along = |pts: &[(f64, f64)], f: fn(&(f64, f64)) -> f64| {
+            pts.iter().all(|p| (f(p) - f(&pts[0])).abs() < 0.5)
+        };
+        for (_, pts) in &lines {
+            assert!(
+                along(pts, |p| p.0) || along(pts, |p| p.1),
+                "a joining line: {pts:?}"
+            );
+        }
+        // the level: the highest long black horizontal line (pixel rows
+        // grow downwards); the brackets: the coloured vertical ones
+        let level = lines
+            .iter()
+            .filter(|(st, p)| *st == "#000000" && along(p, |p| p.1) && p[1].0 - p[0].0 > 300.0)
+            .map(|(_, p)| p[0].1)
+            .fold(f64::INFINITY, f64::min);
+        let mut xs = Vec::new();
+        let mut open = Vec::new();
+        for (_, p) in lines
+            .iter()
+            .filter(|(st, p)| *st != "#000000" && along(p, |p| p.0))
+        {
+            let x = p[0].0.round() as i64;
+            xs.push(x);
+            if p.iter().any(|q| q.1 < level - 3.0) {
+                open.push(x);
+            }
+        }
+        for v in [&mut xs, &mut open] {
+            v.sort();
+            v.dedup();
+        }
+        assert_eq!(xs.len(), 5, "one bar a bracket: {xs:?}");
+        assert_eq!(open.len(), 2, "the open ones rise past the level: {open:?}");
+        assert!(svg.contains("dashed: c") && svg.contains("marker: a"));
+    }
 
     /// A log axis (a sweep's peaks over two decades) labels 1, 2, 3 and 5
     /// times each power of ten, without float noise (it printed
