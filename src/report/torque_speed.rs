@@ -29,7 +29,7 @@ pub fn caption(file: &str) -> Option<&'static str> {
             "Joint torque against time, each curve's peak circled; the least-height schedule, made for its own drop, on a panel of its own. With a stall torque, the torque limit is the black line (named in the key only, when far above the curves); with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
         }
         FILE => {
-            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed."
+            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed. Where a trajectory's torque is under an eighth of its panel's scale, a detail panel follows with the trajectories that fit a quarter above the largest of them, the envelope cut to it."
         }
         "flip.svg" => {
             "Rotation about the initial spine in the forward simulation (motor model applied)."
@@ -57,6 +57,7 @@ pub fn caption_without_limits(file: &str) -> Option<&'static str> {
 }
 
 /// One panel's samples: `(speed, torque)` per method.
+#[derive(Clone)]
 struct Panel {
     title: String,
     xdesc: &'static str,
@@ -129,31 +130,145 @@ pub fn envelope(motor: &Motor, signed: bool) -> Option<Vec<(f64, f64)>> {
     ])
 }
 
-/// The torque-speed figure (see the module doc).
+/// The torque-speed figure (see the module doc): a panel per motor (one
+/// for a Euclidean joint), each followed by its detail ([`detail`]) where
+/// some trajectory is small on its scale.
 pub fn torque_speed(methods: &[MethodTrace], motor: &Motor) -> Result<String> {
-    let panels = panels(methods, motor.norm);
+    let panels: Vec<(Panel, Option<f64>)> = panels(methods, motor.norm)
+        .into_iter()
+        .flat_map(|p| {
+            let window = detail(&p, motor);
+            let zoom = window.map(|w| {
+                let title = format!("{}, detail: |tau| up to {w:.3} N m", p.title);
+                (Panel { title, ..p.clone() }, Some(w))
+            });
+            std::iter::once((p, None)).chain(zoom)
+        })
+        .collect();
     let h = 560 * panels.len() as u32;
     svg((1000, h), |root| {
-        for (area, p) in root.split_evenly((panels.len(), 1)).iter().zip(&panels) {
-            draw_panel(area, p, methods, motor)?;
+        for (area, (p, window)) in root.split_evenly((panels.len(), 1)).iter().zip(&panels) {
+            draw_panel(area, p, methods, motor, *window)?;
         }
         Ok(())
     })
 }
 
-fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Motor) -> Result<()> {
+/// A trajectory whose largest torque is under this share of its panel's
+/// torque scale is drawn again on a detail panel: the robot's peak design
+/// from 6 m (0.026 N m) lay flat on the axis of its 1.4 N m motor.
+const SMALL: f64 = 0.125;
+
+/// A panel's largest torque on its scale (the trajectories', the envelope's
+/// and the stall torque's), N m.
+fn scale(p: &Panel, motor: &Motor) -> f64 {
+    let curves = p.curves.iter().flatten().map(|c| c.1.abs());
+    let band = envelope(motor, p.signed)
+        .into_iter()
+        .flatten()
+        .map(|c| c.1.abs());
+    curves
+        .chain(band)
+        .chain(motor.max_torque)
+        .fold(0.0, f64::max)
+}
+
+/// The detail panel's torque half-range, N m: a quarter more than the
+/// largest torque of the trajectories under [`SMALL`] of the panel's scale;
+/// `None` when there is none (or no torque at all).
+fn detail(p: &Panel, motor: &Motor) -> Option<f64> {
+    let cut = SMALL * scale(p, motor);
+    let small = p
+        .curves
+        .iter()
+        .map(|c| c.iter().fold(0.0f64, |a, p| a.max(p.1.abs())))
+        .filter(|&peak| peak > 0.0 && peak < cut)
+        .fold(0.0, f64::max);
+    (small > 0.0).then_some(1.25 * small)
+}
+
+/// The polygon `poly` cut to the band `|torque| <= w` (Sutherland-Hodgman,
+/// one edge of the band at a time).
+fn clipped(poly: &[(f64, f64)], w: f64) -> Vec<(f64, f64)> {
+    let mut out = poly.to_vec();
+    for side in [1.0, -1.0] {
+        let inside = |p: &(f64, f64)| side * p.1 <= w;
+        let cross = |a: (f64, f64), b: (f64, f64)| {
+            let f = (side * w - a.1) / (b.1 - a.1);
+            (a.0 + f * (b.0 - a.0), side * w)
+        };
+        let input = std::mem::take(&mut out);
+        for (i, &b) in input.iter().enumerate() {
+            let a = input[(i + input.len() - 1) % input.len()];
+            match (inside(&a), inside(&b)) {
+                (true, true) => out.push(b),
+                (true, false) => out.push(cross(a, b)),
+                (false, true) => out.extend([cross(a, b), b]),
+                (false, false) => {}
+            }
+        }
+    }
+    out
+}
+
+/// The part of the segment `a`-`b` within `|torque| <= w`, if any.
+fn segment_within(a: (f64, f64), b: (f64, f64), w: f64) -> Option<((f64, f64), (f64, f64))> {
+    let at = |f: f64| (a.0 + f * (b.0 - a.0), a.1 + f * (b.1 - a.1));
+    let (mut lo, mut hi) = (0.0f64, 1.0f64);
+    let dy = b.1 - a.1;
+    if dy == 0.0 {
+        return (a.1.abs() <= w).then_some((a, b));
+    }
+    for edge in [w, -w] {
+        let f = (edge - a.1) / dy;
+        // entering or leaving the band through this edge
+        if (edge > 0.0) == (dy > 0.0) {
+            hi = hi.min(f);
+        } else {
+            lo = lo.max(f);
+        }
+    }
+    (lo < hi).then(|| (at(lo), at(hi)))
+}
+
+/// One panel; with `window` the detail: torques within `+-window` only,
+/// the trajectories that stay inside it, the envelope cut to it.
+fn draw_panel(
+    area: &super::Area,
+    p: &Panel,
+    methods: &[MethodTrace],
+    motor: &Motor,
+    window: Option<f64>,
+) -> Result<()> {
     let (plot, side) = with_legend(area);
     let k = motor.slope();
-    let poly = envelope(motor, p.signed);
+    let shown: Vec<bool> = p
+        .curves
+        .iter()
+        .map(|c| window.is_none_or(|w| c.iter().all(|p| p.1.abs() <= w)))
+        .collect();
+    let poly = envelope(motor, p.signed).map(|e| match window {
+        Some(w) => clipped(&e, w),
+        None => e,
+    });
     // limits join the scale: the stall torque, the no-load and speed limits
-    let mut xs: Vec<f64> = p.curves.iter().flatten().map(|c| c.0).collect();
-    let mut ys: Vec<f64> = p.curves.iter().flatten().map(|c| c.1).collect();
+    let drawn = || {
+        p.curves
+            .iter()
+            .zip(&shown)
+            .filter(|c| *c.1)
+            .flat_map(|c| c.0)
+    };
+    let mut xs: Vec<f64> = drawn().map(|c| c.0).collect();
+    let mut ys: Vec<f64> = drawn().map(|c| c.1).collect();
     for (w, t) in poly.iter().flatten() {
         xs.push(*w);
         ys.push(*t);
     }
-    if let Some(t) = motor.max_torque {
-        ys.extend([t, -t]);
+    match (window, motor.max_torque) {
+        (Some(w), _) => ys.extend([w, -w]),
+        (None, Some(t)) => ys.extend([t, -t]),
+        (None, None) => {}
     }
     xs.extend(motor.max_speed.into_iter().chain(motor.no_load_speed));
     if p.signed {
@@ -202,13 +317,18 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
                 RGBColor(0xbb, 0xbb, 0xbb).mix(0.35).filled(),
             )))
             .map_err(perr)?;
-            let mut closed = poly.clone();
-            closed.push(poly[0]);
-            c.draw_series(std::iter::once(PathElement::new(
-                closed,
-                BLACK.stroke_width(2),
-            )))
-            .map_err(perr)?;
+            // the outline: the envelope's own edges (in a detail, the parts
+            // inside its window; the cut is not an edge)
+            let whole = envelope(motor, p.signed).unwrap_or_default();
+            let edges = (0..whole.len()).filter_map(|i| {
+                let (a, b) = (whole[i], whole[(i + 1) % whole.len()]);
+                match window {
+                    Some(w) => segment_within(a, b, w),
+                    None => Some((a, b)),
+                }
+            });
+            c.draw_series(edges.map(|(a, b)| PathElement::new(vec![a, b], BLACK.stroke_width(2))))
+                .map_err(perr)?;
         }
         if k > 0.0 {
             keys.push(("envelope |tau + k w| <= T".into(), Key::Band));
@@ -227,7 +347,7 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
                 named.push((-w0, 0.0, format!("no-load -w0 = {} rad/s", -w0), 6, -32));
             }
         }
-        for (w, s, label, dx, dy) in named {
+        for (w, s, label, dx, dy) in named.into_iter().filter(|n| n.1.abs() <= y.1.max(-y.0)) {
             c.draw_series(std::iter::once(Circle::new((w, s), 5, BLACK.filled())))
                 .map_err(perr)?;
             c.draw_series(std::iter::once(text(label, (w, s), dx, dy)))
@@ -273,6 +393,9 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
     }
     c.draw_series(names).map_err(perr)?;
     for (i, (m, pts)) in methods.iter().zip(&p.curves).enumerate() {
+        if !shown[i] {
+            continue;
+        }
         let st: Style = style_of(&m.name, i);
         line(&mut c, pts, st, i as f64 / methods.len() as f64)?;
         let tp = pts.iter().fold(0.0f64, |a, p| a.max(p.1.abs()));
@@ -284,4 +407,56 @@ fn draw_panel(area: &super::Area, p: &Panel, methods: &[MethodTrace], motor: &Mo
     }
     keys.push(("(largest |torque|, |speed|)".into(), Key::Note));
     legend(&side, &keys)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The robot's band (T 1.4 N m, w0 5.969 rad/s) cut at 0.3 N m: six
+    /// corners, each on the band's edges or the window's, the area that of
+    /// the band's part inside the window; an edge's part inside the window,
+    /// or none.
+    #[test]
+    fn the_envelope_cut_to_a_window_keeps_the_part_inside_it() {
+        let (t, w0, w) = (1.4, 5.969, 0.3);
+        let k = t / w0;
+        let band = [(-w0, 2.0 * t), (w0, 0.0), (w0, -2.0 * t), (-w0, 0.0)];
+        let cut = clipped(&band, w);
+        assert_eq!(cut.len(), 6, "{cut:?}");
+        for &(s, tau) in &cut {
+            assert!(tau.abs() <= w + 1e-12);
+            let on_band = ((tau + k * s).abs() - t).abs() < 1e-9 || (s.abs() - w0).abs() < 1e-12;
+            assert!(on_band || (tau.abs() - w).abs() < 1e-12, "({s}, {tau})");
+        }
+        let area = |p: &[(f64, f64)]| {
+            0.5 * (0..p.len())
+                .map(|i| {
+                    let (a, b) = (p[i], p[(i + 1) % p.len()]);
+                    a.0 * b.1 - b.0 * a.1
+                })
+                .sum::<f64>()
+                .abs()
+        };
+        // at speed s the band spans -k (w0 + s) to k (w0 - s) (T = k w0):
+        // inside the window twice the integral of min(w, k u) over u in
+        // [0, 2 w0], a full-width strip 2 w tall less two triangles of legs
+        // w and w / k
+        let want = 4.0 * w * w0 - w * w / k;
+        assert!(
+            (area(&cut) - want).abs() < 1e-9,
+            "{} against {want}",
+            area(&cut)
+        );
+        // a wide window leaves the band whole
+        assert!((area(&clipped(&band, 3.0)) - area(&band)).abs() < 1e-12);
+        // the upper edge from (-w0, 2T) to (w0, 0): its part below w
+        let (a, b) = segment_within(band[0], band[1], w).unwrap();
+        assert!((a.1 - w).abs() < 1e-12 && b == band[1], "{a:?} {b:?}");
+        assert_eq!(segment_within((0.0, 1.0), (1.0, 2.0), w), None);
+        assert_eq!(
+            segment_within((0.0, 0.1), (1.0, 0.1), w),
+            Some(((0.0, 0.1), (1.0, 0.1)))
+        );
+    }
 }

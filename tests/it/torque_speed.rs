@@ -101,10 +101,18 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     );
 
     let polys = elements(&svg, "polygon", &["fill=\"#BBBBBB\""]);
-    assert_eq!(polys.len(), 2, "one envelope per motor");
+    // the free design (0.026 N m) is small on the motors' scale: each
+    // motor's panel is followed by its detail
+    assert_eq!(polys.len(), 4, "one envelope per motor and per detail");
+    assert_eq!(svg.matches(", detail: |tau| up to ").count(), 2);
     // each panel is 560 px tall
     for (j, poly) in polys.iter().enumerate() {
         let rows = (560.0 * j as f64, 560.0 * (j + 1) as f64);
+        if j % 2 == 1 {
+            detail_panel(&svg, poly, rows, (t, k), &summary);
+            continue;
+        }
+        let j = j / 2;
         let (fx, fy) = (
             axis(&ticks(&svg, "middle", rows)),
             axis(&ticks(&svg, "end", rows)),
@@ -158,5 +166,58 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
                 assert!(excess > 10.0, "{name}: drawn inside ({excess} px)");
             }
         }
+    }
+}
+
+/// A detail panel (pixel rows `rows`): the envelope cut to its window, and
+/// the free design's trace, which fits it, inside the band `(T, k)`.
+fn detail_panel(
+    svg: &str,
+    poly: &str,
+    rows: (f64, f64),
+    (t, k): (f64, f64),
+    summary: &serde_json::Value,
+) {
+    let (fx, fy) = (
+        axis(&ticks(svg, "middle", rows)),
+        axis(&ticks(svg, "end", rows)),
+    );
+    // one pixel in data units: the torque's, and the band's torque k w
+    // across one pixel of speed (the detail's torque pixel is finer)
+    let (px, py) = ((fx(1.0) - fx(0.0)).abs(), (fy(1.0) - fy(0.0)).abs());
+    let slack = 1.5 * (py + k * px);
+    let corners: Vec<(f64, f64)> = points(poly).iter().map(|p| (fx(p.0), fy(p.1))).collect();
+    // the band cut at +-w: six corners, the highest torque the window's
+    let w = corners.iter().fold(0.0f64, |a, c| a.max(c.1.abs()));
+    assert_eq!(corners.len(), 6, "{corners:?}");
+    assert!(w < 0.25 * t, "the window {w} N m is a detail of {t} N m");
+    let free = summary["methods"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["method"] == "free")
+        .unwrap();
+    assert!(free["min_envelope_margin"].as_f64().unwrap() >= 0.0);
+    let drawn: Vec<(f64, f64)> = elements(
+        svg,
+        "polyline",
+        &["stroke=\"#D62728\"", "stroke-width=\"2\""],
+    )
+    .into_iter()
+    .flat_map(points)
+    .filter(|p| p.1 >= rows.0 && p.1 < rows.1 && p.0 < 740.0)
+    .map(|p| (fx(p.0), fy(p.1)))
+    .collect();
+    assert!(drawn.len() > 50, "free: {} points drawn", drawn.len());
+    for (speed, tau) in &drawn {
+        assert!(
+            tau.abs() <= w + 1.5 * py,
+            "free at {tau} N m, past the window {w}"
+        );
+        let excess = (tau + k * speed).abs() - t;
+        assert!(
+            excess <= slack,
+            "free outside the band at ({speed}, {tau}): {excess} N m"
+        );
     }
 }
