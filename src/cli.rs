@@ -488,12 +488,10 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
                 .is_none()
                 .then(|| catflip::pipeline::free_start(&spec, |n| eprintln!("note: {n}")))
                 .transpose()?;
-            let design = match &start {
-                Some(s) => design.from_plan(s.plan.as_ref(), s.name),
-                None => match seed {
-                    Some(seed) => design.seed(seed),
-                    None => design,
-                },
+            let design = match (&start, seed) {
+                (Some(s), _) => design.from_plan(s.plan.as_ref(), s.name),
+                (None, Some(seed)) => design.seed(seed),
+                (None, None) => unreachable!("a start is made without --seed"),
             };
             if verbose {
                 eprintln!(
@@ -506,7 +504,7 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
                 .observe(&mut console::progress::IterationTable { verbose })
                 .solve();
             let r = match &start {
-                Some(s) => s.judged(&spec, r),
+                Some(s) => s.judged(&spec, r, catflip::pipeline::LEAST_HEIGHT_FROM_RUN),
                 None => r,
             };
             Design::Free(r?)

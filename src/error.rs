@@ -60,13 +60,15 @@ pub enum Error {
     /// least-height answer says the motors can do (its own design does it):
     /// this design's failure, not the motors' (exit status 1, not 4).
     #[error(
-        "the {what} design, started from the least-height design, found no schedule inside the motor limits in the fall from {height_m} m, {:.1} % above the least drop height found ({least_height_m:.3} m): the flip is possible, the least-height schedule does it (`catflip run` writes it as least-height.csv); a higher fall.height leaves this design more room",
+        "the {what} design, started from the least-height design, found no schedule inside the motor limits in the fall from {height_m} m, {:.1} % above the least drop height found ({least_height_m:.3} m): the flip is possible, the least-height schedule does it ({where_}); a higher fall.height leaves this design more room",
         100.0 * (height_m / least_height_m - 1.0)
     )]
     ShortOfAnswer {
         what: String,
         height_m: f64,
         least_height_m: f64,
+        /// Where the caller's user finds that schedule.
+        where_: String,
     },
     /// The phased seed of a free-form design is impossible where the
     /// free-form design may not be.

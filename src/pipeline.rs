@@ -651,30 +651,40 @@ pub struct FreeStart {
 impl FreeStart {
     /// `r`, the design from this start, its failure restated where the
     /// start is the least-height design in a fall it does
-    /// ([`short_of_answer`]).
-    pub fn judged(&self, spec: &DesignSpec, r: Result<FreeResult>) -> Result<FreeResult> {
-        short_of_answer(spec, self.least_height_m, r)
+    /// ([`short_of_answer`], `where_` saying where that schedule is).
+    pub fn judged(
+        &self,
+        spec: &DesignSpec,
+        r: Result<FreeResult>,
+        where_: &str,
+    ) -> Result<FreeResult> {
+        short_of_answer(spec, self.least_height_m, r, where_)
     }
 }
+
+/// Where `optimize` and `recovery` point to the least-height schedule
+/// ([`short_of_answer`]).
+pub const LEAST_HEIGHT_FROM_RUN: &str = "`catflip run` writes it as least-height.csv";
 
 /// `r`, a free-form design's outcome; where it started from the least-height
 /// design in a fall the answer says the motors can do (`least_height_m`,
 /// the least drop height found), a design that found no schedule inside
-/// the motor limits failed on its own ([`Error::ShortOfAnswer`]): the
-/// motors' answer stays "possible" (the least-height schedule does it),
-/// not exit status 4. Near the least height the feasible schedules are
-/// few: the robot's peak-torque design from 3.5 and 3.52 m (3.483 m found)
-/// ends locally infeasible.
+/// the motor limits failed on its own ([`Error::ShortOfAnswer`], `where_`
+/// saying where the least-height schedule is): the motors' answer stays
+/// "possible", not exit status 4. Near the least height few schedules fit,
+/// and the design can end locally infeasible.
 pub fn short_of_answer(
     spec: &DesignSpec,
     least_height_m: Option<f64>,
     r: Result<FreeResult>,
+    where_: &str,
 ) -> Result<FreeResult> {
     match (r, least_height_m) {
         (Err(Error::BeyondMotors { .. }), Some(least)) => Err(Error::ShortOfAnswer {
             what: format!("free-form {}", spec.objective.name()),
             height_m: spec.fall.height,
             least_height_m: least,
+            where_: where_.to_string(),
         }),
         (r, _) => r,
     }
@@ -747,19 +757,18 @@ mod tests {
                 reason: "cannot keep inside".into(),
             })
         };
-        let e = short_of_answer(&spec, Some(3.4832), beyond()).unwrap_err();
+        let e = short_of_answer(&spec, Some(3.4832), beyond(), LEAST_HEIGHT_FROM_RUN).unwrap_err();
         assert!(!e.is_beyond_motors() && !e.is_bad_input(), "{e:?}");
         let text = e.to_string();
         for words in [
             "free-form peak-torque design",
             "from 3.5 m, 0.5 % above the least drop height found (3.483 m)",
-            "the flip is possible",
-            "least-height.csv",
+            "the flip is possible, the least-height schedule does it (`catflip run` writes it as least-height.csv)",
         ] {
             assert!(text.contains(words), "{words:?} not in {text}");
         }
         assert!(
-            short_of_answer(&spec, None, beyond())
+            short_of_answer(&spec, None, beyond(), LEAST_HEIGHT_FROM_RUN)
                 .unwrap_err()
                 .is_beyond_motors()
         );
@@ -769,7 +778,7 @@ mod tests {
             hint: String::new(),
         });
         assert!(matches!(
-            short_of_answer(&spec, Some(3.4832), solver),
+            short_of_answer(&spec, Some(3.4832), solver, LEAST_HEIGHT_FROM_RUN),
             Err(Error::Solver { .. })
         ));
     }

@@ -354,7 +354,7 @@ impl Origin {
         let design = FreeDesign::new(&spec)
             .from_plan(start.plan.as_ref(), start.name)
             .solve();
-        let design = start.judged(&spec, design)?;
+        let design = start.judged(&spec, design, crate::pipeline::LEAST_HEIGHT_FROM_RUN)?;
         Ok(Origin {
             cfg: at_rest,
             grid: grid.clone(),

@@ -129,9 +129,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     );
     let figure = format!("robustness{suffix}.svg");
     let bins = catflip::control::figure::bins(&cfg, &results, max_tilt_deg);
-    let drawn = if !results.is_empty()
-        && let Some(svg) = catflip::control::figure::success_by_size(&cfg, &results, max_tilt_deg)?
-    {
+    let drawn = if let Some(svg) = catflip::control::figure::success_by_size(&bins, max_tilt_deg)? {
         out.add(figure.clone(), svg);
         true
     } else {

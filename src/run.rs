@@ -454,7 +454,7 @@ impl Methods {
             .as_ref()
             .filter(|a| seed_name == crate::pipeline::FREE_LEAST_TIME && a.possible)
             .map(|a| a.least_height_m);
-        let free = crate::pipeline::short_of_answer(spec, least, free);
+        let free = crate::pipeline::short_of_answer(spec, least, free, "its row, least-height.csv");
         let design = free.map(|fr| {
             let t = fr.solve_time_s;
             (Design::Free(fr), t)

@@ -638,16 +638,16 @@ fn run_design(
                     (Some(s), _) => design.from_plan(s.plan.as_ref(), s.name),
                     (None, Some("phased")) => design.seed(catflip::design::free::Seed::Phased),
                     (None, Some("analytic")) => design.seed(catflip::design::free::Seed::Analytic),
-                    (None, other) => {
+                    (None, Some(other)) => {
                         return Err(ConfigError::new_err(format!(
-                            "unknown seed `{}`; use \"phased\" or \"analytic\"",
-                            other.unwrap_or_default()
+                            "unknown seed `{other}`; use \"phased\" or \"analytic\""
                         )));
                     }
+                    (None, None) => unreachable!("a start is made without a seed"),
                 };
                 let r = design.check_mesh().solve();
                 let r = match &start {
-                    Some(s) => s.judged(&spec, r),
+                    Some(s) => s.judged(&spec, r, "catflip.least_height(config) gives it"),
                     None => r,
                 };
                 staged(&spec, catflip::pipeline::Design::Free(r.map_err(err)?))?

@@ -87,15 +87,12 @@ pub fn bins_note(bins: &[Bins]) -> Option<String> {
     })
 }
 
-/// The SVG, or `None` when no perturbation varies.
-pub fn success_by_size(
-    cfg: &Config,
-    results: &[TrialResult],
-    max_tilt_deg: f64,
-) -> Result<Option<String>> {
+/// The SVG of the study's [`bins`], or `None` when no perturbation varies
+/// or there are no trials.
+pub fn success_by_size(bins: &[Bins], max_tilt_deg: f64) -> Result<Option<String>> {
     let x: Vec<f64> = (0..BINS).map(|b| (b as f64 + 0.5) / BINS as f64).collect();
     let mut series = Vec::new();
-    for b in bins(cfg, results, max_tilt_deg) {
+    for b in bins {
         for (name, landed) in CONTROLLERS.iter().zip(&b.landed) {
             let ys = landed
                 .iter()
@@ -111,7 +108,7 @@ pub fn success_by_size(
             series.push((format!("{name}: {}", b.perturbation), ys));
         }
     }
-    if series.is_empty() || results.is_empty() {
+    if bins.iter().all(|b| b.trials.iter().sum::<usize>() == 0) {
         return Ok(None);
     }
     Ok(Some(crate::report::lines_styled(

@@ -909,8 +909,9 @@ pub struct Bracket {
 /// is known between them), a style per series, nudged apart where they
 /// share an `x`: a marker at `lo`, a cross at `hi` with a bar between them,
 /// or a dashed bar up past `top` (the largest value tried, a thin level)
-/// where every value held. `legend` names, in words of the quantity, the
-/// marker, the cross, the dashed bar and the level.
+/// where every value held. `legend_words` name, in words of the quantity,
+/// the marker, the cross, the dashed bar (listed only when one is drawn)
+/// and the level.
 pub fn brackets(
     title: &str,
     desc: (&str, &str),
@@ -960,7 +961,9 @@ pub fn brackets(
         let [lo, hi, open, level] = legend_words;
         keys.push((format!("marker: {lo}"), Key::Note));
         keys.push((format!("cross: {hi}"), Key::Note));
-        keys.push((format!("dashed: {open}"), Key::Note));
+        if series.iter().flat_map(|s| &s.1).any(|b| b.hi.is_none()) {
+            keys.push((format!("dashed: {open}"), Key::Note));
+        }
         keys.push((level.to_string(), Key::Level));
         legend(&side, &keys)
     })

@@ -139,7 +139,11 @@ pub fn torque_speed(methods: &[MethodTrace], motor: &Motor) -> Result<String> {
         .flat_map(|p| {
             let window = detail(&p, motor);
             let zoom = window.map(|w| {
-                let title = format!("{}, detail: |tau| up to {w:.3} N m", p.title);
+                let title = format!(
+                    "{}, detail: |tau| up to {} N m",
+                    p.title,
+                    crate::table::three_digits(w)
+                );
                 (Panel { title, ..p.clone() }, Some(w))
             });
             std::iter::once((p, None)).chain(zoom)
@@ -155,9 +159,13 @@ pub fn torque_speed(methods: &[MethodTrace], motor: &Motor) -> Result<String> {
 }
 
 /// A trajectory whose largest torque is under this share of its panel's
-/// torque scale is drawn again on a detail panel: the robot's peak design
-/// from 6 m (0.026 N m) lay flat on the axis of its 1.4 N m motor.
+/// torque scale is drawn again on a detail panel: a design far inside a
+/// strong motor's envelope lies flat on its axis.
 const SMALL: f64 = 0.125;
+
+/// Below this share of the scale a trajectory is no torque at all (a
+/// detail of it would show rounding).
+const NOTHING: f64 = 1e-6;
 
 /// A panel's largest torque on its scale (the trajectories', the envelope's
 /// and the stall torque's), N m.
@@ -175,14 +183,16 @@ fn scale(p: &Panel, motor: &Motor) -> f64 {
 
 /// The detail panel's torque half-range, N m: a quarter more than the
 /// largest torque of the trajectories under [`SMALL`] of the panel's scale;
-/// `None` when there is none (or no torque at all).
+/// `None` when there is none, or without a torque limit (the scale is then
+/// the trajectories' own, and the figure compares designs, not a motor).
 fn detail(p: &Panel, motor: &Motor) -> Option<f64> {
-    let cut = SMALL * scale(p, motor);
+    motor.max_torque?;
+    let scale = scale(p, motor);
     let small = p
         .curves
         .iter()
         .map(|c| c.iter().fold(0.0f64, |a, p| a.max(p.1.abs())))
-        .filter(|&peak| peak > 0.0 && peak < cut)
+        .filter(|&peak| peak > NOTHING * scale && peak < SMALL * scale)
         .fold(0.0, f64::max);
     (small > 0.0).then_some(1.25 * small)
 }

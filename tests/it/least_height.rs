@@ -254,3 +254,19 @@ fn a_motor_too_weak_for_any_fall_is_answered_without_a_schedule() {
     assert_eq!(method_line(&s, "least-height")["verdict"], "ok");
     assert!(base.join("least-height.csv").exists());
 }
+
+/// Just above the least height the free-form design starts from the
+/// least-height design and carries that height, so that a failure there is
+/// the design's own, not "not possible" (`pipeline::short_of_answer`);
+/// below it there is no start: the answer is the error.
+#[test]
+fn the_start_just_above_the_least_height_carries_that_height() {
+    use catflip::pipeline::{FREE_LEAST_TIME, free_start};
+    let s = free_start(&robot(&["fall.height=3.5"]).design_spec(), |_| {}).unwrap();
+    assert_eq!(s.name, FREE_LEAST_TIME);
+    let found = least(&robot(&[])).answer.least_height_m;
+    assert_eq!(s.least_height_m, Some(found));
+    assert!(found < 3.5, "{found}");
+    let below = free_start(&robot(&["fall.height=2"]).design_spec(), |_| {});
+    assert!(below.is_err_and(|e| e.is_beyond_motors()));
+}
