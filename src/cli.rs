@@ -482,32 +482,15 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
             {
                 return Err(e.into());
             }
-            let design = catflip::design::free::FreeDesign::new(&spec);
-            // without --seed, the start `run` takes
-            let start = seed
-                .is_none()
-                .then(|| catflip::pipeline::free_start(&spec, |n| eprintln!("note: {n}")))
-                .transpose()?;
-            let design = match (&start, seed) {
-                (Some(s), _) => design.from_plan(s.plan.as_ref(), s.name),
-                (None, Some(seed)) => design.seed(seed),
-                (None, None) => unreachable!("a start is made without --seed"),
-            };
-            if verbose {
-                eprintln!(
-                    "{}",
-                    console::progress::iteration_header(cfg.design.objective.short_name())
-                );
-            }
-            let r = design
-                .check_mesh()
-                .observe(&mut console::progress::IterationTable { verbose })
-                .solve();
-            let r = match &start {
-                Some(s) => s.judged(&spec, r, catflip::pipeline::LEAST_HEIGHT_FROM_RUN),
-                None => r,
-            };
-            Design::Free(r?)
+            let mut table =
+                console::progress::IterationTable::new(verbose, cfg.design.objective.short_name());
+            Design::Free(catflip::pipeline::free_design(
+                &spec,
+                seed,
+                |n| eprintln!("note: {n}"),
+                &mut table,
+                catflip::pipeline::LEAST_HEIGHT_FROM_RUN,
+            )?)
         }
     };
     // the same stage as `run`: schedule, verdict, files

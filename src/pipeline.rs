@@ -644,22 +644,33 @@ pub struct FreeStart {
     /// least-height design).
     pub name: &'static str,
     /// The least drop height found, m, when the start is that answer's
-    /// design and the flip is possible in this fall ([`short_of_answer`]).
+    /// design and the flip is possible in this fall ([`short_of_answer`]'s
+    /// `least_height_m`).
     pub least_height_m: Option<f64>,
 }
 
-impl FreeStart {
-    /// `r`, the design from this start, its failure restated where the
-    /// start is the least-height design in a fall it does
-    /// ([`short_of_answer`], `where_` saying where that schedule is).
-    pub fn judged(
-        &self,
-        spec: &DesignSpec,
-        r: Result<FreeResult>,
-        where_: &str,
-    ) -> Result<FreeResult> {
-        short_of_answer(spec, self.least_height_m, r, where_)
+/// The free-form design `optimize` and Python's `design` make, with its
+/// mesh check: from `seed`, or without one from the start `run` takes
+/// ([`free_start`], `note` told how it was found), a failure from the
+/// least-height design in a fall it does restated ([`short_of_answer`],
+/// `where_` saying where that schedule is).
+pub fn free_design(
+    spec: &DesignSpec,
+    seed: Option<crate::design::free::Seed>,
+    note: impl FnMut(&str),
+    observer: &mut dyn crate::design::free::Observer,
+    where_: &str,
+) -> Result<FreeResult> {
+    let design = crate::design::free::FreeDesign::new(spec).check_mesh();
+    if let Some(seed) = seed {
+        return design.seed(seed).observe(observer).solve();
     }
+    let start = free_start(spec, note)?;
+    let r = design
+        .from_plan(start.plan.as_ref(), start.name)
+        .observe(observer)
+        .solve();
+    short_of_answer(spec, start.least_height_m, r, where_)
 }
 
 /// Where `optimize` and `recovery` point to the least-height schedule

@@ -354,7 +354,12 @@ impl Origin {
         let design = FreeDesign::new(&spec)
             .from_plan(start.plan.as_ref(), start.name)
             .solve();
-        let design = start.judged(&spec, design, crate::pipeline::LEAST_HEIGHT_FROM_RUN)?;
+        let design = crate::pipeline::short_of_answer(
+            &spec,
+            start.least_height_m,
+            design,
+            crate::pipeline::LEAST_HEIGHT_FROM_RUN,
+        )?;
         Ok(Origin {
             cfg: at_rest,
             grid: grid.clone(),

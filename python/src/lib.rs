@@ -627,29 +627,25 @@ fn run_design(
     let (plan, schedule, json, status, reason, peak, durations): (Plan, _, _, Status, _, _, _) =
         match method {
             "free" => {
-                let design = catflip::design::free::FreeDesign::new(&spec);
-                // without a seed, the start `run` takes
-                let start = seed
-                    .is_none()
-                    .then(|| catflip::pipeline::free_start(&spec, |_| {}))
-                    .transpose()
-                    .map_err(err)?;
-                let design = match (&start, seed) {
-                    (Some(s), _) => design.from_plan(s.plan.as_ref(), s.name),
-                    (None, Some("phased")) => design.seed(catflip::design::free::Seed::Phased),
-                    (None, Some("analytic")) => design.seed(catflip::design::free::Seed::Analytic),
-                    (None, Some(other)) => {
+                use catflip::design::free::Seed;
+                let seed = match seed {
+                    None => None,
+                    Some("phased") => Some(Seed::Phased),
+                    Some("analytic") => Some(Seed::Analytic),
+                    Some(other) => {
                         return Err(ConfigError::new_err(format!(
                             "unknown seed `{other}`; use \"phased\" or \"analytic\""
                         )));
                     }
-                    (None, None) => unreachable!("a start is made without a seed"),
                 };
-                let r = design.check_mesh().solve();
-                let r = match &start {
-                    Some(s) => s.judged(&spec, r, "catflip.least_height(config) gives it"),
-                    None => r,
-                };
+                // without a seed, the start `run` takes
+                let r = catflip::pipeline::free_design(
+                    &spec,
+                    seed,
+                    |_| {},
+                    &mut |_: &catflip::design::scp::ScpIteration| {},
+                    "catflip.least_height(config) gives it",
+                );
                 staged(&spec, catflip::pipeline::Design::Free(r.map_err(err)?))?
             }
             "phased" => {

@@ -82,17 +82,39 @@ pub fn iteration_header(objective: &str) -> String {
     format!("  iter      merit {objective:>10}     infeas     radius        rho  step   ms")
 }
 
-/// `--verbose`: one line per SCP iteration on stderr, and a line where each
-/// mesh begins (mesh continuation: the trust radius starts again there,
-/// but inside the motor envelope, where the fine mesh carries the coarse
-/// one's radius and penalty weight).
+/// `--verbose`: one line per SCP iteration on stderr under
+/// [`iteration_header`], and a line where each mesh begins (mesh
+/// continuation: the trust radius starts again there, but inside the motor
+/// envelope, where the fine mesh carries the coarse one's radius and
+/// penalty weight).
 pub struct IterationTable {
-    pub verbose: bool,
+    verbose: bool,
+    /// The header, until the first line is printed under it (after the
+    /// notes on how the start was found).
+    header: Option<String>,
+}
+
+impl IterationTable {
+    /// The table of a design of `objective` (its short name), printed only
+    /// when `verbose`.
+    pub fn new(verbose: bool, objective: &str) -> Self {
+        IterationTable {
+            verbose,
+            header: verbose.then(|| iteration_header(objective)),
+        }
+    }
+
+    fn print_header(&mut self) {
+        if let Some(h) = self.header.take() {
+            eprintln!("{h}");
+        }
+    }
 }
 
 impl Observer for IterationTable {
     fn iteration(&mut self, it: &ScpIteration) {
         if self.verbose {
+            self.print_header();
             eprintln!(
                 "  {:4} {:10.5} {:10.5} {:10.2e} {:10.2e} {:10.3} {:>5} {:5.1}",
                 it.iteration,
@@ -114,6 +136,7 @@ impl Observer for IterationTable {
     }
     fn mesh(&mut self, nodes: usize) {
         if self.verbose {
+            self.print_header();
             eprintln!("  -- {nodes} nodes per phase");
         }
     }
