@@ -7,7 +7,10 @@
 //! the optimiser's dimensionless units, so a change of height or time is no
 //! change at all, F3); the first point of a chunk starts from its phased
 //! design. The least heights inside a motor envelope continue the same way
-//! (`HeightChain`): the chunk's first point is `run`'s answer. Chunks run
+//! (`HeightChain`): the chunk's first point is `run`'s answer, and a point
+//! keeps the last answer's design where it flies there and is faster than
+//! its own (for the same body: where the motor envelope grows, a chunk's
+//! least heights never rise). Chunks run
 //! in parallel, and `--shard K/N` computes a contiguous
 //! run of whole chunks, so every point's result is the same whether the
 //! sweep runs on one machine or on many.
@@ -15,7 +18,7 @@
 use crate::config::Config;
 use crate::design::analytic::analytic_plan;
 use crate::design::free::FreeResult;
-use crate::design::least_height::{Families, Heights, heights, heights_near};
+use crate::design::least_height::{Families, Heights, Near, heights, heights_near};
 use crate::design::phased::BendHint;
 use crate::design::phased::least_height;
 use crate::design::spec::DesignSpec;
@@ -263,6 +266,9 @@ impl Neighbours {
 #[derive(Default)]
 struct HeightChain {
     designs: Neighbours,
+    /// The last answer's free-form design and the body it was made for:
+    /// the next point keeps it where it flies there and is faster.
+    best: Option<(crate::model::Cat, FreeResult)>,
     bends: Vec<f64>,
     /// `Some` in a sweep of `fall.height`: the least heights do not depend
     /// on it (the designs are made for a reference drop, [`reference`]),
@@ -283,15 +289,26 @@ impl HeightChain {
             return Ok(Some(h.clone()));
         }
         let d = &self.designs;
-        let h = match (&d.warm, families.free()) {
+        let best = self
+            .best
+            .as_ref()
+            .filter(|(cat, _)| *cat == spec.cat)
+            .map(|(_, fr)| fr);
+        let near = match (&d.warm, families.free()) {
             (Some(prev), true) => heights_near(
                 spec,
                 prev,
                 d.before.as_ref(),
+                best,
                 BendHint::from_chain(&self.bends),
                 families,
             ),
-            _ => heights(spec, families, |_| {}),
+            _ => heights(spec, families, |_| {}).map(|h| h.map(Near::cold)),
+        };
+        let (h, continued) = match near {
+            Ok(Some(Near { heights, continued })) => (Ok(Some(heights)), continued),
+            Ok(None) => (Ok(None), None),
+            Err(e) => (Err(e), None),
         };
         // (a bend is known only where the phased design was made)
         match &h {
@@ -303,12 +320,10 @@ impl HeightChain {
         {
             *same = Some(h.clone());
         }
-        self.designs.advance(
-            h.as_ref()
-                .ok()
-                .and_then(|h| h.as_ref())
-                .and_then(|h| h.free.clone()),
-        );
+        if let Ok(Some(Heights { free: Some(fr), .. })) = &h {
+            self.best = Some((spec.cat, fr.clone()));
+        }
+        self.designs.advance(continued);
         h
     }
 

@@ -522,35 +522,72 @@ const START_TIE: f64 = 2e-3;
 /// phased design, whose bend search starts at `hint` (the neighbour's). A
 /// neighbour's optimum is a few iterations from this one, where the cold
 /// starts take dozens each; without the stall-only design the answer
-/// carries no lower bound. When the continued design does not verify, the
-/// cold stage answers.
+/// carries no lower bound. `best`, the fastest design found so far for
+/// this body (a sweep of the motors, the bend limit or the fall), is a
+/// candidate too wherever it still flies here, so that where the motor
+/// envelope grows the answers of consecutive points never rise. When no
+/// design verifies, the cold stage answers.
 pub fn heights_near(
     spec: &DesignSpec,
     prev: &FreeResult,
     before: Option<&FreeResult>,
+    best: Option<&FreeResult>,
     hint: Option<BendHint>,
     families: Families,
-) -> Result<Option<Heights>> {
+) -> Result<Option<Near>> {
     if !spec.motor.is_limited() {
         return Ok(None);
     }
     let reference = reference(spec);
-    let continued: Vec<Candidate> = free::FreeDesign::new(&reference)
+    let mut candidates: Vec<Candidate> = free::FreeDesign::new(&reference)
         .warm(prev, before)
         .solve()
         .ok()
         .map(|fr| flown(&reference, fr))
         .into_iter()
         .collect();
-    if !continued.iter().any(|c| c.1.is_some()) {
-        return heights(spec, families, |_| {});
+    let continued = candidates
+        .first()
+        .filter(|c| c.1.is_some())
+        .map(|c| c.0.clone());
+    if let Some(best) = best
+        && continued
+            .as_ref()
+            .is_none_or(|fr| fr.manoeuvre_time_s > best.manoeuvre_time_s)
+    {
+        // (its numbers are its schedule's on this body; the flight judges
+        // it under this point's motors)
+        candidates.push(flown(&reference, best.clone()));
+    }
+    if !candidates.iter().any(|c| c.1.is_some()) {
+        return Ok(heights(spec, families, |_| {})?.map(Near::cold));
     }
     let answer = if families.phased() {
         answer_for(spec, &reference, hint)?
     } else {
         (HeightAnswer::blank(spec), f64::NAN)
     };
-    Ok(Some(concluded(spec, answer, continued)))
+    let heights = concluded(spec, answer, candidates);
+    // (where the fastest is `best`, the next point still continues from
+    // this point's own design: a chain held at one design finds no other)
+    let continued = continued.or_else(|| heights.free.clone());
+    Ok(Some(Near { heights, continued }))
+}
+
+/// [`heights_near`]'s answer, and the design the next point continues
+/// from: this point's continued design where it verified, which is not the
+/// answer's where the answer is an earlier point's.
+pub struct Near {
+    pub heights: Heights,
+    pub continued: Option<FreeResult>,
+}
+
+impl Near {
+    /// The cold stage's answer, continued from its own design.
+    pub fn cold(heights: Heights) -> Near {
+        let continued = heights.free.clone();
+        Near { heights, continued }
+    }
 }
 
 /// The phased answer ([`answer_for`]) when no free-form design in

@@ -269,6 +269,21 @@ fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
     }
 }
 
+/// A higher hard speed limit only grows the motor envelope (docs/model.md,
+/// section 5): along a chunk of a sweep of it the least height never rises,
+/// a point keeping the last answer's design where that flies and is faster
+/// than its own continued one (on this grid the continued design of the
+/// third point was once 2e-5 above the second's answer).
+#[test]
+fn a_higher_speed_limit_never_needs_more_height_along_a_chunk() {
+    let (_, points) = robot_sweep("limits.max_speed=7.0256410256:7.1794871795:4", false);
+    let h: Vec<f64> = points
+        .iter()
+        .map(|p| p.least_height_free_m.unwrap())
+        .collect();
+    assert!(h.windows(2).all(|w| w[1] <= w[0]), "{h:?}");
+}
+
 /// The least height does not depend on the height the question is asked
 /// from: a sweep of `fall.height` gives every point the same answer, the
 /// one the least-height stage gives from the config's own 2 m (continued
