@@ -5,7 +5,8 @@
 //! points (a function of the grid only). Within a chunk the points run in
 //! order and each free-form design starts from its neighbour's solution (in
 //! the optimiser's dimensionless units, so a change of height or time is no
-//! change at all, F3); the first point of a chunk starts from its phased
+//! change at all, F3; a least-time design from its neighbour's schedule in
+//! seconds, its answer); the first point of a chunk starts from its phased
 //! design. The least heights inside a motor envelope continue the same way
 //! (`HeightChain`): the chunk's first point is `run`'s answer, and a point
 //! keeps the last answer's design where it flies there and is faster than

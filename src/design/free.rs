@@ -2257,6 +2257,16 @@ fn continue_from(
     // kept to at least half the last's; the plain start if it fails
     let same_grid = |r: &FreeResult| r.plan.tr == tr;
     let converged = |r: &FreeResult| same_grid(r) && r.status == ScpStatus::Converged;
+    // a time design's durations are its answer, kept in seconds; the others'
+    // relative to the fall (F3: a change of the fall alone is none at all)
+    let seconds = spec.objective == Objective::Time;
+    let duration = |r: &FreeResult, p: usize| {
+        if seconds {
+            r.phase_durations_s[p]
+        } else {
+            r.z_scaled[tr.duration(p)] * spec.available_time()
+        }
+    };
     if let Some(b) = before.filter(|b| converged(b) && converged(prev)) {
         let mut z: Vec<f64> = prev
             .z_scaled
@@ -2265,8 +2275,8 @@ fn continue_from(
             .map(|(p, b)| 2.0 * p - b)
             .collect();
         for p in 0..3 {
-            let i = tr.duration(p);
-            z[i] = z[i].max(0.5 * prev.z_scaled[i]) * spec.available_time();
+            let (d, db) = (duration(prev, p), duration(b, p));
+            z[tr.duration(p)] = (2.0 * d - db).max(0.5 * d);
         }
         if let Ok(r) = optimize_start(
             spec,
@@ -2280,19 +2290,25 @@ fn continue_from(
             return Ok(r);
         }
     }
-    let mut z0 = if same_grid(prev) {
-        prev.z_scaled.clone()
+    let z0 = if same_grid(prev) {
+        let mut z = prev.z_scaled.clone();
+        for p in 0..3 {
+            z[tr.duration(p)] = duration(prev, p);
+        }
+        z
     } else {
         let mut z = tr.sample(&prev.plan);
         let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
+        let k = if seconds {
+            1.0
+        } else {
+            spec.available_time() / total
+        };
         for p in 0..3 {
-            z[tr.duration(p)] /= total;
+            z[tr.duration(p)] *= k;
         }
         z
     };
-    for p in 0..3 {
-        z0[tr.duration(p)] *= spec.available_time();
-    }
     optimize_start(
         spec,
         &z0,

@@ -270,3 +270,29 @@ fn the_start_just_above_the_least_height_carries_that_height() {
     let below = free_start(&robot(&["fall.height=2"]).design_spec(), |_| {});
     assert!(below.is_err_and(|e| e.is_beyond_motors()));
 }
+
+/// A least-time design continued at a neighbour with another reference
+/// drop (a sweep of the motors moves it with the stall torque) starts from
+/// the neighbour's schedule in seconds, its answer: at the servo's body and
+/// motors with a reference drop twice as high, the servo's answer comes
+/// back, no slower, in a few iterations (started from it stretched to the
+/// new drop's time, the continued design took 50 and ended slower).
+#[test]
+fn a_time_design_continues_from_its_neighbours_schedule_in_seconds() {
+    let cfg = robot(&[]);
+    let prev = least(&cfg).free.expect("a free-form answer");
+    let r = reference(&cfg.design_spec());
+    let other = r.with_height(2.0 * r.fall.height);
+    let fr = catflip::design::free::FreeDesign::new(&other)
+        .warm(&prev, None)
+        .solve()
+        .unwrap();
+    let change = fr.manoeuvre_time_s / prev.manoeuvre_time_s - 1.0;
+    assert!(
+        (-1e-3..=1e-9).contains(&change),
+        "{} s, the neighbour's {} s",
+        fr.manoeuvre_time_s,
+        prev.manoeuvre_time_s
+    );
+    assert!(fr.scp_iterations <= 15, "{} iterations", fr.scp_iterations);
+}
