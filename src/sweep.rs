@@ -263,7 +263,7 @@ impl Neighbours {
 
 /// What the least-height stage carries from point to point: its free-form
 /// `time` designs and the phased `time` designs' bends of consecutive
-/// points; in a sweep of `fall.height` the chunk's first answer.
+/// points; in a sweep of `fall.height` the grid's first answer.
 #[derive(Default)]
 struct HeightChain {
     designs: Neighbours,
@@ -273,9 +273,11 @@ struct HeightChain {
     bends: Vec<f64>,
     /// `Some` in a sweep of `fall.height`: the least heights do not depend
     /// on it (the designs are made for a reference drop, [`reference`]),
-    /// so every point from a start at rest has the chunk's first answer,
-    /// which is `run`'s. (Its `answer.height_m` and `answer.possible` are
-    /// the first point's: a point reads the heights and the designs only.)
+    /// so every point from a start at rest has the answer at the whole
+    /// grid's first point, which is `run`'s, made once before the chunks
+    /// start (else the chunk's first answer). (Its `answer.height_m` and
+    /// `answer.possible` are that point's: a point reads the heights and the
+    /// designs only.)
     ///
     /// [`reference`]: crate::design::least_height::reference
     same_answer: Option<Option<Heights>>,
@@ -387,11 +389,7 @@ fn point(
     };
     let mut kept = None;
     let limit = cfg.limits.max_torque;
-    // F7 (the least height from the peak by time scaling) holds for a
-    // torque limit alone: a torque-speed line or a speed limit does not
-    // scale with the fall, so there each least height is its family's
-    // `time` design inside the envelope, as `run` finds it
-    let envelope = limit.is_some() && (cfg.motor().slope() > 0.0 || cfg.limits.max_speed.is_some());
+    let envelope = designs_least_heights(cfg);
     let limited_cfg = cfg;
     let mut cfg = cfg.clone();
     // the peak columns are the least-peak designs without the torque and
@@ -510,15 +508,8 @@ fn point(
             }
         }
     }
-    if envelope && (methods.phased || methods.free) {
+    if let Some(families) = height_families(limited_cfg, methods) {
         let limited = limited_cfg.design_spec();
-        // (without the phased column its design is made only where no
-        // free-form design verifies)
-        let families = match (methods.phased, methods.free) {
-            (true, true) => Families::Both,
-            (true, false) => Families::Phased,
-            _ => Families::Free,
-        };
         match height.heights(&limited, families) {
             Ok(Some(h)) => {
                 if methods.phased {
@@ -548,6 +539,28 @@ fn point(
         p.error = Some(errors.join("; "));
     }
     (p, kept)
+}
+
+/// Whether a point's least heights are designed: F7 (the least height
+/// from the peak by time scaling) holds for a torque limit alone, and a
+/// torque-speed line or a speed limit does not scale with the fall, so
+/// there each least height is its family's `time` design inside the
+/// envelope, as `run` finds it.
+fn designs_least_heights(cfg: &Config) -> bool {
+    cfg.limits.max_torque.is_some() && (cfg.motor().slope() > 0.0 || cfg.limits.max_speed.is_some())
+}
+
+/// The families whose least heights a point gives where they are designed
+/// ([`designs_least_heights`]; without the phased column its design is
+/// made only where no free-form design verifies).
+fn height_families(cfg: &Config, methods: Methods) -> Option<Families> {
+    Some(match (methods.phased, methods.free) {
+        _ if !designs_least_heights(cfg) => return None,
+        (true, true) => Families::Both,
+        (true, false) => Families::Phased,
+        (false, true) => Families::Free,
+        (false, false) => return None,
+    })
 }
 
 /// A kept design that misses a target (unconverged, flip missed, bend
@@ -660,6 +673,7 @@ impl SweepRun<'_> {
         let never = std::sync::atomic::AtomicBool::new(false);
         let grid = Grid {
             values,
+            first: configs.first().and_then(|c| c.as_ref().ok()),
             configs: &configs[range],
             stop: &never,
         };
@@ -760,6 +774,7 @@ pub fn sweep_values(
     let grid = Grid {
         values,
         configs: &configs,
+        first: configs.first().and_then(|c| c.as_ref().ok()),
         stop,
     };
     compute_into(key, grid, methods, threads, &store, progress)?;
@@ -771,6 +786,9 @@ pub fn sweep_values(
 struct Grid<'a> {
     values: &'a [f64],
     configs: &'a [Result<Config>],
+    /// The config at the whole grid's first point (every shard's): in a
+    /// sweep of `fall.height` its least height is every point's.
+    first: Option<&'a Config>,
     stop: &'a std::sync::atomic::AtomicBool,
 }
 
@@ -787,6 +805,7 @@ fn compute_into(
     let Grid {
         values,
         configs,
+        first,
         stop,
     } = grid;
     // shards start on chunk boundaries, so local chunks are global chunks
@@ -800,6 +819,17 @@ fn compute_into(
             .filter(|c| kept[c.clone()].iter().any(|p| p.is_none()))
             .collect()
     };
+    // in a sweep of `fall.height` from rest every point's least height is
+    // the grid's first (the designs are made for a reference drop): made
+    // once, not once a chunk
+    let same_answer = first
+        .filter(|cfg| {
+            key == "fall.height" && !chunks.is_empty() && cfg.design_spec().is_default_start()
+        })
+        .and_then(|cfg| {
+            let families = height_families(cfg, methods)?;
+            heights(&cfg.design_spec(), families, |_| {}).ok()?
+        });
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(values.len() - chunks.iter().map(|c| c.len()).sum::<usize>());
     std::thread::scope(|s| {
@@ -811,6 +841,9 @@ fn compute_into(
                         break;
                     }
                     let mut chain = Continuation::new(key);
+                    if let Some(h) = &same_answer {
+                        chain.height.same_answer = Some(Some(h.clone()));
+                    }
                     for i in chunks[c].clone() {
                         if stop.load(Ordering::SeqCst) {
                             return;
