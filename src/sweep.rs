@@ -8,10 +8,10 @@
 //! change at all, F3; a least-time design from its neighbour's schedule in
 //! seconds, its answer); the first point of a chunk starts from its phased
 //! design. The least heights inside a motor envelope continue the same way
-//! (`HeightChain`): the chunk's first point is `run`'s answer, and a point
-//! keeps the last answer's design where it flies there and is faster than
-//! its own (for the same body: where the motor envelope grows, a chunk's
-//! least heights never rise). Chunks run
+//! (`HeightChain`): the chunk's first point is `run`'s answer, and in a
+//! sweep of the motors or the fall a point keeps the last answer's design
+//! where it flies there and is faster than its own (where the feasible set
+//! grows, a chunk's least heights never rise). Chunks run
 //! in parallel, and `--shard K/N` computes a contiguous
 //! run of whole chunks, so every point's result is the same whether the
 //! sweep runs on one machine or on many.
@@ -267,9 +267,12 @@ impl Neighbours {
 #[derive(Default)]
 struct HeightChain {
     designs: Neighbours,
-    /// The last answer's free-form design and the body it was made for:
-    /// the next point keeps it where it flies there and is faster.
-    best: Option<(crate::model::Cat, FreeResult)>,
+    /// The last answer's free-form design, in a sweep of the motors, the
+    /// bend limit or the fall (`limits.*`, `fall.*`: the same body, start
+    /// and settings at every point), where the next point keeps it when it
+    /// flies there and is faster than its own.
+    best: Option<FreeResult>,
+    keeps_best: bool,
     bends: Vec<f64>,
     /// `Some` in a sweep of `fall.height`: the least heights do not depend
     /// on it (the designs are made for a reference drop, [`reference`]),
@@ -292,11 +295,7 @@ impl HeightChain {
             return Ok(Some(h.clone()));
         }
         let d = &self.designs;
-        let best = self
-            .best
-            .as_ref()
-            .filter(|(cat, _)| *cat == spec.cat)
-            .map(|(_, fr)| fr);
+        let best = self.best.as_ref().filter(|_| self.keeps_best);
         let near = match (&d.warm, families.free()) {
             (Some(prev), true) => heights_near(
                 spec,
@@ -324,7 +323,7 @@ impl HeightChain {
             *same = Some(h.clone());
         }
         if let Ok(Some(Heights { free: Some(fr), .. })) = &h {
-            self.best = Some((spec.cat, fr.clone()));
+            self.best = Some(fr.clone());
         }
         self.designs.advance(continued);
         h
@@ -343,6 +342,7 @@ impl Continuation {
             phased: FALL_ONLY.contains(&key).then_some(None),
             height: HeightChain {
                 same_answer: (key == "fall.height").then_some(None),
+                keeps_best: key.starts_with("limits.") || key.starts_with("fall."),
                 ..Default::default()
             },
             ..Default::default()

@@ -2242,7 +2242,8 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
 /// design `prev` (another point of a sweep). The start is `prev`'s solution
 /// in dimensionless units, so a change of drop height, margin or gravity
 /// (F3) starts exactly at the optimum, and a change of the cat or limits
-/// starts next to it. With the design `before` `prev` (one grid step
+/// starts next to it; a least-time design's durations are kept in seconds
+/// (its answer, which a change of the drop does not move). With the design `before` `prev` (one grid step
 /// further back) the start is the secant predictor `2 prev - before`,
 /// which moves it along the solution path as well.
 fn continue_from(
@@ -2446,7 +2447,8 @@ pub enum Start<'a> {
     /// A given schedule, named in the result (`phased`, `analytic`, ...).
     Plan(&'a dyn ShapePlan, &'a str),
     /// A neighbouring design (continuation, in the optimiser's
-    /// dimensionless units) and the one before it (the secant predictor).
+    /// dimensionless units; a least time's durations in seconds) and the one
+    /// before it (the secant predictor).
     Warm(&'a FreeResult, Option<&'a FreeResult>),
 }
 

@@ -522,11 +522,12 @@ const START_TIE: f64 = 2e-3;
 /// phased design, whose bend search starts at `hint` (the neighbour's). A
 /// neighbour's optimum is a few iterations from this one, where the cold
 /// starts take dozens each; without the stall-only design the answer
-/// carries no lower bound. `best`, the fastest design found so far for
-/// this body (a sweep of the motors, the bend limit or the fall), is a
-/// candidate too wherever it still flies here, so that where the motor
-/// envelope grows the answers of consecutive points never rise. When no
-/// design verifies, the cold stage answers.
+/// carries no lower bound. When the continued design does not verify, the
+/// cold stage answers. `best`, the last answer's design where only the
+/// motors, the bend limit or the fall changed since (the caller's to
+/// know), answers instead when it still flies here and is faster, so that
+/// where the feasible set grows the answers of consecutive points never
+/// rise; it keeps its own status (a sweep reads its time).
 pub fn heights_near(
     spec: &DesignSpec,
     prev: &FreeResult,
@@ -539,44 +540,63 @@ pub fn heights_near(
         return Ok(None);
     }
     let reference = reference(spec);
-    let mut candidates: Vec<Candidate> = free::FreeDesign::new(&reference)
+    let continued = free::FreeDesign::new(&reference)
         .warm(prev, before)
         .solve()
         .ok()
         .map(|fr| flown(&reference, fr))
-        .into_iter()
-        .collect();
-    let continued = candidates
-        .first()
-        .filter(|c| c.1.is_some())
-        .map(|c| c.0.clone());
-    if let Some(best) = best
-        && continued
-            .as_ref()
-            .is_none_or(|fr| fr.manoeuvre_time_s > best.manoeuvre_time_s)
-    {
-        // (its numbers are its schedule's on this body; the flight judges
-        // it under this point's motors)
-        candidates.push(flown(&reference, best.clone()));
-    }
-    if !candidates.iter().any(|c| c.1.is_some()) {
-        return Ok(heights(spec, families, |_| {})?.map(Near::cold));
-    }
+        .filter(|c| c.1.is_some());
+    let Some(own) = continued else {
+        let Some(mut cold) = heights(spec, families, |_| {})? else {
+            return Ok(None);
+        };
+        // (the next point continues from the cold design, not from `best`)
+        let continued = cold.free.clone();
+        if let Some(best) = best {
+            keep_if_faster(spec, &reference, &mut cold, best);
+        }
+        return Ok(Some(Near {
+            heights: cold,
+            continued,
+        }));
+    };
+    let continued = own.0.clone();
     let answer = if families.phased() {
         answer_for(spec, &reference, hint)?
     } else {
         (HeightAnswer::blank(spec), f64::NAN)
     };
-    let heights = concluded(spec, answer, candidates);
-    // (where the fastest is `best`, the next point still continues from
+    let mut heights = concluded(spec, answer, [own]);
+    if let Some(best) = best {
+        keep_if_faster(spec, &reference, &mut heights, best);
+    }
+    // (where the answer is `best`, the next point still continues from
     // this point's own design: a chain held at one design finds no other)
-    let continued = continued.or_else(|| heights.free.clone());
-    Ok(Some(Near { heights, continued }))
+    Ok(Some(Near {
+        heights,
+        continued: Some(continued),
+    }))
+}
+
+/// `best` (an earlier point's design) as `h`'s free-form answer when it is
+/// faster than `h`'s and flies under `reference`'s motors (its numbers are
+/// its schedule's on the same body; the flight judges it here).
+fn keep_if_faster(spec: &DesignSpec, reference: &DesignSpec, h: &mut Heights, best: &FreeResult) {
+    if h.free
+        .as_ref()
+        .is_some_and(|f| f.manoeuvre_time_s <= best.manoeuvre_time_s)
+    {
+        return;
+    }
+    if let Some(sim) = verified(reference, best) {
+        h.answer.improve_with(spec, best, &sim);
+        h.free = Some(best.clone());
+    }
 }
 
 /// [`heights_near`]'s answer, and the design the next point continues
-/// from: this point's continued design where it verified, which is not the
-/// answer's where the answer is an earlier point's.
+/// from: this point's own design (continued, or the cold stage's), which is
+/// not the answer's where the answer is an earlier point's.
 pub struct Near {
     pub heights: Heights,
     pub continued: Option<FreeResult>,

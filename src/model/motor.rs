@@ -176,38 +176,51 @@ mod tests {
     /// docs/model.md, section 5: a higher voltage (`T` and `w0` together,
     /// the same `k`) or a higher speed limit contains the weaker envelope
     /// everywhere; a larger `T` at the same `w0` only below `w0`, above
-    /// which it brakes harder.
+    /// which it brakes harder; per motor and as the disc.
     #[test]
     fn a_stronger_motor_contains_the_weaker_envelope_unless_it_brakes_harder_past_w0() {
-        let weak = servo(TorqueNorm::PerMotor);
-        let with = |t: f64, w0: f64, w: f64| Motor {
-            max_torque: Some(t),
-            no_load_speed: Some(w0),
-            max_speed: Some(w),
-            ..weak
-        };
-        let voltage = with(2.8, 12.0, 5.0);
-        let faster = with(1.4, 6.0, 6.5);
-        let stall = with(2.8, 6.0, 10.0);
-        let weak_unbounded = with(1.4, 6.0, 10.0);
-        let mut past_w0 = 0;
-        for i in -40..=40 {
-            for j in -40..=40 {
-                let (tau, qd) = ([0.1 * i as f64, 0.3], [0.25 * j as f64, 1.0]);
-                if inside(&weak, tau, qd) {
-                    assert!(inside(&voltage, tau, qd), "{tau:?} {qd:?}");
-                    assert!(inside(&faster, tau, qd), "{tau:?} {qd:?}");
-                }
-                if inside(&weak_unbounded, tau, qd) && !inside(&stall, tau, qd) {
-                    assert!(qd[0].abs() > 6.0, "{tau:?} {qd:?}");
-                    past_w0 += 1;
+        for norm in [TorqueNorm::PerMotor, TorqueNorm::Euclidean] {
+            let weak = servo(norm);
+            let with = |t: f64, w0: f64, w: f64| Motor {
+                max_torque: Some(t),
+                no_load_speed: Some(w0),
+                max_speed: Some(w),
+                ..weak
+            };
+            let voltage = with(2.8, 12.0, 5.0);
+            let faster = with(1.4, 6.0, 6.5);
+            let stall = with(2.8, 6.0, 10.0);
+            let weak_unbounded = with(1.4, 6.0, 10.0);
+            let mut past_w0 = 0;
+            for i in -40..=40 {
+                for j in -40..=40 {
+                    let (tau, qd) = ([0.1 * i as f64, 0.3], [0.25 * j as f64, 1.0]);
+                    if inside(&weak, tau, qd) {
+                        assert!(inside(&voltage, tau, qd), "{norm:?} {tau:?} {qd:?}");
+                        assert!(inside(&faster, tau, qd), "{norm:?} {tau:?} {qd:?}");
+                    }
+                    if inside(&weak_unbounded, tau, qd) && !inside(&stall, tau, qd) {
+                        assert!(norm.of(qd) > 6.0, "{norm:?} {tau:?} {qd:?}");
+                        past_w0 += 1;
+                    }
                 }
             }
+            assert!(past_w0 > 0, "{norm:?}");
         }
-        assert!(past_w0 > 0);
-        // at 7 rad/s the weak motor coasts at -0.2 N m; the larger stall
-        // torque has to brake at -0.47 N m at least
-        assert!(inside(&weak_unbounded, [-0.3, 0.0], [7.0, 0.0]));
+        // at 7 rad/s the weak motor gives at most -0.23 N m (braking); the
+        // larger stall torque at least 0.47 N m of braking
+        let (weak, stall) = (
+            Motor {
+                max_speed: None,
+                ..servo(TorqueNorm::PerMotor)
+            },
+            Motor {
+                max_torque: Some(2.8),
+                max_speed: None,
+                ..servo(TorqueNorm::PerMotor)
+            },
+        );
+        assert!(inside(&weak, [-0.3, 0.0], [7.0, 0.0]));
         assert!(!inside(&stall, [-0.3, 0.0], [7.0, 0.0]));
     }
 
