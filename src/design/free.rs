@@ -2261,13 +2261,6 @@ fn continue_from(
     // a time design's durations are its answer, kept in seconds; the others'
     // relative to the fall (F3: a change of the fall alone is none at all)
     let seconds = spec.objective == Objective::Time;
-    let duration = |r: &FreeResult, p: usize| {
-        if seconds {
-            r.phase_durations_s[p]
-        } else {
-            r.z_scaled[tr.duration(p)] * spec.available_time()
-        }
-    };
     if let Some(b) = before.filter(|b| converged(b) && converged(prev)) {
         let mut z: Vec<f64> = prev
             .z_scaled
@@ -2276,8 +2269,13 @@ fn continue_from(
             .map(|(p, b)| 2.0 * p - b)
             .collect();
         for p in 0..3 {
-            let (d, db) = (duration(prev, p), duration(b, p));
-            z[tr.duration(p)] = (2.0 * d - db).max(0.5 * d);
+            let i = tr.duration(p);
+            z[i] = if seconds {
+                let (d, db) = (prev.phase_durations_s[p], b.phase_durations_s[p]);
+                (2.0 * d - db).max(0.5 * d)
+            } else {
+                z[i].max(0.5 * prev.z_scaled[i]) * spec.available_time()
+            };
         }
         if let Ok(r) = optimize_start(
             spec,
@@ -2291,25 +2289,24 @@ fn continue_from(
             return Ok(r);
         }
     }
-    let z0 = if same_grid(prev) {
-        let mut z = prev.z_scaled.clone();
-        for p in 0..3 {
-            z[tr.duration(p)] = duration(prev, p);
-        }
-        z
+    let mut z0 = if same_grid(prev) {
+        prev.z_scaled.clone()
     } else {
         let mut z = tr.sample(&prev.plan);
         let total: f64 = (0..3).map(|p| z[tr.duration(p)]).sum();
-        let k = if seconds {
-            1.0
-        } else {
-            spec.available_time() / total
-        };
         for p in 0..3 {
-            z[tr.duration(p)] *= k;
+            z[tr.duration(p)] /= total;
         }
         z
     };
+    for p in 0..3 {
+        let i = tr.duration(p);
+        z0[i] = if seconds {
+            prev.phase_durations_s[p]
+        } else {
+            z0[i] * spec.available_time()
+        };
+    }
     optimize_start(
         spec,
         &z0,
