@@ -142,17 +142,7 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
             let Some(margin) = m["min_envelope_margin"].as_f64() else {
                 continue;
             };
-            let drawn: Vec<(f64, f64)> = elements(
-                &svg,
-                "polyline",
-                &[&format!("stroke=\"{color}\""), "stroke-width=\"2\""],
-            )
-            .into_iter()
-            .flat_map(points)
-            // this panel's plot area, not its legend
-            .filter(|p| p.1 >= rows.0 && p.1 < rows.1 && p.0 < 740.0)
-            .map(|p| (fx(p.0), fy(p.1)))
-            .collect();
+            let drawn = trace(&svg, color, rows, (&fx, &fy));
             assert!(drawn.len() > 50, "{name}: {} points drawn", drawn.len());
             // worst excess over the band, in pixels of torque
             let excess = drawn
@@ -167,6 +157,27 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
             }
         }
     }
+}
+
+/// The points of the schedule drawn in `color` within a panel's plot area
+/// (pixel rows `rows`, left of the legend), in data units through the
+/// panel's axes `(fx, fy)`.
+fn trace(
+    svg: &str,
+    color: &str,
+    rows: (f64, f64),
+    (fx, fy): (&dyn Fn(f64) -> f64, &dyn Fn(f64) -> f64),
+) -> Vec<(f64, f64)> {
+    elements(
+        svg,
+        "polyline",
+        &[&format!("stroke=\"{color}\""), "stroke-width=\"2\""],
+    )
+    .into_iter()
+    .flat_map(points)
+    .filter(|p| p.1 >= rows.0 && p.1 < rows.1 && p.0 < 740.0)
+    .map(|p| (fx(p.0), fy(p.1)))
+    .collect()
 }
 
 /// A detail panel (pixel rows `rows`): the envelope cut to its window, and
@@ -198,16 +209,7 @@ fn detail_panel(
         .find(|m| m["method"] == "free")
         .unwrap();
     assert!(free["min_envelope_margin"].as_f64().unwrap() >= 0.0);
-    let drawn: Vec<(f64, f64)> = elements(
-        svg,
-        "polyline",
-        &["stroke=\"#D62728\"", "stroke-width=\"2\""],
-    )
-    .into_iter()
-    .flat_map(points)
-    .filter(|p| p.1 >= rows.0 && p.1 < rows.1 && p.0 < 740.0)
-    .map(|p| (fx(p.0), fy(p.1)))
-    .collect();
+    let drawn = trace(svg, "#D62728", rows, (&fx, &fy));
     assert!(drawn.len() > 50, "free: {} points drawn", drawn.len());
     for (speed, tau) in &drawn {
         assert!(
