@@ -267,23 +267,23 @@ impl Neighbours {
 #[derive(Default)]
 struct HeightChain {
     designs: Neighbours,
-    /// The last answer's free-form design, in a sweep of the motors, the
-    /// bend limit or the fall (`limits.*`, `fall.*`: the same body, start
-    /// and settings at every point), where the next point keeps it when it
-    /// flies there and is faster than its own.
+    /// The last answer's free-form design, kept (`keeps_best`) in a sweep
+    /// of the motors, the bend limit or the fall (`limits.*`, `fall.*`: the
+    /// same body, start and settings at every point), where the next point
+    /// takes it when it flies there and is faster than its own.
     best: Option<FreeResult>,
     keeps_best: bool,
     bends: Vec<f64>,
-    /// `Some` in a sweep of `fall.height`: the least heights do not depend
-    /// on it (the designs are made for a reference drop, [`reference`]),
-    /// so every point from a start at rest has the answer at the whole
-    /// grid's first point, which is `run`'s, made once before the chunks
-    /// start (else the chunk's first answer). (Its `answer.height_m` and
+    /// Every point's answer, in a sweep of `fall.height` from a start at
+    /// rest: the least heights do not depend on it (the designs are made
+    /// for a reference drop, [`reference`]), so every point has the answer
+    /// at the whole grid's first point, which is `run`'s, made once before
+    /// the chunks start ([`compute_into`]). (Its `answer.height_m` and
     /// `answer.possible` are that point's: a point reads the heights and the
     /// designs only.)
     ///
     /// [`reference`]: crate::design::least_height::reference
-    same_answer: Option<Option<Heights>>,
+    same_answer: Option<Heights>,
 }
 
 impl HeightChain {
@@ -291,11 +291,11 @@ impl HeightChain {
     /// least-height design when there is one, else the cold stage (so the
     /// chunk's first point answers as `run` does).
     fn heights(&mut self, spec: &DesignSpec, families: Families) -> Result<Option<Heights>> {
-        if let Some(Some(h)) = &self.same_answer {
+        if let Some(h) = &self.same_answer {
             return Ok(Some(h.clone()));
         }
         let d = &self.designs;
-        let best = self.best.as_ref().filter(|_| self.keeps_best);
+        let best = self.best.as_ref();
         let near = match (&d.warm, families.free()) {
             (Some(prev), true) => heights_near(
                 spec,
@@ -317,12 +317,9 @@ impl HeightChain {
             Ok(Some(h)) if h.phased_bend.is_finite() => self.bends.push(h.phased_bend),
             _ => self.bends.clear(),
         }
-        if let (Ok(Some(h)), Some(same)) = (&h, self.same_answer.as_mut())
-            && spec.is_default_start()
+        if let Ok(Some(Heights { free: Some(fr), .. })) = &h
+            && self.keeps_best
         {
-            *same = Some(h.clone());
-        }
-        if let Ok(Some(Heights { free: Some(fr), .. })) = &h {
             self.best = Some(fr.clone());
         }
         self.designs.advance(continued);
@@ -341,7 +338,6 @@ impl Continuation {
         Continuation {
             phased: FALL_ONLY.contains(&key).then_some(None),
             height: HeightChain {
-                same_answer: (key == "fall.height").then_some(None),
                 keeps_best: key.starts_with("limits.") || key.starts_with("fall."),
                 ..Default::default()
             },
@@ -823,12 +819,11 @@ fn compute_into(
     // the grid's first (the designs are made for a reference drop): made
     // once, not once a chunk
     let same_answer = first
-        .filter(|cfg| {
-            key == "fall.height" && !chunks.is_empty() && cfg.design_spec().is_default_start()
-        })
+        .filter(|_| key == "fall.height" && !chunks.is_empty())
         .and_then(|cfg| {
-            let families = height_families(cfg, methods)?;
-            heights(&cfg.design_spec(), families, |_| {}).ok()?
+            let (spec, families) = (cfg.design_spec(), height_families(cfg, methods)?);
+            spec.is_default_start()
+                .then(|| heights(&spec, families, |_| {}).ok())??
         });
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(values.len() - chunks.iter().map(|c| c.len()).sum::<usize>());
@@ -842,7 +837,7 @@ fn compute_into(
                     }
                     let mut chain = Continuation::new(key);
                     if let Some(h) = &same_answer {
-                        chain.height.same_answer = Some(Some(h.clone()));
+                        chain.height.same_answer = Some(h.clone());
                     }
                     for i in chunks[c].clone() {
                         if stop.load(Ordering::SeqCst) {

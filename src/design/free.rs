@@ -2243,9 +2243,10 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
 /// in dimensionless units, so a change of drop height, margin or gravity
 /// (F3) starts exactly at the optimum, and a change of the cat or limits
 /// starts next to it; a least-time design's durations are kept in seconds
-/// (its answer, which a change of the drop does not move). With the design `before` `prev` (one grid step
-/// further back) the start is the secant predictor `2 prev - before`,
-/// which moves it along the solution path as well.
+/// (its answer, which a change of the drop does not move). With the design
+/// `before` `prev` (one grid step further back) the start is the secant
+/// predictor `2 prev - before`, which moves it along the solution path as
+/// well.
 fn continue_from(
     spec: &DesignSpec,
     prev: &FreeResult,
