@@ -24,7 +24,9 @@
 //! [`sensitivity_correction`]), and when that recovers less than
 //! [`Correction::sensitivity_accept`] of the predicted decrease, a conic one (one more conic solve, or two when the
 //! bounded one fails, see [`correction`]); a cheap one that falls short
-//! stands in only when the conic one fails. The model's Hessian is scaled by the steps' `rho`
+//! stands in only when the conic one fails. For a linear cost an accepted
+//! step that leaves a violation above `feasibility` gets the first of these
+//! too ([`Correction::accepted_steps`]). The model's Hessian is scaled by the steps' `rho`
 //! ([`Multipliers::adapt_curvature`]). Accepted when `rho` exceeds
 //! [`TrustRegion::accept`] (so an accepted step never increases `phi`); the
 //! radius falls to a share of the model's step below it and grows above
