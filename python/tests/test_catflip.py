@@ -161,7 +161,7 @@ def test_impossible_from_this_height(tmp_path):
 
 
 def test_a_design_just_above_the_least_height_that_finds_nothing_is_no_impossibility():
-    # from 3.5 m, 0.5 % above the robot's least height (3.483 m), the free-form peak
+    # from 3.5 m, 0.5 % above the robot's least height (3.484 m), the free-form peak
     # design from the least-height design finds no schedule inside the motors (about
     # 30 s); the flip is possible, so the error is the design's, with the schedule's place
     robot = ROOT / "configs" / "robot-universal.toml"
@@ -176,7 +176,7 @@ def test_a_design_just_above_the_least_height_that_finds_nothing_is_no_impossibi
 
 
 def test_a_named_phased_seed_that_does_not_fit_is_no_impossibility(tmp_path):
-    # from 4 m the robot flips (the least height is 3.483 m), but no phased schedule fits:
+    # from 4 m the robot flips (the least height is 3.484 m), but no phased schedule fits:
     # the named phased seed fails as the CLI's exit 1, not as the motors' impossibility
     robot = ROOT / "configs" / "robot-universal.toml"
     status, _, stderr = cli("optimize", robot, "--mode", "free", "--seed", "phased",

@@ -25,7 +25,7 @@ ROBOT = ROOT / "configs" / "robot-universal.toml"
 def config(name):
     if name == "seed":
         return catflip.Config.from_toml(SEED)
-    # the robot from 4.25 m, about 1.2 times its least height (3.483 m), where it can flip
+    # the robot from 4.25 m, about 1.2 times its least height (3.484 m), where it can flip
     return catflip.Config.from_toml(ROBOT, ["fall.height=4.25"])
 
 
