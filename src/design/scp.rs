@@ -354,11 +354,11 @@ settings! {
         pub slack_weight: f64 = 10.0,
         /// Whether an accepted step of a linear cost (least time) whose
         /// trial point breaks the constraints by more than `feasibility` is
-        /// corrected too (the sensitivity correction alone, kept when it
-        /// lowers the merit). Such a cost's steps run along the
-        /// constraints, each leaving a violation of about its square, and
-        /// without the correction every mesh round spent two more
-        /// iterations removing it.
+        /// corrected too (the sensitivity correction alone, `rounds` rounds
+        /// or one, kept when it lowers the merit). Such a cost's steps run
+        /// along the constraints, each leaving a violation of about its
+        /// square, and without the correction every mesh round spent two
+        /// more iterations removing it.
         pub accepted_steps: bool = true,
         /// Whether the conic correction is tried at all. A real-time
         /// iteration leaves it out: it is a second conic solve in a period
