@@ -70,7 +70,7 @@ pub struct HeightAnswer {
 
 /// Answers the question when the motors are limited (`None` otherwise: an
 /// unlimited motor flips the cat from any height), with the phased `time`
-/// design made for the [`reference`] drop.
+/// design made for the [`reference`](fn@reference) drop.
 pub fn answer(spec: &DesignSpec) -> Result<Option<HeightAnswer>> {
     if !spec.motor.is_limited() {
         return Ok(None);
@@ -191,7 +191,7 @@ pub fn reference(spec: &DesignSpec) -> DesignSpec {
         .with_objective(Objective::Time)
 }
 
-/// The reference drop's manoeuvre time, s ([`reference`]); `None` from a
+/// The reference drop's manoeuvre time, s ([`reference`](fn@reference)); `None` from a
 /// start with momentum, where the reference is the config's own drop.
 fn reference_time(spec: &DesignSpec) -> Option<f64> {
     if !spec.is_default_start() {
@@ -324,7 +324,7 @@ impl Families {
 }
 
 /// [`answer`], improved by the free-form time designs from two starts, both
-/// made for the [`reference`] drop so that neither depends on
+/// made for the [`reference`](fn@reference) drop so that neither depends on
 /// `fall.height`: the stall-only design ([`stall_only`], on [`STALL_ONLY_NODES`]) at the stall-only
 /// least time (too fast for the line: the SCP slows it down), and the
 /// analytic plan. Both are solved on the coarse mesh and the better one
