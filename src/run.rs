@@ -249,12 +249,13 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
 
 /// The robot question's step: the answer, the shortest free-form time
 /// design (a seed when no phased design fits), the phased least height
-/// when no phased schedule fits this fall, and the notes it leaves.
+/// when no phased schedule fits this fall (and whether its time design
+/// flips in the simulation), and the notes it leaves.
 #[derive(Default)]
 struct Question {
     answer: Option<HeightAnswer>,
     fastest_free: Option<crate::design::free::FreeResult>,
-    phased_short: Option<f64>,
+    phased_short: Option<(f64, bool)>,
     seconds: f64,
     notes: Vec<String>,
 }
@@ -277,8 +278,8 @@ impl Question {
         stages.end(clock, heights.as_ref().err());
         match heights {
             Ok(Some(h)) => {
-                q.phased_short =
-                    (!crate::design::least_height::fits(spec, h.phased_m)).then_some(h.phased_m);
+                q.phased_short = (!crate::design::least_height::fits(spec, h.phased_m))
+                    .then_some((h.phased_m, h.phased_verified));
                 q.fastest_free = h.free;
                 // its schedule becomes the least-height method (`settle`)
                 q.answer = Some(h.answer);
@@ -296,9 +297,16 @@ impl Question {
         if let Some(a) = self.answer.as_ref().filter(|a| a.beyond_longest_fall) {
             return Some(crate::pipeline::beyond_reach(a));
         }
-        self.phased_short.map(|least| {
+        self.phased_short.map(|(least, verified)| {
+            // (a lopsided body: the phased family tilts its spine, and its
+            // time design can miss the flip, as a sweep's column says)
+            let unverified = if verified {
+                ""
+            } else {
+                ", though that design misses the flip in the simulation (not a verified height)"
+            };
             format!(
-                "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m",
+                "no phased schedule fits the motors in the fall from {} m (fall.height); the phased time-optimal design needs at least {least:.3} m{unverified}",
                 spec.fall.height
             )
         })

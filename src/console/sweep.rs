@@ -4,7 +4,9 @@
 use crate::sweep::{SweepPoint, SweepSpec};
 use std::path::PathBuf;
 
-/// The sweep's table, `threads` the points computed at once.
+/// The sweep's table, `threads` the chunks it may compute at once (each
+/// chunk's points one after another, continued: fewer chunks than threads
+/// leave threads idle).
 pub fn points(
     name: &str,
     spec: &SweepSpec,
@@ -12,12 +14,14 @@ pub fn points(
     threads: usize,
     written: &[PathBuf],
 ) -> Vec<String> {
+    let chunks = points.len().div_ceil(crate::sweep::CHUNK);
     let mut lines = vec![format!(
-        "catflip sweep: {} over {} ({}, {} at a time)",
+        "catflip sweep: {} over {} ({} in {}, {} at a time)",
         name,
         spec.key,
         super::count(points.len(), "point"),
-        threads
+        super::count(chunks, "chunk"),
+        threads.min(chunks).max(1)
     )];
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
     // the least drop heights, when a torque limit gives them
@@ -85,4 +89,27 @@ pub fn empty_shard_warning(shard: crate::sweep::Shard, count: usize) -> String {
 /// seconds ([`super::progress::bar`]).
 pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> String {
     super::progress::bar(&format!("sweep {key}"), done, total, "points", elapsed)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_header_counts_the_chunks_that_can_run_at_once() {
+        let spec: SweepSpec = "cat.radius=0.05:0.06:3".parse().unwrap();
+        let header = |n: usize, threads: usize| {
+            let pts: Vec<SweepPoint> = (0..n)
+                .map(|i| SweepPoint {
+                    value: i as f64,
+                    ..Default::default()
+                })
+                .collect();
+            points("seed", &spec, &pts, threads, &[]).remove(0)
+        };
+        // a chunk's points run one after another: three points are one chunk
+        assert!(header(3, 2).ends_with("(3 points in 1 chunk, 1 at a time)"));
+        assert!(header(25, 2).ends_with("(25 points in 3 chunks, 2 at a time)"));
+        assert!(header(40, 8).ends_with("(40 points in 4 chunks, 4 at a time)"));
+    }
 }

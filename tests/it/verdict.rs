@@ -71,6 +71,16 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
                         ("failed".into(), "failed".into())
                     }
                 };
+            if mode == "phased" && m["verdict"] == "impossible" {
+                // the phased least height a row names is a verified height
+                // unless its design misses the flip (the lopsided box robot,
+                // whose spine the phased family tilts), which the row says
+                let unverified = m["reason"]
+                    .as_str()
+                    .unwrap()
+                    .contains("misses the flip in the simulation (not a verified height)");
+                assert_eq!(unverified, cfg.ends_with("box-robot.toml"), "{cfg}: {m}");
+            }
             assert_eq!(m["verdict"], verdict, "{cfg} {mode}: run {m}");
             assert_eq!(m["status"], status, "{cfg} {mode}");
             checked += 1;
