@@ -148,6 +148,27 @@ fn design_rows(
 
 /// `optimize --mode phased`'s table.
 /// `sim`: the stage's flight of it.
+/// Why a peak above the stall torque can be sound (`run`'s braking note,
+/// [`crate::run::RunSummary::braking_note`]): under a torque-speed line a
+/// motor driven against its speed brakes with up to `T + k |w|`.
+/// Said only of a schedule inside the envelope at every row (else its
+/// verdict names the broken limit).
+fn braking(cfg: &Config, peak: f64, plan: &dyn crate::design::plan::ShapePlan) -> String {
+    let inside = || {
+        crate::design::envelope::usage_of(&cfg.design_spec(), plan)
+            .min_margin
+            .is_some_and(|m| m >= -1e-6)
+    };
+    match cfg.limits.max_torque {
+        Some(stall) if cfg.motor().slope() > 0.0 && peak > stall * (1.0 + 1e-6) && inside() => {
+            format!(
+                "; above the {stall} N m stall torque while braking, which the torque-speed line allows (T + k |w| against the speed; docs/model.md, section 5)"
+            )
+        }
+        _ => String::new(),
+    }
+}
+
 pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBuf]) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode phased: {} ({} joint), status {}",
@@ -158,9 +179,10 @@ pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBu
     t.row(
         "peak torque",
         format!(
-            "{:.5} N m (SOCP bound {})",
+            "{:.5} N m (SOCP bound {}){}",
             r.peak_torque_nm,
-            maybe(r.socp_peak_torque_nm, 5)
+            maybe(r.socp_peak_torque_nm, 5),
+            braking(cfg, r.peak_torque_nm, &r.plan)
         ),
     )
     .row(
@@ -228,8 +250,10 @@ pub fn free(cfg: &Config, r: &FreeResult, sim: &SimReport, written: &[PathBuf]) 
     .row(
         "peak torque",
         format!(
-            "{:.5} N m (at check points {:.5})",
-            r.peak_torque_nm, r.node_peak_torque_nm
+            "{:.5} N m (at check points {:.5}){}",
+            r.peak_torque_nm,
+            r.node_peak_torque_nm,
+            braking(cfg, r.peak_torque_nm, &r.plan)
         ),
     )
     .row(

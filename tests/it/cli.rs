@@ -469,6 +469,56 @@ fn optimize_free_without_a_seed_starts_from_the_least_height_design_where_no_pha
     assert!((a - b).abs() <= 1e-9 * a, "optimize {a} N m, run {b} N m");
 }
 
+/// A sound design's peak above the stall torque (the robot's least time
+/// brakes with up to `T + k |w|`) is explained on its table's peak row, as
+/// `run`'s braking note explains it; a design within its stall torque, or
+/// without one, gets no such words.
+#[test]
+fn optimize_says_why_a_sound_peak_is_above_the_stall_torque() {
+    let dir = temp_dir();
+    let robot = util::config_arg("robot-universal");
+    let time = [
+        "optimize",
+        &robot,
+        "--mode",
+        "free",
+        "--seed",
+        "analytic",
+        "--set",
+        "design.objective=time",
+        "--set",
+        "fall.height=6",
+    ];
+    let (code, out, err) = util::run(&time, dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    let row = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("peak torque"))
+        .unwrap();
+    let peak: f64 = row.split_whitespace().nth(2).unwrap().parse().unwrap();
+    assert!(peak > 1.4, "{row}");
+    assert!(
+        row.contains("above the 1.4 N m stall torque while braking"),
+        "{row}"
+    );
+    let seed = util::config_arg("seed");
+    for args in [
+        &[
+            "optimize",
+            &robot,
+            "--mode",
+            "phased",
+            "--set",
+            "fall.height=6",
+        ][..],
+        &["optimize", &seed, "--mode", "free"][..],
+    ] {
+        let (code, out, err) = util::run(args, dir.path());
+        assert_eq!(code, Some(0), "{err}");
+        assert!(!out.contains("while braking"), "{args:?}: {out}");
+    }
+}
+
 /// A `time` design answers "from what height": its JSON and table give the
 /// least drop height, F7's `g (T + margin)^2 / 2` of its own manoeuvre, and
 /// the table says what the configured fall leaves.
