@@ -1807,7 +1807,8 @@ impl<'a> Scp<'a> {
             && self.linear_cost
             && s.correction.accepted_steps
             && there.2 > s.feasibility
-            && let Some(polished) = self.polish(state, &sub, &x, &at)
+            && let Some(polished) =
+                self.sensitivity(state, &sub, &x, &at, s.correction.rounds.max(1))
             && polished.1.0 < there.0
         {
             (trial, there) = polished;
@@ -1872,20 +1873,9 @@ impl<'a> Scp<'a> {
         // the terms' bounds: t, L + sigma from the subproblem
         let has_bounds = p.cost() == Cost::Peak || p.limit().is_some();
         let sigma = 1.0 + v.slack(x);
-        let cheap = match state.solvers.subproblem.as_mut() {
-            Some(solver) if s.correction.rounds > 0 => {
-                let model = Model {
-                    z: &state.z,
-                    lin: &sub.lin,
-                    data: &sub.data,
-                    term_rows: &sub.term_rows,
-                    limit_rows: &sub.limit_rows,
-                    w: state.weight,
-                };
-                sensitivity_correction(p, &model, v.step(x), at, solver, s.correction.rounds)
-            }
-            _ => None,
-        };
+        let cheap = (s.correction.rounds > 0)
+            .then(|| self.sensitivity(state, sub, x, at, s.correction.rounds))
+            .flatten();
         let mut best: Option<(Vec<f64>, Merit)> = None;
         let mut fallback = None;
         if let Some((corrected, at_c)) = cheap
@@ -1933,17 +1923,17 @@ impl<'a> Scp<'a> {
         best.or(fallback).unwrap_or((trial, there))
     }
 
-    /// The sensitivity correction of a step the merit accepts
-    /// ([`Correction::accepted_steps`]): the trial point moved back onto the
-    /// model's residual, with its merit.
-    fn polish(
+    /// [`sensitivity_correction`] of the model's solution `x` (the trial's
+    /// values `at`) on the subproblem's own solver, `rounds` rounds: the
+    /// point and its merit.
+    fn sensitivity(
         &self,
         state: &mut State,
         sub: &Subproblem,
         x: &[f64],
         at: &Values,
+        rounds: usize,
     ) -> Option<(Vec<f64>, Merit)> {
-        let (p, s, v) = (self.p, self.s, sub.layout);
         let solver = state.solvers.subproblem.as_mut()?;
         let model = Model {
             z: &state.z,
@@ -1953,7 +1943,7 @@ impl<'a> Scp<'a> {
             limit_rows: &sub.limit_rows,
             w: state.weight,
         };
-        sensitivity_correction(p, &model, v.step(x), at, solver, s.correction.rounds.max(1))
+        sensitivity_correction(self.p, &model, sub.layout.step(x), at, solver, rounds)
     }
 
     /// A subproblem the conic solver could not finish: a rejected step (a
