@@ -504,7 +504,8 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     // a failed flight or a number that is not finite is the error
     let mut json = judged.design_json(&spec)?;
     let partial = flag(what, reason.clone());
-    with_verdict(&mut json, judged.verdict.grade(), reason);
+    let grade = judged.verdict.grade();
+    with_verdict(&mut json, grade, reason);
     let json = serde_json::to_string_pretty(&json)?;
     let mut out = Output::default();
     judged.add_files(&mut out);
@@ -517,8 +518,12 @@ fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Statu
     // (flown: `design_json` returns the failed flight's error)
     if let Ok(sim) = &judged.sim {
         match &judged.design {
-            Design::Phased(r) => say_lines(console::design::phased(&cfg, r, sim, &written).lines()),
-            Design::Free(r) => say_lines(console::design::free(&cfg, r, sim, &written).lines()),
+            Design::Phased(r) => {
+                say_lines(console::design::phased(&cfg, r, sim, &written, grade).lines())
+            }
+            Design::Free(r) => {
+                say_lines(console::design::free(&cfg, r, sim, &written, grade).lines())
+            }
             Design::Analytic(_) | Design::LeastHeight(_) => {}
         }
     }

@@ -742,17 +742,24 @@ fn above_stall<'a>(
 ) -> Option<String> {
     let stall = stall?;
     let above: Vec<&str> = methods
-        .filter(|(_, verdict, peak)| {
-            *verdict == Grade::Ok && peak.is_some_and(|p| p > stall * (1.0 + 1e-6))
-        })
+        .filter(|&(_, verdict, peak)| sound_above(stall, verdict, peak))
         .map(|(name, _, _)| name)
         .collect();
-    (!above.is_empty()).then(|| {
-        format!(
-            "{}: peak above the {stall} N m stall torque while braking, which the motor's torque-speed line allows (T + k |w| against the speed; docs/model.md, section 5)",
-            above.join(", ")
-        )
-    })
+    (!above.is_empty()).then(|| format!("{}: {}", above.join(", "), braking_words(stall)))
+}
+
+/// Whether a design judged `verdict` is a sound one whose `peak` is above
+/// the `stall` torque (beyond rounding): braking inside the torque-speed line.
+pub fn sound_above(stall: f64, verdict: Grade, peak: Option<f64>) -> bool {
+    verdict == Grade::Ok && peak.is_some_and(|p| p > stall * (1.0 + 1e-6))
+}
+
+/// The braking note's words, after the names of the designs it is about
+/// (`run`'s note; `optimize`'s peak row).
+pub fn braking_words(stall: f64) -> String {
+    format!(
+        "peak above the {stall} N m stall torque while braking, which the motor's torque-speed line allows (T + k |w| against the speed; docs/model.md, section 5)"
+    )
 }
 
 #[cfg(test)]

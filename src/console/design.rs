@@ -7,7 +7,7 @@ use super::table::{maybe, shown};
 use crate::config::Config;
 use crate::design::free::FreeResult;
 use crate::design::phased::PhasedResult;
-use crate::verdict::Status;
+use crate::verdict::{Grade, Status};
 use crate::verify::analyze::Analysis;
 use crate::verify::simulate::SimReport;
 use std::path::PathBuf;
@@ -146,8 +146,6 @@ fn design_rows(
     .wrote(written);
 }
 
-/// `optimize --mode phased`'s table.
-/// `sim`: the stage's flight of it.
 /// The largest change of the objective at twice the nodes for which the
 /// table calls a design resolved by its mesh (the bundled configs' designs
 /// move by 0.03 to 0.3 %).
@@ -175,28 +173,27 @@ fn mesh_check(m: &crate::design::free::MeshCheck, unit: &str) -> String {
     )
 }
 
-/// Why a peak above the stall torque can be sound (`run`'s braking note,
-/// [`crate::run::RunSummary::braking_note`]): under a torque-speed line a
-/// motor driven against its speed brakes with up to `T + k |w|`.
-/// Said only of a schedule inside the envelope at every row (else its
-/// verdict names the broken limit).
-fn braking(cfg: &Config, peak: f64, plan: &dyn crate::design::plan::ShapePlan) -> String {
-    let inside = || {
-        crate::design::envelope::usage_of(&cfg.design_spec(), plan)
-            .min_margin
-            .is_some_and(|m| m >= -1e-6)
-    };
+/// Why a sound design's peak is above the stall torque, on its peak row:
+/// `run`'s braking note ([`crate::run::RunSummary::braking_note`]) for a
+/// design whose verdict is `grade`.
+fn braking(cfg: &Config, peak: f64, grade: Grade) -> String {
     match cfg.limits.max_torque {
-        Some(stall) if cfg.motor().slope() > 0.0 && peak > stall * (1.0 + 1e-6) && inside() => {
-            format!(
-                "; above the {stall} N m stall torque while braking, which the torque-speed line allows (T + k |w| against the speed; docs/model.md, section 5)"
-            )
+        Some(stall) if crate::run::sound_above(stall, grade, Some(peak)) => {
+            format!("; {}", crate::run::braking_words(stall))
         }
         _ => String::new(),
     }
 }
 
-pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBuf]) -> Rows {
+/// `optimize --mode phased`'s table, `grade` its verdict.
+/// `sim`: the stage's flight of it.
+pub fn phased(
+    cfg: &Config,
+    r: &PhasedResult,
+    sim: &SimReport,
+    written: &[PathBuf],
+    grade: Grade,
+) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode phased: {} ({} joint), status {}",
         cfg.name,
@@ -209,7 +206,7 @@ pub fn phased(cfg: &Config, r: &PhasedResult, sim: &SimReport, written: &[PathBu
             "{:.5} N m (SOCP bound {}){}",
             r.peak_torque_nm,
             maybe(r.socp_peak_torque_nm, 5),
-            braking(cfg, r.peak_torque_nm, &r.plan)
+            braking(cfg, r.peak_torque_nm, grade)
         ),
     )
     .row(
@@ -255,9 +252,15 @@ fn least_height_row(t: &mut Rows, cfg: &Config, manoeuvre_s: f64) {
     }
 }
 
-/// `optimize --mode free`'s table.
+/// `optimize --mode free`'s table, `grade` its verdict.
 /// `sim`: the stage's flight of it.
-pub fn free(cfg: &Config, r: &FreeResult, sim: &SimReport, written: &[PathBuf]) -> Rows {
+pub fn free(
+    cfg: &Config,
+    r: &FreeResult,
+    sim: &SimReport,
+    written: &[PathBuf],
+    grade: Grade,
+) -> Rows {
     let mut t = Rows::titled(format!(
         "catflip optimize --mode free: {} ({} joint), status {}, seed {}",
         cfg.name,
@@ -280,7 +283,7 @@ pub fn free(cfg: &Config, r: &FreeResult, sim: &SimReport, written: &[PathBuf]) 
             "{:.5} N m (at check points {:.5}){}",
             r.peak_torque_nm,
             r.node_peak_torque_nm,
-            braking(cfg, r.peak_torque_nm, &r.plan)
+            braking(cfg, r.peak_torque_nm, grade)
         ),
     )
     .row(
