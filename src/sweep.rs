@@ -821,9 +821,9 @@ fn compute_into(
     let same_answer = first
         .filter(|_| key == "fall.height" && !chunks.is_empty())
         .and_then(|cfg| {
-            let (spec, families) = (cfg.design_spec(), height_families(cfg, methods)?);
-            spec.is_default_start()
-                .then(|| heights(&spec, families, |_| {}).ok())??
+            let spec = cfg.design_spec();
+            let families = height_families(cfg, methods).filter(|_| spec.is_default_start())?;
+            heights(&spec, families, |_| {}).ok().flatten()
         });
     let next = AtomicUsize::new(0);
     let done = AtomicUsize::new(values.len() - chunks.iter().map(|c| c.len()).sum::<usize>());
