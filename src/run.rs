@@ -128,10 +128,12 @@ pub struct RunResult {
 }
 
 impl RunResult {
-    /// True when some method is flagged or failed (always so when the flip
-    /// is impossible: [`RunResult::is_impossible`] comes first).
+    /// True when the run is partial (exit status 3): some design is flagged
+    /// or failed in a fall the motors can do. Not when the flip is
+    /// impossible ([`RunResult::is_impossible`], exit 4): there the designs
+    /// that could not fit are the answer, not failures.
     pub fn is_partial(&self) -> bool {
-        self.summary.outcome != Outcome::Ok
+        self.summary.outcome == Outcome::Partial
     }
 
     /// True when the motors cannot flip the cat from the configured height.

@@ -33,6 +33,22 @@ from ._catflip import (
 from ._catflip import __version__
 from ._catflip import sweep_columns as _sweep_columns
 
+from typing import Any as _Any, Literal as _Literal, Sequence as _Sequence, Union as _Union
+
+import numpy as _np
+import numpy.typing as _npt
+
+# The stubs' type aliases, here too so that annotations may name them
+# (``m: catflip.Method = "free"``); catflip/__init__.pyi has the same.
+F64 = _npt.NDArray[_np.float64]
+Method = _Literal["free", "phased", "analytic"]
+Objective = _Literal["peak-torque", "time", "energy"]
+Seed = _Literal["phased", "analytic"]
+SimulatorName = _Literal["mujoco", "pybullet"]
+Value = _Union[bool, int, float, str, _Sequence[_Any], _np.generic, _npt.NDArray[_Any]]
+ControllerKind = _Literal["tvlqr", "open-loop", "replan"]
+ArrayLike = _Union[_Sequence[float], F64]
+
 __all__ = [
     "CatflipError",
     "Config",
@@ -84,6 +100,12 @@ def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
     ``pandas.DataFrame`` when pandas is installed and ``frame`` is not False
     (``frame=True`` requires pandas), else as a dict of those columns; the
     dict also holds ``"csv"``, the text of the CLI's ``sweep-<key>.csv``.
+
+    Under motor limits the peak columns are the least-peak designs *without*
+    the limits (the torque each method needs), as in the CLI's sweep; whether
+    the motors can do it at a point is read from the least-height columns
+    (where the lower is below the point's ``fall.height``), not from
+    ``free_status``.
     """
     import numpy as np
 

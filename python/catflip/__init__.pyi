@@ -17,12 +17,14 @@ import numpy.typing as npt
 
 __version__: str
 
+# the type aliases below exist at runtime too (``catflip.Method``), for annotations
 F64 = npt.NDArray[np.float64]
 Method = Literal["free", "phased", "analytic"]
 Objective = Literal["peak-torque", "time", "energy"]
 Seed = Literal["phased", "analytic"]
 SimulatorName = Literal["mujoco", "pybullet"]
-Value = Union[bool, int, float, str, Sequence[Any]]
+# (numpy scalars and arrays are taken as the number or list they hold)
+Value = Union[bool, int, float, str, Sequence[Any], np.generic, npt.NDArray[Any]]
 
 SWEEP_METHODS: Tuple[str, str, str]
 
@@ -301,7 +303,10 @@ def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
     Returns the CSV's columns (float64 arrays of shape ``(len(values),)``, NaN where a method
     gave no number; ``free_status`` and ``error`` lists of str or None): a
     ``pandas.DataFrame`` when pandas is installed and ``frame`` is not False, else a dict that
-    also holds ``"csv"``, the CLI's ``sweep-<key>.csv`` text."""
+    also holds ``"csv"``, the CLI's ``sweep-<key>.csv`` text. Under motor limits the peak
+    columns are the least-peak designs *without* the limits (the torque each method needs),
+    as in the CLI's sweep; whether the motors can do it at a point is read from the
+    least-height columns (where the lower is below the point's ``fall.height``)."""
 
 class Run:
     """A whole ``catflip run``, kept in memory: the summary and every file it would write."""
@@ -315,7 +320,8 @@ class Run:
         ``impossible`` (exit 4)."""
     @property
     def partial(self) -> bool:
-        """Whether some method is flagged or failed."""
+        """Whether the run is partial (``outcome == "partial"``, the CLI's exit 3): some design
+        is flagged or failed in a fall the motors can do; False when the flip is impossible."""
     @property
     def impossible(self) -> bool:
         """Whether the motors cannot flip the cat from ``fall.height``."""

@@ -329,8 +329,8 @@ fn toml_text(v: &Bound<'_, PyAny>, key: &str) -> PyResult<String> {
     }
     match toml_value(v, key)? {
         Some(x) => Ok(text_of(&x)),
-        None => Err(PyTypeError::new_err(format!(
-            "`{key}`: a config value is a number, true/false, a string or a list, not None"
+        None => Err(ConfigError::new_err(format!(
+            "`{key}`: None is no value (give a number, true/false, a string or a list); to unset an optional key, set it to None in `config.to_dict()` and read that with `Config.from_dict`"
         ))),
     }
 }
@@ -1436,7 +1436,8 @@ impl Run {
     fn outcome(&self) -> String {
         self.summary["outcome"].as_str().unwrap_or("").into()
     }
-    /// Whether some method is flagged or failed.
+    /// Whether the run is partial (`outcome == "partial"`, the CLI's exit 3): some design is
+    /// flagged or failed in a fall the motors can do; False when the flip is impossible.
     #[getter]
     fn partial(&self) -> bool {
         self.partial

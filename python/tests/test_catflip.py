@@ -250,6 +250,34 @@ def test_numpy_values_and_none_as_config_values():
     d["fall"]["height"] = float("nan")
     with pytest.raises(catflip.ConfigError, match="fall.height` = NaN is invalid"):
         catflip.Config.from_dict(d)
+    # None is no value: a ConfigError that says how to unset, and the config unchanged
+    with pytest.raises(catflip.ConfigError, match="None is no value.*Config.from_dict"):
+        c.set("fall.height", None)
+    assert c.to_dict()["fall"]["height"] == 9.0
+
+
+def test_the_stubs_type_aliases_exist_at_runtime():
+    # every top-level alias of the stubs (`Method = Literal[...]`) is also a name of the
+    # package, the same type: an annotation that names one runs
+    import re
+    import typing
+
+    stub = (ROOT / "python" / "catflip" / "__init__.pyi").read_text()
+    names = re.findall(r"^([A-Z][A-Za-z0-9]*) = ", stub, flags=re.M)
+    assert {"Method", "Seed", "Value", "ControllerKind", "ArrayLike"} <= set(names), names
+    for name in names:
+        assert hasattr(catflip, name), name
+    assert catflip.Method == typing.Literal["free", "phased", "analytic"]
+    assert set(typing.get_args(catflip.Seed)) == {"phased", "analytic"}
+    assert np.generic in typing.get_args(catflip.Value)
+
+
+def test_an_impossible_run_is_not_partial():
+    # the robot from its configured 2 m: the motors cannot do it (exit 4); the flagged
+    # analytic reference and the designs that could not fit do not make it partial (exit 3)
+    r = catflip.run(catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml"))
+    assert r.outcome == "impossible" and r.impossible and not r.partial
+    assert r.summary["outcome"] == "impossible"
 
 
 def test_a_design_is_simulated_only_in_a_fall_it_fits():

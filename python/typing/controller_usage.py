@@ -24,7 +24,11 @@ def corrections(controller: catflip.Controller, states: npt.NDArray[np.float64])
 
 def main() -> None:
     seed = catflip.Config.from_toml("configs/seed.toml")
-    along: catflip.Controller = catflip.Controller(seed, catflip.design(seed), kind="tvlqr")
+    # numpy scalars and arrays are config values (the stub's `Value`)
+    seed.set("fall.height", np.float32(10.0))
+    seed.set("start.angular_velocity", np.zeros(3))
+    method: catflip.Method = "free"
+    along: catflip.Controller = catflip.Controller(seed, catflip.design(seed, method), kind="tvlqr")
     print(f"seed, along its free-form design: {along.control_steps} control steps")
     # the robot from 1.2 times its least height, along the study's own design
     config = catflip.Config.from_toml("configs/robot-universal.toml", ["fall.height=4.25"])
