@@ -27,6 +27,7 @@ from ._catflip import (
     export_mjcf,
     export_urdf,
     least_height,
+    robustness,
     run,
     simulate,
 )
@@ -68,6 +69,7 @@ __all__ = [
     "export_mjcf",
     "export_urdf",
     "least_height",
+    "robustness",
     "run",
     "simulate",
     "sweep",

@@ -1,8 +1,9 @@
 """Type stubs of catflip (the Python bindings of the catflip Rust library).
 
-Long calls (``design``, ``run``, ``least_height``, ``sweep``, ``Controller(...)``) run with
-the GIL released and end at Ctrl-C with KeyboardInterrupt within 50 ms (a sweep starts no
-new point; other work finishes in the background, its result dropped).
+Long calls (``design``, ``run``, ``least_height``, ``sweep``, ``robustness``,
+``Controller(...)``) run with the GIL released and end at Ctrl-C with KeyboardInterrupt
+within 50 ms (a sweep starts no new point, a study no new trials; other work finishes in
+the background, its result dropped).
 
 Shapes: N schedule rows (3 phases of ``simulate.samples_per_phase + 1``
 samples; a phase junction appears twice), M simulation steps, n simulator
@@ -330,6 +331,16 @@ class Run:
         """Names of the files ``catflip run`` writes."""
     def file(self, name: str) -> str:
         """One of those files, as text; KeyError for another name."""
+
+def robustness(config: Config, trials: int = 1000, seed: int = 1,
+               threads: Optional[int] = None) -> Dict[str, Any]:
+    """The Monte Carlo study of ``catflip robustness CONFIG --trials N --seed S [--threads T]
+    --json``, in memory (nothing written), with the GIL released: the CLI's
+    ``robustness.json`` as a dict (``trials``, ``controllers`` with each one's ``name``
+    (``"open-loop"``, ``"tvlqr"``, ``"replan"``), ``success_rate`` and ``ci95``, ...) and
+    ``"csv"``, the text of its ``robustness.csv``. ``trials`` 1 to 1,000,000; ``seed`` 0 to
+    2**64 - 1; ``threads`` at least 1 (None: one per core). Ctrl-C stops it after the trials
+    in flight. Raises ConfigError, DesignError."""
 
 def run(config: Config) -> Run:
     """The CLI's main job, ``catflip run``, in memory (nothing written), with the GIL released.

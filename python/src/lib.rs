@@ -1280,8 +1280,12 @@ fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>
         py,
         || {},
         move || {
-            let h = catflip::design::least_height::heights(&cfg.design_spec(), catflip::design::least_height::Families::Both, |_| {})
-                .map_err(err)?;
+            let h = catflip::design::least_height::heights(
+                &cfg.design_spec(),
+                catflip::design::least_height::Families::Both,
+                |_| {},
+            )
+            .map_err(err)?;
             Ok(h.map(|h| LeastHeight {
                 answer: h.answer,
                 phased_m: h.phased_m,
@@ -1389,6 +1393,71 @@ fn sweep_columns<'py>(
         points.iter().map(|p| p.error.clone()).collect::<Vec<_>>(),
     )?;
     Ok((d, csv))
+}
+
+/// The Monte Carlo study of `catflip robustness CONFIG --trials N --seed S [--threads T]
+/// --json`, in memory (nothing written), with the GIL released: the CLI's `robustness.json`
+/// as a dict (`trials`, `controllers` with each one's `name`, `success_rate` and `ci95`,
+/// ...) and `"csv"`, the text of its `robustness.csv`. Ctrl-C stops it after the trials in
+/// flight.
+#[pyfunction]
+#[pyo3(signature = (config, trials = 1000, seed = 1, threads = None))]
+fn robustness<'py>(
+    py: Python<'py>,
+    config: &Config,
+    trials: i64,
+    seed: i128,
+    threads: Option<i64>,
+) -> PyResult<Bound<'py, PyAny>> {
+    use catflip::control::robustness::{DEFAULT_MAX_TILT_DEG, Study, summarise, to_csv};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let (_, cfg) = config.snapshot();
+    let max = catflip::config::MAX_TRIALS;
+    let trials = usize::try_from(trials)
+        .ok()
+        .filter(|t| (1..=max).contains(t))
+        .ok_or_else(|| ConfigError::new_err(format!("trials = {trials}: give 1 to {max}")))?;
+    // the CLI's `--seed`: any 64-bit unsigned value
+    let seed = u64::try_from(seed)
+        .map_err(|_| ConfigError::new_err(format!("seed = {seed}: give 0 to 2**64 - 1")))?;
+    let threads = match threads {
+        None => std::thread::available_parallelism().map_or(1, |n| n.get()),
+        Some(t) if t >= 1 => t as usize,
+        Some(t) => {
+            return Err(ConfigError::new_err(format!(
+                "threads={t}: at least one trial must be flown at a time; give 1 or more, or None for one per core"
+            )));
+        }
+    };
+    let stop = std::sync::Arc::new(AtomicBool::new(false));
+    let asked = stop.clone();
+    let json = interruptible(
+        py,
+        move || asked.store(true, Ordering::SeqCst),
+        move || {
+            let design = catflip::control::robustness::design(&cfg).map_err(err)?;
+            let study = Study::new(&cfg, std::sync::Arc::new(design.plan), seed);
+            // a few trials a thread at a time, so that a stop leaves little in flight
+            let mut results = Vec::with_capacity(trials);
+            let chunk = 4 * threads;
+            let mut from = 0;
+            while from < trials && !stop.load(Ordering::SeqCst) {
+                let to = (from + chunk).min(trials);
+                results.extend(study.run(from..to, threads, |_, _| {}));
+                from = to;
+            }
+            let max_tilt_deg = cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG);
+            let summary = summarise(&results, seed, max_tilt_deg, cfg.robustness.worst_kept);
+            let mut json = serde_json::to_value(catflip::control::resume::Published {
+                status: catflip::sweep::resume::SweepStatus::Complete,
+                summary: &summary,
+            })
+            .expect("serialises");
+            json["csv"] = to_csv(&results, true).into();
+            Ok(json)
+        },
+    )?;
+    json_loads(py, &json)
 }
 
 /// A whole `catflip run`, kept in memory: the summary and every file it would write.
@@ -2133,6 +2202,7 @@ fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(least_height, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(robustness, m)?)?;
     m.add_function(wrap_pyfunction!(export_mjcf, m)?)?;
     m.add_function(wrap_pyfunction!(export_urdf, m)?)?;
     m.add_function(wrap_pyfunction!(controls, m)?)?;

@@ -8,6 +8,7 @@ The binary is $CATFLIP_BIN, else target/release/catflip (as test_catflip.py).
 
 import csv
 import io
+import json
 import math
 import threading
 import time
@@ -142,6 +143,16 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
             f = c.fly(trial=int(row["trial"]), seed=5)
             assert f.landing_error_deg == pytest.approx(float(row[col]), rel=1e-12, abs=1e-12)
             assert f.draw["tilt_deg"] == float(row["tilt_deg"])
+    # the study in-process: the CLI's JSON and CSV, on any number of threads
+    for threads in (1, 2):
+        study = catflip.robustness(config("seed"), trials=3, seed=5, threads=threads)
+        assert study.pop("csv") == open(next(tmp_path.rglob("robustness.csv"))).read()
+        assert study == json.loads(out)
+    assert [c["name"] for c in study["controllers"]] == ["open-loop", "tvlqr", "replan"]
+    for bad, what in (({"trials": 0}, "trials = 0: give 1 to"), ({"seed": -1}, "seed = -1"),
+                      ({"threads": 0}, "threads=0")):
+        with pytest.raises(catflip.ConfigError, match=what):
+            catflip.robustness(config("seed"), **{"trials": 1, **bad})
     # without a seed, the CLI's default one
     code, out, err = cli("robustness", SEED, "--trials", "1", "--json", out=tmp_path / "default")
     assert code == 0, err
