@@ -57,9 +57,22 @@ fn inertial(link: &Node, file: &str) -> Result<Part> {
             ));
         }
     };
+    // (URDF requires it, with all six moments, as urdfdom reads it: a
+    // missing one taken as 0 made a link a point mass, or a typo `ix` a body
+    // that breaks the triangle inequality, named at its link)
     let inertia = match i.children().find(|c| c.has_tag_name("inertia")) {
         Some(t) => {
-            let g = |a: &str| number(&t, a, Some(0.0), file);
+            let g = |a: &str| {
+                if t.attribute(a).is_none() {
+                    return Err(site(&t).error(
+                        file,
+                        format!(
+                            "needs the attribute `{a}` (kg m^2): an <inertia> gives all six of ixx, ixy, ixz, iyy, iyz, izz (0 for a product that is zero)"
+                        ),
+                    ));
+                }
+                number(&t, a, None, file)
+            };
             xml::tensor(
                 g("ixx")?,
                 g("iyy")?,
@@ -69,7 +82,12 @@ fn inertial(link: &Node, file: &str) -> Result<Part> {
                 g("iyz")?,
             )
         }
-        None => nalgebra::Matrix3::zeros(),
+        None => {
+            return Err(site(&i).error(
+                file,
+                "an <inertial> without <inertia>: give <inertia ixx=\"...\" ixy=\"...\" ixz=\"...\" iyy=\"...\" iyz=\"...\" izz=\"...\"/> in kg m^2 about the <inertial>'s origin",
+            ));
+        }
     };
     Ok(Part {
         mass,

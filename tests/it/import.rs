@@ -343,6 +343,32 @@ fn files_catflip_cannot_model_are_refused_with_the_element_and_its_line() {
             "<inertial>",
             "without <mass>",
         ),
+        // URDF requires the <inertia> and its six moments (urdfdom refuses
+        // them missing): taken as 0 they made a link a point mass
+        (
+            "inertial without inertia",
+            urdf_of(
+                &[("front", 0.2), ("rear", 1.0)],
+                &joint("ball", "spherical", "rear", "front", "0 0 0.1", "0 0 1"),
+            )
+            .replacen(
+                "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.002\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/>",
+                "",
+                1,
+            ),
+            "<inertial>",
+            "without <inertia>",
+        ),
+        (
+            "a misspelt moment",
+            urdf_of(
+                &[("front", 0.2), ("rear", 1.0)],
+                &joint("ball", "spherical", "rear", "front", "0 0 0.1", "0 0 1"),
+            )
+            .replacen("<inertia ixx=", "<inertia ix=", 1),
+            "<inertia>",
+            "needs the attribute `ixx`",
+        ),
         (
             "negative motor limit",
             std::fs::read_to_string(util::configs().join("box-robot.urdf"))
