@@ -188,11 +188,16 @@ pub struct SizeAnswer {
     pub height_m: f64,
     pub manoeuvre_time_s: f64,
     /// The least stall torque at an unlimited no-load speed, N m (the
-    /// free-form peak design without limits): no motor weaker than this can.
+    /// free-form peak design without limits): no weaker motor was found to.
     pub torque_asymptote_nm: f64,
     /// The least no-load speed at an unlimited stall torque, rad/s (the
-    /// least-time design under the speed limit alone): no slower motor can.
+    /// least-time design under the speed limit alone): no slower motor was
+    /// found to (a local optimum, which the curve's points may pass).
     pub speed_asymptote_rad_s: f64,
+    /// The configured hard speed limit over the no-load speed, which every
+    /// motor of the curve and the gear search keeps (none without one).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub speed_limit_ratio: Option<f64>,
     /// The curve, by increasing no-load speed.
     pub curve: Vec<CurvePoint>,
     /// Points whose design failed, with the reason (the curve has a gap there).
@@ -394,6 +399,7 @@ pub fn size(q: &Config, settings: &SizeSettings) -> Result<SizeAnswer> {
         manoeuvre_time_s: t_h,
         torque_asymptote_nm: t_inf,
         speed_asymptote_rad_s: w_min,
+        speed_limit_ratio: speed_ratio(q),
         curve,
         failed,
         gear,
@@ -602,11 +608,42 @@ impl SizeAnswer {
     pub fn sentences(&self) -> Vec<String> {
         let g = &self.gear;
         let can = |ok: bool| if ok { "makes it" } else { "does not make it" };
+        // the ends are designs too (local optima): a point of the curve may
+        // pass one, and then the curve, not the end, is the better answer
+        let least =
+            |f: fn(&CurvePoint) -> f64| self.curve.iter().map(f).fold(f64::INFINITY, f64::min);
+        let passed = |end: f64, found: f64, what: &str, unit: &str| {
+            if found < end * (1.0 - HEIGHT_TOLERANCE) {
+                format!(
+                    " The curve's point at {found:.4} {unit} passes the {what} end: that end's design found a worse local optimum, so below it read the curve."
+                )
+            } else {
+                String::new()
+            }
+        };
+        let mut ends = format!(
+            "No motor weaker than {:.4} N m stall torque (at any no-load speed) or slower than {:.3} rad/s no-load speed (at any stall torque) flips it from {} m, in catflip's designs (local optima, not a proof).",
+            self.torque_asymptote_nm, self.speed_asymptote_rad_s, self.height_m
+        );
+        ends += &passed(
+            self.torque_asymptote_nm,
+            least(|p| p.stall_torque_nm),
+            "torque",
+            "N m",
+        );
+        ends += &passed(
+            self.speed_asymptote_rad_s,
+            least(|p| p.no_load_speed_rad_s),
+            "speed",
+            "rad/s",
+        );
+        if let Some(r) = self.speed_limit_ratio {
+            ends += &format!(
+                " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} w0): to check a motor (T, w0) with `catflip run`, set all three: --set limits.max_torque=T --set limits.no_load_speed=w0 --set limits.max_speed={r:.4}*w0."
+            );
+        }
         vec![
-            format!(
-                "No motor weaker than {:.4} N m stall torque (at any no-load speed) or slower than {:.3} rad/s no-load speed (at any stall torque) flips it from {} m.",
-                self.torque_asymptote_nm, self.speed_asymptote_rad_s, self.height_m
-            ),
+            ends,
             format!(
                 "The configured motor ({:.4} N m, {:.3} rad/s, gear ratio 1) needs {:.3} m: it {} from {} m.",
                 g.evaluations

@@ -13,7 +13,7 @@ use plotters::prelude::*;
 pub fn caption(file: &str) -> Option<&'static str> {
     Some(match file {
         crate::size::files::CURVE_SVG => {
-            "The motors that just make the flip from the height: each point is a DC motor (stall torque, no-load speed) whose least-time design inside its torque-speed envelope fits the fall exactly; every motor above and right of the curve can, none below or left. The dashed lines are the ends no motor passes: the least stall torque at any speed (no speed limit) and the least no-load speed at any torque. The black dot is the configured motor; the thin line through it is the same motor behind every gear ratio N (torque times N, speed over N), the open circle its best ratio."
+            "The motors that just make the flip from the height: each point is a DC motor (stall torque, no-load speed) whose least-time design inside its torque-speed envelope fits the fall exactly; every motor above and right of the curve can, none below or left. The dashed lines are the ends, each a design of its own (a local optimum, which a point of the curve may pass): the least stall torque at any speed (no speed limit) and the least no-load speed at any torque. The black dot is the configured motor; the thin line through it is the same motor behind every gear ratio N (torque times N, speed over N), the open circle its best ratio."
         }
         crate::size::files::GEAR_SVG => {
             "The configured motor's least drop height against the gear ratio N (torque times N, speed over N), each point one least-time design; the level line is the height asked. Below the best ratio the motor is too weak, above it too slow."
@@ -248,8 +248,9 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
     })
 }
 
-/// The report page of `size` (`index.html`): the curve's table, the
-/// answer's sentences and both figures.
+/// The report page of `size` (`index.html`): the answer first (the
+/// configured motor, its best gear ratio, the curve's ends), then the
+/// curve's table and both figures.
 pub fn page(a: &SizeAnswer) -> String {
     let header = [
         "no-load speed (rad/s)",
@@ -277,14 +278,29 @@ pub fn page(a: &SizeAnswer) -> String {
             ]
         })
         .collect();
-    let mut notes = a.sentences();
+    // the answer's block, as `run`'s: green when the configured motor, or
+    // the best gear ratio of it, makes the flip
+    let said = a.sentences();
+    let g = &a.gear;
+    let lead = format!(
+        "<section id=\"answer\" class=\"{}\">\n<p class=\"headline\">{}</p>\n<p class=\"height\">{}</p>\n<p>{}</p>\n</section>\n",
+        if g.configured_possible || g.possible {
+            "possible"
+        } else {
+            "impossible"
+        },
+        super::esc(&said[1]),
+        super::esc(&said[2]),
+        super::esc(&said[0])
+    );
+    let mut notes = Vec::new();
     notes.push(format!(
         "{} designs in {:.1} s. Each point is one least-time design scaled by time scaling (F3): a motor (T, w0) whose least time is t also fits (k^2 T, k w0) in t / k; see docs/usage.md.",
         a.designs, a.solve_time_s
     ));
     super::index_html(&super::Page {
         title: &format!("catflip size: {} from {} m", a.name, a.height_m),
-        lead: None,
+        lead: Some(&lead),
         header: &header,
         rows: &rows,
         notes: &notes,

@@ -380,6 +380,12 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
     let html = std::fs::read_to_string(set.join("index.html")).unwrap();
     assert!(html.contains("size.svg") && html.contains("size-gear.svg"));
     assert!(html.contains("No motor weaker than"));
+    // the answer leads: its block above the curve's table
+    let (block, table) = (
+        html.find("id=\"answer\"").unwrap(),
+        html.find("<table").unwrap(),
+    );
+    assert!(block < table, "the answer comes after the table");
     // with no gear search, no ratio is called the best: the prediction is named as one
     let best = json["gear"]["predicted"]
         .as_array()
@@ -405,4 +411,28 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
         )),
         "the prediction named"
     );
+}
+
+/// The curve's ends are designs too: where a point of the curve passes one,
+/// the answer says so instead of claiming the end as a bound; with a hard
+/// speed limit it says how `run` checks a motor of the curve (the limit
+/// keeps its ratio to the no-load speed).
+#[test]
+fn the_ends_are_named_as_designs_and_a_point_past_one_is_said() {
+    let a = answer();
+    let plain = a.sentences()[0].clone();
+    assert!(plain.contains("local optima, not a proof"), "{plain}");
+    assert!(!plain.contains("passes the"), "{plain}");
+    let slowest = a.curve[0].no_load_speed_rad_s;
+    let mut past = a.clone();
+    // an end's design that stopped above the curve's slowest point
+    past.speed_asymptote_rad_s = 1.2 * slowest;
+    past.speed_limit_ratio = Some(1.5);
+    let said = past.sentences()[0].clone();
+    assert!(
+        said.contains(&format!("point at {slowest:.4} rad/s passes the speed end")),
+        "{said}"
+    );
+    assert!(!said.contains("passes the torque end"), "{said}");
+    assert!(said.contains("--set limits.max_speed=1.5000*w0"), "{said}");
 }
