@@ -798,9 +798,17 @@ impl HeightAnswer {
                 self.method, self.status
             )
         };
+        // far below the answer the bound reads as a range: say what the gap is
         let bound = self
             .least_height_lower_bound_m
-            .map(|b| format!(" (at least {b:.3} m within the stall torque)"))
+            .map(|b| {
+                let gap = if b < 0.5 * self.least_height_m {
+                    "; the motor's speed, not its torque, needs the rest"
+                } else {
+                    ""
+                };
+                format!(" (at least {b:.3} m within the stall torque{gap})")
+            })
             .unwrap_or_default();
         if self.beyond_longest_fall {
             format!(
@@ -872,7 +880,7 @@ mod tests {
         a.verified = true;
         assert!(
             a.sentence()
-                .contains("from 62.514 m (at least 1.700 m within the stall torque) it is")
+                .contains("from 62.514 m (at least 1.700 m within the stall torque; the motor's speed, not its torque, needs the rest) it is")
         );
     }
 

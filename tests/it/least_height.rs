@@ -56,7 +56,15 @@ fn the_least_height_is_the_same_from_any_question_height() {
         assert_eq!(json["least_height_lower_bound_m"].as_f64(), Some(bound));
         assert!(
             a.sentence()
-                .contains(&format!("(at least {bound:.3} m within the stall torque)")),
+                .contains(&format!("(at least {bound:.3} m within the stall torque")),
+            "{}",
+            a.sentence()
+        );
+        // far below the answer (the robot's speed is what it lacks) the gap is named
+        assert_eq!(
+            a.sentence()
+                .contains("the motor's speed, not its torque, needs the rest"),
+            bound < 0.5 * a.least_height_m,
             "{}",
             a.sentence()
         );
