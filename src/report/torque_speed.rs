@@ -29,7 +29,7 @@ pub fn caption(file: &str) -> Option<&'static str> {
             "Joint torque against time, each curve's peak circled; the least-height schedule, made for its own drop, on a panel of its own. With a stall torque, the torque limit is the black line (named in the key only, when far above the curves); with a torque-speed line, each method's thin line is the torque its motors can give whatever the direction at that instant's speed, T - k|w| (more is available only when braking)."
         }
         FILE => {
-            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule. Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed. Where a trajectory's torque is under an eighth of its panel's scale, a detail panel follows with the trajectories that fit a quarter above the largest of them, the envelope cut to it."
+            "Torque-speed plane, the figure a motor is sized with: the grey band is the DC-motor envelope |tau + k w| <= T (stall torque T at rest, no torque left at the no-load speed when motoring, more when braking), closed at the speed limit (max_speed, else the no-load speed); the dashed lines continue its edges past the no-load speed, where a joint driven by the other's reaction can only brake (a sound design may pass the no-load speed there; a hard limit is max_speed); each method's trajectory from its schedule (one more than three times faster than the motor's speeds, as a reference beyond the motors, is cut to the plot, 'cut' in its legend). Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed. Where a trajectory's torque is under an eighth of its panel's scale, a detail panel follows with the trajectories that fit a quarter above the largest of them, the envelope cut to it."
         }
         "flip.svg" => {
             "Rotation about the initial spine in the forward simulation (motor model applied)."
@@ -241,6 +241,10 @@ fn segment_within(a: (f64, f64), b: (f64, f64), w: f64) -> Option<((f64, f64), (
     (lo < hi).then(|| (at(lo), at(hi)))
 }
 
+/// A trajectory faster than this multiple of the motor's speeds (the larger
+/// of the no-load speed and the speed limit) does not set a panel's scale.
+const FAR_SPEED: f64 = 3.0;
+
 /// One panel; with `window` the detail: torques within `+-window` only,
 /// the trajectories that stay inside it, the envelope cut to it.
 fn draw_panel(
@@ -261,12 +265,26 @@ fn draw_panel(
         Some(w) => clipped(&e, w),
         None => e,
     });
+    // a trajectory far past the motor's speeds (a reference beyond the
+    // motors, as the seed's analytic schedule on a servo) would squeeze the
+    // envelope into a sliver: it leaves the scale to the others and is
+    // drawn cut to the plot
+    let speed_scale = motor
+        .max_speed
+        .into_iter()
+        .chain(motor.no_load_speed)
+        .fold(0.0f64, f64::max);
+    let far: Vec<bool> = p
+        .curves
+        .iter()
+        .map(|c| speed_scale > 0.0 && c.iter().any(|q| q.0.abs() > FAR_SPEED * speed_scale))
+        .collect();
     // limits join the scale: the stall torque, the no-load and speed limits
     let drawn = || {
         p.curves
             .iter()
-            .zip(&shown)
-            .filter(|c| *c.1)
+            .zip(shown.iter().zip(&far))
+            .filter(|c| *c.1.0 && !*c.1.1)
             .flat_map(|c| c.0)
     };
     let mut xs: Vec<f64> = drawn().map(|c| c.0).collect();
@@ -407,11 +425,21 @@ fn draw_panel(
             continue;
         }
         let st: Style = style_of(&m.name, i);
-        line(&mut c, pts, st, i as f64 / methods.len() as f64)?;
+        let shift = i as f64 / methods.len() as f64;
+        if far[i] {
+            // the runs of samples inside the plot, each drawn on its own
+            let inside = |q: &(f64, f64)| (x.0..=x.1).contains(&q.0) && (y.0..=y.1).contains(&q.1);
+            for run in pts.split(|q| !inside(q)).filter(|r| r.len() >= 2) {
+                line(&mut c, run, st, shift)?;
+            }
+        } else {
+            line(&mut c, pts, st, shift)?;
+        }
         let tp = pts.iter().fold(0.0f64, |a, p| a.max(p.1.abs()));
         let wp = pts.iter().fold(0.0f64, |a, p| a.max(p.0.abs()));
+        let cut = if far[i] { ", cut" } else { "" };
         keys.push((
-            format!("{} ({tp:.3} N m, {wp:.2} rad/s)", m.name),
+            format!("{} ({tp:.3} N m, {wp:.2} rad/s{cut})", m.name),
             Key::Line(st),
         ));
     }

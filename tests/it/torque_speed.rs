@@ -93,6 +93,14 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     let (t, w0) = (1.4, 5.969);
     let k = t / w0;
     assert!(svg.contains("stall T = 1.4 N m") && svg.contains("no-load w0 = 5.969 rad/s"));
+    // the reference cut to the plot says so in its legend; the designs are whole
+    let cut = svg.matches("rad/s, cut)").count();
+    assert!(cut >= 2, "the analytic's, per motor: {cut}");
+    assert_eq!(
+        cut,
+        svg.matches("analytic (").count(),
+        "the analytic's alone"
+    );
     // the torque figure draws the limits: the stall torque and T - k|w| along each method
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     // (with a torque-speed line the limit line is the stall torque, which braking passes)
@@ -113,10 +121,16 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
             continue;
         }
         let j = j / 2;
-        let (fx, fy) = (
-            axis(&ticks(&svg, "middle", rows)),
-            axis(&ticks(&svg, "end", rows)),
+        // the analytic reference (23 rad/s, over three times w0) does not set
+        // the speed scale: the ticks stay near the envelope's
+        let speed_ticks = ticks(&svg, "middle", rows);
+        let widest = speed_ticks.iter().fold(0.0f64, |a, t| a.max(t.1.abs()));
+        assert!(
+            widest < 1.5 * w0,
+            "motor {}: speed ticks to {widest} rad/s",
+            j + 1
         );
+        let (fx, fy) = (axis(&speed_ticks), axis(&ticks(&svg, "end", rows)));
         // one pixel in data units, the resolution of the check
         let (px, py) = ((fx(1.0) - fx(0.0)).abs(), (fy(1.0) - fy(0.0)).abs());
         let corners: Vec<(f64, f64)> = points(poly).iter().map(|p| (fx(p.0), fy(p.1))).collect();
