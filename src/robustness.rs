@@ -67,7 +67,6 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     let max_tilt_deg = cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG);
     let quiet = c.json;
     let progress = Progress::new(quiet);
-    let clock = std::time::Instant::now();
     // the trials land in a store this thread reads when a signal stops the study
     let store = Arc::new(Mutex::new(kept));
     let interrupt = catflip::interrupt::Interrupt::catch()?;
@@ -76,6 +75,9 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         move || -> catflip::Result<()> {
             let design = catflip::control::robustness::design(&cfg)?;
             let study = Study::new(&cfg, Arc::new(design.plan), seed);
+            // the trials' own clock: the design before them would make the
+            // first trials' rate, and the time left, many times too long
+            let clock = std::time::Instant::now();
             study.run_into(range, threads, &store, |done, total| {
                 // a log gets a line per 5 % of the trials
                 if progress.is_live() || done % (total / 20).max(1) == 0 || done == total {
