@@ -248,7 +248,7 @@ impl Config {
             }
             apply_override(&mut table, arg)?;
         }
-        let halves = crate::import::resolve(&mut table, base, origin)?;
+        let resolved = crate::import::resolve(&mut table, base, origin)?;
         // together: what is left is a key that neither gives
         let mut cfg: Config =
             table
@@ -261,8 +261,11 @@ impl Config {
                     },
                     message: plain_types(e.message().trim()),
                 })?;
-        if let Some(b) = cfg.body.as_mut() {
-            b.halves = halves;
+        if let Some(b) = cfg.body.as_mut()
+            && let Some((halves, from_file)) = resolved
+        {
+            b.halves = Some(halves);
+            b.file_limits = from_file;
         }
         cfg.validate().map_err(|e| match e {
             // the user typed [body] keys or a file, not these

@@ -481,6 +481,17 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             ),
         );
     }
+    // a speed the robot file gave is named there, not as a key the user never typed
+    let from_file = |key: &str| {
+        cfg.body
+            .as_ref()
+            .filter(|b| b.file_limits.iter().any(|k| format!("limits.{k}") == key))
+            .map(|b| {
+                let file = b.urdf.as_ref().map_or("body.mjcf", |_| "body.urdf");
+                format!("{file} (its joints' velocity, read as {key})")
+            })
+            .unwrap_or_else(|| key.to_string())
+    };
     for (key, w) in [
         ("limits.no_load_speed", cfg.limits.no_load_speed),
         ("limits.max_speed", cfg.limits.max_speed),
@@ -489,7 +500,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             && w > 30.0
         {
             warn(
-                key,
+                &from_file(key),
                 format!(
                     "{w} rad/s ({:.0} rev/min) is faster than the geared servos of small robots (5 to 15 rad/s): a datasheet's rev/min typed as rad/s? ({w} rev/min = {:.4} rad/s)",
                     w / RPM,

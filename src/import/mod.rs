@@ -34,6 +34,10 @@ pub struct BodyConfig {
     /// The halves the section resolves to ([`resolve`]).
     #[serde(skip)]
     pub halves: Option<Halves>,
+    /// The `[limits]` keys the file gave (not typed in the config), so that
+    /// a warning about one names the file.
+    #[serde(skip)]
+    pub file_limits: Vec<&'static str>,
 }
 
 /// One half in its own frame (parallel to the other half's in the straight cat).
@@ -136,7 +140,11 @@ fn invalid(key: &str, value: impl std::fmt::Display, expected: impl Into<String>
 /// cylinder keys filled with the halves' equivalent cylinders (scales and
 /// drawings), `cat.joint` from the file, and the file's motor limits as
 /// `[limits]` where the config sets none. `base` is the config's folder.
-pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Option<Halves>> {
+pub fn resolve(
+    table: &mut toml::Table,
+    base: &Path,
+    origin: &str,
+) -> Result<Option<(Halves, Vec<&'static str>)>> {
     let Some(body) = table.get("body").cloned() else {
         return Ok(None);
     };
@@ -244,6 +252,7 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
     fr.insert("length".into(), ef.length.into());
     fr.insert("radius".into(), ef.radius.into());
     cat.insert("front".into(), toml::Value::Table(fr));
+    let mut from_file = Vec::new();
     if let Some(f) = &file {
         let limits = table
             .entry("limits")
@@ -268,10 +277,11 @@ pub fn resolve(table: &mut toml::Table, base: &Path, origin: &str) -> Result<Opt
                 && !limits.contains_key(key)
             {
                 limits.insert(key.into(), v.into());
+                from_file.push(key);
             }
         }
     }
-    Ok(Some(halves))
+    Ok(Some((halves, from_file)))
 }
 
 /// One half from the file and the keys that replace its values; without a

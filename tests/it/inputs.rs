@@ -300,6 +300,20 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["analyze", path.to_str().unwrap()],
         &["body.urdf (rear half's mass)", "grams", "0.423 kg"],
     );
+    // a joint velocity in rev/min, named by the file, not as a key never typed
+    let rpm = urdf.replace("velocity=\"5.969\"", "velocity=\"57\"");
+    std::fs::write(grams.path().join("rpm.urdf"), rpm).unwrap();
+    let toml = util::config_text("box-robot").replace("box-robot.urdf", "rpm.urdf");
+    std::fs::write(grams.path().join("rpm.toml"), toml).unwrap();
+    let path = grams.path().join("rpm.toml");
+    warns(
+        &["analyze", path.to_str().unwrap()],
+        &[
+            "body.urdf (its joints' velocity, read as limits.max_speed)",
+            "rev/min",
+            "5.9690 rad/s",
+        ],
+    );
     // the analytic reference folding a robot's halves through each other at
     // the default angle says it is the default, and what to set instead
     // (two boxes whose shorter half reaches the other at 48.33 deg)
