@@ -395,14 +395,16 @@ fn draw_panel(
             .map_err(perr)?;
             // the two ends' labels at the top and the bottom: side by side
             // they overlapped at a small max_speed
-            let (at_y, dy) = if w < 0.0 { (y.0, -18) } else { (y.1, 4) };
-            c.draw_series(std::iter::once(text(
-                format!("max_speed {w} rad/s"),
-                (w, at_y),
-                4,
-                dy,
-            )))
-            .map_err(perr)?;
+            // (the top one left of its line: right of it, it ran into the legend;
+            // the bottom one a row above the quadrant's name)
+            let label = format!("max_speed {w} rad/s");
+            let (at_y, dx, dy) = if w < 0.0 {
+                (y.0, 4, -34)
+            } else {
+                (y.1, -4 - 7 * label.len() as i32, 4)
+            };
+            c.draw_series(std::iter::once(text(label, (w, at_y), dx, dy)))
+                .map_err(perr)?;
         }
         keys.push((format!("max_speed {wm} rad/s"), Key::DashedLevel));
     }
