@@ -292,22 +292,23 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
             format!("<mass value=\"{}\"{rest}", m * 1000.0)
         })
         .collect();
-    std::fs::write(grams.path().join("grams.urdf"), heavy).unwrap();
-    let toml = util::config_text("box-robot").replace("box-robot.urdf", "grams.urdf");
-    std::fs::write(grams.path().join("grams.toml"), toml).unwrap();
-    let path = grams.path().join("grams.toml");
+    // the box robot's config on another URDF, `name.urdf` in the folder
+    let box_robot_on = |name: &str, text: &str| {
+        std::fs::write(grams.path().join(format!("{name}.urdf")), text).unwrap();
+        let toml =
+            util::config_text("box-robot").replace("box-robot.urdf", &format!("{name}.urdf"));
+        let path = grams.path().join(format!("{name}.toml"));
+        std::fs::write(&path, toml).unwrap();
+        path.to_str().unwrap().to_string()
+    };
     warns(
-        &["analyze", path.to_str().unwrap()],
+        &["analyze", &box_robot_on("grams", &heavy)],
         &["body.urdf (rear half's mass)", "grams", "0.423 kg"],
     );
     // a joint velocity in rev/min, named by the file, not as a key never typed
     let rpm = urdf.replace("velocity=\"5.969\"", "velocity=\"57\"");
-    std::fs::write(grams.path().join("rpm.urdf"), rpm).unwrap();
-    let toml = util::config_text("box-robot").replace("box-robot.urdf", "rpm.urdf");
-    std::fs::write(grams.path().join("rpm.toml"), toml).unwrap();
-    let path = grams.path().join("rpm.toml");
     warns(
-        &["analyze", path.to_str().unwrap()],
+        &["analyze", &box_robot_on("rpm", &rpm)],
         &[
             "body.urdf (its joints' velocity, read as limits.max_speed)",
             "rev/min",
