@@ -1409,7 +1409,7 @@ fn robustness<'py>(
     seed: i128,
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    use catflip::control::robustness::{DEFAULT_MAX_TILT_DEG, Study, summarise, to_csv};
+    use catflip::control::robustness::{Study, summarise, to_csv};
     use std::sync::atomic::{AtomicBool, Ordering};
     let (_, cfg) = config.snapshot();
     let max = catflip::config::MAX_TRIALS;
@@ -1446,8 +1446,12 @@ fn robustness<'py>(
                 results.extend(study.run(from..to, threads, |_, _| {}));
                 from = to;
             }
-            let max_tilt_deg = cfg.land.max_tilt_deg.unwrap_or(DEFAULT_MAX_TILT_DEG);
-            let summary = summarise(&results, seed, max_tilt_deg, cfg.robustness.worst_kept);
+            let summary = summarise(
+                &results,
+                seed,
+                study.max_tilt_deg(),
+                cfg.robustness.worst_kept,
+            );
             let mut json = serde_json::to_value(catflip::control::resume::Published {
                 status: catflip::sweep::resume::SweepStatus::Complete,
                 summary: &summary,

@@ -109,11 +109,17 @@ fn shown_text(a: &HeightAnswer) -> String {
 /// The block: headline, least height (and bound), and where the
 /// least-height schedule is shown and written.
 pub fn lead(a: &HeightAnswer) -> String {
-    let class = if a.possible { "possible" } else { "impossible" };
+    block(a.possible, &headline(a), &height_text(a), &shown_text(a))
+}
+
+/// The answer's block (green when `possible`, else red): a headline, a
+/// larger line under it and a paragraph, in plain text.
+pub fn block(possible: bool, headline: &str, second: &str, more: &str) -> String {
+    let class = if possible { "possible" } else { "impossible" };
     format!(
         "<section id=\"answer\" class=\"{class}\">\n<p class=\"headline\">{}</p>\n<p class=\"height\">{}</p>\n<p>{}</p>\n</section>\n",
-        esc(&headline(a)),
-        esc(&height_text(a)),
-        esc(&shown_text(a))
+        esc(headline),
+        esc(second),
+        esc(more)
     )
 }

@@ -282,16 +282,11 @@ pub fn page(a: &SizeAnswer) -> String {
     // the best gear ratio of it, makes the flip
     let said = a.sentences();
     let g = &a.gear;
-    let lead = format!(
-        "<section id=\"answer\" class=\"{}\">\n<p class=\"headline\">{}</p>\n<p class=\"height\">{}</p>\n<p>{}</p>\n</section>\n",
-        if g.configured_possible || g.possible {
-            "possible"
-        } else {
-            "impossible"
-        },
-        super::esc(&said[1]),
-        super::esc(&said[2]),
-        super::esc(&said[0])
+    let lead = super::answer::block(
+        g.configured_possible || g.possible,
+        &said[1],
+        &said[2],
+        &said[0],
     );
     let mut notes = Vec::new();
     notes.push(format!(
