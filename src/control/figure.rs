@@ -1,32 +1,51 @@
 //! The study's figure: each controller's success rate against the size of
 //! each perturbation, as a fraction of its largest configured value (trials
-//! binned by that one perturbation, the others drawn as they fell).
+//! binned by that one perturbation, the others drawn as they fell), with the
+//! rate's 95 % interval, so that a bin of few trials shows how little it says.
 
-use super::robustness::{CONTROLLERS, TrialResult};
+use super::robustness::{CONTROLLERS, TrialResult, wilson};
 use crate::config::Config;
 use crate::error::Result;
+use crate::report::{Rate, RatePanel};
 
-/// Bins along each perturbation's size.
-const BINS: usize = 5;
+/// The most bins along each perturbation's size.
+const MAX_BINS: usize = 5;
+
+/// Trials a bin holds on average: a smaller study gets fewer bins (at
+/// least two), so that its rates are not each a handful of trials.
+const TRIALS_PER_BIN: usize = 20;
+
+/// Bins along each perturbation's size for a study of `trials`.
+pub fn bin_count(trials: usize) -> usize {
+    (trials / TRIALS_PER_BIN).clamp(2, MAX_BINS)
+}
 
 /// The index.html caption of the study's figure (any shard's).
 pub fn caption(file: &str) -> Option<&'static str> {
     (file.starts_with("robustness") && file.ends_with(".svg")).then_some(
-        "Each controller's success rate against the size of each perturbation (spin, tilt, inertia error), as a fraction of its largest value in [robustness]: the trials binned by that one perturbation, the others as they fell. A colour per controller, a dash and marker per perturbation; a bin without trials is left out. The notes above give each bin's trials: a rate from few trials is uncertain.",
+        "Each controller's success rate against the size of each perturbation (spin, tilt, inertia error; a panel each), as a fraction of its largest value in [robustness]: the trials binned by that one perturbation, the others as they fell. A colour per controller; each bar is the rate's 95 % (Wilson) interval, wide where a bin holds few trials; a bin without trials is left out. The notes above give each bin's trials.",
     )
 }
 
-/// One perturbation's trials in the figure's bins, a fifth of its largest
-/// configured value each, smallest first.
+/// One perturbation's trials in the figure's bins ([`bin_count`] equal
+/// parts of its largest configured value, smallest first).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Bins {
     /// `spin` (the release rate's magnitude), `tilt` or `inertia` (the
     /// larger of the halves' errors).
     pub perturbation: &'static str,
     /// Trials in each bin.
-    pub trials: [usize; BINS],
+    pub trials: Vec<usize>,
     /// Of them, the ones each controller ([`CONTROLLERS`]) landed.
-    pub landed: [[usize; BINS]; CONTROLLERS.len()],
+    pub landed: [Vec<usize>; CONTROLLERS.len()],
+}
+
+impl Bins {
+    /// Each bin's centre, as a fraction of the largest value.
+    pub fn centres(&self) -> Vec<f64> {
+        let n = self.trials.len();
+        (0..n).map(|b| (b as f64 + 0.5) / n as f64).collect()
+    }
 }
 
 /// The bins of each perturbation the study varies (one whose largest value
@@ -51,13 +70,14 @@ pub fn bins(cfg: &Config, results: &[TrialResult], max_tilt_deg: f64) -> Vec<Bin
         .into_iter()
         .filter(|s| s.1 > 0.0)
         .map(|(perturbation, max, size)| {
+            let bins = bin_count(results.len());
             let mut b = Bins {
                 perturbation,
-                trials: [0; BINS],
-                landed: [[0; BINS]; CONTROLLERS.len()],
+                trials: vec![0; bins],
+                landed: std::array::from_fn(|_| vec![0; bins]),
             };
             for r in results {
-                let k = ((size(r) / max * BINS as f64) as usize).min(BINS - 1);
+                let k = ((size(r) / max * bins as f64) as usize).min(bins - 1);
                 b.trials[k] += 1;
                 for (c, landed) in b.landed.iter_mut().enumerate() {
                     if r.landing_error_deg[c] <= max_tilt_deg {
@@ -81,64 +101,58 @@ pub fn bins_note(bins: &[Bins]) -> Option<String> {
             })
             .collect();
         format!(
-            "The figure's bins (a fifth of each perturbation's largest value each, smallest first) hold these trials: {}.",
+            "The figure's bins ({} equal parts of each perturbation's largest value, smallest first: at most {}, about {} trials each on average where the study has them) hold these trials: {}.",
+            bins[0].trials.len(),
+            MAX_BINS,
+            TRIALS_PER_BIN,
             each.join("; ")
         )
     })
 }
 
-/// The SVG of the study's [`bins`], or `None` when no perturbation varies
-/// or there are no trials.
+/// The SVG of the study's [`bins`], a panel a perturbation, or `None` when
+/// no perturbation varies or there are no trials.
 pub fn success_by_size(bins: &[Bins], max_tilt_deg: f64) -> Result<Option<String>> {
-    let x: Vec<f64> = (0..BINS).map(|b| (b as f64 + 0.5) / BINS as f64).collect();
-    let mut series = Vec::new();
-    for b in bins {
-        for (name, landed) in CONTROLLERS.iter().zip(&b.landed) {
-            let ys = landed
-                .iter()
-                .zip(&b.trials)
-                .map(|(&k, &n)| {
-                    if n == 0 {
-                        f64::NAN
-                    } else {
-                        k as f64 / n as f64
-                    }
-                })
-                .collect();
-            series.push((format!("{name}: {}", b.perturbation), ys));
-        }
-    }
     if bins.iter().all(|b| b.trials.iter().sum::<usize>() == 0) {
         return Ok(None);
     }
-    Ok(Some(crate::report::lines_styled(
+    let panels: Vec<RatePanel> = bins.iter().map(panel).collect();
+    Ok(Some(crate::report::rate_panels(
         &format!("Landing within {max_tilt_deg} deg against each perturbation's size"),
-        "size, fraction of its largest value in [robustness]",
+        "size / its largest value",
         "success rate",
-        &x,
-        &series,
-        series_style,
+        &panels,
+        "95 % interval (Wilson)",
     )?))
 }
 
-/// A series' style from its name `controller: perturbation`: the colour
-/// tells the controller, the dash and marker the perturbation (nine series:
-/// the report's four styles would repeat), both from
-/// [`crate::report::distinct_style`].
-fn series_style(name: &str, _: usize) -> crate::report::Style {
-    use crate::report::distinct_style;
-    let (controller, what) = name.split_once(": ").unwrap_or((name, ""));
-    let c = CONTROLLERS
+/// One perturbation's panel: each controller's rate in each bin with its
+/// Wilson interval (a `NaN` rate in an empty bin).
+fn panel(b: &Bins) -> RatePanel {
+    let series = CONTROLLERS
         .iter()
-        .position(|&n| n == controller)
-        .unwrap_or(0);
-    let p = ["spin", "tilt", "inertia"]
-        .iter()
-        .position(|&n| n == what)
-        .unwrap_or(0);
-    crate::report::Style {
-        color: distinct_style(c).color,
-        ..distinct_style(p)
+        .zip(&b.landed)
+        .map(|(name, landed)| {
+            let rates = b
+                .centres()
+                .into_iter()
+                .zip(landed.iter().zip(&b.trials))
+                .map(|(x, (&k, &n))| {
+                    let [lo, hi] = wilson(k, n);
+                    let rate = if n == 0 {
+                        f64::NAN
+                    } else {
+                        k as f64 / n as f64
+                    };
+                    Rate { x, rate, lo, hi }
+                })
+                .collect();
+            (name.to_string(), rates)
+        })
+        .collect();
+    RatePanel {
+        title: b.perturbation.to_string(),
+        series,
     }
 }
 
@@ -180,7 +194,7 @@ mod tests {
         for b in &b {
             assert_eq!(b.trials.iter().sum::<usize>(), 200, "{b:?}");
             assert_eq!(b.landed[1], b.trials, "TVLQR lands every trial");
-            assert_eq!(b.landed[2], [0; BINS], "replanning lands none");
+            assert_eq!(b.landed[2], [0; 5], "replanning lands none");
         }
         let tilt = &b[1];
         // tilts are uniform up to the largest: the open loop lands the
@@ -188,13 +202,13 @@ mod tests {
         assert_eq!(tilt.landed[0][..2], tilt.trials[..2]);
         assert!(0 < tilt.landed[0][2] && tilt.landed[0][2] < tilt.trials[2]);
         assert_eq!(tilt.landed[0][3..], [0, 0]);
-        let tilt_by_hand = (0..BINS)
+        let tilt_by_hand = (0..5)
             .map(|k| {
                 results
                     .iter()
                     .filter(|r| {
                         let f = r.draw.tilt_deg / cfg.robustness.tilt_deg;
-                        ((f * BINS as f64) as usize).min(BINS - 1) == k
+                        ((f * 5.0) as usize).min(4) == k
                     })
                     .count()
             })
@@ -210,26 +224,56 @@ mod tests {
         assert_eq!(bins_note(&[]), None);
     }
 
-    /// The study's nine series are drawn nine ways: one colour a
-    /// controller, one dash and marker a perturbation.
+    /// A small study gets fewer bins, about twenty trials each (at least
+    /// two, at most five), and each drawn rate carries the Wilson interval
+    /// of its own bin's counts, which holds the rate.
     #[test]
-    fn every_series_of_the_study_has_its_own_style() {
-        let mut seen = Vec::new();
-        for what in ["spin", "tilt", "inertia"] {
-            for c in CONTROLLERS {
-                let st = series_style(&format!("{c}: {what}"), 0);
-                let key = (
-                    (st.color.0, st.color.1, st.color.2),
-                    st.dash,
-                    format!("{:?}", st.marker),
-                );
-                assert!(!seen.contains(&key), "{c}: {what} repeats {key:?}");
-                seen.push(key);
+    fn a_small_study_gets_fewer_bins_and_each_rate_its_interval() {
+        assert_eq!(
+            [1, 20, 50, 60, 99, 100, 1000].map(bin_count),
+            [2, 2, 2, 3, 4, 5, 5]
+        );
+        let cfg = Config::from_toml(include_str!("../../configs/seed.toml"), "seed", &[]).unwrap();
+        let results: Vec<TrialResult> = (0..30)
+            .map(|t| TrialResult {
+                draw: crate::control::robustness::Draw::new(&cfg, 3, t),
+                // the open loop lands every third trial
+                landing_error_deg: [if t % 3 == 0 { 1.0 } else { 40.0 }, 0.0, 180.0],
+                replans: Vec::new(),
+            })
+            .collect();
+        let b = bins(&cfg, &results, 10.0);
+        assert_eq!(b.len(), 3);
+        for b in &b {
+            assert_eq!(b.trials.len(), 2, "{b:?}");
+            assert_eq!(b.centres(), [0.25, 0.75]);
+            let p = panel(b);
+            assert_eq!(p.title, b.perturbation);
+            for ((name, rates), landed) in p.series.iter().zip(&b.landed) {
+                for ((r, &k), &n) in rates.iter().zip(landed).zip(&b.trials) {
+                    assert_eq!([r.lo, r.hi], wilson(k, n), "{name}");
+                    if n == 0 {
+                        assert!(r.rate.is_nan());
+                    } else {
+                        assert_eq!(r.rate, k as f64 / n as f64);
+                        assert!(r.lo <= r.rate && r.rate <= r.hi, "{name}: {r:?}");
+                        // a bin of a dozen trials says little: its interval
+                        // is wider than a tenth unless the rate is certain
+                        assert!(n > 100 || k == 0 || k == n || r.hi - r.lo > 0.1);
+                    }
+                }
             }
         }
-        // a controller keeps its colour across perturbations
-        let color = |n: &str| series_style(n, 0).color.0;
-        assert_eq!(color("tvlqr: spin"), color("tvlqr: inertia"));
-        assert_ne!(color("tvlqr: spin"), color("replan: spin"));
+        let svg = success_by_size(&b, 10.0).unwrap().unwrap();
+        for what in [
+            "spin",
+            "tilt",
+            "inertia",
+            "95 % interval (Wilson)",
+            "open-loop",
+        ] {
+            assert!(svg.contains(what), "{what}");
+        }
+        assert!(bins_note(&b).unwrap().contains("(2 equal parts"));
     }
 }

@@ -299,7 +299,10 @@ pub fn wilson(k: usize, n: usize) -> [f64; 2] {
     let d = 1.0 + z * z / n;
     let c = (p + z * z / (2.0 * n)) / d;
     let h = z * (p * (1.0 - p) / n + z * z / (4.0 * n * n)).sqrt() / d;
-    [(c - h).max(0.0), (c + h).min(1.0)]
+    // (exact at the ends: `c - h` rounds to 3e-17 at no success)
+    let lo = if k == 0 { 0.0 } else { (c - h).max(0.0) };
+    let hi = if k as f64 == n { 1.0 } else { (c + h).min(1.0) };
+    [lo, hi]
 }
 
 /// A trial kept for replay: `catflip robustness --seed S` draws trial `trial` again.
@@ -542,6 +545,11 @@ mod tests {
         assert!((lo - 10.0 / (10.0 + z2)).abs() < 1e-12 && (hi - 1.0).abs() < 1e-12);
         let [lo, hi] = wilson(0, 10);
         assert!(lo.abs() < 1e-12 && (hi - z2 / (10.0 + z2)).abs() < 1e-12);
+        // exactly at the ends, where the rate is (a JSON `ci95` of
+        // [2.8e-17, ...] for no success read as a positive bound)
+        for n in 1..200 {
+            assert_eq!((wilson(0, n)[0], wilson(n, n)[1]), (0.0, 1.0), "{n}");
+        }
         // 50 of 100: 0.4038 to 0.5962 (Wilson 1927; Newcombe 1998, table I)
         let [lo, hi] = wilson(50, 100);
         assert!((lo - 0.4038).abs() < 1e-4 && (hi - 0.5962).abs() < 1e-4);

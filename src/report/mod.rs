@@ -895,6 +895,102 @@ pub fn lines_styled(
     })
 }
 
+/// A rate measured on a sample, with its confidence interval (`NaN`
+/// rate: no sample).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rate {
+    pub x: f64,
+    pub rate: f64,
+    pub lo: f64,
+    pub hi: f64,
+}
+
+/// One panel of [`rate_panels`]: its title and a named series of rates per
+/// line.
+pub struct RatePanel {
+    pub title: String,
+    pub series: Vec<(String, Vec<Rate>)>,
+}
+
+/// Rates (0 to 1) against `x` in 0 to 1, one panel side by side for each
+/// of `panels`, a style per series name ([`distinct_style`] by position,
+/// the same in every panel): each rate a marker on its series' line, its
+/// interval a bar, nudged apart where the series share an `x`, so that a
+/// rate from few trials shows how little it says. `interval` names the
+/// bars in the legend.
+pub fn rate_panels(
+    title: &str,
+    xdesc: &str,
+    ydesc: &str,
+    panels: &[RatePanel],
+    interval: &str,
+) -> Result<String> {
+    let n = panels.len().max(1) as u32;
+    svg((360 * n + LEGEND_W, 460), |root| {
+        let (plot, side) = with_legend(root);
+        let (top, plot) = plot.split_vertically(36);
+        top.draw_text(
+            title,
+            &TextStyle::from((FONT, 20).into_font()).color(&BLACK),
+            (12, 10),
+        )
+        .map_err(perr)?;
+        let areas = plot.split_evenly((1, panels.len().max(1)));
+        let mut names: Vec<&str> = Vec::new();
+        for (area, panel) in areas.iter().zip(panels) {
+            let mut c = chart(
+                area,
+                &panel.title,
+                (0.0, 1.0),
+                (-0.03, 1.03),
+                (xdesc, ydesc),
+                false,
+            )?;
+            let count = panel.series.len() as f64;
+            for (k, (name, rates)) in panel.series.iter().enumerate() {
+                let i = names.iter().position(|n| n == name).unwrap_or_else(|| {
+                    names.push(name);
+                    names.len() - 1
+                });
+                let st = Style {
+                    dash: None,
+                    ..distinct_style(i)
+                };
+                let dx = (k as f64 - 0.5 * (count - 1.0)) * 0.02;
+                let pts: Vec<(f64, f64)> = rates
+                    .iter()
+                    .filter(|r| r.rate.is_finite())
+                    .map(|r| (r.x + dx, r.rate))
+                    .collect();
+                let stroke = st.color.stroke_width(1);
+                for r in rates.iter().filter(|r| r.rate.is_finite()) {
+                    let x = r.x + dx;
+                    c.draw_series(LineSeries::new([(x, r.lo), (x, r.hi)], stroke))
+                        .map_err(perr)?;
+                    for y in [r.lo, r.hi] {
+                        c.draw_series(LineSeries::new([(x - 0.008, y), (x + 0.008, y)], stroke))
+                            .map_err(perr)?;
+                    }
+                }
+                line(&mut c, &pts, st, 0.0)?;
+            }
+        }
+        let mut keys: Vec<(String, Key)> = names
+            .iter()
+            .enumerate()
+            .map(|(i, name)| {
+                let st = Style {
+                    dash: None,
+                    ..distinct_style(i)
+                };
+                (name.to_string(), Key::Line(st))
+            })
+            .collect();
+        keys.push((format!("bars: {interval}"), Key::Note));
+        legend(&side, &keys)
+    })
+}
+
 /// A quantity known only to lie in `[lo, hi)`: the largest value found to
 /// hold and the smallest found not to (`hi` `None`: every value tried held,
 /// up to the figure's `top`, so it is at least `lo`).

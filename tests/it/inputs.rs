@@ -991,7 +991,8 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     }
     assert!(page.contains("<img src=\"robustness.svg\"") && page.contains("<figcaption>"));
     assert!(!page.contains("Partial study"));
-    // each perturbation's bins, with the trials each holds: all 40 of them
+    // each perturbation's bins (two for 40 trials), with the trials each
+    // holds: all 40 of them
     let bins = page
         .split("hold these trials: ")
         .nth(1)
@@ -1002,7 +1003,7 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
         .map(|b| {
             let (what, n) = b.split_once(' ').unwrap();
             let n: Vec<usize> = n.split(", ").map(|k| k.parse().unwrap()).collect();
-            assert_eq!(n.len(), 5, "{b}");
+            assert_eq!(n.len(), catflip::control::figure::bin_count(40), "{b}");
             (what, n.iter().sum())
         })
         .collect();
