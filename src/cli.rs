@@ -699,7 +699,9 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
         // flown first, as `simulate` flies it: a schedule the model cannot
         // follow gives no controls or gains (it wrote NaN gains)
         catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &s)?;
-        catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim);
+        if let Some(w) = catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim) {
+            eprintln!("warning: {w}.");
+        }
     }
     for w in publisher.publish(out)? {
         say!("wrote {}", w.display());

@@ -11,6 +11,37 @@ use crate::model::Joint;
 
 /// The design's gains, one row per control step.
 pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
+    gains(cfg, plan).csv
+}
+
+/// The gains' CSV and its nominal flight's landing errors.
+pub struct Gains {
+    pub csv: String,
+    /// The nominal flown under the TVLQR (the model, no delay or noise),
+    /// deg from belly-down: the TVLQR lands no closer to belly-down than its
+    /// nominal.
+    pub nominal_tvlqr_deg: f64,
+    /// The same flight under the open loop's joint PD on the planned shape.
+    pub nominal_open_loop_deg: f64,
+}
+
+/// A nominal that lands this far off (deg), and ten times as far as the
+/// open loop's, is worth a warning: a tenth of a degree is a hundredth of
+/// the default landing tolerance.
+const DRIFT_DEG: f64 = 0.1;
+
+impl Gains {
+    /// Whether the TVLQR's nominal lands off where the open loop's PD on
+    /// the planned shape does not: the feed-forward alone drifts from the
+    /// plan (a schedule read back from its rows smooths the design's torque
+    /// between them), and the TVLQR holds the flight to that nominal.
+    pub fn drifts(&self) -> bool {
+        self.nominal_tvlqr_deg > DRIFT_DEG.max(10.0 * self.nominal_open_loop_deg)
+    }
+}
+
+/// [`gains_csv`] with the nominal's landing errors.
+pub fn gains(cfg: &Config, plan: &dyn ShapePlan) -> Gains {
     let r = Reference::new(cfg, plan);
     let tv = Tvlqr::new(&r, &cfg.control);
     let shape = match cfg.cat.joint {
@@ -39,6 +70,16 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
     let pd = crate::verify::simulate::Controller::from_spec(&cfg.design_spec());
     let nominal = |r: &Reference, fb| fly(r, fb, &motor, Flight::nominal(r)).error_deg;
     let open = r.for_open_loop(cfg, plan);
+    let (nominal_tvlqr_deg, nominal_open_loop_deg) = (
+        nominal(&r, Feedback::Tvlqr(&tv)),
+        nominal(
+            &open,
+            Feedback::JointPd {
+                kp: pd.kp,
+                kd: pd.kd,
+            },
+        ),
+    );
     let keys = [
         ("step_s", r.h),
         ("steps", r.steps as f64),
@@ -49,20 +90,8 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         ("pd_kp", pd.kp),
         ("pd_kd", pd.kd),
         ("nominal_held", if r.is_held() { 1.0 } else { 0.0 }),
-        (
-            "nominal_landing_error_deg_tvlqr",
-            nominal(&r, Feedback::Tvlqr(&tv)),
-        ),
-        (
-            "nominal_landing_error_deg_open_loop",
-            nominal(
-                &open,
-                Feedback::JointPd {
-                    kp: pd.kp,
-                    kd: pd.kd,
-                },
-            ),
-        ),
+        ("nominal_landing_error_deg_tvlqr", nominal_tvlqr_deg),
+        ("nominal_landing_error_deg_open_loop", nominal_open_loop_deg),
     ];
     if r.is_held() {
         s.push_str(
@@ -115,5 +144,9 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         s.push_str(&v.join(","));
         s.push('\n');
     }
-    s
+    Gains {
+        csv: s,
+        nominal_tvlqr_deg,
+        nominal_open_loop_deg,
+    }
 }
