@@ -70,10 +70,14 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     // the trials land in a store this thread reads when a signal stops the study
     let store = Arc::new(Mutex::new(kept));
     let interrupt = catflip::interrupt::Interrupt::catch()?;
+    // what the page says of the design the controllers fly
+    let flown = Arc::new(Mutex::new(None::<String>));
     let work = {
         let (cfg, store, range) = (cfg.clone(), store.clone(), range.clone());
+        let flown = flown.clone();
         move || -> catflip::Result<()> {
             let design = catflip::control::robustness::design(&cfg)?;
+            *flown.lock().unwrap_or_else(|p| p.into_inner()) = Some(described(&design));
             let study = Study::new(&cfg, Arc::new(design.plan), seed);
             // the trials' own clock: the design before them would make the
             // first trials' rate, and the time left, many times too long
@@ -143,10 +147,10 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             &cfg,
             &summary,
             &timing,
-            &range,
-            trials,
+            (&range, trials),
             interrupted,
             drawn.then_some((figure.as_str(), bins.as_slice())),
+            flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref(),
         ),
     );
     out.add(
@@ -185,15 +189,16 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
 }
 
 /// The study's page: each controller's line, what was drawn and how to fly
-/// a trial again, and the figure with its bins' trials.
+/// a trial again, the controllers and the design they fly, and the figure
+/// with its bins' trials; `range` is the trials of the study's `trials` on it.
 fn page(
     cfg: &catflip::Config,
     s: &catflip::control::robustness::Summary,
     timing: &catflip::control::robustness::ReplanTiming,
-    range: &std::ops::Range<usize>,
-    trials: usize,
+    (range, trials): (&std::ops::Range<usize>, usize),
     interrupted: bool,
     figure: Option<(&str, &[catflip::control::figure::Bins])>,
+    design: Option<&str>,
 ) -> String {
     let rows: Vec<Vec<String>> = s
         .controllers
@@ -238,6 +243,7 @@ fn page(
             p.rate_noise_rad_s,
             100.0 * p.pd_gain_error,
         ),
+        controllers(cfg, design),
         format!(
             "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}) (docs/control.md); robustness.csv has every trial's draws and landings.",
             s.seed
@@ -271,4 +277,37 @@ fn page(
         figures: &figures,
         captions: catflip::control::figure::caption,
     })
+}
+
+/// The design a study's controllers fly, in words.
+fn described(d: &catflip::design::free::FreeResult) -> String {
+    let kebab = |v: serde_json::Value| v.as_str().unwrap_or_default().to_string();
+    format!(
+        "the free-form {} design seeded by the {} schedule, with a continuous torque (status {}; peak {:.4} N m, manoeuvre {:.4} s; catflip optimize --mode free --seed {seed} --set free.torque_jumps=false, with the study's other --set keys, makes it, and catflip export ... --schedule of its schedule the TVLQR gains, docs/control.md)",
+        kebab(serde_json::json!(d.objective)),
+        d.seed,
+        kebab(serde_json::json!(d.status)),
+        d.peak_torque_nm,
+        d.manoeuvre_time_s,
+        seed = d.seed,
+    )
+}
+
+/// The page's note on the controllers: the design they fly, their rate and
+/// the delay they predict over beside the simulated robot's, and that a
+/// replan is used whatever its wall time.
+fn controllers(cfg: &catflip::Config, design: Option<&str>) -> String {
+    let (c, r) = (&cfg.control, &cfg.robustness);
+    let mut s = format!(
+        "The controllers fly {}. TVLQR and replanning correct it {} times a second (control.rate_hz) and predict over a delay of {} ms (control.delay_ms); the simulated robot's actuator delay is {} ms (robustness.delay_ms)",
+        design.unwrap_or("the study's free-form design"),
+        c.rate_hz,
+        c.delay_ms,
+        r.delay_ms,
+    );
+    if c.delay_ms != r.delay_ms {
+        s.push_str(": the controllers assume another delay than the robot has");
+    }
+    s.push_str(". The study is deterministic: each replan is used whatever its wall time (the replans' times below say how many a robot's processor would have missed).");
+    s
 }

@@ -53,15 +53,23 @@ pub fn gains(cfg: &Config, plan: &dyn ShapePlan) -> Gains {
     let mut s = format!(
         "# catflip TVLQR gains for {name}: u = -K (x_measured - x_nominal), held from t_apply_s to the next row's,\n\
          # added to the schedule's feed-forward torque (catflip's tau, hinge torques for universal),\n\
-         # measured delay_s = {delay:.6e} s before t_apply_s and predicted over the delay with the model.\n\
+         # measured delay_s = {delay:.6e} s before t_apply_s and predicted over the delay with the model (catflip's rigid\n\
+         # two-body model, docs/model.md) under the corrections already sent. t = 0 is the release; touchdown is steps * step_s.\n\
+         # Feed-forward: the schedule's tau_nm, linear between its rows (<stem>.mujoco.csv holds it a simulator step at a time,\n\
+         # as the DC command tau + k qd where the motor has a torque-speed line); u is capped at max_correction_nm and\n\
+         # tau + u kept inside the motor envelope at the joint speed. Units: s, rad, rad/s, N m s (lambda), N m (u, tau),\n\
+         # K_i_j in N m per unit of x_j. Columns: qnom_w..qnom_z the nominal attitude, lnom_* its lambda, qnom_1, qnom_2 its q,\n\
+         # qdnom_* its qd.\n\
          # x = [dtheta (3), dlambda (3), dq (2), dqd (2)]: dtheta = log(R_nom' R) of the rear half in its own frame\n\
          # (the same in catflip's world and the simulator's: R_sim = W R), lambda = R' L the momentum about the\n\
          # common centre of mass in the rear half's frame, N m s; {shape}.\n\
          # Nominal attitude qnom_* = W R_nom, [w x y z], the simulator's world (gravity -z). K_i_j: row i (torque), column j (x).\n\
-         # control.rate_hz = {rate}, control.delay_ms = {dms}, simulator step {h:.9e} s.\n",
+         # control.rate_hz = {rate} (a correction every period_steps = {p} simulator steps: {applied:.6} Hz), control.delay_ms = {dms}, simulator step {h:.9e} s.\n",
         name = cfg.name,
         delay = tv.delay_steps as f64 * r.h,
         rate = cfg.control.rate_hz,
+        p = tv.period_steps,
+        applied = 1.0 / (tv.period_steps as f64 * r.h),
         dms = cfg.control.delay_ms,
         h = r.h,
     );

@@ -241,23 +241,50 @@ fn an_empty_shard_warns_and_rates_nothing() {
     );
 }
 
-/// Bad input is refused with the key, the value and the range; nothing is written.
+/// Bad input is refused with the key, the value and the range or why;
+/// nothing is written.
 #[test]
 fn bad_input_is_refused_before_anything_is_written() {
     let dir = crate::util::temp_dir();
     let seed = crate::util::config_arg("seed");
-    for (args, key) in [
-        (vec!["--set", "control.delay_ms=-1"], "control.delay_ms"),
+    for (args, key, says) in [
+        (
+            vec!["--set", "control.delay_ms=-1"],
+            "control.delay_ms",
+            "must be in",
+        ),
         (
             vec!["--set", "robustness.delay_ms=-5"],
             "robustness.delay_ms",
+            "must be in",
         ),
-        (vec!["--set", "control.rate_hz=5000"], "control.rate_hz"),
+        (
+            vec!["--set", "control.rate_hz=5000"],
+            "control.rate_hz",
+            "must be in",
+        ),
+        (
+            vec!["--set", "control.rate_hz=0"],
+            "control.rate_hz",
+            "at least one correction a second",
+        ),
+        // a period of 4/3 simulator steps would run every step, at 4 kHz
+        (
+            vec!["--set", "control.rate_hz=3000"],
+            "control.rate_hz",
+            "would run at 4000 Hz; use a rate that divides the simulator's evenly, e.g. 2000 or 4000 Hz",
+        ),
         (
             vec!["--set", "robustness.mass_error=1.0"],
             "robustness.mass_error",
+            "makes a half massless",
         ),
-        (vec!["--trials", "1000001"], "--trials"),
+        (
+            vec!["--set", "robustness.length_error=-1"],
+            "robustness.length_error",
+            "its sign is drawn at random",
+        ),
+        (vec!["--trials", "1000001"], "--trials", "must be in"),
     ] {
         let mut argv = vec!["robustness", &seed, "--out", "."];
         argv.extend(&args);
@@ -265,13 +292,17 @@ fn bad_input_is_refused_before_anything_is_written() {
         let err = crate::util::stderr(&out);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(key), "{args:?}: {err}");
-        assert!(err.contains("must be in"), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
             0,
             "{args:?} wrote files"
         );
     }
+    // a rate within a few percent of whole steps is taken: 60 Hz runs every
+    // 67 steps of the default 4 kHz, at 59.7 Hz
+    let cfg = crate::util::seed(&["control.rate_hz=60"]);
+    assert_eq!(cfg.control.rate_hz, 60.0);
 }
 
 /// A design longer than the fall is refused before any flight, naming the
@@ -296,4 +327,33 @@ fn a_design_longer_than_the_fall_is_refused_with_the_height_it_needs() {
     check_fits(&at(need), &design.plan).unwrap();
     check_fits(&at(6.0), &design.plan).unwrap();
     assert!(check_fits(&at(need - 0.01), &design.plan).is_err());
+}
+
+/// A controller that assumes another delay than the study's robot has is
+/// said so on the study's page, with both delays.
+#[test]
+fn the_page_says_when_the_controllers_assume_another_delay() {
+    let dir = crate::util::temp_dir();
+    let seed = crate::util::config_arg("seed");
+    let (ok, _, err) = crate::util::run_ok(
+        &[
+            "robustness",
+            &seed,
+            "--trials",
+            "1",
+            "--set",
+            "control.delay_ms=20",
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    let page = std::fs::read_to_string(
+        dir.path()
+            .join("output/seed/robustness@control.delay_ms=20/index.html"),
+    )
+    .unwrap();
+    assert!(
+        page.contains("predict over a delay of 20 ms (control.delay_ms); the simulated robot's actuator delay is 5 ms (robustness.delay_ms): the controllers assume another delay than the robot has"),
+        "{page}"
+    );
 }

@@ -990,6 +990,12 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
         assert!(page.contains(&row), "{row}: {page}");
     }
     assert!(page.contains("<img src=\"robustness.svg\"") && page.contains("<figcaption>"));
+    // the design flown, the controllers' rate and delay beside the robot's
+    assert!(
+        page.contains("The controllers fly the free-form peak-torque design seeded by the phased schedule")
+            && page.contains("predict over a delay of 5 ms (control.delay_ms); the simulated robot's actuator delay is 5 ms (robustness.delay_ms). "),
+        "{page}"
+    );
     assert!(!page.contains("Partial study"));
     // each perturbation's bins (two for 40 trials), with the trials each
     // holds: all 40 of them
