@@ -245,7 +245,7 @@ fn page(
         ),
         controllers(cfg, design),
         format!(
-            "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}) (docs/control.md); robustness.csv has every trial's draws and landings.",
+            "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}), config carrying the study's --set keys (docs/control.md); robustness.csv has every trial's draws and landings.",
             s.seed
         ),
     ];
