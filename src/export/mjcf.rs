@@ -82,12 +82,13 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
         s.push('.');
     }
     if let Some(w) = super::common::speed_limit(cfg) {
-        let why = if cfg.limits.max_speed.is_some() {
-            "limits.max_speed"
+        if cfg.limits.max_speed.is_some() {
+            s.push_str(&format!("\n     Joint speed limit {w} rad/s (limits.max_speed)."));
         } else {
-            "the no-load speed: the motor cannot drive faster"
-        };
-        s.push_str(&format!("\n     Joint speed limit {w} rad/s ({why})."));
+            s.push_str(&format!(
+                "\n     No-load speed {w} rad/s: the motor drives no faster, but brakes beyond it (a schedule that brakes hard may pass it)."
+            ));
+        }
     }
     s
 }
