@@ -283,7 +283,7 @@ fn page(
 fn described(d: &catflip::design::free::FreeResult) -> String {
     let kebab = |v: serde_json::Value| v.as_str().unwrap_or_default().to_string();
     format!(
-        "the free-form {} design seeded by the {} schedule, with a continuous torque (status {}; peak {:.4} N m, manoeuvre {:.4} s; catflip optimize --mode free --seed {seed} --set free.torque_jumps=false, with the study's other --set keys, makes it, and catflip export ... --schedule of its schedule the TVLQR gains, docs/control.md)",
+        "the free-form {} design seeded by the {} schedule, with a continuous torque (status {}; peak {:.4} N m, manoeuvre {:.4} s; catflip optimize --mode free --seed {seed} --set free.torque_jumps=false --set simulate.samples_per_phase=2000, with the study's other --set keys, makes it with rows enough to export, and catflip export mjcf CONFIG --schedule on its free.csv writes its TVLQR gains: docs/control.md)",
         kebab(serde_json::json!(d.objective)),
         d.seed,
         kebab(serde_json::json!(d.status)),

@@ -83,7 +83,9 @@ pub(crate) fn motor_note(cfg: &Config) -> String {
     }
     if let Some(w) = super::common::speed_limit(cfg) {
         if cfg.limits.max_speed.is_some() {
-            s.push_str(&format!("\n     Joint speed limit {w} rad/s (limits.max_speed)."));
+            s.push_str(&format!(
+                "\n     Joint speed limit {w} rad/s (limits.max_speed)."
+            ));
         } else {
             s.push_str(&format!(
                 "\n     No-load speed {w} rad/s: the motor drives no faster, but brakes beyond it (a schedule that brakes hard may pass it)."
