@@ -150,7 +150,8 @@ def wilson(k, n):
     d = 1.0 + z * z / n
     c = (p + z * z / (2.0 * n)) / d
     h = z * math.sqrt(p * (1.0 - p) / n + z * z / (4.0 * n * n)) / d
-    return [max(c - h, 0.0), min(c + h, 1.0)]
+    # exact at the ends, as catflip's (c - h rounds to 6e-17 at no success)
+    return [0.0 if k == 0 else max(c - h, 0.0), 1.0 if k == n else min(c + h, 1.0)]
 
 
 # --- rotations -----------------------------------------------------------------
@@ -481,6 +482,9 @@ def main():
     ap.add_argument("--route", choices=("auto", "package", "csv"), default="auto",
                     help="controllers from the catflip package (auto: where installed) or from the exported CSVs")
     ap.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="worker processes (default: one per core)")
+    ap.add_argument("--trials-csv", default=None, metavar="PATH",
+                    help="also write each trial's landing error under each controller, catflip's and MuJoCo's, "
+                         "to PATH (a row a trial)")
     args = ap.parse_args()
     main_with(args)
 
@@ -539,6 +543,7 @@ def main_with(args):
     print(f"  {'controller':<10} {'catflip':>8} {'95 % CI':>15} {'MuJoCo':>8} {'95 % CI':>15} "
           f"{'max |diff| deg':>14} {'disagree':>8} {'MuJoCo s':>9}")
     results = {}
+    per_trial = {}
     _SHARED.update(robot=robot, ctls=ctls, base=base, rate0=rate0, cfg=cfg, seed=args.seed, tv_period=tv_period)
     jobs = max(1, min(args.jobs, len(rows)))
     for name, c in ctls.items():
@@ -557,6 +562,7 @@ def main_with(args):
             errs.append(e)
             diffs.append(abs(e - t))
             disagree += (e <= tol) != (t <= tol)
+        per_trial[name] = [(theirs[name], e) for e, (_, theirs) in zip(mine, rows)]
         k = sum(e <= tol for e in errs)
         cs = next(x for x in summary["controllers"] if x["name"] == name)
         lo, hi = wilson(k, len(errs))
@@ -564,6 +570,8 @@ def main_with(args):
         print(f"  {name:<10} {cs['success_rate'] * 100:7.1f}% {cs['ci95'][0] * 100:6.1f}-{cs['ci95'][1] * 100:5.1f} % "
               f"{k / len(errs) * 100:7.1f}% {lo * 100:6.1f}-{hi * 100:5.1f} % {max(diffs):14.2e} {disagree:8d} "
               f"{time.perf_counter() - t0:9.1f}")
+    if args.trials_csv:
+        write_trials(args.trials_csv, [d["trial"] for d, _ in rows], per_trial)
     print(json.dumps({"trials": len(rows), "seed": args.seed, "mujoco": results,
                       "catflip": {c["name"]: {"success_rate": c["success_rate"], "ci95": c["ci95"]}
                                   for c in summary["controllers"]}}))
@@ -571,6 +579,19 @@ def main_with(args):
         for f in fails:
             print("MISMATCH:", f, file=sys.stderr)
         sys.exit(1)
+
+
+def write_trials(path, trials, per_trial):
+    """A row a trial: its index, then each controller's landing error (deg from belly-down at
+    touchdown; nan: the flight diverged), catflip's and MuJoCo's."""
+    names = list(per_trial)
+    lines = [",".join(["trial"] + [f"{n}_{engine}_deg" for n in names for engine in ("catflip", "mujoco")])]
+    for i, t in enumerate(trials):
+        lines.append(",".join([str(t)] + [repr(float(x)) for n in names for x in per_trial[n][i]]))
+    path = pathlib.Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(lines) + "\n")
+    print(f"  wrote {path}")
 
 
 def run_cli(cmd):
