@@ -43,6 +43,12 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             catflip::console::count(trials, "trial")
         );
     }
+    if cfg.control.delay_ms != cfg.robustness.delay_ms {
+        eprintln!(
+            "warning: the controllers predict over a delay of {} ms (control.delay_ms) but the simulated robot's is {} ms (robustness.delay_ms); set both to your robot's delay to study it",
+            cfg.control.delay_ms, cfg.robustness.delay_ms
+        );
+    }
     let state = StudyState {
         status: SweepStatus::Partial,
         trials,
@@ -175,7 +181,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     if c.json {
         say!("{json}");
     } else {
-        say_lines(catflip::console::robustness::study(
+        let mut lines = catflip::console::robustness::study(
             &summary,
             &timing,
             results.len(),
@@ -183,7 +189,11 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             trials,
             seed,
             &written,
-        ));
+        );
+        if let Some(d) = flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref() {
+            lines.insert(1, format!("  the controllers fly {d}"));
+        }
+        say_lines(lines);
     }
     Ok(Status::Ok)
 }

@@ -330,12 +330,12 @@ fn a_design_longer_than_the_fall_is_refused_with_the_height_it_needs() {
 }
 
 /// A controller that assumes another delay than the study's robot has is
-/// said so on the study's page, with both delays.
+/// said so on the console and the study's page, with both delays.
 #[test]
 fn the_page_says_when_the_controllers_assume_another_delay() {
     let dir = crate::util::temp_dir();
     let seed = crate::util::config_arg("seed");
-    let (ok, _, err) = crate::util::run_ok(
+    let (ok, out, err) = crate::util::run_ok(
         &[
             "robustness",
             &seed,
@@ -347,6 +347,17 @@ fn the_page_says_when_the_controllers_assume_another_delay() {
         dir.path(),
     );
     assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: the controllers predict over a delay of 20 ms (control.delay_ms) but the simulated robot's is 5 ms (robustness.delay_ms)"),
+        "{err}"
+    );
+    // the console names the design flown, as the page does
+    assert!(
+        out.contains(
+            "the controllers fly the free-form peak-torque design seeded by the phased schedule"
+        ),
+        "{out}"
+    );
     let page = std::fs::read_to_string(
         dir.path()
             .join("output/seed/robustness@control.delay_ms=20/index.html"),
