@@ -228,6 +228,25 @@ impl SweepState {
         if points.iter().any(|p| p.error.is_some()) {
             notes.push("A point whose method failed keeps the other methods' numbers.".into());
         }
+        // a shard of a job array wider than the grid: nothing failed here
+        let warnings: Vec<String> = self
+            .points
+            .is_empty()
+            .then(|| {
+                let count = self.range.rsplit(':').next().and_then(|c| c.parse::<usize>().ok());
+                format!(
+                    "Shard {} holds no points of the grid {}: shards take whole continuation chunks of {} points{}. Nothing failed; the other shards hold the points.",
+                    self.shard,
+                    self.range,
+                    super::CHUNK,
+                    count.map_or(String::new(), |n| format!(
+                        ", so use at most {}",
+                        crate::console::count(n.div_ceil(super::CHUNK), "shard")
+                    )),
+                )
+            })
+            .into_iter()
+            .collect();
         let figs: Vec<&str> = figures.iter().map(String::as_str).collect();
         crate::report::index_html(&crate::report::Page {
             title: &format!("catflip sweep: {name}, {key}"),
@@ -244,7 +263,7 @@ impl SweepState {
             ],
             rows: &rows,
             notes: &notes,
-            warnings: &[],
+            warnings: &warnings,
             animation: "",
             figures: &figs,
             captions: super::caption,

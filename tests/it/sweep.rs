@@ -94,6 +94,18 @@ fn sharded_sweep_concatenates_into_the_single_machine_result() {
         assert!(ok, "{err}");
         // 11 points are two chunks of 10: the first of three shards is empty, and says so
         assert_eq!(err.contains("holds no points"), k == 1, "{k}: {err}");
+        // and so does its page, which a job array's log reader opens
+        let page = std::fs::read_to_string(dir.path().join(format!(
+            "shards/seed/sweep-cat_radius.shard-{k}-of-3@free.nodes=10,phased.nodes=12/index.html"
+        )))
+        .unwrap();
+        assert_eq!(
+            page.contains(&format!(
+                "Shard {k}/3 holds no points of the grid cat.radius=0.06:0.14:11: shards take whole continuation chunks of 10 points, so use at most 2 shards. Nothing failed"
+            )),
+            k == 1,
+            "{k}: {page}"
+        );
         let part = std::fs::read_to_string(dir.path().join(format!(
             "shards/seed/sweep-cat_radius.shard-{k}-of-3@free.nodes=10,phased.nodes=12/sweep-cat_radius.shard-{k}-of-3.csv"
         )))
