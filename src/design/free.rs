@@ -1239,7 +1239,8 @@ pub struct FreeResult {
     pub peak_torque_nm: f64,
     /// Peak at the collocation nodes and interval midpoints (the SCP objective), N m.
     pub node_peak_torque_nm: f64,
-    /// Largest bend along the motion, and the angle between the halves there.
+    /// Largest bend at the collocation nodes, and the angle between the
+    /// halves there (the schedule between the nodes may bend a little more).
     pub bend_deg: f64,
     pub theta_deg: f64,
     /// Total rotation of the bend direction (unwrapped), rad.
