@@ -99,6 +99,12 @@ enum Command {
         /// config) from the partial set it published.
         #[arg(long)]
         resume: bool,
+        /// Drop a replan that takes longer than this wall time, ms, as a
+        /// robot's controller would (the plan in use continues): the rates
+        /// then depend on this machine's speed and load. Default: every
+        /// replan is used (a deterministic study).
+        #[arg(long, value_name = "MS", value_parser = budget_ms, allow_negative_numbers = true)]
+        replan_budget_ms: Option<f64>,
     },
     /// The motors needed for a drop height: the stall torque against no-load speed that just makes the flip, and the configured motor's best gear ratio.
     Size {
@@ -213,6 +219,16 @@ fn trials(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `--replan-budget-ms`: a wall time, ms, positive and at most a second.
+fn budget_ms(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(b) if b > 0.0 && b <= 1000.0 => Ok(b),
+        _ => Err(format!(
+            "{s}: must be in (0, 1000] ms, a replan's wall-clock budget (e.g. the control period, 10 ms at 100 Hz); leave it out to use every replan"
+        )),
+    }
+}
+
 /// `--threads`: a whole number, at least 1.
 fn thread_count(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
@@ -306,6 +322,7 @@ pub fn run() -> Result<Status> {
             threads,
             shard,
             resume,
+            replan_budget_ms,
         } => crate::robustness::cmd_robustness(
             &common,
             crate::robustness::StudyArgs {
@@ -314,6 +331,7 @@ pub fn run() -> Result<Status> {
                 threads: threads_or_cores(threads),
                 shard: shard.unwrap_or(Shard::ALL),
                 resume,
+                replan_budget_ms,
             },
         ),
         Command::Size {

@@ -21,6 +21,8 @@ pub struct StudyArgs {
     pub threads: usize,
     pub shard: Shard,
     pub resume: bool,
+    /// A replan over this wall time, ms, is dropped (None: every one counts).
+    pub replan_budget_ms: Option<f64>,
 }
 
 pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
@@ -30,6 +32,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         threads,
         shard,
         resume,
+        replan_budget_ms,
     } = args;
     let cfg = load(c)?;
     let suffix = shard.suffix();
@@ -54,6 +57,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         trials,
         seed,
         shard: format!("{}/{}", shard.index, shard.count),
+        replan_budget_ms,
         config: serde_json::to_value(&cfg)?,
     };
     let mut kept = vec![None; range.len()];
@@ -84,7 +88,8 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         move || -> catflip::Result<()> {
             let design = catflip::control::robustness::design(&cfg)?;
             *flown.lock().unwrap_or_else(|p| p.into_inner()) = Some(described(&design));
-            let study = Study::new(&cfg, Arc::new(design.plan), seed);
+            let mut study = Study::new(&cfg, Arc::new(design.plan), seed);
+            study.replanning.budget_s = replan_budget_ms.map(|b| 1e-3 * b);
             // the trials' own clock: the design before them would make the
             // first trials' rate, and the time left, many times too long
             let clock = std::time::Instant::now();
@@ -156,7 +161,10 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             (&range, trials),
             interrupted,
             drawn.then_some((figure.as_str(), bins.as_slice())),
-            flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref(),
+            (
+                flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref(),
+                replan_budget_ms,
+            ),
         ),
     );
     out.add(
@@ -199,8 +207,9 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
 }
 
 /// The study's page: each controller's line, what was drawn and how to fly
-/// a trial again, the controllers and the design they fly, and the figure
-/// with its bins' trials; `range` is the trials of the study's `trials` on it.
+/// a trial again, the controllers and the design they fly (and the replans'
+/// budget, ms, if any), and the figure with its bins' trials; `range` is the
+/// trials of the study's `trials` on it.
 fn page(
     cfg: &catflip::Config,
     s: &catflip::control::robustness::Summary,
@@ -208,7 +217,7 @@ fn page(
     (range, trials): (&std::ops::Range<usize>, usize),
     interrupted: bool,
     figure: Option<(&str, &[catflip::control::figure::Bins])>,
-    design: Option<&str>,
+    (design, budget_ms): (Option<&str>, Option<f64>),
 ) -> String {
     let rows: Vec<Vec<String>> = s
         .controllers
@@ -253,7 +262,7 @@ fn page(
             p.rate_noise_rad_s,
             100.0 * p.pd_gain_error,
         ),
-        controllers(cfg, design),
+        controllers(cfg, design, budget_ms),
         format!(
             "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}), config carrying the study's --set keys (docs/control.md); robustness.csv has every trial's draws and landings.",
             s.seed
@@ -306,7 +315,7 @@ fn described(d: &catflip::design::free::FreeResult) -> String {
 /// The page's note on the controllers: the design they fly, their rate and
 /// the delay they predict over beside the simulated robot's, and that a
 /// replan is used whatever its wall time.
-fn controllers(cfg: &catflip::Config, design: Option<&str>) -> String {
+fn controllers(cfg: &catflip::Config, design: Option<&str>, budget_ms: Option<f64>) -> String {
     let (c, r) = (&cfg.control, &cfg.robustness);
     let mut s = format!(
         "The controllers fly {}. TVLQR and replanning correct it {} times a second (control.rate_hz) and predict over a delay of {} ms (control.delay_ms); the simulated robot's actuator delay is {} ms (robustness.delay_ms)",
@@ -318,6 +327,11 @@ fn controllers(cfg: &catflip::Config, design: Option<&str>) -> String {
     if c.delay_ms != r.delay_ms {
         s.push_str(": the controllers assume another delay than the robot has");
     }
-    s.push_str(". The study is deterministic: each replan is used whatever its wall time (the replans' times below say how many a robot's processor would have missed).");
+    match budget_ms {
+        None => s.push_str(". The study is deterministic: each replan is used whatever its wall time (the replans' times below say how many a robot's processor would have missed; --replan-budget-ms drops them as a robot would)."),
+        Some(b) => s.push_str(&format!(
+            ". A replan that took longer than {b} ms of wall time on this machine was dropped, the plan in use going on (--replan-budget-ms): the replanning controller's rate depends on this machine's speed and load."
+        )),
+    }
     s
 }

@@ -17,6 +17,9 @@ pub struct StudyState {
     pub seed: u64,
     /// `K/N`.
     pub shard: String,
+    /// `--replan-budget-ms`, when given (a replan over it is dropped).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub replan_budget_ms: Option<f64>,
     pub config: serde_json::Value,
 }
 
@@ -61,6 +64,13 @@ impl StudyState {
                 ("--trials", old.trials.to_string(), self.trials.to_string()),
                 ("--seed", old.seed.to_string(), self.seed.to_string()),
                 ("--shard", old.shard.clone(), self.shard.clone()),
+                (
+                    "--replan-budget-ms",
+                    old.replan_budget_ms
+                        .map_or("none".into(), |b| b.to_string()),
+                    self.replan_budget_ms
+                        .map_or("none".into(), |b| b.to_string()),
+                ),
             ],
             &old.config,
             &self.config,

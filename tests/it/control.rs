@@ -368,3 +368,80 @@ fn the_page_says_when_the_controllers_assume_another_delay() {
         "{page}"
     );
 }
+
+/// `--replan-budget-ms` drops a replan over its wall time, as a robot's
+/// controller would: with a budget no replan can meet (1 us), the replanning
+/// controller flies its design's TVLQR, trial for trial to the bit; the page
+/// and the state say so, `--resume` keeps to the budget, and a budget
+/// outside (0, 1000] ms is refused.
+#[test]
+fn a_replan_budget_nothing_meets_leaves_the_tvlqr() {
+    let dir = crate::util::temp_dir();
+    let seed = crate::util::config_arg("seed");
+    let study = [
+        "robustness",
+        &seed,
+        "--trials",
+        "2",
+        "--threads",
+        "1",
+        "--replan-budget-ms",
+        "0.001",
+    ];
+    let (ok, out, err) = crate::util::run_ok(&study, dir.path());
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("0 taken") && out.contains("dropped over their budget"),
+        "{out}"
+    );
+    let set = dir.path().join("output/seed/robustness");
+    let csv = std::fs::read_to_string(set.join("robustness.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let (tv, rp) = (
+        col("tvlqr_landing_error_deg"),
+        col("replan_landing_error_deg"),
+    );
+    let mut rows = 0;
+    for line in lines {
+        let cells: Vec<&str> = line.split(',').collect();
+        assert_eq!(cells[tv], cells[rp], "{line}");
+        rows += 1;
+    }
+    assert_eq!(rows, 2);
+    let page = std::fs::read_to_string(set.join("index.html")).unwrap();
+    assert!(
+        page.contains(
+            "A replan that took longer than 0.001 ms of wall time on this machine was dropped"
+        ),
+        "{page}"
+    );
+    let state = std::fs::read_to_string(set.join("robustness.state.json")).unwrap();
+    assert!(state.contains("\"replan_budget_ms\": 0.001"), "{state}");
+    // resumed without the budget: another study, refused
+    let (ok, _, err) = crate::util::run_ok(&study[..6], dir.path());
+    assert!(ok, "{err}");
+    let (ok, _, err) = crate::util::run_ok(&[&study[..], &["--resume"]].concat(), dir.path());
+    assert!(
+        !ok && err.contains("--replan-budget-ms none (now 0.001)"),
+        "{err}"
+    );
+    for bad in ["0", "-5", "1001", "nan"] {
+        let out = crate::util::output(
+            &[
+                "robustness",
+                &seed,
+                "--replan-budget-ms",
+                bad,
+                "--out",
+                "bad",
+            ],
+            dir.path(),
+        );
+        let err = crate::util::stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{bad}: {err}");
+        assert!(err.contains("must be in (0, 1000] ms"), "{bad}: {err}");
+        assert!(!dir.path().join("bad").exists(), "{bad}");
+    }
+}
