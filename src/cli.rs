@@ -594,14 +594,17 @@ fn cmd_sweep(
         })
         .collect();
     let key = format!("{key}{}", shard.suffix());
-    if shard.points(spec.count).is_empty() {
-        // a job array wider than the grid: legitimate, but worth a word
-        eprintln!("{}", console::sweep::empty_shard_warning(shard, spec.count));
-    }
     let publisher = publisher(c, &cfg, &format!("sweep-{key}"))?;
     let progress = Progress::new(quiet);
     let clock = std::time::Instant::now();
     let state = catflip::sweep::resume::SweepState::new(spec, shard, m, &cfg);
+    if state.points.is_empty() {
+        // a job array wider than the grid: legitimate, but worth a word
+        eprintln!(
+            "warning: {}",
+            console::sweep::empty_shard(&state.shard, &state.range, spec.count)
+        );
+    }
     let kept = if resume {
         let old = state.resume_from(&publisher.link(), &key)?;
         eprintln!(

@@ -119,6 +119,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         Outcome::Interrupted => true,
     };
     let results: Vec<TrialResult> = slots.into_iter().flatten().collect();
+    let flown = flown.lock().unwrap_or_else(|p| p.into_inner()).take();
     let state = StudyState {
         status: if interrupted {
             SweepStatus::Partial
@@ -161,10 +162,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             (&range, trials),
             interrupted,
             drawn.then_some((figure.as_str(), bins.as_slice())),
-            (
-                flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref(),
-                replan_budget_ms,
-            ),
+            (flown.as_deref(), replan_budget_ms),
         ),
     );
     out.add(
@@ -198,7 +196,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             seed,
             &written,
         );
-        if let Some(d) = flown.lock().unwrap_or_else(|p| p.into_inner()).as_deref() {
+        if let Some(d) = &flown {
             lines.insert(1, format!("  the controllers fly {d}"));
         }
         say_lines(lines);
@@ -300,12 +298,11 @@ fn page(
 
 /// The design a study's controllers fly, in words.
 fn described(d: &catflip::design::free::FreeResult) -> String {
-    let kebab = |v: serde_json::Value| v.as_str().unwrap_or_default().to_string();
     format!(
         "the free-form {} design seeded by the {} schedule, with a continuous torque (status {}; peak {:.4} N m, manoeuvre {:.4} s; catflip optimize --mode free --seed {seed} --set free.torque_jumps=false --set simulate.samples_per_phase=2000, with the study's other --set keys, makes it with rows enough to export, and catflip export mjcf CONFIG --schedule on its free.csv writes its TVLQR gains: docs/control.md)",
-        kebab(serde_json::json!(d.objective)),
+        d.objective.name(),
         d.seed,
-        kebab(serde_json::json!(d.status)),
+        catflip::verdict::Status::from(d.status).name(),
         d.peak_torque_nm,
         d.manoeuvre_time_s,
         seed = d.seed,

@@ -73,15 +73,14 @@ pub fn partial_warning(points: &[SweepPoint]) -> Option<String> {
     })
 }
 
-/// The warning of a shard that holds no points of a `count`-point grid.
-pub fn empty_shard_warning(shard: crate::sweep::Shard, count: usize) -> String {
+/// What a shard that holds no points of the grid `grid` (`KEY=FROM:TO:N`,
+/// `count` points) says, on the console and on its page: a job array wider
+/// than the grid is legitimate, and nothing failed.
+pub fn empty_shard(shard: &str, grid: &str, count: usize) -> String {
     format!(
-        "warning: shard {}/{} holds no points: shards take whole continuation chunks of {} points, and the {} points make {}; use at most that many shards",
-        shard.index,
-        shard.count,
+        "shard {shard} holds no points of the grid {grid}: shards take whole continuation chunks of {} points, so use at most {}",
         crate::sweep::CHUNK,
-        count,
-        count.div_ceil(crate::sweep::CHUNK)
+        super::count(count.div_ceil(crate::sweep::CHUNK), "shard")
     )
 }
 

@@ -936,6 +936,11 @@ pub fn rate_panels(
         )
         .map_err(perr)?;
         let areas = plot.split_evenly((1, panels.len().max(1)));
+        // a series' style by its name's first appearance, the same in every panel
+        let solid = |i| Style {
+            dash: None,
+            ..distinct_style(i)
+        };
         let mut names: Vec<&str> = Vec::new();
         for (area, panel) in areas.iter().zip(panels) {
             let mut c = chart(
@@ -952,10 +957,7 @@ pub fn rate_panels(
                     names.push(name);
                     names.len() - 1
                 });
-                let st = Style {
-                    dash: None,
-                    ..distinct_style(i)
-                };
+                let st = solid(i);
                 let dx = (k as f64 - 0.5 * (count - 1.0)) * 0.02;
                 let pts: Vec<(f64, f64)> = rates
                     .iter()
@@ -978,13 +980,7 @@ pub fn rate_panels(
         let mut keys: Vec<(String, Key)> = names
             .iter()
             .enumerate()
-            .map(|(i, name)| {
-                let st = Style {
-                    dash: None,
-                    ..distinct_style(i)
-                };
-                (name.to_string(), Key::Line(st))
-            })
+            .map(|(i, name)| (name.to_string(), Key::Line(solid(i))))
             .collect();
         keys.push((format!("bars: {interval}"), Key::Note));
         legend(&side, &keys)

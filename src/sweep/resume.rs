@@ -233,17 +233,14 @@ impl SweepState {
             .points
             .is_empty()
             .then(|| {
-                let count = self.range.rsplit(':').next().and_then(|c| c.parse::<usize>().ok());
-                format!(
-                    "Shard {} holds no points of the grid {}: shards take whole continuation chunks of {} points{}. Nothing failed; the other shards hold the points.",
-                    self.shard,
-                    self.range,
-                    super::CHUNK,
-                    count.map_or(String::new(), |n| format!(
-                        ", so use at most {}",
-                        crate::console::count(n.div_ceil(super::CHUNK), "shard")
-                    )),
-                )
+                let count = self.range.rsplit(':').next().and_then(|c| c.parse().ok());
+                let mut w = crate::console::sweep::empty_shard(
+                    &self.shard,
+                    &self.range,
+                    count.unwrap_or(0),
+                );
+                w[..1].make_ascii_uppercase();
+                format!("{w}. Nothing failed; the other shards hold the points.")
             })
             .into_iter()
             .collect();
