@@ -105,6 +105,12 @@ enum Command {
         /// replan is used (a deterministic study).
         #[arg(long, value_name = "MS", value_parser = budget_ms, allow_negative_numbers = true)]
         replan_budget_ms: Option<f64>,
+        /// Fly only trial K of the study again (its index in robustness.csv,
+        /// below --trials), under each controller (at once with --threads 2
+        /// or more): its landings, flights (CSV, figures) and draws, in
+        /// `robustness-trial-K/`.
+        #[arg(long, value_name = "K", value_parser = trial_index, allow_negative_numbers = true, conflicts_with_all = ["shard", "resume"])]
+        trial: Option<usize>,
     },
     /// The motors needed for a drop height: the stall torque against no-load speed that just makes the flip, and the configured motor's best gear ratio.
     Size {
@@ -219,6 +225,15 @@ fn trials(s: &str) -> Result<usize, String> {
     }
 }
 
+/// `--trial`: a trial's index, 0 or more.
+fn trial_index(s: &str) -> Result<usize, String> {
+    s.parse::<usize>().map_err(|_| {
+        format!(
+            "{s}: must be a trial's index, a whole number from 0 (robustness.csv's `trial` column)"
+        )
+    })
+}
+
 /// `--replan-budget-ms`: a wall time, ms, positive and at most a second.
 fn budget_ms(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
@@ -323,17 +338,21 @@ pub fn run() -> Result<Status> {
             shard,
             resume,
             replan_budget_ms,
-        } => crate::robustness::cmd_robustness(
-            &common,
-            crate::robustness::StudyArgs {
+            trial,
+        } => {
+            let args = crate::robustness::StudyArgs {
                 trials,
                 seed,
                 threads: threads_or_cores(threads),
                 shard: shard.unwrap_or(Shard::ALL),
                 resume,
                 replan_budget_ms,
-            },
-        ),
+            };
+            match trial {
+                Some(k) => crate::robustness::cmd_trial(&common, args, k),
+                None => crate::robustness::cmd_robustness(&common, args),
+            }
+        }
         Command::Size {
             common,
             height,

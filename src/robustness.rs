@@ -204,6 +204,110 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     Ok(Status::Ok)
 }
 
+/// `robustness --trial K`: trial `k` of the study `args` describes flown
+/// again under each controller, its flights written and shown.
+pub fn cmd_trial(c: &Common, args: StudyArgs, k: usize) -> Result<Status> {
+    use catflip::control::replay;
+    if k >= args.trials {
+        return Err(catflip::Error::Usage(format!(
+            "--trial {k}: the study has {} (numbered 0 to {}); give a trial below --trials, or a larger --trials",
+            catflip::console::count(args.trials, "trial"),
+            args.trials - 1
+        ))
+        .into());
+    }
+    let cfg = load(c)?;
+    let publisher = publisher(c, &cfg, &format!("robustness-trial-{k}"))?;
+    let design = catflip::control::robustness::design(&cfg)?;
+    let flown = described(&design);
+    let mut study = Study::new(&cfg, Arc::new(design.plan), args.seed);
+    study.replanning.budget_s = args.replan_budget_ms.map(|b| 1e-3 * b);
+    let r = study.replay(k, replay::every(study.reference.h), args.threads > 1);
+    let max_tilt_deg = study.max_tilt_deg();
+    let summary = replay::summary(&r, args.seed, max_tilt_deg);
+    let json = serde_json::to_string_pretty(&summary)?;
+    let mut out = Output::default();
+    out.add("flight.csv", replay::to_csv(&r));
+    out.add("trial.json", json.clone());
+    out.add("belly.svg", replay::belly_figure(&r, max_tilt_deg)?);
+    let mut figures = vec!["belly.svg".to_string()];
+    for i in 0..r.flights.len() {
+        figures.push(replay::torque_file(i));
+        out.add(replay::torque_file(i), replay::torque_figure(&r, i)?);
+    }
+    out.add(
+        "index.html",
+        trial_page(&cfg, &summary, &figures, (&flown, args.replan_budget_ms)),
+    );
+    let written = publisher.publish(out)?;
+    if c.json {
+        say!("{json}");
+    } else {
+        let mut lines = catflip::console::robustness::trial(&summary, &written);
+        lines.insert(1, format!("  the controllers fly {flown}"));
+        say_lines(lines);
+    }
+    Ok(Status::Ok)
+}
+
+/// A replayed trial's page: each controller's landing, the draws, the
+/// controllers and the figures.
+fn trial_page(
+    cfg: &catflip::Config,
+    s: &catflip::control::replay::Summary,
+    figures: &[String],
+    (design, budget_ms): (&str, Option<f64>),
+) -> String {
+    let rows: Vec<Vec<String>> = s
+        .controllers
+        .iter()
+        .map(|f| {
+            vec![
+                f.name.to_string(),
+                format!("{:.3}", f.landing_error_deg),
+                if f.landed { "yes" } else { "no" }.to_string(),
+                format!("{:.4}", f.max_correction_nm),
+                f.commands.to_string(),
+                if f.replans > 0 {
+                    format!("{} ({} taken)", f.replans, f.replans_taken)
+                } else {
+                    String::new()
+                },
+            ]
+        })
+        .collect();
+    let notes = vec![
+        format!(
+            "Trial {} of the study seeded {}, dropped from {} m (fall.height): {}. It lands when the belly ends within {} deg of straight down (land.max_tilt_deg; 10 deg unless set). These are the landings robustness.csv records for this trial; flight.csv holds each flight's state (the simulators' world, docs/control.md) and torque every millisecond.",
+            s.trial,
+            s.seed,
+            cfg.fall.height,
+            catflip::control::replay::draws(&s.draw),
+            s.max_tilt_deg,
+        ),
+        controllers(cfg, Some(design), budget_ms, false),
+    ];
+    let figures: Vec<&str> = figures.iter().map(String::as_str).collect();
+    catflip::report::index_html(&catflip::report::Page {
+        title: &format!("catflip robustness: {}, trial {}", cfg.name, s.trial),
+        lead: None,
+        header: &[
+            "controller",
+            "landing deg",
+            "landed",
+            "largest correction N m",
+            "commands",
+            "replans",
+        ],
+        rows: &rows,
+        notes: &notes,
+        warnings: &[],
+        animation: "",
+        figures: &figures,
+        captions: catflip::control::replay::caption,
+    })
+}
+
 /// The study's page: each controller's line, what was drawn and how to fly
 /// a trial again, the controllers and the design they fly (and the replans'
 /// budget, ms, if any), and the figure with its bins' trials; `range` is the
@@ -260,10 +364,10 @@ fn page(
             p.rate_noise_rad_s,
             100.0 * p.pd_gain_error,
         ),
-        controllers(cfg, design, budget_ms),
+        controllers(cfg, design, budget_ms, true),
         format!(
-            "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}), config carrying the study's --set keys (docs/control.md); robustness.csv has every trial's draws and landings.",
-            s.seed
+            "The success rate's interval is Wilson's 95 % interval; a flight that diverged counts as 180 deg. A trial flies again, with its flights written and drawn, by this command with --seed {} --trial K (and the study's --set keys), or from Python with catflip.Controller(config, kind=...).fly(trial=K, seed={}) (docs/control.md); robustness.csv has every trial's draws and landings.",
+            s.seed, s.seed
         ),
     ];
     if let Some((_, bins)) = figure {
@@ -311,8 +415,14 @@ fn described(d: &catflip::design::free::FreeResult) -> String {
 
 /// The page's note on the controllers: the design they fly, their rate and
 /// the delay they predict over beside the simulated robot's, and that a
-/// replan is used whatever its wall time.
-fn controllers(cfg: &catflip::Config, design: Option<&str>, budget_ms: Option<f64>) -> String {
+/// replan is used whatever its wall time (`timed`: the page lists the
+/// replans' times).
+fn controllers(
+    cfg: &catflip::Config,
+    design: Option<&str>,
+    budget_ms: Option<f64>,
+    timed: bool,
+) -> String {
     let (c, r) = (&cfg.control, &cfg.robustness);
     let mut s = format!(
         "The controllers fly {}. TVLQR and replanning correct it {} times a second (control.rate_hz) and predict over a delay of {} ms (control.delay_ms); the simulated robot's actuator delay is {} ms (robustness.delay_ms)",
@@ -325,7 +435,11 @@ fn controllers(cfg: &catflip::Config, design: Option<&str>, budget_ms: Option<f6
         s.push_str(": the controllers assume another delay than the robot has");
     }
     match budget_ms {
-        None => s.push_str(". The study is deterministic: each replan is used whatever its wall time (the replans' times below say how many a robot's processor would have missed; --replan-budget-ms drops them as a robot would)."),
+        None => s.push_str(if timed {
+            ". The study is deterministic: each replan is used whatever its wall time (the replans' times below say how many a robot's processor would have missed; --replan-budget-ms drops them as a robot would)."
+        } else {
+            ". The flight is deterministic: each replan is used whatever its wall time (--replan-budget-ms drops those over a budget as a robot would)."
+        }),
         Some(b) => s.push_str(&format!(
             ". A replan that took longer than {b} ms of wall time on this machine was dropped, the plan in use going on (--replan-budget-ms): the replanning controller's rate depends on this machine's speed and load."
         )),

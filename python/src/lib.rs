@@ -2111,9 +2111,10 @@ impl Controller {
                     },
                 },
             };
-            let mut log = Vec::new();
+            let mut log = catflip::control::closed_loop::Log::default();
             let landing =
                 catflip::control::closed_loop::fly_logged(r, fb, &o.motor, flight, Some(&mut log));
+            let log = log.commands;
             Flight {
                 landing_error_deg: landing.error_deg,
                 max_correction_nm: landing.max_correction_nm,

@@ -51,6 +51,40 @@ pub fn study(
     lines
 }
 
+/// A replayed trial's table: its draws, then each controller's landing.
+pub fn trial(s: &crate::control::replay::Summary, written: &[PathBuf]) -> Vec<String> {
+    let mut lines = vec![
+        format!(
+            "catflip robustness: trial {} of the study seeded {}, flown again; landing within {} deg of belly-down",
+            s.trial, s.seed, s.max_tilt_deg
+        ),
+        format!("  {}", crate::control::replay::draws(&s.draw)),
+        format!(
+            "  {:<10} {:>12} {:>7} {:>24} {:>9} {:>9}",
+            "controller", "landing deg", "landed", "largest correction N m", "commands", "replans"
+        ),
+    ];
+    for f in &s.controllers {
+        lines.push(format!(
+            "  {:<10} {:>12.3} {:>7} {:>24.4} {:>9} {:>9}",
+            f.name,
+            f.landing_error_deg,
+            if f.landed { "yes" } else { "no" },
+            f.max_correction_nm,
+            f.commands,
+            if f.replans > 0 {
+                format!("{} ({} taken)", f.replans, f.replans_taken)
+            } else {
+                String::new()
+            }
+        ));
+    }
+    for p in written {
+        lines.push(format!("  wrote {}", p.display()));
+    }
+    lines
+}
+
 /// The replans' counts and wall times, when there were any.
 pub fn replans(timing: &ReplanTiming) -> Option<String> {
     (timing.replans > 0).then(|| {

@@ -103,6 +103,35 @@ pub struct Command {
     pub correction: [f64; 2],
 }
 
+/// The true state at simulator step `step` and the joint torque acting
+/// over that step (the motor's, after saturation and back-EMF).
+#[derive(Debug, Clone, Copy)]
+pub struct Sample {
+    pub step: usize,
+    pub state: Y,
+    pub torque: [f64; 2],
+}
+
+/// What a flight records beside its landing ([`fly_logged`]).
+#[derive(Debug, Clone, Default)]
+pub struct Log {
+    /// Every command sent.
+    pub commands: Vec<Command>,
+    /// The true state every `every` steps and at touchdown (none when `every` is 0).
+    pub samples: Vec<Sample>,
+    pub every: usize,
+}
+
+impl Log {
+    /// A log of the commands and of the state every `every` steps.
+    pub fn every(every: usize) -> Log {
+        Log {
+            every,
+            ..Log::default()
+        }
+    }
+}
+
 /// The joint PD's correction at step `j` from the measurement `m`.
 pub fn pd_command(r: &Reference, kp: f64, kd: f64, j: usize, m: &Y) -> [f64; 2] {
     let (q, qd) = r.shape[j.min(r.steps)];
@@ -135,14 +164,15 @@ pub fn fly(r: &Reference, fb: Feedback, motor: &Motor, f: Flight) -> Landing {
     fly_logged(r, fb, motor, f, None)
 }
 
-/// [`fly`], with every command appended to `log`: what a controller run
-/// outside catflip (the Python package's) is checked against.
+/// [`fly`], with every command appended to `log` (what a controller run
+/// outside catflip, the Python package's, is checked against) and the true
+/// state sampled ([`Log::every`]: what a replayed trial shows).
 pub fn fly_logged(
     r: &Reference,
     fb: Feedback,
     motor: &Motor,
     mut f: Flight,
-    mut log: Option<&mut Vec<Command>>,
+    mut log: Option<&mut Log>,
 ) -> Landing {
     let n = r.steps;
     // corrections by the step from which they act
@@ -209,7 +239,7 @@ pub fn fly_logged(
             };
             if let Some((m, u)) = u {
                 if let Some(log) = log.as_deref_mut() {
-                    log.push(Command {
+                    log.commands.push(Command {
                         step: j,
                         measured: m,
                         correction: u,
@@ -230,10 +260,31 @@ pub fn fly_logged(
         }
         let plant = f.plant;
         let live = replanned.as_ref().map_or(r, |(l, _)| l);
-        y = rk4(&plant, &y, live.h, |s, ys| {
+        let torque = |s: usize, ys: &Y| {
             let ff = live.ff_at(j, s);
             motor.clip([0, 1].map(|i| ff[i] + acting[i] + noise[i]), [ys[6], ys[7]])
-        });
+        };
+        // (the torque over the step from the state: only where it is logged)
+        let sampling = log.as_deref_mut().filter(|l| l.every > 0);
+        let acted = sampling.as_ref().map(|_| torque(0, &y));
+        if let (Some(log), Some(t)) = (sampling, acted)
+            && j % log.every == 0
+        {
+            log.samples.push(Sample {
+                step: j,
+                state: y,
+                torque: t,
+            });
+        }
+        y = rk4(&plant, &y, live.h, &torque);
+        let ended = j + 1 == n || !y.iter().all(|v| v.is_finite());
+        if let (Some(log), Some(t), true) = (log.as_deref_mut(), acted, ended) {
+            log.samples.push(Sample {
+                step: j + 1,
+                state: y,
+                torque: t,
+            });
+        }
         if !y.iter().all(|v| v.is_finite()) {
             return finish(y, max_corr, replanned);
         }

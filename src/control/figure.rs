@@ -1,7 +1,7 @@
 //! The study's figure: each controller's success rate against the size of
-//! each perturbation, as a fraction of its largest configured value (trials
-//! binned by that one perturbation, the others drawn as they fell), with the
-//! rate's 95 % interval, so that a bin of few trials shows how little it says.
+//! each perturbation, in its own unit (trials binned by that one
+//! perturbation, the others drawn as they fell), with the rate's 95 %
+//! interval, so that a bin of few trials shows how little it says.
 
 use super::robustness::{CONTROLLERS, TrialResult, wilson};
 use crate::config::Config;
@@ -23,7 +23,7 @@ pub fn bin_count(trials: usize) -> usize {
 /// The index.html caption of the study's figure (any shard's).
 pub fn caption(file: &str) -> Option<&'static str> {
     (file.starts_with("robustness") && file.ends_with(".svg")).then_some(
-        "Each controller's success rate against the size of each perturbation (spin, tilt, inertia error; a panel each), as a fraction of its largest value in [robustness]: the trials binned by that one perturbation, the others as they fell. A colour per controller; each bar is the rate's 95 % (Wilson) interval, wide where a bin holds few trials; a bin without trials is left out. The notes above give each bin's trials.",
+        "Each controller's success rate against the size of each perturbation (spin, tilt, inertia error; a panel each, its axis in the perturbation's unit up to its largest value in [robustness]): the trials binned by that one perturbation, the others as they fell. A colour per controller; each bar is the rate's 95 % (Wilson) interval, wide where a bin holds few trials; a bin without trials is left out. The notes above give each bin's trials.",
     )
 }
 
@@ -34,6 +34,10 @@ pub struct Bins {
     /// `spin` (the release rate's magnitude), `tilt` or `inertia` (the
     /// larger of the halves' errors).
     pub perturbation: &'static str,
+    /// The size's axis: what it is and its unit.
+    pub axis: &'static str,
+    /// The largest size drawn, in the axis' unit: the bins split 0 to it.
+    pub largest: f64,
     /// Trials in each bin.
     pub trials: Vec<usize>,
     /// Of them, the ones each controller ([`CONTROLLERS`]) landed.
@@ -41,10 +45,12 @@ pub struct Bins {
 }
 
 impl Bins {
-    /// Each bin's centre, as a fraction of the largest value.
+    /// Each bin's centre, in the axis' unit.
     pub fn centres(&self) -> Vec<f64> {
         let n = self.trials.len();
-        (0..n).map(|b| (b as f64 + 0.5) / n as f64).collect()
+        (0..n)
+            .map(|b| self.largest * (b as f64 + 0.5) / n as f64)
+            .collect()
     }
 }
 
@@ -54,25 +60,36 @@ pub fn bins(cfg: &Config, results: &[TrialResult], max_tilt_deg: f64) -> Vec<Bin
     let p = &cfg.robustness;
     let spin_max = p.spin_rad_s.iter().copied().fold(0.0, f64::max);
     type Size = fn(&TrialResult) -> f64;
-    let sizes: [(&str, f64, Size); 3] = [
-        ("spin", spin_max, |r| {
+    // (the inertia error in % on its axis: a fraction reads as a rate)
+    let sizes: [(&str, &str, f64, f64, Size); 3] = [
+        ("spin", "spin at release, rad/s", spin_max, 1.0, |r| {
             let w = r.draw.spin_rad_s;
             (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt()
         }),
-        ("tilt", p.tilt_deg, |r| r.draw.tilt_deg),
-        ("inertia", p.inertia_error, |r| {
-            r.draw.inertia_error[0]
-                .abs()
-                .max(r.draw.inertia_error[1].abs())
+        ("tilt", "tilt at release, deg", p.tilt_deg, 1.0, |r| {
+            r.draw.tilt_deg
         }),
+        (
+            "inertia",
+            "inertia error (larger half), %",
+            p.inertia_error,
+            100.0,
+            |r| {
+                r.draw.inertia_error[0]
+                    .abs()
+                    .max(r.draw.inertia_error[1].abs())
+            },
+        ),
     ];
     sizes
         .into_iter()
-        .filter(|s| s.1 > 0.0)
-        .map(|(perturbation, max, size)| {
+        .filter(|s| s.2 > 0.0)
+        .map(|(perturbation, axis, max, unit, size)| {
             let bins = bin_count(results.len());
             let mut b = Bins {
                 perturbation,
+                axis,
+                largest: max * unit,
                 trials: vec![0; bins],
                 landed: std::array::from_fn(|_| vec![0; bins]),
             };
@@ -119,7 +136,6 @@ pub fn success_by_size(bins: &[Bins], max_tilt_deg: f64) -> Result<Option<String
     let panels: Vec<RatePanel> = bins.iter().map(panel).collect();
     Ok(Some(crate::report::rate_panels(
         &format!("Landing within {max_tilt_deg} deg against each perturbation's size"),
-        "size / its largest value",
         "success rate",
         &panels,
         "95 % interval (Wilson)",
@@ -152,6 +168,8 @@ fn panel(b: &Bins) -> RatePanel {
         .collect();
     RatePanel {
         title: b.perturbation.to_string(),
+        xdesc: b.axis.to_string(),
+        xmax: b.largest,
         series,
     }
 }
@@ -246,9 +264,16 @@ mod tests {
         assert_eq!(b.len(), 3);
         for b in &b {
             assert_eq!(b.trials.len(), 2, "{b:?}");
-            assert_eq!(b.centres(), [0.25, 0.75]);
+            let largest = match b.perturbation {
+                "spin" => 0.5,
+                "tilt" => 20.0,
+                _ => 10.0,
+            };
+            assert!((b.largest - largest).abs() < 1e-12, "{b:?}");
+            assert_eq!(b.centres(), [0.25 * b.largest, 0.75 * b.largest]);
             let p = panel(b);
             assert_eq!(p.title, b.perturbation);
+            assert_eq!(p.xmax, b.largest);
             for ((name, rates), landed) in p.series.iter().zip(&b.landed) {
                 for ((r, &k), &n) in rates.iter().zip(landed).zip(&b.trials) {
                     assert_eq!([r.lo, r.hi], wilson(k, n), "{name}");
@@ -266,9 +291,9 @@ mod tests {
         }
         let svg = success_by_size(&b, 10.0).unwrap().unwrap();
         for what in [
-            "spin",
-            "tilt",
-            "inertia",
+            "spin at release, rad/s",
+            "tilt at release, deg",
+            "inertia error (larger half), %",
             "95 % interval (Wilson)",
             "open-loop",
         ] {

@@ -3,7 +3,7 @@
 //! stream ([`super::rng`]), so that the study is deterministic for a seed,
 //! independent of threads, and its shards concatenate into the whole.
 
-use super::closed_loop::{Feedback, Flight, fly};
+use super::closed_loop::{Feedback, Flight, Landing, Log, fly_logged};
 use super::reference::{Reference, release};
 use super::replanning::SharedPlan;
 use super::replanning::{Outcome, Record, Replanning};
@@ -143,6 +143,16 @@ impl Draw {
     }
 }
 
+/// A trial flown again ([`Study::replay`]): its draws and, under each of
+/// [`CONTROLLERS`], the landing and the flight's log.
+#[derive(Debug, Clone)]
+pub struct Replay {
+    pub draw: Draw,
+    /// The simulator's step, s.
+    pub h: f64,
+    pub flights: [(Landing, Log); 3],
+}
+
 /// A trial's outcome: the landing error under each of [`CONTROLLERS`].
 #[derive(Debug, Clone, Serialize)]
 pub struct TrialResult {
@@ -223,23 +233,58 @@ impl<'a> Study<'a> {
     }
 
     pub fn trial(&self, trial: usize) -> TrialResult {
+        let (draw, [open, closed, replan]) = self.flights(trial, None, false);
+        TrialResult {
+            draw,
+            landing_error_deg: [open.0.error_deg, closed.0.error_deg, replan.0.error_deg],
+            replans: replan.0.replans,
+        }
+    }
+
+    /// Trial `trial` flown again under each of [`CONTROLLERS`] (at once on
+    /// three threads if `parallel`), each flight's commands and its true
+    /// state every `every` simulator steps logged: the same landings as
+    /// [`Study::trial`]'s.
+    pub fn replay(&self, trial: usize, every: usize, parallel: bool) -> Replay {
+        let (draw, flights) = self.flights(trial, Some(every.max(1)), parallel);
+        Replay {
+            draw,
+            h: self.reference.h,
+            flights: flights.map(|(landing, log)| (landing, log.unwrap_or_default())),
+        }
+    }
+
+    /// The trial's draws and its landing under each controller, logged
+    /// every `every` steps if given.
+    fn flights(
+        &self,
+        trial: usize,
+        every: Option<usize>,
+        parallel: bool,
+    ) -> (Draw, [(Landing, Option<Log>); 3]) {
         let (cfg, r) = (self.cfg, &self.reference);
         let (draw, flight) = trial_flight(cfg, r, &self.tvlqr, self.seed, trial);
         let motor = cfg.motor();
-        let open = fly(
-            &self.open_loop,
-            open_loop(&self.pd, &draw),
-            &motor,
-            flight.clone(),
-        );
-        let closed = fly(r, Feedback::Tvlqr(&self.tvlqr), &motor, flight.clone());
-        let fb = Feedback::Replan(&self.tvlqr, &self.replanning);
-        let replan = fly(r, fb, &motor, flight);
-        TrialResult {
-            draw,
-            landing_error_deg: [open.error_deg, closed.error_deg, replan.error_deg],
-            replans: replan.replans,
-        }
+        let fly = |c: usize| {
+            let (r, fb) = match c {
+                0 => (&self.open_loop, open_loop(&self.pd, &draw)),
+                1 => (r, Feedback::Tvlqr(&self.tvlqr)),
+                _ => (r, Feedback::Replan(&self.tvlqr, &self.replanning)),
+            };
+            let mut log = every.map(Log::every);
+            let landing = fly_logged(r, fb, &motor, flight.clone(), log.as_mut());
+            (landing, log)
+        };
+        let flights = if parallel {
+            std::thread::scope(|s| {
+                let fly = &fly;
+                let handles = [0, 1, 2].map(|c| s.spawn(move || fly(c)));
+                handles.map(|h| h.join().unwrap_or_else(|e| std::panic::resume_unwind(e)))
+            })
+        } else {
+            [0, 1, 2].map(fly)
+        };
+        (draw, flights)
     }
 
     /// Trials `range` on `threads` threads, in trial order; `progress(done, total)`.

@@ -905,14 +905,16 @@ pub struct Rate {
     pub hi: f64,
 }
 
-/// One panel of [`rate_panels`]: its title and a named series of rates per
-/// line.
+/// One panel of [`rate_panels`]: its title, its `x` axis (what, with its
+/// unit, from 0 to `xmax`) and a named series of rates per line.
 pub struct RatePanel {
     pub title: String,
+    pub xdesc: String,
+    pub xmax: f64,
     pub series: Vec<(String, Vec<Rate>)>,
 }
 
-/// Rates (0 to 1) against `x` in 0 to 1, one panel side by side for each
+/// Rates (0 to 1) against `x`, one panel side by side for each
 /// of `panels`, a style per series name ([`distinct_style`] by position,
 /// the same in every panel): each rate a marker on its series' line, its
 /// interval a bar, nudged apart where the series share an `x`, so that a
@@ -920,7 +922,6 @@ pub struct RatePanel {
 /// bars in the legend.
 pub fn rate_panels(
     title: &str,
-    xdesc: &str,
     ydesc: &str,
     panels: &[RatePanel],
     interval: &str,
@@ -943,12 +944,13 @@ pub fn rate_panels(
         };
         let mut names: Vec<&str> = Vec::new();
         for (area, panel) in areas.iter().zip(panels) {
+            let w = panel.xmax;
             let mut c = chart(
                 area,
                 &panel.title,
-                (0.0, 1.0),
+                (0.0, w),
                 (-0.03, 1.03),
-                (xdesc, ydesc),
+                (&panel.xdesc, ydesc),
                 false,
             )?;
             let count = panel.series.len() as f64;
@@ -958,7 +960,7 @@ pub fn rate_panels(
                     names.len() - 1
                 });
                 let st = solid(i);
-                let dx = (k as f64 - 0.5 * (count - 1.0)) * 0.02;
+                let dx = (k as f64 - 0.5 * (count - 1.0)) * 0.02 * w;
                 let pts: Vec<(f64, f64)> = rates
                     .iter()
                     .filter(|r| r.rate.is_finite())
@@ -970,7 +972,8 @@ pub fn rate_panels(
                     c.draw_series(LineSeries::new([(x, r.lo), (x, r.hi)], stroke))
                         .map_err(perr)?;
                     for y in [r.lo, r.hi] {
-                        c.draw_series(LineSeries::new([(x - 0.008, y), (x + 0.008, y)], stroke))
+                        let tick = 0.008 * w;
+                        c.draw_series(LineSeries::new([(x - tick, y), (x + tick, y)], stroke))
                             .map_err(perr)?;
                     }
                 }

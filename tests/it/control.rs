@@ -445,3 +445,110 @@ fn a_replan_budget_nothing_meets_leaves_the_tvlqr() {
         assert!(!dir.path().join("bad").exists(), "{bad}");
     }
 }
+
+/// `--trial K` flies trial K again under each controller: the landings
+/// `robustness.csv` recorded for it, to the bit; each flight's logged
+/// states start from the trial's release (belly 180 deg less its tilt from
+/// straight down) and end at touchdown on the landing; a trial beyond
+/// `--trials`, or with `--shard`, is refused before anything is written.
+#[test]
+fn a_replayed_trial_lands_as_the_study_recorded_it() {
+    let dir = crate::util::temp_dir();
+    let seed = crate::util::config_arg("seed");
+    let study = [
+        "robustness",
+        &seed,
+        "--trials",
+        "3",
+        "--seed",
+        "7",
+        "--threads",
+        "1",
+    ];
+    let (ok, _, err) = crate::util::run_ok(&study, dir.path());
+    assert!(ok, "{err}");
+    let csv =
+        std::fs::read_to_string(dir.path().join("output/seed/robustness/robustness.csv")).unwrap();
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let row: Vec<f64> = csv
+        .lines()
+        .nth(3)
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    let cell = |name: &str| row[header.iter().position(|h| *h == name).unwrap()];
+    let (ok, out, err) = crate::util::run_ok(
+        &[&study[..6], &["--trial", "2", "--json"]].concat(),
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    let json: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert_eq!(json["trial"], 2);
+    let set = dir.path().join("output/seed/robustness-trial-2");
+    let flights = std::fs::read_to_string(set.join("flight.csv")).unwrap();
+    let fheader: Vec<&str> = flights.lines().next().unwrap().split(',').collect();
+    let at = |name: &str| fheader.iter().position(|h| *h == name).unwrap();
+    let tilt = cell("tilt_deg");
+    for (i, c) in ["open-loop", "tvlqr", "replan"].iter().enumerate() {
+        let flown = &json["controllers"][i];
+        assert_eq!(flown["name"], *c);
+        let recorded = cell(&format!("{}_landing_error_deg", c.replace('-', "_")));
+        let landing = flown["landing_error_deg"].as_f64().unwrap();
+        assert_eq!(landing, recorded, "{c}");
+        assert_eq!(flown["landed"], landing <= 10.0, "{c}");
+        let rows: Vec<Vec<&str>> = flights
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|r| r[0] == *c)
+            .collect();
+        let num = |r: &[&str], name: &str| r[at(name)].parse::<f64>().unwrap();
+        let (first, last) = (&rows[0], rows.last().unwrap());
+        assert_eq!(num(first, "t_s"), 0.0);
+        let released = num(first, "belly_from_down_deg");
+        assert!(
+            (released - (180.0 - tilt)).abs() < 1e-9,
+            "{c}: {released} against {tilt}"
+        );
+        assert_eq!(num(last, "belly_from_down_deg"), landing, "{c}");
+        assert!(
+            (num(last, "t_s")
+                - catflip::Config::load(&crate::util::seed_toml(), &[])
+                    .unwrap()
+                    .fall_time())
+            .abs()
+                < 1e-9
+        );
+        // a row a millisecond
+        assert!((num(&rows[1], "t_s") - 1e-3).abs() < 2e-4, "{c}");
+    }
+    for file in [
+        "belly.svg",
+        "torque-open-loop.svg",
+        "torque-replan.svg",
+        "index.html",
+    ] {
+        assert!(set.join(file).exists(), "{file}");
+    }
+    for (bad, says) in [
+        (
+            vec!["--trial", "3"],
+            "--trial 3: the study has 3 trials (numbered 0 to 2)",
+        ),
+        (vec!["--trial", "-1"], "must be a trial's index"),
+        (
+            vec!["--trial", "0", "--shard", "1/2"],
+            "cannot be used with",
+        ),
+    ] {
+        let mut argv = study.to_vec();
+        argv.extend(&bad);
+        argv.extend(["--out", "bad"]);
+        let out = crate::util::output(&argv, dir.path());
+        let err = crate::util::stderr(&out);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {err}");
+        assert!(err.contains(says), "{bad:?}: {err}");
+        assert!(!dir.path().join("bad").exists(), "{bad:?}");
+    }
+}
