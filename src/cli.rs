@@ -303,6 +303,18 @@ impl Optimizer {
 
 pub fn run() -> Result<Status> {
     let cli = Cli::parse();
+    // a sweep, a study or a recovery map catch the signals themselves to
+    // publish what they finished; any other command stops with nothing
+    // half-written
+    let studies = matches!(
+        cli.command,
+        Command::Sweep { .. } | Command::Recovery { .. } | Command::Robustness { trial: None, .. }
+    );
+    let _exit = if studies {
+        None
+    } else {
+        Some(catflip::interrupt::ExitOnSignal::install()?)
+    };
     match cli.command {
         Command::Run(c) => cmd_run(&c),
         Command::Sweep {

@@ -110,6 +110,47 @@ impl Drop for Interrupt {
     }
 }
 
+/// While it lives, SIGINT or SIGTERM ends a command that publishes no
+/// partial set (`run`, `size`, a design): the sets it has not published are
+/// removed ([`crate::output::abandon_unpublished`]), what it published stays,
+/// and it exits with [`EXIT_INTERRUPTED`].
+pub struct ExitOnSignal {
+    _interrupt: Interrupt,
+    done: Arc<AtomicBool>,
+}
+
+impl ExitOnSignal {
+    pub fn install() -> Result<ExitOnSignal> {
+        let interrupt = Interrupt::catch()?;
+        let (flag, done) = (
+            Arc::clone(&interrupt.flag),
+            Arc::new(AtomicBool::new(false)),
+        );
+        let watching = Arc::clone(&done);
+        std::thread::spawn(move || {
+            while !watching.load(Ordering::SeqCst) {
+                if flag.load(Ordering::SeqCst) {
+                    crate::output::abandon_unpublished(
+                        EXIT_INTERRUPTED as i32,
+                        "\ninterrupted: stopped, and the files it had not published were removed; exit status 130",
+                    );
+                }
+                std::thread::sleep(POLL);
+            }
+        });
+        Ok(ExitOnSignal {
+            _interrupt: interrupt,
+            done,
+        })
+    }
+}
+
+impl Drop for ExitOnSignal {
+    fn drop(&mut self) {
+        self.done.store(true, Ordering::SeqCst);
+    }
+}
+
 /// How supervised work ended.
 #[derive(Debug)]
 pub enum Outcome<T> {

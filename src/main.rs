@@ -7,7 +7,8 @@
 //! 4 impossible: the motors cannot flip the cat from the configured height
 //! (`run`: the least drop height and its schedule are written; a design
 //! command: the error names the height that would do); 130 interrupted
-//! (a sweep or a robustness study publishes what it finished as a partial set).
+//! (a sweep or a robustness study publishes what it finished as a partial set;
+//! any other command removes what it had not published).
 mod cli;
 mod common;
 mod recovery_cli;

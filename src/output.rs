@@ -186,6 +186,34 @@ pub struct Publisher {
     links_only: bool,
 }
 
+/// This process's sets not published yet, by staging id: their staging
+/// folder, lock file and the folders `begin` created (what an interrupted
+/// command removes, [`abandon_unpublished`]). A publish holds it while it
+/// switches the set, so that an interrupt sees a set either whole or not begun.
+static UNPUBLISHED: std::sync::Mutex<Vec<Unpublished>> = std::sync::Mutex::new(Vec::new());
+
+/// A staging id, its staging folder and lock file, and the folders created for it.
+type Unpublished = (String, [PathBuf; 2], Vec<PathBuf>);
+
+fn unpublished() -> std::sync::MutexGuard<'static, Vec<Unpublished>> {
+    UNPUBLISHED.lock().unwrap_or_else(|p| p.into_inner())
+}
+
+/// Removes the staging folders, lock files and created folders of this
+/// process's unpublished sets, and ends the process with `status` while
+/// still holding the registry, so that no publish starts after (what a
+/// command that does not publish a partial set does on SIGINT or SIGTERM).
+pub fn abandon_unpublished(status: i32, message: &str) -> ! {
+    let sets = unpublished();
+    for (_, [staging, lock], created) in sets.iter() {
+        let _ = fs::remove_dir_all(staging);
+        let _ = fs::remove_file(lock);
+        remove_created(created);
+    }
+    eprintln!("{message}");
+    std::process::exit(status)
+}
+
 /// The hidden file that marks a folder as a set catflip published.
 pub const MARKER: &str = ".catflip-set";
 const MARKER_TEXT: &str = "A set of files published by catflip; its next run of the same command replaces the folder whole.\n";
@@ -234,6 +262,11 @@ impl Publisher {
             });
         }
         fs::create_dir(p.staging()).map_err(|e| oerr(&p.staging(), e))?;
+        unpublished().push((
+            p.id.clone(),
+            [p.staging(), p.lock_path(&p.id)],
+            p.created.clone(),
+        ));
         p.remove_leftovers();
         Ok(p)
     }
@@ -256,7 +289,12 @@ impl Publisher {
     /// Writes every file into the staging folder, then switches the link to it.
     /// Returns the files' published paths.
     pub fn publish(mut self, out: Output) -> Result<Vec<PathBuf>> {
-        self.switch(&out)?;
+        {
+            // an interrupt waits for the switch (and finds the set gone from the list)
+            let mut sets = unpublished();
+            self.switch(&out)?;
+            sets.retain(|(id, ..)| *id != self.id);
+        }
         self.retire();
         Ok(out.files.iter().map(|(n, _)| self.link().join(n)).collect())
     }
@@ -381,6 +419,7 @@ impl Publisher {
 impl Drop for Publisher {
     fn drop(&mut self) {
         if !self.published {
+            unpublished().retain(|(id, ..)| *id != self.id);
             let _ = fs::remove_dir_all(self.staging());
             let _ = fs::remove_file(self.lock_path(&self.id));
             remove_created(&self.created);

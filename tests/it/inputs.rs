@@ -423,13 +423,13 @@ fn sweep_args(out: &str) -> Vec<String> {
     .to_vec()
 }
 
-/// Starts the sweep, waits for the progress line that shows `points` done,
-/// sends `signal`; returns the exit status, the time from the signal to the
-/// exit, and stderr.
+/// Starts the command, waits for the line of stderr that holds `needle`
+/// (a sweep's progress: `" 11/"`), sends `signal` `times` times; returns the
+/// exit status, the time from the signal to the exit, and stderr.
 fn interrupt_after(
     dir: &Path,
     args: &[String],
-    points: usize,
+    needle: &str,
     signal: &str,
     times: usize,
 ) -> (Option<i32>, std::time::Duration, String) {
@@ -443,12 +443,11 @@ fn interrupt_after(
         .unwrap();
     let mut err = std::io::BufReader::new(child.stderr.take().unwrap());
     let mut text = String::new();
-    let needle = format!(" {points}/");
     loop {
         let mut line = String::new();
         assert!(err.read_line(&mut line).unwrap() > 0, "ended early: {text}");
         text.push_str(&line);
-        if line.contains(&needle) {
+        if line.contains(needle) {
             break;
         }
     }
@@ -493,7 +492,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
     let whole = read(set("whole").join("sweep-cat_mass.csv"));
     // SIGINT after the first chunk (10 points) and one more point
     let args = sweep_args("part");
-    let (code, took, err) = interrupt_after(dir.path(), &args, 11, "-INT", 1);
+    let (code, took, err) = interrupt_after(dir.path(), &args, " 11/", "-INT", 1);
     assert_eq!(code, Some(130), "{err}");
     assert!(
         took < std::time::Duration::from_secs(1),
@@ -589,7 +588,7 @@ fn an_interrupted_sweep_publishes_its_finished_points_and_resumes_to_the_same_re
 #[test]
 fn sigterm_stops_a_sweep_too() {
     let dir = util::temp_dir();
-    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), 1, "-TERM", 1);
+    let (code, took, err) = interrupt_after(dir.path(), &sweep_args("t"), " 1/", "-TERM", 1);
     assert_eq!(code, Some(130), "{err}");
     assert!(
         took < std::time::Duration::from_secs(1),
@@ -1022,7 +1021,7 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     // twice at once, as GNU `timeout` sends it (to the command, then to its
     // process group): one request, the finished trials still published
     let args = robustness_args("part", 40);
-    let (code, took, err) = interrupt_after(dir.path(), &args, 10, "-INT", 2);
+    let (code, took, err) = interrupt_after(dir.path(), &args, " 10/", "-INT", 2);
     eprintln!("robustness stopped {took:?} after SIGINT");
     assert_eq!(code, Some(130), "{err}");
     assert!(
@@ -1101,4 +1100,46 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     let state: serde_json::Value =
         serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
     assert_eq!(state["status"], "complete");
+}
+
+/// A command that publishes no partial set (`run`, `size`, the designs)
+/// stopped by SIGINT mid-work exits 130 within a second and leaves nothing:
+/// no staging folder, no lock, not even the output folder it created; a set
+/// it published before stays.
+#[test]
+fn an_interrupted_run_leaves_nothing_half_written() {
+    let dir = crate::util::temp_dir();
+    let robot = crate::util::config_arg("robot-universal");
+    let args: Vec<String> = ["run", &robot, "--out", "o"].map(String::from).to_vec();
+    // the analytic schedule done, the least height (about 2 s) under way
+    let (code, took, err) = interrupt_after(dir.path(), &args, "[1/5]", "-INT", 1);
+    assert_eq!(code, Some(130), "{err}");
+    assert!(took < std::time::Duration::from_secs(1), "{took:?}");
+    assert!(err.contains("interrupted: "), "{err}");
+    assert!(!dir.path().join("o").exists(), "{err}");
+    // with a published set beside it: that set stays, the new one is not begun
+    let seed = crate::util::config_arg("seed");
+    let (ok, _, err) = crate::util::run_ok(&["analyze", &seed, "--out", "o"], dir.path());
+    assert!(ok, "{err}");
+    let (code, _, err) = interrupt_after(dir.path(), &args, "[1/5]", "-TERM", 1);
+    assert_eq!(code, Some(130), "{err}");
+    let left: Vec<String> = walk(&dir.path().join("o"));
+    assert!(left.iter().all(|p| p.starts_with("seed")), "{left:?}");
+    assert!(left.iter().any(|p| p.ends_with("analyze.json")), "{left:?}");
+}
+
+/// Every path under `root`, relative to it.
+fn walk(root: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for e in std::fs::read_dir(&d).unwrap() {
+            let p = e.unwrap().path();
+            out.push(p.strip_prefix(root).unwrap().display().to_string());
+            if p.is_dir() && !p.is_symlink() {
+                stack.push(p);
+            }
+        }
+    }
+    out
 }
