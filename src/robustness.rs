@@ -145,6 +145,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         format!("robustness{suffix}.timing.json"),
         serde_json::to_string_pretty(&timing)?,
     );
+    let late = catflip::console::robustness::late_replans(&timing, replan_budget_ms);
     let figure = format!("robustness{suffix}.svg");
     let bins = catflip::control::figure::bins(&cfg, &results, max_tilt_deg);
     let drawn = if let Some(svg) = catflip::control::figure::success_by_size(&bins, max_tilt_deg)? {
@@ -162,7 +163,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             (&range, trials),
             interrupted,
             drawn.then_some((figure.as_str(), bins.as_slice())),
-            (flown.as_deref(), replan_budget_ms),
+            (flown.as_deref(), replan_budget_ms, late.as_slice()),
         ),
     );
     out.add(
@@ -184,6 +185,9 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         );
     }
     let written = publisher.publish(out)?;
+    if let Some(w) = &late {
+        eprintln!("warning: {w}");
+    }
     if c.json {
         say!("{json}");
     } else {
@@ -310,8 +314,8 @@ fn trial_page(
 
 /// The study's page: each controller's line, what was drawn and how to fly
 /// a trial again, the controllers and the design they fly (and the replans'
-/// budget, ms, if any), and the figure with its bins' trials; `range` is the
-/// trials of the study's `trials` on it.
+/// budget, ms, if any), `warnings` first, and the figure with its bins'
+/// trials; `range` is the trials of the study's `trials` on it.
 fn page(
     cfg: &catflip::Config,
     s: &catflip::control::robustness::Summary,
@@ -319,7 +323,7 @@ fn page(
     (range, trials): (&std::ops::Range<usize>, usize),
     interrupted: bool,
     figure: Option<(&str, &[catflip::control::figure::Bins])>,
-    (design, budget_ms): (Option<&str>, Option<f64>),
+    (design, budget_ms, warnings): (Option<&str>, Option<f64>, &[String]),
 ) -> String {
     let rows: Vec<Vec<String>> = s
         .controllers
@@ -393,7 +397,7 @@ fn page(
         ],
         rows: &rows,
         notes: &notes,
-        warnings: &[],
+        warnings,
         animation: "",
         figures: &figures,
         captions: catflip::control::figure::caption,

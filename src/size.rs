@@ -210,6 +210,17 @@ pub struct SizeAnswer {
 }
 
 impl SizeAnswer {
+    /// The `--set` keys that give `catflip run` the motor (stall torque,
+    /// no-load speed), with the hard speed limit in its configured ratio.
+    pub fn motor_keys(&self, torque: f64, no_load: f64) -> String {
+        let mut keys =
+            format!("--set limits.max_torque={torque:.4} --set limits.no_load_speed={no_load:.3}");
+        if let Some(r) = self.speed_limit_ratio {
+            keys += &format!(" --set limits.max_speed={:.3}", r * no_load);
+        }
+        keys
+    }
+
     /// Whether some design failed (exit status 3).
     pub fn is_partial(&self) -> bool {
         !self.failed.is_empty()
@@ -342,12 +353,21 @@ fn asymptotes(q: &Config) -> Result<(f64, f64)> {
     Ok((torque, speed))
 }
 
-/// Answers `catflip size` for the question `q` ([`question`]).
-pub fn size(q: &Config, settings: &SizeSettings) -> Result<SizeAnswer> {
+/// Answers `catflip size` for the question `q` ([`question`]);
+/// `progress(done, total)` counts its steps: the asymptotes, each point of
+/// the curve, the gear-ratio search.
+pub fn size(
+    q: &Config,
+    settings: &SizeSettings,
+    mut progress: impl FnMut(usize, usize),
+) -> Result<SizeAnswer> {
     settings.validate()?;
     let clock = Instant::now();
     let t_h = q.available_time();
+    let steps = settings.points + 2;
+    progress(0, steps);
     let (t_inf, w_min) = asymptotes(q)?;
+    progress(1, steps);
     let mut designs = 4; // two each
     let u_c = t_inf / (w_min * w_min);
     let n = settings.points;
@@ -387,10 +407,12 @@ pub fn size(q: &Config, settings: &SizeSettings) -> Result<SizeAnswer> {
             Ok(p) => curve.push(p),
             Err(e) => failed.push(format!("ratio {u:.4e} N m s^2: {e}")),
         }
+        progress(2 + i, steps);
     }
     curve.sort_by(|a, b| a.no_load_speed_rad_s.total_cmp(&b.no_load_speed_rad_s));
     let (gear, gear_designs) = gear_search(q, &curve, settings)?;
     designs += gear_designs;
+    progress(steps, steps);
     Ok(SizeAnswer {
         name: q.name.clone(),
         joint: q.cat.joint.name(),
@@ -609,21 +631,26 @@ impl SizeAnswer {
         let g = &self.gear;
         let can = |ok: bool| if ok { "makes it" } else { "does not make it" };
         // the ends are designs too (local optima): a point of the curve may
-        // pass one, and then the curve, not the end, is the better answer
+        // pass one, and then the curve, not the end's design, is the bound
         let least =
             |f: fn(&CurvePoint) -> f64| self.curve.iter().map(f).fold(f64::INFINITY, f64::min);
+        let (torque_end, speed_end) = (
+            self.torque_asymptote_nm.min(least(|p| p.stall_torque_nm)),
+            self.speed_asymptote_rad_s
+                .min(least(|p| p.no_load_speed_rad_s)),
+        );
         let passed = |end: f64, found: f64, what: &str, unit: &str| {
             if found < end * (1.0 - HEIGHT_TOLERANCE) {
                 format!(
-                    " The curve's point at {found:.4} {unit} passes the {what} end: that end's design found a worse local optimum, so below it read the curve."
+                    " (The {what} end is the curve's point at {found:.4} {unit}: the {what}-only design found a worse local optimum, {end:.4} {unit}.)"
                 )
             } else {
                 String::new()
             }
         };
         let mut ends = format!(
-            "No motor weaker than {:.4} N m stall torque (at any no-load speed) or slower than {:.3} rad/s no-load speed (at any stall torque) flips it from {} m, in catflip's designs (local optima, not a proof).",
-            self.torque_asymptote_nm, self.speed_asymptote_rad_s, self.height_m
+            "No motor weaker than {torque_end:.4} N m stall torque (at any no-load speed) or slower than {speed_end:.3} rad/s no-load speed (at any stall torque) flips it from {} m, in catflip's designs (local optima, not a proof).",
+            self.height_m
         );
         ends += &passed(
             self.torque_asymptote_nm,
@@ -639,7 +666,7 @@ impl SizeAnswer {
         );
         if let Some(r) = self.speed_limit_ratio {
             ends += &format!(
-                " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} w0): to check a motor (T, w0) with `catflip run`, set all three: --set limits.max_torque=T --set limits.no_load_speed=w0 --set limits.max_speed={r:.4}*w0."
+                " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} times limits.no_load_speed): to check a motor with `catflip run`, set all three keys (the gear ratio's line below gives them)."
             );
         }
         vec![
@@ -661,7 +688,7 @@ impl SizeAnswer {
             if g.evaluations.len() > 1 {
                 let [lo, hi] = g.bracket;
                 format!(
-                    "Its best gear ratio is N = {:.4}{} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m. The search ended between N = {:.4} and {:.4}{}.",
+                    "Its best gear ratio is N = {:.4}{} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m ({}). The search ended between N = {:.4} and {:.4}{}.",
                     g.best_ratio,
                     // (N < 1: the speed is what the flip lacks)
                     if g.best_ratio < 1.0 {
@@ -681,6 +708,7 @@ impl SizeAnswer {
                     g.least_time_s,
                     can(g.possible),
                     self.height_m,
+                    self.motor_keys(g.stall_torque_nm, g.no_load_speed_rad_s),
                     lo,
                     hi,
                     if hi > GEAR_BRACKET_WIDE * lo {

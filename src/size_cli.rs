@@ -24,7 +24,19 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
     let q = catflip::size::question(&cfg, height)?;
     let publisher = publisher(c, &cfg, &format!("size-{height}m"))?;
     let dir = publisher.link();
-    let a = catflip::size::size(&q, &settings)?;
+    let progress = crate::common::Progress::new(c.json);
+    let clock = std::time::Instant::now();
+    let a = catflip::size::size(&q, &settings, |done, total| {
+        progress.show(&catflip::console::progress::bar(
+            "size",
+            done,
+            total,
+            "steps (the asymptotes, the curve's points, the gear ratio)",
+            clock.elapsed().as_secs_f64(),
+        ))
+    });
+    progress.finish();
+    let a = a?;
     let json = serde_json::to_value(&a)?;
     catflip::output::ensure_finite(&json, &[])?;
     let json = serde_json::to_string_pretty(&json)?;

@@ -367,6 +367,15 @@ impl std::fmt::Display for Slip {
 
 const RPM: f64 = 2.0 * PI / 60.0;
 
+/// A no-load or top speed above this, rad/s, is asked about as rev/min
+/// typed as rad/s: servos' 40 to 120 rev/min are 40 to 120 "rad/s" then;
+/// the lightly geared motors a `catflip size` speed-up gives stay below.
+const SERVO_SPEED_SLIP: f64 = 40.0;
+
+/// A stall torque above this many times `m g L` (the whole body's weight at
+/// its length) is asked about as N mm or kg cm typed as N m.
+const TORQUE_SLIP: f64 = 10.0;
+
 /// Legal but implausible values, each with the likely slip. Bounds are those
 /// of the hardware catflip models (small animals, hobby and research robots).
 pub fn slips(cfg: &Config) -> Vec<Slip> {
@@ -497,7 +506,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
         ("limits.max_speed", cfg.limits.max_speed),
     ] {
         if let Some(w) = w
-            && w > 30.0
+            && w > SERVO_SPEED_SLIP
         {
             warn(
                 &from_file(key),
@@ -505,6 +514,24 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
                     "{w} rad/s ({:.0} rev/min) is faster than the geared servos of small robots (5 to 15 rad/s): a datasheet's rev/min typed as rad/s? ({w} rev/min = {:.4} rad/s)",
                     w / RPM,
                     w * RPM
+                ),
+            );
+        }
+    }
+    // a motor that could hold the whole body out at arm's length many times
+    // over: N mm or kg cm typed as N m (a flip needs a fraction of m g L)
+    if let Some(t) = cfg.limits.max_torque {
+        let cat = cfg.cat();
+        let mgl = (cat.rear.mass + cat.front.mass)
+            * cfg.fall.gravity
+            * (cat.rear.length + cat.front.length);
+        if t > TORQUE_SLIP * mgl {
+            warn(
+                &from_file("limits.max_torque"),
+                format!(
+                    "{t} N m is over {TORQUE_SLIP} times the torque that holds the whole body out at arm's length (m g L = {mgl:.3} N m): N mm or kg cm typed as N m? ({t} N mm = {:.4} N m, {t} kg cm = {:.4} N m)",
+                    t * 1e-3,
+                    t * 0.0980665
                 ),
             );
         }

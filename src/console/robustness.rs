@@ -85,6 +85,22 @@ pub fn trial(s: &crate::control::replay::Summary, written: &[PathBuf]) -> Vec<St
     lines
 }
 
+/// The warning a study's replans earn when their p99 wall time is over the
+/// control period without a budget: the replanning rate is then not one a
+/// robot's processor like this machine would reach.
+pub fn late_replans(timing: &ReplanTiming, budget_ms: Option<f64>) -> Option<String> {
+    (budget_ms.is_none() && timing.replans > 0 && timing.p99_s > timing.period_s).then(|| {
+        format!(
+            "{} of {} replans took longer than the {:.1} ms control period (p99 {:.1} ms) on this machine: the replanning rate assumes each was in time; with --replan-budget-ms {:.0} a late replan is dropped, as on a robot with this processor",
+            timing.over_period,
+            timing.replans,
+            1e3 * timing.period_s,
+            1e3 * timing.p99_s,
+            1e3 * timing.period_s,
+        )
+    })
+}
+
 /// The replans' counts and wall times, when there were any.
 pub fn replans(timing: &ReplanTiming) -> Option<String> {
     (timing.replans > 0).then(|| {
@@ -105,4 +121,43 @@ pub fn replans(timing: &ReplanTiming) -> Option<String> {
             1e3 * timing.period_s
         )
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn timing(p99_ms: f64, over: usize) -> ReplanTiming {
+        ReplanTiming {
+            replans: 500,
+            taken: 40,
+            failed: 0,
+            late: 0,
+            worse: 3,
+            median_s: 3e-3,
+            p99_s: 1e-3 * p99_ms,
+            max_s: 30e-3,
+            solve_median_s: 2e-3,
+            solve_p99_s: 1e-3 * p99_ms,
+            solve_max_s: 29e-3,
+            period_s: 10e-3,
+            over_period: over,
+        }
+    }
+
+    /// Replans whose p99 is over the control period are a warning, with
+    /// their count and the budget that would drop them; not when a budget
+    /// already dropped them, nor when the p99 is in time.
+    #[test]
+    fn late_replans_are_a_warning_unless_a_budget_dropped_them() {
+        let w = late_replans(&timing(22.0, 16), None).unwrap();
+        assert!(
+            w.starts_with(
+                "16 of 500 replans took longer than the 10.0 ms control period (p99 22.0 ms)"
+            ) && w.contains("--replan-budget-ms 10"),
+            "{w}"
+        );
+        assert_eq!(late_replans(&timing(22.0, 16), Some(10.0)), None);
+        assert_eq!(late_replans(&timing(6.0, 2), None), None);
+    }
 }

@@ -254,6 +254,23 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["analyze", &robot, "--set", "limits.no_load_speed=46"],
         &["limits.no_load_speed", "rev/min", "4.8171 rad/s"],
     );
+    // a speed-up of the servo (what `size` may suggest) is not a slip
+    let d = util::temp_dir();
+    let o = run(
+        &["analyze", &robot, "--set", "limits.no_load_speed=35"],
+        d.path(),
+    );
+    assert!(!stderr(&o).contains("rev/min"), "{}", stderr(&o));
+    // 1500 N mm on a 0.7 kg, 0.4 m robot (m g L = 2.747 N m)
+    warns(
+        &["analyze", &robot, "--set", "limits.max_torque=1500"],
+        &[
+            "limits.max_torque",
+            "m g L = 2.747 N m",
+            "1.5000 N m",
+            "147.0998 N m",
+        ],
+    );
     warns(
         &["analyze", &seed, "--set", "analytic.theta_deg=0.785"],
         &["analytic.theta_deg", "radians", "44.98 deg"],

@@ -20,18 +20,23 @@ fn robot_question(height: f64) -> catflip::Config {
     question(&util::config("robot-universal", &["free.nodes=30"]), height).unwrap()
 }
 
-/// The robot sized from 2 m with a small curve (4 points, 3 gear designs).
+/// The robot sized from 2 m with a small curve (4 points, 3 gear designs);
+/// its progress counts each step once, in order, to the end.
 fn answer() -> &'static SizeAnswer {
     static ANSWER: OnceLock<SizeAnswer> = OnceLock::new();
     ANSWER.get_or_init(|| {
-        size(
+        let mut seen = Vec::new();
+        let a = size(
             &robot_question(HEIGHT),
             &SizeSettings {
                 points: 4,
                 gear_evaluations: 3,
             },
+            |done, total| seen.push((done, total)),
         )
-        .unwrap()
+        .unwrap();
+        assert_eq!(seen, (0..=6).map(|d| (d, 6)).collect::<Vec<_>>());
+        a
     })
 }
 
@@ -414,25 +419,51 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
 }
 
 /// The curve's ends are designs too: where a point of the curve passes one,
-/// the answer says so instead of claiming the end as a bound; with a hard
-/// speed limit it says how `run` checks a motor of the curve (the limit
-/// keeps its ratio to the no-load speed).
+/// that point is the end the answer states (not the worse design's, which a
+/// motor of its own curve contradicts), and the answer says so; with a hard
+/// speed limit the gear ratio's motor comes as `--set` keys `run` takes,
+/// the limit in its ratio to the no-load speed.
 #[test]
 fn the_ends_are_named_as_designs_and_a_point_past_one_is_said() {
     let a = answer();
     let plain = a.sentences()[0].clone();
     assert!(plain.contains("local optima, not a proof"), "{plain}");
-    assert!(!plain.contains("passes the"), "{plain}");
+    assert!(!plain.contains("the curve's point at"), "{plain}");
     let slowest = a.curve[0].no_load_speed_rad_s;
     let mut past = a.clone();
     // an end's design that stopped above the curve's slowest point
     past.speed_asymptote_rad_s = 1.2 * slowest;
     past.speed_limit_ratio = Some(1.5);
-    let said = past.sentences()[0].clone();
+    let said = past.sentences();
     assert!(
-        said.contains(&format!("point at {slowest:.4} rad/s passes the speed end")),
-        "{said}"
+        said[0].contains(&format!("or slower than {slowest:.3} rad/s no-load speed"))
+            && said[0].contains(&format!(
+                "The speed end is the curve's point at {slowest:.4} rad/s: the speed-only design found a worse local optimum, {:.4} rad/s",
+                1.2 * slowest
+            )),
+        "{}",
+        said[0]
     );
-    assert!(!said.contains("passes the torque end"), "{said}");
-    assert!(said.contains("--set limits.max_speed=1.5000*w0"), "{said}");
+    assert!(!said[0].contains("The torque end"), "{}", said[0]);
+    let g = &a.gear;
+    let keys = format!(
+        "--set limits.max_torque={:.4} --set limits.no_load_speed={:.3} --set limits.max_speed={:.3}",
+        g.stall_torque_nm,
+        g.no_load_speed_rad_s,
+        1.5 * g.no_load_speed_rad_s
+    );
+    assert!(said[2].contains(&keys), "{}", said[2]);
+    // the keys run takes: the motor they set is the gear ratio's
+    let cfg = util::config(
+        "robot-universal",
+        &keys
+            .split("--set ")
+            .map(str::trim)
+            .filter(|k| !k.is_empty())
+            .collect::<Vec<_>>(),
+    );
+    assert_eq!(
+        cfg.limits.max_torque,
+        Some(format!("{:.4}", g.stall_torque_nm).parse().unwrap())
+    );
 }
