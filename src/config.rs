@@ -159,6 +159,19 @@ const REQUIRED: [(&str, &str); 5] = [
     ("height", "fall.height"),
 ];
 
+/// The sections a config must give, by the parser's field name, and what
+/// to add.
+const REQUIRED_SECTIONS: [(&str, &str); 2] = [
+    (
+        "fall",
+        "missing section `[fall]` (required): add it with `height`, the drop height in m",
+    ),
+    (
+        "cat",
+        "missing section `[cat]` (required unless `[body]` gives the halves): add it with `mass` (kg), `length` and `radius` (m), each half's",
+    ),
+];
+
 /// The parser's messages name Rust's types ("expected f64") and a missing
 /// field without its table; the user wrote TOML keys.
 fn plain_types(message: &str) -> String {
@@ -174,11 +187,14 @@ fn plain_types(message: &str) -> String {
             .map_or(m.len(), |e| at + 16 + e);
         m.replace_range(at..end, "expected a table (a [section] of keys)");
     }
-    REQUIRED.iter().fold(m, |m, (field, key)| {
+    let m = REQUIRED.iter().fold(m, |m, (field, key)| {
         m.replace(
             &format!("missing field `{field}`"),
             &format!("missing key `{key}` (required)"),
         )
+    });
+    REQUIRED_SECTIONS.iter().fold(m, |m, (field, what)| {
+        m.replace(&format!("missing field `{field}`"), what)
     })
 }
 
@@ -222,7 +238,12 @@ impl Config {
     ) -> Result<Config> {
         let file_err = |e: toml::de::Error| Error::ConfigParse {
             origin: origin.into(),
-            message: plain_types(&e.to_string()),
+            // a missing key has no line: the parser would point at the file's first
+            message: if e.message().starts_with("missing field") {
+                plain_types(e.message().trim())
+            } else {
+                plain_types(&e.to_string())
+            },
         };
         let mut table: toml::Table = toml::from_str(text).map_err(file_err)?;
         // the file alone, parsed from its own text: unknown keys and wrong
@@ -240,10 +261,11 @@ impl Config {
             let mut t = template.clone();
             apply_override(&mut t, arg)?;
             if let Err(e) = t.try_into::<Config>() {
+                let expects = expected_kind(e.message());
                 return Err(Error::Override {
                     arg: arg.clone(),
-                    message: plain_types(e.message().trim()),
-                    expects: expected_kind(e.message()),
+                    message: plain_types(e.message().trim()) + &with_unit(arg, expects),
+                    expects,
                 });
             }
             apply_override(&mut table, arg)?;
@@ -407,12 +429,22 @@ impl Config {
             } else {
                 ""
             };
+            // a few "degrees" is most likely radians: asked before the advice
+            // to lower the other key, which would keep the slip
+            let radians = if b <= std::f64::consts::PI {
+                format!(
+                    "; if {b} is in radians, it is {:.2} deg: the key is in degrees",
+                    b.to_degrees()
+                )
+            } else {
+                String::new()
+            };
             check(
                 "limits.max_bend_deg",
                 b,
                 b > self.phased.bend_min_deg,
                 &format!(
-                    "must exceed phased.bend_min_deg = {} deg, the phased design's least bend: lower that key too for a tighter limit{from_file}",
+                    "must exceed phased.bend_min_deg = {} deg, the phased design's least bend{radians}; for a tighter limit, lower that key too{from_file}",
                     self.phased.bend_min_deg
                 ),
             )?;
@@ -570,6 +602,34 @@ pub fn apply_override(table: &mut toml::Table, arg: &str) -> Result<()> {
     }
     cur.insert(parts[parts.len() - 1].to_string(), value);
     Ok(())
+}
+
+/// For a number given with its unit (`fall.height=1.5m`): the advice to give
+/// the number alone, in the key's unit ([`UNITS`]); empty otherwise.
+fn with_unit(arg: &str, expects: Option<crate::error::ValueKind>) -> String {
+    let Some((key, raw)) = arg.split_once('=') else {
+        return String::new();
+    };
+    let raw = raw.trim();
+    let number = raw
+        .find(|c: char| c.is_alphabetic())
+        .filter(|&i| i > 0 && raw[..i].trim().parse::<f64>().is_ok());
+    match (expects, number) {
+        (Some(crate::error::ValueKind::Number), Some(i)) => {
+            let (number, typed) = (raw[..i].trim(), raw[i..].trim());
+            match UNITS.iter().find(|(k, _)| *k == key.trim()) {
+                Some((_, unit)) if *unit == typed => format!(
+                    "; give the number alone: `{}={number}` (the key is in {unit})",
+                    key.trim()
+                ),
+                Some((_, unit)) => format!(
+                    "; give the number alone, converted to the key's unit, {unit} (`{raw}` is not read)"
+                ),
+                None => format!("; give the number alone (`{raw}` is not read)"),
+            }
+        }
+        _ => String::new(),
+    }
 }
 
 /// Unit of each numeric config key, for axis labels (`fall.height (m)`).

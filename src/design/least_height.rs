@@ -789,6 +789,14 @@ impl HeightAnswer {
     }
 
     /// One plain sentence for the terminal and the report.
+    /// Where to ask for the motors that would flip it from this height.
+    pub fn sizing(&self) -> String {
+        format!(
+            "The motors (or the gear ratio) that would do it from {} m: catflip size CONFIG --height {}.",
+            self.height_m, self.height_m
+        )
+    }
+
     pub fn sentence(&self) -> String {
         let what = if self.status.is_proven() {
             format!("the {} time-optimal schedule", self.method)
@@ -844,8 +852,11 @@ impl HeightAnswer {
             )
         } else {
             format!(
-                "The flip is NOT possible from {} m with these motors: from {:.3} m{bound} it is ({:.4} s of manoeuvre, {what} in least-height.csv).",
-                self.height_m, self.least_height_m, self.least_time_s
+                "The flip is NOT possible from {} m with these motors: from {:.3} m{bound} it is ({:.4} s of manoeuvre, {what} in least-height.csv). {}",
+                self.height_m,
+                self.least_height_m,
+                self.least_time_s,
+                self.sizing()
             )
         }
     }

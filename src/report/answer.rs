@@ -101,8 +101,13 @@ fn shown_text(a: &HeightAnswer) -> String {
             a.method, a.status
         )
     };
+    let sizing = if a.possible {
+        String::new()
+    } else {
+        format!(" {}", a.sizing())
+    };
     format!(
-        "The shortest manoeuvre found inside the motor envelope ({proven}) is the least-height row below: in the animation, the torque and torque-speed figures, and written as least-height.csv with its simulator controls (least-height.mujoco.csv, least-height.pybullet.csv)."
+        "The shortest manoeuvre found inside the motor envelope ({proven}) is the least-height row below: in the animation, the torque and torque-speed figures, and written as least-height.csv with its simulator controls (least-height.mujoco.csv, least-height.pybullet.csv).{sizing}"
     )
 }
 

@@ -1160,3 +1160,72 @@ fn walk(root: &Path) -> Vec<String> {
     }
     out
 }
+
+/// A config without a required key or section says which and what to add
+/// (not the parser's "line 1, column 1" over the file's first comment),
+/// exits 2 and writes nothing.
+#[test]
+fn a_missing_key_or_section_is_named_with_what_to_add() {
+    let dir = util::temp_dir();
+    let cat = "[cat]\nmass = 1.0\nlength = 0.2\nradius = 0.03\n";
+    let fall = "[fall]\nheight = 2.0\n";
+    for (text, says) in [
+        (
+            format!("# my robot\n{cat}{fall}"),
+            "missing key `name` (required)",
+        ),
+        (
+            format!("# my robot\nname = \"r\"\n{cat}"),
+            "missing section `[fall]` (required): add it with `height`, the drop height in m",
+        ),
+        (
+            format!("# my robot\nname = \"r\"\n{fall}"),
+            "missing section `[cat]` (required unless `[body]` gives the halves)",
+        ),
+        (
+            format!("# my robot\nname = \"r\"\n{cat}[fall]\nmargin = 0.1\n"),
+            "missing key `fall.height` (required)",
+        ),
+    ] {
+        let path = dir.path().join("mine.toml");
+        std::fs::write(&path, &text).unwrap();
+        let o = run(&["run", path.to_str().unwrap(), "--out", "out"], dir.path());
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{text}: {err}");
+        assert!(err.contains(says), "{text}: {err}");
+        assert!(!err.contains("# my robot"), "{text}: {err}");
+        assert!(!dir.path().join("out").exists(), "{text}");
+    }
+}
+
+/// A number typed with its unit is refused with the number alone to give
+/// (in the key's unit, or converted to it); a bend limit of a few "degrees"
+/// is asked about as radians before the advice to lower the other key.
+#[test]
+fn a_number_with_its_unit_or_in_radians_is_refused_with_what_to_give() {
+    let dir = util::temp_dir();
+    let (seed, robot) = (config("seed"), config("robot-universal"));
+    for (cfg, set, says) in [
+        (
+            &seed,
+            "fall.height=1.5m",
+            "give the number alone: `fall.height=1.5` (the key is in m)",
+        ),
+        (
+            &seed,
+            "cat.mass=350g",
+            "give the number alone, converted to the key's unit, kg (`350g` is not read)",
+        ),
+        (
+            &robot,
+            "limits.max_bend_deg=2.5",
+            "if 2.5 is in radians, it is 143.24 deg: the key is in degrees; for a tighter limit, lower that key too",
+        ),
+    ] {
+        let o = run(&["run", cfg, "--set", set, "--out", "out"], dir.path());
+        let err = stderr(&o);
+        assert_eq!(o.status.code(), Some(2), "{set}: {err}");
+        assert!(err.contains(says), "{set}: {err}");
+        assert!(!dir.path().join("out").exists(), "{set}");
+    }
+}
