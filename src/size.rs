@@ -168,6 +168,69 @@ pub struct GearAnswer {
     /// The least heights the curve's designs predict for the ratios whose
     /// `T / w0^2` they share (`N = (u / u0)^(1/3)`, F3), by increasing ratio.
     pub predicted: Vec<GearPrediction>,
+    /// The ratios that make it from the question's height, from the designed
+    /// and the predicted ones ([`working_range`]); absent from the JSON
+    /// when none makes it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub working_range: Option<GearRange>,
+}
+
+/// The gear ratios that make the flip from the question's height: the
+/// run of designed ratios around the best that fit it, its ends placed
+/// between the last ratio that fits and the first that does not,
+/// interpolating the least height linearly in `log N`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct GearRange {
+    pub low: f64,
+    pub high: f64,
+    /// The end is the smallest (largest) ratio designed: smaller (larger)
+    /// ratios were not tried and may make it too.
+    pub low_untried_beyond: bool,
+    pub high_untried_beyond: bool,
+}
+
+/// [`GearRange`] of the designed `(ratio, least height)` pairs against
+/// `height`, `None` when none of them fits it.
+pub fn working_range(pairs: &[(f64, f64)], height: f64) -> Option<GearRange> {
+    let mut p: Vec<(f64, f64)> = pairs
+        .iter()
+        .filter(|(n, h)| *n > 0.0 && h.is_finite())
+        .map(|&(n, h)| (n.ln(), h))
+        .collect();
+    p.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let best = p
+        .iter()
+        .enumerate()
+        .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
+        .map(|(i, _)| i)?;
+    if p[best].1 > height {
+        return None;
+    }
+    let (mut lo, mut hi) = (best, best);
+    while lo > 0 && p[lo - 1].1 <= height {
+        lo -= 1;
+    }
+    while hi + 1 < p.len() && p[hi + 1].1 <= height {
+        hi += 1;
+    }
+    // where the height crosses `height` between a fitting pair and the next
+    let cross = |a: (f64, f64), b: (f64, f64)| a.0 + (height - a.1) / (b.1 - a.1) * (b.0 - a.0);
+    Some(GearRange {
+        low: if lo > 0 {
+            cross(p[lo], p[lo - 1])
+        } else {
+            p[0].0
+        }
+        .exp(),
+        high: if hi + 1 < p.len() {
+            cross(p[hi], p[hi + 1])
+        } else {
+            p[hi].0
+        }
+        .exp(),
+        low_untried_beyond: lo == 0,
+        high_untried_beyond: hi + 1 == p.len(),
+    })
 }
 
 /// A gear ratio's least height as a curve point's design predicts it.
@@ -554,6 +617,12 @@ fn gear_search(
         .expect("the configured ratio at least");
     let spec = q.design_spec();
     let fits = |h: f64| crate::design::least_height::fits(&spec, h);
+    let pairs: Vec<(f64, f64)> = evals
+        .iter()
+        .map(|g| (g.gear_ratio, g.design.least_height_m))
+        .chain(predictions.iter().map(|p| (p.gear_ratio, p.least_height_m)))
+        .collect();
+    let working_range = working_range(&pairs, q.fall.height);
     Ok((
         GearAnswer {
             best_ratio: top.gear_ratio,
@@ -567,6 +636,7 @@ fn gear_search(
             bracket: [a.exp(), b.exp()],
             evaluations: evals,
             predicted: predictions,
+            working_range,
         },
         designs,
     ))
@@ -669,6 +739,21 @@ impl SizeAnswer {
                 " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} times limits.no_load_speed): to check a motor with `catflip run`, set all three keys (the gear ratio's line below gives them)."
             );
         }
+        let range = match g.working_range {
+            Some(r) => format!(
+                " Gear ratios from N = {}{:.4} to {:.4}{} make it from {} m (between the ratios designed, the least height interpolated in log N).",
+                if r.low_untried_beyond { "at most " } else { "" },
+                r.low,
+                r.high,
+                if r.high_untried_beyond {
+                    " or more"
+                } else {
+                    ""
+                },
+                self.height_m
+            ),
+            None => format!(" No gear ratio designed makes it from {} m.", self.height_m),
+        };
         vec![
             ends,
             format!(
@@ -730,7 +815,43 @@ impl SizeAnswer {
                         p.gear_ratio, p.least_height_m
                     ))
                 )
-            },
+            } + &range,
         ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A least height linear in `log N` either side of its minimum: the
+    /// ends are its crossings exactly; the run stops at the first ratio
+    /// that does not fit; at the designed span's ends it says so; nothing
+    /// fitting gives none.
+    #[test]
+    fn the_working_range_is_where_the_heights_cross() {
+        // h = 1 + |ln N - ln 0.2|, crossing 1.5 at ln N = ln 0.2 -+ 0.5
+        let h = |n: f64| 1.0 + (n.ln() - 0.2f64.ln()).abs();
+        let pairs: Vec<(f64, f64)> = (0..12)
+            .map(|i| 0.05 * 1.3f64.powi(i))
+            .map(|n| (n, h(n)))
+            .collect();
+        let r = working_range(&pairs, 1.5).unwrap();
+        assert!(
+            (r.low / (0.2 * (-0.5f64).exp()) - 1.0).abs() < 1e-12,
+            "{r:?}"
+        );
+        assert!((r.high / (0.2 * 0.5f64.exp()) - 1.0).abs() < 1e-12, "{r:?}");
+        assert!(!r.low_untried_beyond && !r.high_untried_beyond);
+        // another dip that fits, beyond a ratio that does not, is not joined
+        let mut dipped = pairs.clone();
+        dipped.push((5.0, 1.2));
+        assert_eq!(working_range(&dipped, 1.5), Some(r));
+        // everything fits: the designed span, open at both ends
+        let all = working_range(&pairs, 10.0).unwrap();
+        assert!(all.low_untried_beyond && all.high_untried_beyond);
+        assert!((all.low - 0.05).abs() < 1e-15 && (all.high / pairs[11].0 - 1.0).abs() < 1e-12);
+        assert_eq!(working_range(&pairs, 0.5), None);
+        assert_eq!(working_range(&[], 1.0), None);
     }
 }

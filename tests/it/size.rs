@@ -180,6 +180,43 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
     }
 }
 
+/// The gear ratios that make it: around the best, their ends where the
+/// designed least heights cross the question's; a ratio designed afresh
+/// well inside makes it, one well outside each finite end does not.
+#[test]
+fn the_gear_ratios_that_make_it_are_named_and_hold() {
+    let a = answer();
+    let g = &a.gear;
+    let q = robot_question(HEIGHT);
+    let (t0, w0) = (
+        q.limits.max_torque.unwrap(),
+        q.limits.no_load_speed.unwrap(),
+    );
+    let r = g.working_range.expect("the best ratio makes it from 2 m");
+    assert!(
+        g.possible && r.low < g.best_ratio && g.best_ratio < r.high,
+        "{r:?}"
+    );
+    let said = a.sentences()[2].clone();
+    assert!(
+        said.contains(&format!("{:.4} to {:.4}", r.low, r.high))
+            && said.contains("make it from 2 m"),
+        "{said}"
+    );
+    let design = |n: f64| design_motor(&q, t0 * n, w0 / n).unwrap().least_height_m;
+    let inside = (r.low * r.high).sqrt();
+    assert!(
+        design(inside) <= HEIGHT * (1.0 + HEIGHT_TOLERANCE),
+        "N = {inside}"
+    );
+    if !r.low_untried_beyond {
+        assert!(design(r.low / 1.5) > HEIGHT, "N = {}", r.low / 1.5);
+    }
+    if !r.high_untried_beyond {
+        assert!(design(r.high * 1.5) > HEIGHT, "N = {}", r.high * 1.5);
+    }
+}
+
 #[test]
 fn the_curve_scales_with_the_fall_time_f3() {
     // a motor that just makes it from 2 m, sped up by k = t(2 m) / t(H'),
