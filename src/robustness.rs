@@ -374,6 +374,12 @@ fn page(
             s.seed, s.seed
         ),
     ];
+    notes.extend(
+        catflip::console::robustness::nearest_rank(s.trials).map(|n| {
+            let n = n.trim_matches(|c| c == '(' || c == ')');
+            format!("{}{}.", n[..1].to_uppercase(), &n[1..])
+        }),
+    );
     if let Some((_, bins)) = figure {
         notes.extend(catflip::control::figure::bins_note(bins));
     }

@@ -50,6 +50,36 @@ create_exception!(
 );
 
 /// The library's error as the exception of its kind, with the CLI's message.
+/// A parse error of the TOML made from a dict (`message`, which points
+/// at `text`'s line and column), said of the dict's key: `fall.heigth`:
+/// unknown key ... .
+fn dict_error(text: &str, message: &str) -> String {
+    let reason = message.trim().lines().last().unwrap_or(message).trim();
+    let line = message
+        .split_once("at line ")
+        .and_then(|(_, rest)| rest.split(',').next()?.trim().parse::<usize>().ok());
+    let key = line.filter(|&n| n > 0).and_then(|n| {
+        let lines: Vec<&str> = text.lines().collect();
+        let name = lines.get(n - 1)?.split_once('=')?.0.trim().to_string();
+        let section = lines[..n - 1]
+            .iter()
+            .rev()
+            .find(|l| l.starts_with('['))
+            .map(|l| l.trim_matches(|c| c == '[' || c == ']').to_string());
+        Some(match section {
+            Some(s) => format!("{s}.{name}"),
+            None => name,
+        })
+    });
+    match key {
+        Some(k) => format!(
+            "config dict: key `{k}`: {}",
+            reason.replace("unknown field", "unknown key")
+        ),
+        None => format!("config dict: {reason}"),
+    }
+}
+
 fn err(e: catflip::Error) -> PyErr {
     use catflip::Error as E;
     let msg = e.to_string();
@@ -400,15 +430,25 @@ impl Config {
     fn from_dict(py: Python<'_>, d: &Bound<'_, PyDict>) -> PyResult<Config> {
         let table = toml_value(d.as_any(), "")?.unwrap_or(toml::Value::Table(Default::default()));
         let text = toml::to_string(&table).map_err(|e| ConfigError::new_err(e.to_string()))?;
-        Config::from_source(
-            py,
-            Source {
-                text,
-                origin: "dict".into(),
-                overrides: Vec::new(),
-                base: folder(std::path::Path::new(".")),
-            },
-        )
+        let source = Source {
+            text: text.clone(),
+            origin: "dict".into(),
+            overrides: Vec::new(),
+            base: folder(std::path::Path::new(".")),
+        };
+        // a parse error points into TOML the user never wrote: name the dict's key
+        match source.load(None) {
+            Err(catflip::Error::ConfigParse { message, .. }) => {
+                Err(ConfigError::new_err(dict_error(&text, &message)))
+            }
+            Err(e) => Err(err(e)),
+            Ok(cfg) => {
+                warn_slips(py, &cfg)?;
+                Ok(Config {
+                    inner: Mutex::new(Snapshot { source, cfg }),
+                })
+            }
+        }
     }
 
     /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;

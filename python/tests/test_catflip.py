@@ -220,6 +220,16 @@ def test_from_dict_and_from_text_read_as_the_file():
     assert catflip.Config.from_text(a.to_toml()).to_dict() == a.to_dict()
     with pytest.raises(catflip.ConfigError, match="masss"):
         catflip.Config.from_dict({**tomllib.loads(seed.read_text()), "cat": {"masss": 1}})
+    # a dict's mistake is said of its key, not of a TOML line it never had
+    base = tomllib.loads(seed.read_text())
+    for fall, says in [({"heigth": 1}, "config dict: key `fall.heigth`: unknown key `heigth`, expected one of `height`"),
+                       ({"height": "1.5m"}, 'config dict: key `fall.height`: invalid type: string "1.5m", expected a number')]:
+        with pytest.raises(catflip.ConfigError) as e:
+            catflip.Config.from_dict({**base, "fall": fall})
+        assert str(e.value).startswith(says) and "line" not in str(e.value), str(e.value)
+    without_fall = {k: v for k, v in base.items() if k != "fall"}
+    with pytest.raises(catflip.ConfigError, match=r"missing section `\[fall\]`"):
+        catflip.Config.from_dict(without_fall)
 
 
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.stem)

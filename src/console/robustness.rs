@@ -42,6 +42,9 @@ pub fn study(
             s.landing_error_deg.max
         ));
     }
+    if let Some(note) = nearest_rank(trials) {
+        lines.push(format!("  {note}"));
+    }
     if let Some(line) = replans(timing) {
         lines.push(format!("  {line}"));
     }
@@ -49,6 +52,17 @@ pub fn study(
         lines.push(format!("  wrote {}", p.display()));
     }
     lines
+}
+
+/// What the percentiles of a study of `trials` are, when p99 is its largest
+/// landing error (fewer than 100 trials, nearest rank).
+pub fn nearest_rank(trials: usize) -> Option<String> {
+    (0 < trials && trials < 100).then(|| {
+        format!(
+            "(percentiles by nearest rank: of {trials} trials, p99 is the largest landing error{})",
+            if trials < 10 { ", and p90 too" } else { "" }
+        )
+    })
 }
 
 /// A replayed trial's table: its draws, then each controller's landing.
@@ -159,5 +173,32 @@ mod tests {
         );
         assert_eq!(late_replans(&timing(22.0, 16), Some(10.0)), None);
         assert_eq!(late_replans(&timing(6.0, 2), None), None);
+    }
+
+    /// Nearest rank: of n trials p99 is the largest below 100 (the rank
+    /// ceil(0.99 n) is n), p90 too below 10; a study of 100 or more is not noted.
+    #[test]
+    fn a_small_studys_p99_is_said_to_be_its_largest() {
+        use crate::control::robustness::{Draw, TrialResult, summarise};
+        let cfg =
+            crate::Config::from_toml(include_str!("../../configs/seed.toml"), "seed", &[]).unwrap();
+        for n in [5usize, 50, 99, 100, 120] {
+            let results: Vec<TrialResult> = (0..n)
+                .map(|t| TrialResult {
+                    draw: Draw::new(&cfg, 1, t),
+                    landing_error_deg: [t as f64; 3],
+                    replans: Vec::new(),
+                })
+                .collect();
+            let s = summarise(&results, 1, 10.0, 3);
+            let p = &s.controllers[0].landing_error_deg;
+            let note = nearest_rank(n);
+            assert_eq!(p.p99 == p.max, note.is_some(), "{n}");
+            assert_eq!(
+                p.p90 == p.max,
+                note.as_deref().is_some_and(|t| t.contains("p90 too")),
+                "{n}"
+            );
+        }
     }
 }
