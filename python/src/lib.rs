@@ -80,9 +80,33 @@ fn dict_error(text: &str, message: &str) -> String {
     }
 }
 
+/// The library's advice in the package's words: its messages name the
+/// command line's flags and commands where Python has arguments and functions.
+const PYTHONIC: [(&str, &str); 5] = [
+    (
+        "another seed (--seed)",
+        "another seed (seed=\"analytic\" or \"phased\")",
+    ),
+    (
+        "`--seed analytic` starts it",
+        "`seed=\"analytic\"` starts it",
+    ),
+    (
+        "`catflip run` finds the least drop height",
+        "`catflip.least_height(config)` finds the least drop height",
+    ),
+    ("`catflip run`", "`catflip.run(config)`"),
+    (
+        "catflip size CONFIG --height",
+        "the command line's `catflip size CONFIG --height`",
+    ),
+];
+
 fn err(e: catflip::Error) -> PyErr {
     use catflip::Error as E;
-    let msg = e.to_string();
+    let msg = PYTHONIC
+        .iter()
+        .fold(e.to_string(), |m, (cli, py)| m.replace(cli, py));
     match e {
         E::BeyondMotors { .. } => ImpossibleError::new_err(msg),
         e if e.is_bad_input() => ConfigError::new_err(msg),
