@@ -427,14 +427,16 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             );
         }
     }
-    for (key, h, set) in [
-        ("cat", &c.rear, typed),
-        ("cat.front", &c.front, typed && cfg.cat.front.is_some()),
+    // the front half's own keys only: one it inherits from [cat] is warned
+    // about there, under the key the user typed
+    let front = cfg.cat.front.as_ref();
+    let front_length = typed && front.is_some_and(|f| f.length.is_some());
+    let front_radius = typed && front.is_some_and(|f| f.radius.is_some() || f.length.is_some());
+    for (key, h, (length, radius)) in [
+        ("cat", &c.rear, (typed, typed)),
+        ("cat.front", &c.front, (front_length, front_radius)),
     ] {
-        if !set {
-            continue;
-        }
-        if h.length > 5.0 {
+        if length && h.length > 5.0 {
             warn(
                 &format!("{key}.length"),
                 format!(
@@ -445,7 +447,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
                 ),
             );
         }
-        if 2.0 * h.radius > h.length {
+        if radius && 2.0 * h.radius > h.length {
             warn(
                 &format!("{key}.radius"),
                 format!(

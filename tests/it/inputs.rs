@@ -1229,3 +1229,37 @@ fn a_number_with_its_unit_or_in_radians_is_refused_with_what_to_give() {
         assert!(!dir.path().join("out").exists(), "{set}");
     }
 }
+
+/// A slip in a key the front half inherits is warned about once, under the
+/// key the user typed; the front half's own key, typed, under its own.
+#[test]
+fn an_inherited_slip_is_warned_about_under_the_typed_key() {
+    let dir = util::temp_dir();
+    let path = dir.path().join("r.toml");
+    std::fs::write(
+        &path,
+        "name = \"r\"\n[cat]\nmass = 0.6\nlength = 0.12\nradius = 0.03\n[cat.front]\nmass = 0.4\n[fall]\nheight = 2.0\n",
+    )
+    .unwrap();
+    let warnings = |set: &str| -> Vec<String> {
+        let o = run(
+            &["analyze", path.to_str().unwrap(), "--set", set],
+            dir.path(),
+        );
+        stderr(&o)
+            .lines()
+            .filter(|l| l.starts_with("warning:") && l.contains("centimetres"))
+            .map(String::from)
+            .collect()
+    };
+    let w = warnings("cat.length=12");
+    assert!(
+        w.len() == 1 && w[0].starts_with("warning: cat.length: 12 m"),
+        "{w:?}"
+    );
+    let w = warnings("cat.front.length=12");
+    assert!(
+        w.len() == 1 && w[0].starts_with("warning: cat.front.length: 12 m"),
+        "{w:?}"
+    );
+}
