@@ -364,7 +364,7 @@ impl Judged {
             spec.norm(),
             self.design.method().name(),
             &self.sim_or_failed(),
-            crate::report::animation::FRAMES,
+            (crate::report::animation::FRAMES, spec.fall.margin),
         )
     }
 }

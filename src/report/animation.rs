@@ -96,8 +96,17 @@ fn quat(r: &Rotation3<f64>) -> [f64; 4] {
 }
 
 /// Picks about `count` trace points evenly spread in time (the simulation's
-/// adaptive steps are uneven) and adds body B's attitude `R_A R_rel(q)`.
-pub fn track(cat: &Cat, norm: TorqueNorm, name: &str, sim: &SimReport, count: usize) -> Track {
+/// adaptive steps are uneven) and adds body B's attitude `R_A R_rel(q)`;
+/// then the `margin` to touchdown, the cat held in its last shape and
+/// turning rigidly with its momentum (F8, the landing error's own model),
+/// so that the track ends where the landing is judged.
+pub fn track(
+    cat: &Cat,
+    norm: TorqueNorm,
+    name: &str,
+    sim: &SimReport,
+    (count, margin): (usize, f64),
+) -> Track {
     let tr = &sim.trace;
     let mut picked: Vec<usize> = Vec::new();
     if let (Some(first), Some(last)) = (tr.first(), tr.last()) {
@@ -113,7 +122,7 @@ pub fn track(cat: &Cat, norm: TorqueNorm, name: &str, sim: &SimReport, count: us
             }
         }
     }
-    let frames = picked
+    let mut frames: Vec<Frame> = picked
         .into_iter()
         .map(|k| {
             let p = &tr[k];
@@ -131,11 +140,82 @@ pub fn track(cat: &Cat, norm: TorqueNorm, name: &str, sim: &SimReport, count: us
             }
         })
         .collect();
+    if let (Some(last), Some(end)) = (tr.last(), frames.last().cloned())
+        && margin > 0.0
+    {
+        frames.extend(touchdown(cat, norm, sim, last.q, &end, (count, margin)));
+    }
     Track {
         name: name.into(),
         status: String::new(),
         frames,
     }
+}
+
+/// The frames after the manoeuvre's `end` to touchdown, `margin` s on, at
+/// the track's frame rate (`count` frames over its manoeuvre): the
+/// simulation's own landing flight where it flew one (the shape held
+/// straight by the motors), else the straight cat in shape `q` turning
+/// rigidly ([`rigid_turn`](crate::model::momentum::rigid_turn), no torque);
+/// the flip unwrapped on from `end`'s, the quaternions' signs kept
+/// continuous.
+fn touchdown(
+    cat: &Cat,
+    norm: TorqueNorm,
+    sim: &SimReport,
+    q: [f64; 2],
+    end: &Frame,
+    (count, margin): (usize, f64),
+) -> Vec<Frame> {
+    use crate::model::so3::{flip_and_tilt, wrap};
+    let steps = ((count as f64 * margin / end.t.max(1e-9)).ceil() as usize).clamp(2, count);
+    let [w, x, y, z] = sim.final_attitude;
+    let r0 = *UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z))
+        .to_rotation_matrix()
+        .matrix();
+    let held = &sim.landing_trace;
+    // (attitude of A, shape, torque) `dt` after the manoeuvre
+    let at = |dt: f64| -> (Rotation3<f64>, [f64; 2], [f64; 2]) {
+        if let Some(p) = held
+            .iter()
+            .min_by(|a, b| (a.t - dt).abs().total_cmp(&(b.t - dt).abs()))
+        {
+            let [w, x, y, z] = p.attitude;
+            let r =
+                UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)).to_rotation_matrix();
+            (r, p.q, p.tau)
+        } else {
+            let r = crate::model::momentum::rigid_turn(cat, &r0, sim.final_body_momentum, dt);
+            (Rotation3::from_matrix_unchecked(r), q, [0.0; 2])
+        }
+    };
+    let continuous = |q: [f64; 4], before: [f64; 4]| {
+        let dot: f64 = q.iter().zip(before).map(|(a, b)| a * b).sum();
+        if dot < 0.0 { q.map(|v| -v) } else { q }
+    };
+    let mut flip = end.flip_deg.to_radians();
+    let mut before = flip_and_tilt(&UnitQuaternion::from_matrix(&r0)).0;
+    let (mut last_a, mut last_b) = (end.a, end.b);
+    (1..=steps)
+        .map(|i| {
+            let dt = margin * i as f64 / steps as f64;
+            let (ra, shape, tau) = at(dt);
+            let rel = Rotation3::from_matrix_unchecked(to_na(&cat.rel_rotation(shape)));
+            let f = flip_and_tilt(&UnitQuaternion::from_rotation_matrix(&ra)).0;
+            flip += wrap(f - before);
+            before = f;
+            last_a = continuous(quat(&ra), last_a);
+            last_b = continuous(quat(&(ra * rel)), last_b);
+            Frame {
+                t: end.t + dt,
+                a: last_a,
+                b: last_b,
+                flip_deg: flip.to_degrees(),
+                bend_deg: shape[0].hypot(shape[1]).to_degrees(),
+                tau_nm: norm.of(tau),
+            }
+        })
+        .collect()
 }
 
 /// JSON that is safe inside a `<script>` element.

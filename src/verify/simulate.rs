@@ -67,6 +67,11 @@ pub struct SimReport {
     pub steps: usize,
     #[serde(skip)]
     pub trace: Vec<TracePoint>,
+    /// The landing margin flown with the shape held straight, `t` from the
+    /// manoeuvre's end (empty where the landing is the rigid turn of
+    /// [`SimReport::land`]): the animation's way to touchdown.
+    #[serde(skip)]
+    pub landing_trace: Vec<TracePoint>,
 }
 
 impl SimReport {
@@ -110,6 +115,7 @@ impl SimReport {
             peak_torque_nm: f64::NAN,
             steps: 0,
             trace: Vec::new(),
+            landing_trace: Vec::new(),
         }
     }
 }
@@ -196,6 +202,7 @@ fn finish(
         peak_torque_nm: 0.0,
         steps,
         trace,
+        landing_trace: Vec::new(),
     })
 }
 
@@ -528,6 +535,7 @@ pub fn dynamic_landing(
                 .matrix(),
         ));
         r.landing_error_deg = landing_error(&m).to_degrees();
+        r.landing_trace = held.trace;
     }
     Ok(r)
 }

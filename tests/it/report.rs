@@ -312,16 +312,30 @@ fn run_shows_an_exceeded_limit_and_an_unconverged_optimiser() {
 fn animation_frames_follow_the_simulation() {
     use catflip::report::animation::{FRAMES, track};
     use nalgebra::{Quaternion, UnitQuaternion, Vector3};
-    let cfg = catflip::Config::load(&configs().join("seed.toml"), &[]).unwrap();
+    // (the seed's margin is 0: a tenth of a second of it, to touchdown)
+    let cfg =
+        catflip::Config::load(&configs().join("seed.toml"), &["fall.margin=0.1".into()]).unwrap();
     let cat = cfg.cat();
     let plan = catflip::design::analytic::analytic_plan(&cfg.design_spec());
     let sim = catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &plan).unwrap();
-    let tr = track(&cat, cfg.norm(), "analytic", &sim, FRAMES);
-    let f = &tr.frames;
+    let margin = cfg.fall.margin;
+    let tr = track(&cat, cfg.norm(), "analytic", &sim, (FRAMES, margin));
+    let manoeuvre = sim.trace.last().unwrap().t;
+    let (f, after): (Vec<_>, Vec<_>) = tr.frames.iter().cloned().partition(|fr| fr.t <= manoeuvre);
     assert!(f.len() > FRAMES / 2 && f.len() <= FRAMES, "{}", f.len());
     assert_eq!(f[0].t, sim.trace[0].t);
-    assert_eq!(f.last().unwrap().t, sim.trace.last().unwrap().t);
-    assert!(f.windows(2).all(|w| w[1].t > w[0].t));
+    assert_eq!(f.last().unwrap().t, manoeuvre);
+    assert!(tr.frames.windows(2).all(|w| w[1].t > w[0].t));
+    // then to touchdown: at zero momentum the straight cat holds its attitude
+    assert!((tr.frames.last().unwrap().t - (manoeuvre + margin)).abs() < 1e-12);
+    assert!(after.len() >= 2);
+    let held = f.last().unwrap();
+    for fr in &after {
+        assert_eq!((fr.a, fr.b), (held.a, held.b), "t {}", fr.t);
+        assert!((fr.flip_deg - held.flip_deg).abs() < 1e-9, "t {}", fr.t);
+        assert!(fr.tau_nm < 1e-6 && fr.bend_deg < 1e-6, "t {}: {fr:?}", fr.t);
+    }
+    let f = &f;
     let uq = |q: [f64; 4]| UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
     let mut largest = 0.0f64;
     for fr in f {
@@ -347,4 +361,57 @@ fn animation_frames_follow_the_simulation() {
     // the embedded flip is the simulation's, whatever its sign convention
     let last = sim.trace.last().unwrap();
     assert_eq!(end.flip_deg, last.flip.to_degrees());
+}
+
+/// From a start with momentum the straight cat turns on during the margin:
+/// the track's last frame is the touchdown whose belly angle the
+/// simulation reports as its landing error.
+#[test]
+fn the_animation_ends_at_touchdown_on_the_landing() {
+    use catflip::report::animation::{FRAMES, track};
+    use nalgebra::{Quaternion, UnitQuaternion};
+    let cfg = catflip::Config::load(
+        &configs().join("seed.toml"),
+        &[
+            "start.angular_velocity=[0.3, 0.2, 0.5]".into(),
+            "fall.margin=0.15".into(),
+        ],
+    )
+    .unwrap();
+    let spec = cfg.design_spec();
+    let plan = catflip::design::analytic::analytic_plan(&spec);
+    let sim = catflip::verify::simulate::dynamic_spec(&spec, &plan).unwrap();
+    let tr = track(
+        &cfg.cat(),
+        cfg.norm(),
+        "analytic",
+        &sim,
+        (FRAMES, cfg.fall.margin),
+    );
+    let manoeuvre = sim.trace.last().unwrap().t;
+    let end = tr.frames.last().unwrap();
+    assert!(
+        (end.t - cfg.fall_time()).abs() < 1e-9,
+        "{} against {}",
+        end.t,
+        cfg.fall_time()
+    );
+    let q = end.a;
+    let r = UnitQuaternion::from_quaternion(Quaternion::new(q[0], q[1], q[2], q[3]));
+    let belly =
+        catflip::model::momentum::landing_error(r.to_rotation_matrix().matrix()).to_degrees();
+    // the page stores quaternions to 1e-7
+    assert!(
+        (belly - sim.landing_error_deg).abs() < 1e-4,
+        "{belly} against {}",
+        sim.landing_error_deg
+    );
+    // and it moved over the margin
+    let at_end = tr.frames.iter().rev().find(|f| f.t <= manoeuvre).unwrap();
+    assert!(
+        at_end.a != end.a && (end.flip_deg - at_end.flip_deg).abs() > 0.1,
+        "{} {}",
+        at_end.flip_deg,
+        end.flip_deg
+    );
 }
