@@ -40,6 +40,14 @@ fn answer() -> &'static SizeAnswer {
     })
 }
 
+/// The question's motor: its stall torque and no-load speed (gear ratio 1).
+fn configured_motor(q: &catflip::Config) -> (f64, f64) {
+    (
+        q.limits.max_torque.unwrap(),
+        q.limits.no_load_speed.unwrap(),
+    )
+}
+
 /// The point nearest the curve's knee (geometric middle of its ratios),
 /// where both the torque and the speed matter.
 fn knee(a: &SizeAnswer) -> catflip::size::CurvePoint {
@@ -125,10 +133,7 @@ fn the_best_gear_ratio_is_a_stationary_point_of_the_least_height() {
     let a = answer();
     let g = &a.gear;
     let q = robot_question(HEIGHT);
-    let (t0, w0) = (
-        q.limits.max_torque.unwrap(),
-        q.limits.no_load_speed.unwrap(),
-    );
+    let (t0, w0) = configured_motor(&q);
     // the search's own designs: none better than the best
     for e in &g.evaluations {
         assert!(e.design.least_height_m >= g.least_height_m);
@@ -188,10 +193,7 @@ fn the_gear_ratios_that_make_it_are_named_and_hold() {
     let a = answer();
     let g = &a.gear;
     let q = robot_question(HEIGHT);
-    let (t0, w0) = (
-        q.limits.max_torque.unwrap(),
-        q.limits.no_load_speed.unwrap(),
-    );
+    let (t0, w0) = configured_motor(&q);
     let r = g.working_range.expect("the best ratio makes it from 2 m");
     assert!(
         g.possible && r.low < g.best_ratio && g.best_ratio < r.high,
