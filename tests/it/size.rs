@@ -506,3 +506,31 @@ fn the_ends_are_named_as_designs_and_a_point_past_one_is_said() {
         Some(format!("{:.4}", g.stall_torque_nm).parse().unwrap())
     );
 }
+
+/// Where only a gear ratio of the configured motor makes it, the report's
+/// green answer box leads with that ratio, not with "the configured motor
+/// does not make it" (a green box under that read as a contradiction).
+#[test]
+fn the_page_leads_with_what_makes_it() {
+    let a = answer();
+    let g = &a.gear;
+    assert!(
+        g.possible && !g.configured_possible,
+        "the robot from 2 m: {g:?}"
+    );
+    let page = catflip::report::size::page(a);
+    let headline = page
+        .split("<p class=\"headline\">")
+        .nth(1)
+        .and_then(|h| h.split("</p>").next())
+        .unwrap();
+    assert!(page.contains("<section id=\"answer\" class=\"possible\">"));
+    assert!(
+        headline.starts_with("Its best gear ratio is N = "),
+        "{headline}"
+    );
+    assert!(
+        page.contains("The configured motor ("),
+        "the configured motor still said"
+    );
+}
