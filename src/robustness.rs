@@ -269,14 +269,10 @@ fn trial_page(
             vec![
                 f.name.to_string(),
                 format!("{:.3}", f.landing_error_deg),
-                if f.landed { "yes" } else { "no" }.to_string(),
+                f.landed_text().to_string(),
                 format!("{:.4}", f.max_correction_nm),
                 f.commands.to_string(),
-                if f.replans > 0 {
-                    format!("{} ({} taken)", f.replans, f.replans_taken)
-                } else {
-                    String::new()
-                },
+                f.replans_text(),
             ]
         })
         .collect();
@@ -374,12 +370,7 @@ fn page(
             s.seed, s.seed
         ),
     ];
-    notes.extend(
-        catflip::console::robustness::nearest_rank(s.trials).map(|n| {
-            let n = n.trim_matches(|c| c == '(' || c == ')');
-            format!("{}{}.", n[..1].to_uppercase(), &n[1..])
-        }),
-    );
+    notes.extend(catflip::console::robustness::nearest_rank(s.trials));
     if let Some((_, bins)) = figure {
         notes.extend(catflip::control::figure::bins_note(bins));
     }

@@ -55,11 +55,11 @@ pub fn study(
 }
 
 /// What the percentiles of a study of `trials` are, when p99 is its largest
-/// landing error (fewer than 100 trials, nearest rank).
+/// landing error (fewer than 100 trials, nearest rank): a sentence.
 pub fn nearest_rank(trials: usize) -> Option<String> {
     (0 < trials && trials < 100).then(|| {
         format!(
-            "(percentiles by nearest rank: of {trials} trials, p99 is the largest landing error{})",
+            "Percentiles by nearest rank: of {trials} trials, p99 is the largest landing error{}.",
             if trials < 10 { ", and p90 too" } else { "" }
         )
     })
@@ -83,14 +83,10 @@ pub fn trial(s: &crate::control::replay::Summary, written: &[PathBuf]) -> Vec<St
             "  {:<10} {:>12.3} {:>7} {:>24.4} {:>9} {:>9}",
             f.name,
             f.landing_error_deg,
-            if f.landed { "yes" } else { "no" },
+            f.landed_text(),
             f.max_correction_nm,
             f.commands,
-            if f.replans > 0 {
-                format!("{} ({} taken)", f.replans, f.replans_taken)
-            } else {
-                String::new()
-            }
+            f.replans_text()
         ));
     }
     for p in written {

@@ -277,15 +277,15 @@ pub fn fly_logged(
             });
         }
         y = rk4(&plant, &y, live.h, &torque);
-        let ended = j + 1 == n || !y.iter().all(|v| v.is_finite());
-        if let (Some(log), Some(t), true) = (log.as_deref_mut(), acted, ended) {
+        let diverged = !y.iter().all(|v| v.is_finite());
+        if let (Some(log), Some(t), true) = (log.as_deref_mut(), acted, diverged || j + 1 == n) {
             log.samples.push(Sample {
                 step: j + 1,
                 state: y,
                 torque: t,
             });
         }
-        if !y.iter().all(|v| v.is_finite()) {
+        if diverged {
             return finish(y, max_corr, replanned);
         }
     }

@@ -20,6 +20,11 @@ pub fn every(h: f64) -> usize {
     (1e-3 / h).floor().max(1.0) as usize
 }
 
+/// The times of a flight's logged states, s.
+fn times(log: &Log, h: f64) -> Vec<f64> {
+    log.samples.iter().map(|p| p.step as f64 * h).collect()
+}
+
 /// The belly's angle from straight down, deg, of a state.
 fn belly_deg(y: &super::plant::Y) -> f64 {
     landing_error(attitude(y).to_rotation_matrix().matrix()).to_degrees()
@@ -59,6 +64,22 @@ pub struct Flown {
     /// Replans made and taken (replanning only; 0 otherwise).
     pub replans: usize,
     pub replans_taken: usize,
+}
+
+impl Flown {
+    /// "yes" or "no", for the tables.
+    pub fn landed_text(&self) -> &'static str {
+        if self.landed { "yes" } else { "no" }
+    }
+
+    /// "12 (3 taken)", empty for a controller that does not replan.
+    pub fn replans_text(&self) -> String {
+        if self.replans > 0 {
+            format!("{} ({} taken)", self.replans, self.replans_taken)
+        } else {
+            String::new()
+        }
+    }
 }
 
 /// `trial.json`: the trial, its draws and each controller's landing.
@@ -155,7 +176,7 @@ pub fn belly_figure(r: &Replay, max_tilt_deg: f64) -> Result<String> {
 /// PD ringing under a delay).
 pub fn torque_figure(r: &Replay, c: usize) -> Result<String> {
     let (_, log) = &r.flights[c];
-    let t: Vec<f64> = log.samples.iter().map(|p| p.step as f64 * r.h).collect();
+    let t = times(log, r.h);
     let named: Vec<(String, Vec<f64>)> = (0..2)
         .map(|j| {
             let y = log.samples.iter().map(|p| p.torque[j]).collect();
@@ -187,7 +208,7 @@ fn aligned(r: &Replay, ys: Vec<Vec<f64>>) -> (Vec<f64>, Vec<Vec<f64>>) {
         .flights
         .iter()
         .max_by_key(|(_, l)| l.samples.len())
-        .map(|(_, l)| l.samples.iter().map(|p| p.step as f64 * r.h).collect())
+        .map(|(_, l)| times(l, r.h))
         .unwrap_or_default();
     let n = longest.len();
     let ys = ys

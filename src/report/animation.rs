@@ -169,10 +169,8 @@ fn touchdown(
 ) -> Vec<Frame> {
     use crate::model::so3::{flip_and_tilt, wrap};
     let steps = ((count as f64 * margin / end.t.max(1e-9)).ceil() as usize).clamp(2, count);
-    let [w, x, y, z] = sim.final_attitude;
-    let r0 = *UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z))
-        .to_rotation_matrix()
-        .matrix();
+    use crate::model::so3::quat_from;
+    let r0 = *quat_from(&sim.final_attitude).to_rotation_matrix().matrix();
     let held = &sim.landing_trace;
     // (attitude of A, shape, torque) `dt` after the manoeuvre
     let at = |dt: f64| -> (Rotation3<f64>, [f64; 2], [f64; 2]) {
@@ -180,10 +178,7 @@ fn touchdown(
             .iter()
             .min_by(|a, b| (a.t - dt).abs().total_cmp(&(b.t - dt).abs()))
         {
-            let [w, x, y, z] = p.attitude;
-            let r =
-                UnitQuaternion::from_quaternion(Quaternion::new(w, x, y, z)).to_rotation_matrix();
-            (r, p.q, p.tau)
+            (quat_from(&p.attitude).to_rotation_matrix(), p.q, p.tau)
         } else {
             let r = crate::model::momentum::rigid_turn(cat, &r0, sim.final_body_momentum, dt);
             (Rotation3::from_matrix_unchecked(r), q, [0.0; 2])
