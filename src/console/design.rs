@@ -38,6 +38,13 @@ pub fn analysis(a: &Analysis, written: &[PathBuf]) -> Rows {
         format!("{:.4} rad/s", cf.omega0_rad_s),
     )
     .row(
+        "seed's omega (section 7)",
+        format!(
+            "{:.4} rad/s (with sin(theta/2) where the seed's section 7 has sin^2, E2; the whole fall as the twist's time, E8)",
+            cf.seed_omega_rad_s
+        ),
+    )
+    .row(
         "one-turn theta (F6)",
         format!("{:.3} deg", cf.one_turn_theta_deg),
     )

@@ -70,6 +70,30 @@ fn analyze_json_has_the_documented_keys_and_writes_a_schedule() {
     );
 }
 
+/// `analyze` prints the seed's own example rate with erratum E2 named: the
+/// seed's numbers (its inertia, 10 m) give 2.2587 rad/s with `sin(theta/2)`.
+#[test]
+fn analyze_names_the_seeds_rate_and_its_erratum() {
+    let dir = temp_dir();
+    let cfg = configs().join("seed.toml");
+    let o = output(
+        &[
+            "analyze",
+            cfg.to_str().unwrap(),
+            "--set",
+            "analytic.seed_inertia=true",
+        ],
+        dir.path(),
+    );
+    let (out, err) = text(&o);
+    assert!(o.status.success(), "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.contains("seed's omega"))
+        .unwrap_or_else(|| panic!("no seed's omega line: {out}"));
+    assert!(line.contains("2.2587 rad/s") && line.contains("E2"), "{line}");
+}
+
 #[test]
 fn simulate_replays_a_written_schedule() {
     let dir = temp_dir();
