@@ -46,12 +46,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
             catflip::console::count(trials, "trial")
         );
     }
-    if cfg.control.delay_ms != cfg.robustness.delay_ms {
-        eprintln!(
-            "warning: the controllers predict over a delay of {} ms (control.delay_ms) but the simulated robot's is {} ms (robustness.delay_ms); set both to your robot's delay to study it",
-            cfg.control.delay_ms, cfg.robustness.delay_ms
-        );
-    }
+    warn_of_delay_mismatch(&cfg);
     let state = StudyState {
         status: SweepStatus::Partial,
         trials,
@@ -210,6 +205,17 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
 
 /// `robustness --trial K`: trial `k` of the study `args` describes flown
 /// again under each controller, its flights written and shown.
+/// Says on stderr when the controllers predict over another delay than the
+/// simulated robot has (a study and a trial flown again alike).
+fn warn_of_delay_mismatch(cfg: &catflip::config::Config) {
+    if cfg.control.delay_ms != cfg.robustness.delay_ms {
+        eprintln!(
+            "warning: the controllers predict over a delay of {} ms (control.delay_ms) but the simulated robot's is {} ms (robustness.delay_ms); set both to your robot's delay to study it",
+            cfg.control.delay_ms, cfg.robustness.delay_ms
+        );
+    }
+}
+
 pub fn cmd_trial(c: &Common, args: StudyArgs, k: usize) -> Result<Status> {
     use catflip::control::replay;
     if k >= args.trials {
@@ -221,6 +227,7 @@ pub fn cmd_trial(c: &Common, args: StudyArgs, k: usize) -> Result<Status> {
         .into());
     }
     let cfg = load(c)?;
+    warn_of_delay_mismatch(&cfg);
     let publisher = publisher(c, &cfg, &format!("robustness-trial-{k}"))?;
     let design = catflip::control::robustness::design(&cfg)?;
     let flown = described(&design);

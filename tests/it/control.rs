@@ -367,6 +367,25 @@ fn the_page_says_when_the_controllers_assume_another_delay() {
         page.contains("predict over a delay of 20 ms (control.delay_ms); the simulated robot's actuator delay is 5 ms (robustness.delay_ms): the controllers assume another delay than the robot has"),
         "{page}"
     );
+    // a trial flown again warns alike
+    let (ok, _, err) = crate::util::run_ok(
+        &[
+            "robustness",
+            &seed,
+            "--trials",
+            "1",
+            "--trial",
+            "0",
+            "--set",
+            "control.delay_ms=20",
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: the controllers predict over a delay of 20 ms (control.delay_ms) but the simulated robot's is 5 ms (robustness.delay_ms)"),
+        "{err}"
+    );
 }
 
 /// `--replan-budget-ms` drops a replan over its wall time, as a robot's
