@@ -533,6 +533,23 @@ impl Config {
             simulate: self.simulate.clone(),
             phased: self.phased.clone(),
             free: self.free.clone(),
+            limits_from: self.limits_from(),
+        }
+    }
+
+    /// Where the motor limits came from: the keys, or the robot file that
+    /// gave some of them.
+    pub fn limits_from(&self) -> crate::design::spec::LimitOrigin {
+        match &self.body {
+            Some(b) if !b.file_limits.is_empty() => crate::design::spec::LimitOrigin {
+                file: Some(if b.urdf.is_some() {
+                    "body.urdf"
+                } else {
+                    "body.mjcf"
+                }),
+                keys: b.file_limits.clone(),
+            },
+            _ => Default::default(),
         }
     }
 
@@ -544,22 +561,6 @@ impl Config {
             max_speed: self.limits.max_speed,
             norm: self.norm(),
         }
-    }
-
-    /// The motor limits the config sets, as the keys a user would change
-    /// (`limits.max_torque, limits.no_load_speed`), for messages.
-    pub fn envelope_keys(&self) -> String {
-        let l = &self.limits;
-        [
-            ("limits.max_torque", l.max_torque.is_some()),
-            ("limits.no_load_speed", l.no_load_speed.is_some()),
-            ("limits.max_speed", l.max_speed.is_some()),
-        ]
-        .iter()
-        .filter(|(_, set)| *set)
-        .map(|(k, _)| *k)
-        .collect::<Vec<_>>()
-        .join(", ")
     }
 
     /// Largest bend the phased design may use (and the free-form design's
@@ -729,7 +730,10 @@ gravity = 9.8
     fn messages_name_only_the_limits_the_config_sets() {
         let with = |ov: &[&str]| {
             let ov: Vec<String> = ov.iter().map(|s| s.to_string()).collect();
-            Config::from_toml(SEED, "t", &ov).unwrap().envelope_keys()
+            Config::from_toml(SEED, "t", &ov)
+                .unwrap()
+                .design_spec()
+                .envelope_keys()
         };
         assert_eq!(with(&[]), "");
         assert_eq!(with(&["limits.max_torque=1"]), "limits.max_torque");

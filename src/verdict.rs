@@ -136,6 +136,8 @@ pub struct Targets {
     pub judge_flip: bool,
     /// The limit keys the config sets, for messages.
     pub envelope_keys: String,
+    /// Where the limits came from (the keys, or a robot file), for messages.
+    pub limits_from: crate::design::spec::LimitOrigin,
 }
 
 impl Targets {
@@ -156,6 +158,7 @@ impl Targets {
             },
             judge_flip: spec.is_default_start(),
             envelope_keys: spec.envelope_keys(),
+            limits_from: spec.limits_from.clone(),
         }
     }
 
@@ -221,31 +224,26 @@ pub enum Miss {
     /// The solver's result is not proven.
     Status(Status),
     /// Flip error beyond the tolerance (or NaN), rad.
-    Flip {
-        error_rad: f64,
-        tolerance: f64,
-    },
+    Flip { error_rad: f64, tolerance: f64 },
     /// Spine tilt beyond the tolerance (or NaN), deg.
-    Tilt {
-        tilt_deg: f64,
-        tolerance: f64,
-    },
+    Tilt { tilt_deg: f64, tolerance: f64 },
+    /// Above the torque limit; `name` says where the limit was set.
     Torque {
         peak_nm: f64,
         limit: f64,
+        name: String,
     },
     Speed {
         speed_rad_s: f64,
         limit: f64,
+        name: String,
     },
     /// Outside the motor envelope (the keys that set it).
-    Envelope {
-        margin: f64,
-        keys: String,
-    },
+    Envelope { margin: f64, keys: String },
     Bend {
         bend_deg: f64,
         limit: f64,
+        name: String,
     },
     /// The belly's angle from straight down at touchdown beyond the tolerance
     /// (or NaN), deg, and the key that sets the tolerance.
@@ -295,22 +293,28 @@ impl fmt::Display for Miss {
                 "tilts the spine by {tilt_deg:.3} deg = {} rad (simulate.flip_tolerance = {tolerance:e} rad)",
                 crate::table::three_digits(tilt_deg.to_radians())
             ),
-            Miss::Torque { peak_nm, limit } => write!(
+            Miss::Torque {
+                peak_nm,
+                limit,
+                name,
+            } => write!(f, "needs {peak_nm:.4} N m, above {name} = {limit} N m"),
+            Miss::Speed {
+                speed_rad_s,
+                limit,
+                name,
+            } => write!(
                 f,
-                "needs {peak_nm:.4} N m, above limits.max_torque = {limit} N m"
-            ),
-            Miss::Speed { speed_rad_s, limit } => write!(
-                f,
-                "moves at {speed_rad_s:.4} rad/s, above limits.max_speed = {limit} rad/s"
+                "moves at {speed_rad_s:.4} rad/s, above {name} = {limit} rad/s"
             ),
             Miss::Envelope { margin, keys } => write!(
                 f,
                 "leaves the motor envelope (smallest margin {margin:.3}; {keys})"
             ),
-            Miss::Bend { bend_deg, limit } => write!(
-                f,
-                "bends {bend_deg:.2} deg, above limits.max_bend_deg = {limit} deg"
-            ),
+            Miss::Bend {
+                bend_deg,
+                limit,
+                name,
+            } => write!(f, "bends {bend_deg:.2} deg, above {name} = {limit} deg"),
             Miss::Landing {
                 error_deg,
                 tolerance_deg,
@@ -464,6 +468,7 @@ pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
         why.push(Miss::Torque {
             peak_nm: d.peak_torque_nm,
             limit,
+            name: targets.limits_from.name("limits.max_torque"),
         });
     }
     if let (Some(limit), Some(s)) = (targets.max_speed, d.max_speed_rad_s)
@@ -472,6 +477,7 @@ pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
         why.push(Miss::Speed {
             speed_rad_s: s,
             limit,
+            name: targets.limits_from.name("limits.max_speed"),
         });
     }
     // NaN (a failed sample) is outside
@@ -489,6 +495,7 @@ pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
         why.push(Miss::Bend {
             bend_deg: d.bend_deg,
             limit,
+            name: targets.limits_from.name("limits.max_bend_deg"),
         });
     }
     why
@@ -583,6 +590,7 @@ mod tests {
             landing_tolerance: None,
             judge_flip: true,
             envelope_keys: "limits.max_torque, limits.max_speed".into(),
+            limits_from: Default::default(),
         }
     }
 

@@ -493,16 +493,8 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
         );
     }
     // a speed the robot file gave is named there, not as a key the user never typed
-    let from_file = |key: &str| {
-        cfg.body
-            .as_ref()
-            .filter(|b| b.file_limits.iter().any(|k| format!("limits.{k}") == key))
-            .map(|b| {
-                let file = b.urdf.as_ref().map_or("body.mjcf", |_| "body.urdf");
-                format!("{file} (its joints' velocity, read as {key})")
-            })
-            .unwrap_or_else(|| key.to_string())
-    };
+    let origin = cfg.limits_from();
+    let from_file = |key: &str| origin.name(key);
     for (key, w) in [
         ("limits.no_load_speed", cfg.limits.no_load_speed),
         ("limits.max_speed", cfg.limits.max_speed),

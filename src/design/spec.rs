@@ -37,6 +37,41 @@ pub struct DesignSpec {
     pub simulate: SimulateSettings,
     pub phased: PhasedSettings,
     pub free: FreeSettings,
+    /// Where the motor limits came from, so that a message names them as
+    /// the user gave them.
+    pub limits_from: LimitOrigin,
+}
+
+/// Where the motor limits came from: the `[limits]` keys, or a robot file
+/// that gave some of them (their values were never typed in the config, so a
+/// message naming only the key would send the user to a key they never set).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct LimitOrigin {
+    /// `body.urdf` or `body.mjcf`, when the file gave a limit.
+    pub file: Option<&'static str>,
+    /// The `[limits]` keys the file gave (`max_torque`, ...).
+    pub keys: Vec<&'static str>,
+}
+
+impl LimitOrigin {
+    /// How a message names the limit `key` (`limits.max_speed`): the key,
+    /// or the file's attribute it was read from and the key that replaces it.
+    pub fn name(&self, key: &str) -> String {
+        let Some(file) = self.file.filter(|_| {
+            self.keys
+                .iter()
+                .any(|k| key.strip_prefix("limits.") == Some(k))
+        }) else {
+            return key.to_string();
+        };
+        let what = match (file, key) {
+            ("body.mjcf", _) => "its actuators' ctrlrange or forcerange",
+            (_, "limits.max_torque") => "its joints' effort",
+            (_, "limits.max_speed") => "its joints' velocity",
+            _ => "its joints' range",
+        };
+        format!("{file} ({what}, read as {key})")
+    }
 }
 
 /// The drop.
@@ -456,7 +491,7 @@ impl DesignSpec {
         ]
         .iter()
         .filter(|(_, set)| *set)
-        .map(|(k, _)| *k)
+        .map(|(k, _)| self.limits_from.name(k))
         .collect::<Vec<_>>()
         .join(", ")
     }

@@ -91,7 +91,10 @@ fn analyze_names_the_seeds_rate_and_its_erratum() {
         .lines()
         .find(|l| l.contains("seed's omega"))
         .unwrap_or_else(|| panic!("no seed's omega line: {out}"));
-    assert!(line.contains("2.2587 rad/s") && line.contains("E2"), "{line}");
+    assert!(
+        line.contains("2.2587 rad/s") && line.contains("E2"),
+        "{line}"
+    );
 }
 
 #[test]

@@ -563,3 +563,59 @@ fn zero_effort_and_velocity_in_a_urdf_mean_no_limit() {
     let cfg = Config::load(&toml, &["limits.max_torque=1.2".into()]).unwrap();
     assert_eq!(cfg.limits.max_torque, Some(1.2));
 }
+
+/// A limit the robot file gave is named in a verdict's reasons by the file
+/// and its attribute (the user never typed the key); the same limit typed
+/// in the config is named by its key.
+#[test]
+fn a_verdict_names_a_limit_where_the_robot_file_gave_it() {
+    use catflip::verdict::{DesignNumbers, Status, Targets, limit_misses};
+    let dir = temp_dir();
+    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf"))
+        .unwrap()
+        .replacen(
+            "lower=\"-2.6\" upper=\"2.6\"",
+            "lower=\"-0.5\" upper=\"0.7\"",
+            1,
+        );
+    std::fs::write(dir.path().join("robot.urdf"), &urdf).unwrap();
+    let toml = dir.path().join("robot.toml");
+    std::fs::write(
+        &toml,
+        "name = \"r\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
+    )
+    .unwrap();
+    let reasons = |sets: &[&str]| {
+        let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+        let spec = Config::load(&toml, &sets).unwrap().design_spec();
+        let over = DesignNumbers {
+            status: Status::Solved,
+            peak_torque_nm: 100.0,
+            bend_deg: 170.0,
+            max_speed_rad_s: Some(100.0),
+            envelope_margin: None,
+        };
+        limit_misses(&Targets::of(&spec), &over)
+            .iter()
+            .map(|m| m.to_string())
+            .collect::<Vec<_>>()
+    };
+    let from_file = reasons(&[]);
+    assert_eq!(from_file.len(), 3, "{from_file:?}");
+    for (m, what) in from_file.iter().zip([
+        "its joints' effort, read as limits.max_torque) = 1.4 N m",
+        "its joints' velocity, read as limits.max_speed) = 5.969 rad/s",
+        "its joints' range, read as limits.max_bend_deg) = ",
+    ]) {
+        assert!(m.contains(&format!("above body.urdf ({what}")), "{m}");
+    }
+    let typed = reasons(&["limits.max_speed=3"]);
+    assert!(
+        typed[1].contains("above limits.max_speed = 3 rad/s"),
+        "{typed:?}"
+    );
+    assert!(
+        typed[0].contains("body.urdf (its joints' effort"),
+        "{typed:?}"
+    );
+}
