@@ -30,6 +30,7 @@ from ._catflip import (
     robustness,
     run,
     simulate,
+    size,
 )
 from ._catflip import __version__
 from ._catflip import sweep_columns as _sweep_columns
@@ -72,6 +73,7 @@ __all__ = [
     "robustness",
     "run",
     "simulate",
+    "size",
     "sweep",
 ]
 

@@ -1,6 +1,6 @@
 """Type stubs of catflip (the Python bindings of the catflip Rust library).
 
-Long calls (``design``, ``run``, ``least_height``, ``sweep``, ``robustness``,
+Long calls (``design``, ``run``, ``least_height``, ``size``, ``sweep``, ``robustness``,
 ``Controller(...)``) run with the GIL released and end at Ctrl-C with KeyboardInterrupt
 within 50 ms (a sweep starts no new point, a study no new trials; other work finishes in
 the background, its result dropped).
@@ -294,6 +294,14 @@ def least_height(config: Config) -> Optional[LeastHeight]:
     """The least drop height at which the config's motors flip the cat (the phased and
     free-form ``time`` designs inside the motor envelope), or None when the config sets no
     motor limit. GIL released."""
+
+def size(config: Config, height: float, points: int = 8, gear_evaluations: int = 6) -> Dict[str, Any]:
+    """The motors that would flip the cat from ``height`` m: ``catflip size CONFIG --height H
+    --json`` in memory (nothing written), GIL released. The CLI's ``size.json`` as a dict:
+    ``curve`` (stall torque against no-load speed that just makes it), ``gear`` (the best gear
+    ratio for the config's motor, ``best_ratio``, and the least height it gives), the
+    asymptotes. Needs ``limits.max_torque`` and ``limits.no_load_speed``; raises
+    ConfigError for a bad height, count or config."""
 
 def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
           methods: Union[str, Sequence[str]] = ..., threads: Optional[int] = None,

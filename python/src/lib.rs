@@ -82,7 +82,7 @@ fn dict_error(text: &str, message: &str) -> String {
 
 /// The library's advice in the package's words: its messages name the
 /// command line's flags and commands where Python has arguments and functions.
-const PYTHONIC: [(&str, &str); 5] = [
+const PYTHONIC: [(&str, &str); 4] = [
     (
         "another seed (--seed)",
         "another seed (seed=\"analytic\" or \"phased\")",
@@ -96,17 +96,31 @@ const PYTHONIC: [(&str, &str); 5] = [
         "`catflip.least_height(config)` finds the least drop height",
     ),
     ("`catflip run`", "`catflip.run(config)`"),
-    (
-        "catflip size CONFIG --height",
-        "the command line's `catflip size CONFIG --height`",
-    ),
 ];
+
+/// The library's advice in this package's words: [`PYTHONIC`], and `catflip
+/// size CONFIG --height H.` as the call `catflip.size(config, H).`.
+fn pythonic(message: String) -> String {
+    let mut m = PYTHONIC
+        .iter()
+        .fold(message, |m, (cli, py)| m.replace(cli, py));
+    const SIZE: &str = "catflip size CONFIG --height ";
+    while let Some(at) = m.find(SIZE) {
+        let rest = &m[at + SIZE.len()..];
+        // the height's digits, without the sentence's full stop
+        let len = rest
+            .find(|c: char| !(c.is_ascii_digit() || ".e+-".contains(c)))
+            .unwrap_or(rest.len());
+        let height = rest[..len].trim_end_matches('.');
+        let call = format!("catflip.size(config, {height})");
+        m.replace_range(at..at + SIZE.len() + height.len(), &call);
+    }
+    m
+}
 
 fn err(e: catflip::Error) -> PyErr {
     use catflip::Error as E;
-    let msg = PYTHONIC
-        .iter()
-        .fold(e.to_string(), |m, (cli, py)| m.replace(cli, py));
+    let msg = pythonic(e.to_string());
     match e {
         E::BeyondMotors { .. } => ImpossibleError::new_err(msg),
         e if e.is_bad_input() => ConfigError::new_err(msg),
@@ -1319,7 +1333,7 @@ impl LeastHeight {
     }
     /// The answer in one sentence, as the CLI's table prints it.
     fn sentence(&self) -> String {
-        self.answer.sentence()
+        pythonic(self.answer.sentence())
     }
     /// The `answer` object of `summary.json`.
     fn to_json(&self) -> String {
@@ -1356,6 +1370,55 @@ fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>
             }))
         },
     )
+}
+
+/// The motors that would flip the cat from `height`, m: `catflip size CONFIG --height H
+/// [--points P] [--gear-evaluations G] --json` in memory (nothing written), with the GIL
+/// released: the CLI's `size.json` as a dict (`curve`, the stall torque against no-load
+/// speed that just makes it; `gear`, the best gear ratio for the config's motor and the
+/// least height it gives; the asymptotes). The config needs `limits.max_torque` and
+/// `limits.no_load_speed`; `height` replaces its `fall.height`.
+#[pyfunction]
+#[pyo3(signature = (config, height, points = 8, gear_evaluations = 6))]
+fn size<'py>(
+    py: Python<'py>,
+    config: &Config,
+    height: f64,
+    points: i64,
+    gear_evaluations: i64,
+) -> PyResult<Bound<'py, PyAny>> {
+    // the CLI's options, as this function names them
+    let pythonic = |e: catflip::Error| match e {
+        catflip::Error::Usage(m) => err(catflip::Error::Usage(
+            m.replace("--height ", "height=")
+                .replace("--points ", "points=")
+                .replace("--gear-evaluations ", "gear_evaluations="),
+        )),
+        e => err(e),
+    };
+    let count = |name: &str, n: i64| {
+        usize::try_from(n)
+            .map_err(|_| ConfigError::new_err(format!("{name}={n}: give a count, 0 or more")))
+    };
+    let settings = catflip::size::SizeSettings {
+        points: count("points", points)?,
+        gear_evaluations: count("gear_evaluations", gear_evaluations)?,
+    };
+    settings.validate().map_err(pythonic)?;
+    let (source, _) = config.snapshot();
+    let cfg = source
+        .load(Some(&format!("fall.height={height}")))
+        .map_err(|e| pythonic(catflip::size::height_error(height, e)))?;
+    let q = catflip::size::question(&cfg, height).map_err(pythonic)?;
+    let json = interruptible(
+        py,
+        || {},
+        move || {
+            let a = catflip::size::size(&q, &settings, |_, _| {}).map_err(err)?;
+            Ok(serde_json::to_value(&a).expect("serialises"))
+        },
+    )?;
+    json_loads(py, &json)
 }
 
 /// Columns of a sweep: floats (NaN where a method gave none) and texts.
@@ -2269,6 +2332,7 @@ fn _catflip(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(design, m)?)?;
     m.add_function(wrap_pyfunction!(simulate, m)?)?;
     m.add_function(wrap_pyfunction!(least_height, m)?)?;
+    m.add_function(wrap_pyfunction!(size, m)?)?;
     m.add_function(wrap_pyfunction!(sweep_columns, m)?)?;
     m.add_function(wrap_pyfunction!(run, m)?)?;
     m.add_function(wrap_pyfunction!(robustness, m)?)?;

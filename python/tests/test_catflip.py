@@ -9,6 +9,7 @@ import json
 import math
 import os
 import pathlib
+import re
 import subprocess
 import sys
 import threading
@@ -54,14 +55,14 @@ PYTHONIC = [
     ("`--seed analytic` starts it", '`seed="analytic"` starts it'),
     ("`catflip run` finds the least drop height", "`catflip.least_height(config)` finds the least drop height"),
     ("`catflip run`", "`catflip.run(config)`"),
-    ("catflip size CONFIG --height", "the command line's `catflip size CONFIG --height`"),
 ]
 
 
 def in_python_words(cli_message):
     for cli_words, py_words in PYTHONIC:
         cli_message = cli_message.replace(cli_words, py_words)
-    return cli_message
+    # the pointer to `catflip size` is the call here
+    return re.sub(r"catflip size CONFIG --height ([0-9.e+-]*[0-9])", r"catflip.size(config, \1)", cli_message)
 
 
 def assert_close(a, b, path="", tol=1e-12):
@@ -419,6 +420,9 @@ def test_least_height_is_runs_answer():
     assert h.least_time_s == pytest.approx(answer["least_time_s"], rel=1e-12)
     assert h.least_height_lower_bound_m == pytest.approx(answer["least_height_lower_bound_m"], rel=1e-12)
     assert 0 < h.least_height_lower_bound_m < h.least_height_m
+    # not possible from its 2 m: the sentence points to the call that sizes the motors for it
+    assert h.sentence().endswith(" The motors (or the gear ratio) that would do it from 2 m: catflip.size(config, 2)."), \
+        h.sentence()
     # F7's relation between the least time and height, with the robot's margin
     g, margin = robot.to_dict()["fall"]["gravity"], robot.to_dict()["fall"]["margin"]
     assert h.least_height_m == pytest.approx(g * (h.least_time_s + margin) ** 2 / 2, rel=1e-9)
@@ -552,3 +556,44 @@ def test_simulate_from_another_start_equals_the_cli(tmp_path):
     assert cfg.overrides == []
     with pytest.raises(catflip.ConfigError, match="start"):
         catflip.simulate(cfg, d, start={"angular_velocity": [0, 0, 500]})
+
+
+def test_size_equals_the_cli(tmp_path):
+    robot = ROOT / "configs" / "robot-universal.toml"
+    status, stdout, stderr = cli("size", robot, "--height", 3, "--points", 2, "--gear-evaluations", 0, "--json",
+                                 out=tmp_path)
+    assert status == 0, stderr
+    config = catflip.Config.from_toml(robot)
+    ours = catflip.size(config, 3.0, points=2, gear_evaluations=0)
+    assert_close(ours, json.loads(stdout))
+    assert len(ours["curve"]) == 2 and ours["height_m"] == 3.0
+    # each point is a designed motor scaled in time by F3 (torque by s^2, speed by s, the
+    # manoeuvre by 1/s) onto the asked height: g (t + margin)^2 / 2 = 3 m
+    fall = config.to_dict()["fall"]
+    for p in ours["curve"]:
+        d, s = p["design"], p["scale"]
+        assert p["stall_torque_nm"] == pytest.approx(d["stall_torque_nm"] * s * s, rel=1e-12)
+        assert p["no_load_speed_rad_s"] == pytest.approx(d["no_load_speed_rad_s"] * s, rel=1e-12)
+        t = d["least_time_s"] / s
+        assert fall["gravity"] * (t + fall["margin"]) ** 2 / 2 == pytest.approx(3.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("config, height, points, gear_evaluations", [
+    ("robot-universal", -1.0, 8, 6),
+    ("robot-universal", 3.0, 1, 6),
+    ("robot-universal", 3.0, 8, 21),
+    ("seed", 3.0, 8, 6),
+])
+def test_size_refuses_what_the_cli_refuses(config, height, points, gear_evaluations, tmp_path):
+    path = ROOT / "configs" / f"{config}.toml"
+    status, _, stderr = cli("size", path, "--height", height, "--points", points, "--gear-evaluations",
+                            gear_evaluations, out=tmp_path)
+    assert status == 2, stderr
+    with pytest.raises(catflip.ConfigError) as e:
+        catflip.size(catflip.Config.from_toml(path), height, points=points, gear_evaluations=gear_evaluations)
+    said = in_python_words(cli_error(stderr))
+    for flag, arg in [("--height ", "height="), ("--points ", "points="),
+                      ("--gear-evaluations ", "gear_evaluations=")]:
+        said = said.replace(flag, arg)
+    assert message(e) == said
+    assert not any(tmp_path.iterdir())
