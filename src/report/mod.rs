@@ -8,6 +8,7 @@
 
 pub mod animation;
 pub mod answer;
+mod glossary;
 pub mod size;
 mod torque_speed;
 
@@ -1166,6 +1167,7 @@ pub fn index_html(page: &Page) -> String {
     for n in notes {
         h.push_str(&format!("<p>{}</p>\n", esc(n)));
     }
+    h.push_str(&glossary::section());
     h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));

@@ -27,6 +27,21 @@ fn run_writes_a_complete_consistent_report() {
         "{}",
         &html[..html.len().min(2000)]
     );
+    // the glossary, folded, under the table: its words beside the columns that use them
+    let terms = html
+        .find("<details class=\"terms\">")
+        .expect("the glossary's section");
+    assert!(
+        html.find("</table>").unwrap() < terms,
+        "the glossary follows the table"
+    );
+    for word in [
+        "<td>sim peak</td>",
+        "<td>verdict</td>",
+        "<code>|q|</code>, how far",
+    ] {
+        assert!(html[terms..].contains(word), "{word}");
+    }
     for m in methods {
         let name = m["method"].as_str().unwrap();
         let peak = m["peak_torque_nm"].as_f64().unwrap();
@@ -77,12 +92,15 @@ fn run_writes_a_complete_consistent_report() {
     // without motor limits the captions describe no envelope, limit line or
     // least-height panel (none is drawn)
     assert!(html.contains("no motor limits are configured, so no envelope is drawn"));
+    // (the glossary names every word of any report)
+    let end = terms + html[terms..].find("</details>").unwrap();
+    let page = format!("{}{}", &html[..terms], &html[end..]);
     for absent in [
         "grey band",
         "least-height",
         "torque limit is the black line",
     ] {
-        assert!(!html.contains(absent), "{absent}");
+        assert!(!page.contains(absent), "{absent}");
     }
     let peaks: Vec<f64> = methods
         .iter()
