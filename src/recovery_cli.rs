@@ -213,5 +213,6 @@ fn report(cfg: &catflip::Config, s: &Summary, figures: &[String]) -> String {
         animation: "",
         figures: &figs,
         captions: catflip::recovery::caption,
+        glossary: false,
     })
 }

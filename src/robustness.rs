@@ -312,6 +312,7 @@ fn trial_page(
         animation: "",
         figures: &figures,
         captions: catflip::control::replay::caption,
+        glossary: false,
     })
 }
 
@@ -405,6 +406,7 @@ fn page(
         animation: "",
         figures: &figures,
         captions: catflip::control::figure::caption,
+        glossary: false,
     })
 }
 

@@ -730,6 +730,7 @@ fn page(
         } else {
             report::caption_without_limits
         },
+        glossary: true,
     })
 }
 

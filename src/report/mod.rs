@@ -1104,6 +1104,8 @@ pub struct Page<'a> {
     pub figures: &'a [&'a str],
     /// Each figure's caption, by file name (the command's own).
     pub captions: fn(&str) -> Option<&'static str>,
+    /// Whether the glossary follows the table: the words of `run`'s table.
+    pub glossary: bool,
 }
 
 /// The report page: the answer when there is one ([`answer::lead`]), a
@@ -1119,6 +1121,7 @@ pub fn index_html(page: &Page) -> String {
         animation,
         figures,
         captions,
+        glossary: with_glossary,
     } = *page;
     let mut h = String::new();
     h.push_str("<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>");
@@ -1167,7 +1170,9 @@ pub fn index_html(page: &Page) -> String {
     for n in notes {
         h.push_str(&format!("<p>{}</p>\n", esc(n)));
     }
-    h.push_str(&glossary::section());
+    if with_glossary {
+        h.push_str(&glossary::section());
+    }
     h.push_str(animation);
     for f in figures {
         h.push_str(&format!("<figure><img src=\"{f}\" alt=\"{f}\">"));

@@ -305,5 +305,6 @@ pub fn page(a: &SizeAnswer) -> String {
         animation: "",
         figures: &[crate::size::files::CURVE_SVG, crate::size::files::GEAR_SVG],
         captions: caption,
+        glossary: false,
     })
 }

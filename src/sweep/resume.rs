@@ -264,6 +264,7 @@ impl SweepState {
             animation: "",
             figures: &figs,
             captions: super::caption,
+            glossary: false,
         })
     }
 
