@@ -9,39 +9,9 @@ use crate::design::plan::ShapePlan;
 use crate::export::start::world_map;
 use crate::model::Joint;
 
-/// The design's gains, one row per control step.
+/// The design's gains, one row per control step, and in the header the
+/// nominal's landing under the TVLQR and under the open loop.
 pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
-    gains(cfg, plan).csv
-}
-
-/// The gains' CSV and its nominal flight's landing errors.
-pub struct Gains {
-    pub csv: String,
-    /// The nominal flown under the TVLQR (the model, no delay or noise),
-    /// deg from belly-down: the TVLQR lands no closer to belly-down than its
-    /// nominal.
-    pub nominal_tvlqr_deg: f64,
-    /// The same flight under the open loop's joint PD on the planned shape.
-    pub nominal_open_loop_deg: f64,
-}
-
-/// A nominal that lands this far off (deg), and ten times as far as the
-/// open loop's, is worth a warning: a tenth of a degree is a hundredth of
-/// the default landing tolerance.
-const DRIFT_DEG: f64 = 0.1;
-
-impl Gains {
-    /// Whether the TVLQR's nominal lands off where the open loop's PD on
-    /// the planned shape does not: the feed-forward alone drifts from the
-    /// plan (a schedule read back from its rows smooths the design's torque
-    /// between them), and the TVLQR holds the flight to that nominal.
-    pub fn drifts(&self) -> bool {
-        self.nominal_tvlqr_deg > DRIFT_DEG.max(10.0 * self.nominal_open_loop_deg)
-    }
-}
-
-/// [`gains_csv`] with the nominal's landing errors.
-pub fn gains(cfg: &Config, plan: &dyn ShapePlan) -> Gains {
     let r = Reference::new(cfg, plan);
     let tv = Tvlqr::new(&r, &cfg.control);
     let shape = match cfg.cat.joint {
@@ -103,7 +73,7 @@ pub fn gains(cfg: &Config, plan: &dyn ShapePlan) -> Gains {
     ];
     if r.is_held() {
         s.push_str(
-            "# From this start (angular momentum) the nominal holds the planned shape: its feed-forward is the\n\
+            "# The nominal holds the planned shape: its feed-forward is the\n\
              # schedule's torque plus the joint PD (pd_kp, pd_kd) on the planned shape along the nominal\n\
              # (nominal_held = 1); the schedule's controls alone lack it (the Python package's feedforward has it).\n",
         );
@@ -152,9 +122,5 @@ pub fn gains(cfg: &Config, plan: &dyn ShapePlan) -> Gains {
         s.push_str(&v.join(","));
         s.push('\n');
     }
-    Gains {
-        csv: s,
-        nominal_tvlqr_deg,
-        nominal_open_loop_deg,
-    }
+    s
 }

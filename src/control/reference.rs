@@ -1,8 +1,8 @@
 //! The nominal motion a controller tracks: a design's feed-forward torque
 //! on the fixed-step grid of the closed-loop simulator, and the state the
 //! model reaches under it from the config's start, through `fall.margin`
-//! (straight, no torque) to touchdown. From a start with momentum the
-//! feed-forward also holds the planned shape ([`Reference::new`]).
+//! (straight, no torque) to touchdown. The feed-forward also holds the
+//! planned shape ([`Reference::new`]).
 
 use super::plant::{Y, rk4};
 use crate::config::Config;
@@ -69,9 +69,9 @@ pub fn release(cat: &Cat, start: &Start) -> Y {
 }
 
 impl Reference {
-    /// The design's nominal for a full-state feedback: from a start with
-    /// momentum held on the planned shape ([`Reference::fly_held`]), else
-    /// the feed-forward's flight.
+    /// The design's nominal for a full-state feedback: held on the planned
+    /// shape ([`Reference::fly_held`]; the feed-forward's flight without
+    /// PD gains).
     pub fn new(cfg: &Config, plan: &dyn ShapePlan) -> Reference {
         Self::build(cfg, plan, true)
     }
@@ -122,7 +122,7 @@ impl Reference {
         let spec = cfg.design_spec();
         let y0 = release(&cat, &spec.release());
         let pd = crate::verify::simulate::Controller::from_spec(&spec);
-        if hold && spec.has_momentum() && (pd.kp, pd.kd) != (0.0, 0.0) {
+        if hold && (pd.kp, pd.kd) != (0.0, 0.0) {
             r.replace_plan(0, plan);
             r.fly_held(y0, pd.kp, pd.kd, &cfg.motor());
         } else {
@@ -231,8 +231,10 @@ impl Reference {
     /// step's middle), inside `motor`'s envelope, its torque folded into the
     /// feed-forward, so that the feed-forward flown alone is the nominal
     /// still. From a start with momentum the flight under the plan's
-    /// feed-forward alone is unstable and loses the design; the nominal, and
-    /// the TVLQR about it, must be the design's motion.
+    /// feed-forward alone is unstable and loses the design; from one at rest
+    /// it drifts from the design by what the transcription leaves between
+    /// its nodes: the nominal, and the TVLQR about it, must be the design's
+    /// motion.
     fn fly_held(&mut self, y: Y, kp: f64, kd: f64, motor: &Motor) {
         self.nominal[0] = y;
         let (cat, h) = (self.cat, self.h);

@@ -41,35 +41,18 @@ pub fn add_simulator_files(cfg: &Config, out: &mut Output, methods: &[(&str, &dy
 
 /// What `export --schedule` writes beside the model: the schedule's
 /// controls for `sim` at its time step (`<stem>.<sim>.csv`) and the closed
-/// loop's gains along it (`<stem>.tvlqr.csv`); and a warning, also at the
-/// top of the gains, when their nominal lands off belly-down
-/// ([`crate::control::export::Gains::drifts`]).
+/// loop's gains along it (`<stem>.tvlqr.csv`).
 pub fn add_schedule_files(
     cfg: &Config,
     out: &mut Output,
     schedule: &crate::design::plan::Schedule,
     stem: &str,
     sim: controls::Simulator,
-) -> Option<String> {
+) {
     let c = controls::Controls::sample(cfg, schedule, sim);
     out.add(format!("{stem}.{}.csv", sim.name()), c.to_csv(cfg, stem));
-    let g = crate::control::export::gains(cfg, schedule);
-    let warning = g.drifts().then(|| {
-        let per_phase = (schedule.rows.len() / 3).saturating_sub(1);
-        format!(
-            "the TVLQR's nominal (this schedule's feed-forward alone, catflip's model) lands {:.3} deg off \
-             belly-down, the open loop's (joint PD on the planned shape) {:.3} deg: the TVLQR holds the \
-             flight to its nominal, so it lands no closer. The schedule's {per_phase} rows a phase smooth \
-             the design's torque between them; written with more (`--set simulate.samples_per_phase=2000` \
-             where it is designed) the nominal follows the design more closely (docs/control.md, \
-             \"Time-varying LQR\")",
-            g.nominal_tvlqr_deg, g.nominal_open_loop_deg
-        )
-    });
-    let csv = match &warning {
-        Some(w) => format!("# warning: {w}.\n{}", g.csv),
-        None => g.csv,
-    };
-    out.add(format!("{stem}.tvlqr.csv"), csv);
-    warning
+    out.add(
+        format!("{stem}.tvlqr.csv"),
+        crate::control::export::gains_csv(cfg, schedule),
+    );
 }

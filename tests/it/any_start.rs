@@ -183,7 +183,7 @@ fn a_design_from_a_spinning_start_lasts_the_fall_and_lands_at_touchdown() {
 /// nominal holds the planned shape, its holding torque in the feed-forward:
 /// it lands as designed, the feed-forward alone flies it to the bit, and the
 /// TVLQR corrects nothing on it. The open loop's nominal is the unheld
-/// feed-forward's, and at rest nothing is held.
+/// feed-forward's; at rest the nominal is held too.
 #[test]
 fn the_closed_loops_nominal_from_a_spinning_start_is_the_designs_motion() {
     let (cfg, r) = spinning();
@@ -220,11 +220,17 @@ fn the_closed_loops_nominal_from_a_spinning_start_is_the_designs_motion() {
         closed.error_deg
     );
     assert!(closed.max_correction_nm < 1e-9 * reference.peak_torque);
-    // at rest the nominal is the feed-forward's flight, unheld
+    // at rest too the nominal holds the planned shape: the feed-forward
+    // alone drifts from the design by what its transcription leaves between
+    // the nodes, the held nominal lands as designed
     let rest = util::seed(&[]);
     let today = FreeDesign::new(&rest.design_spec()).solve().unwrap();
     let a = Reference::new(&rest, &today.plan);
     let b = Reference::unheld(&rest, &today.plan);
-    assert!(!a.is_held());
-    assert!(a.nominal == b.nominal && a.ff == b.ff);
+    assert!(a.is_held() && !b.is_held());
+    let (held, unheld) = (landing(&a), landing(&b));
+    assert!(
+        held < 1e-4 && held < 0.01 * unheld,
+        "held {held} deg, unheld {unheld} deg"
+    );
 }

@@ -112,8 +112,10 @@ fn inside_the_robots_motor_envelope_replanning_corrects_nothing_on_the_nominal()
     let r = Reference::new(cfg, plan.as_ref());
     let tv = Tvlqr::new(&r, &cfg.control);
     let motor = cfg.motor();
+    // (on the held nominal nearly every replan lands worse than the plan in
+    // use; replanning every second period takes one)
     let rp = Replanning {
-        every: 3,
+        every: 2,
         ..Replanning::new(cfg, plan.clone())
     };
     let re = fly(&r, Feedback::Replan(&tv, &rp), &motor, Flight::nominal(&r));
