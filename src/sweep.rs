@@ -894,6 +894,22 @@ pub fn to_csv(key: &str, points: &[SweepPoint]) -> String {
 /// The least-height figure's line of the configured drop.
 const FALL_HEIGHT_SERIES: &str = "fall.height (the drop asked)";
 
+/// The motor limits of a sweep's config (its `[limits]` as JSON) in words,
+/// for the least-height figure's title: every limit that bounds the answer
+/// (a speed-limited robot's answer is its no-load speed's, not its stall
+/// torque's).
+pub fn motor_words(limits: &serde_json::Value) -> String {
+    [
+        ("max_torque", "stall torque", "N m"),
+        ("no_load_speed", "no-load speed", "rad/s"),
+        ("max_speed", "speed limit", "rad/s"),
+    ]
+    .iter()
+    .filter_map(|(k, what, unit)| Some(format!("{what} {} {unit}", limits[*k].as_f64()?)))
+    .collect::<Vec<_>>()
+    .join(", ")
+}
+
 /// The index.html caption of a sweep's figure, by file name.
 pub fn caption(file: &str) -> Option<&'static str> {
     if !file.starts_with("sweep-") || !file.ends_with(".svg") {
@@ -906,14 +922,14 @@ pub fn caption(file: &str) -> Option<&'static str> {
     })
 }
 
-/// Peak against the swept value, one line per method; and, with a torque
-/// limit, the least drop height.
+/// Peak against the swept value, one line per method; and, with motor
+/// limits (`motor`, in words: [`motor_words`]), the least drop height.
 /// `file_key` names the files, `key` labels the axes.
 pub fn figures(
     file_key: &str,
     key: &str,
     points: &[SweepPoint],
-    limit: Option<f64>,
+    motor: Option<&str>,
     fall_height: f64,
 ) -> Result<Vec<(String, String)>> {
     let x: Vec<f64> = points.iter().map(|p| p.value).collect();
@@ -948,7 +964,7 @@ pub fn figures(
             &series,
         )?,
     )];
-    if let Some(l) = limit {
+    if let Some(motor) = motor {
         let mut hs = Vec::new();
         for (name, f) in [
             (
@@ -973,9 +989,7 @@ pub fn figures(
         figs.push((
             format!("sweep-{file_key}-least-height.svg"),
             crate::report::lines_styled(
-                &format!(
-                    "Least drop height within the motor limits (stall torque {l} N m) against {key}"
-                ),
+                &format!("Least drop height within the motor limits ({motor}) against {key}"),
                 &xdesc,
                 "least drop height (m)",
                 &x,
@@ -1001,6 +1015,30 @@ mod tests {
     /// at the configured drop, the diagonal in a sweep of the drop itself;
     /// without a motor limit there is no such figure.
     #[test]
+    fn the_least_height_figures_title_names_every_motor_limit() {
+        let limits = serde_json::json!({"max_torque": 1.4, "no_load_speed": 5.969});
+        let words = motor_words(&limits);
+        assert_eq!(words, "stall torque 1.4 N m, no-load speed 5.969 rad/s");
+        assert_eq!(
+            motor_words(&serde_json::json!({"max_torque": 2.0, "max_speed": 3.0})),
+            "stall torque 2 N m, speed limit 3 rad/s"
+        );
+        let points = [SweepPoint {
+            value: 0.2,
+            least_height_free_m: Some(3.0),
+            ..Default::default()
+        }];
+        let figs = figures("k", "cat.length", &points, Some(&words), 2.0).unwrap();
+        assert!(
+            figs[1].1.contains(
+                "Least drop height within the motor limits (stall torque 1.4 N m, no-load speed 5.969 rad/s)"
+            ),
+            "{}",
+            figs[1].1
+        );
+    }
+
+    #[test]
     fn the_least_height_figure_draws_the_questions_height() {
         let points: Vec<SweepPoint> = [2.0, 3.0, 4.0]
             .iter()
@@ -1012,7 +1050,7 @@ mod tests {
             .collect();
         // the level line's y in pixels equals across the points; the diagonal's rises
         let line_ys = |key: &str| -> Vec<f64> {
-            let figs = figures("k", key, &points, Some(1.4), 2.5).unwrap();
+            let figs = figures("k", key, &points, Some("stall torque 1.4 N m"), 2.5).unwrap();
             let svg = &figs[1].1;
             assert!(svg.contains(FALL_HEIGHT_SERIES), "{key}");
             // the line's dashes, in its style's colour (the legend's sample last)

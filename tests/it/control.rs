@@ -335,22 +335,26 @@ fn a_design_longer_than_the_fall_is_refused_with_the_height_it_needs() {
 fn the_page_says_when_the_controllers_assume_another_delay() {
     let dir = crate::util::temp_dir();
     let seed = crate::util::config_arg("seed");
-    let (ok, out, err) = crate::util::run_ok(
-        &[
-            "robustness",
-            &seed,
-            "--trials",
-            "1",
-            "--set",
-            "control.delay_ms=20",
-        ],
-        dir.path(),
-    );
-    assert!(ok, "{err}");
-    assert!(
-        err.contains("warning: the controllers predict over a delay of 20 ms (control.delay_ms) but the simulated robot's is 5 ms (robustness.delay_ms)"),
-        "{err}"
-    );
+    // the study, and a trial of it flown again, warn alike
+    let study = [
+        "robustness",
+        &seed,
+        "--trials",
+        "1",
+        "--set",
+        "control.delay_ms=20",
+    ];
+    let warned = |args: &[&str]| {
+        let (ok, out, err) = crate::util::run_ok(args, dir.path());
+        assert!(ok, "{err}");
+        assert!(
+            err.contains("warning: the controllers predict over a delay of 20 ms (control.delay_ms) but the simulated robot's is 5 ms (robustness.delay_ms)"),
+            "{err}"
+        );
+        out
+    };
+    warned(&[&study[..], &["--trial", "0"]].concat());
+    let out = warned(&study);
     // the console names the design flown, as the page does
     assert!(
         out.contains(
@@ -366,25 +370,6 @@ fn the_page_says_when_the_controllers_assume_another_delay() {
     assert!(
         page.contains("predict over a delay of 20 ms (control.delay_ms); the simulated robot's actuator delay is 5 ms (robustness.delay_ms): the controllers assume another delay than the robot has"),
         "{page}"
-    );
-    // a trial flown again warns alike
-    let (ok, _, err) = crate::util::run_ok(
-        &[
-            "robustness",
-            &seed,
-            "--trials",
-            "1",
-            "--trial",
-            "0",
-            "--set",
-            "control.delay_ms=20",
-        ],
-        dir.path(),
-    );
-    assert!(ok, "{err}");
-    assert!(
-        err.contains("warning: the controllers predict over a delay of 20 ms (control.delay_ms) but the simulated robot's is 5 ms (robustness.delay_ms)"),
-        "{err}"
     );
 }
 

@@ -538,25 +538,33 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
     );
 }
 
+/// `robot.toml` in `dir`, reading `robot.urdf`: the box robot's URDF
+/// through `edit` (which must change it).
+fn box_robot_with(dir: &Path, edit: impl Fn(&str) -> String) -> std::path::PathBuf {
+    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf")).unwrap();
+    let edited = edit(&urdf);
+    assert_ne!(edited, urdf, "the edit changes nothing");
+    std::fs::write(dir.join("robot.urdf"), &edited).unwrap();
+    let toml = dir.join("robot.toml");
+    std::fs::write(
+        &toml,
+        "name = \"r\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
+    )
+    .unwrap();
+    toml
+}
+
 /// A URDF's `effort` and `velocity` of 0 (what exporters write for "not
 /// given") set no motor limit; the config's own keys still do.
 #[test]
 fn zero_effort_and_velocity_in_a_urdf_mean_no_limit() {
     let dir = temp_dir();
-    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf"))
-        .unwrap()
-        .replace(
+    let toml = box_robot_with(dir.path(), |u| {
+        u.replace(
             "effort=\"1.4\" velocity=\"5.969\"",
             "effort=\"0\" velocity=\"0\"",
-        );
-    assert!(urdf.contains("effort=\"0\""));
-    std::fs::write(dir.path().join("robot.urdf"), &urdf).unwrap();
-    let toml = dir.path().join("robot.toml");
-    std::fs::write(
-        &toml,
-        "name = \"zero\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
-    )
-    .unwrap();
+        )
+    });
     let cfg = Config::load(&toml, &[]).unwrap();
     assert_eq!(cfg.limits.max_torque, None);
     assert_eq!(cfg.limits.max_speed, None);
@@ -571,20 +579,13 @@ fn zero_effort_and_velocity_in_a_urdf_mean_no_limit() {
 fn a_verdict_names_a_limit_where_the_robot_file_gave_it() {
     use catflip::verdict::{DesignNumbers, Status, Targets, limit_misses};
     let dir = temp_dir();
-    let urdf = std::fs::read_to_string(util::configs().join("box-robot.urdf"))
-        .unwrap()
-        .replacen(
+    let toml = box_robot_with(dir.path(), |u| {
+        u.replacen(
             "lower=\"-2.6\" upper=\"2.6\"",
             "lower=\"-0.5\" upper=\"0.7\"",
             1,
-        );
-    std::fs::write(dir.path().join("robot.urdf"), &urdf).unwrap();
-    let toml = dir.path().join("robot.toml");
-    std::fs::write(
-        &toml,
-        "name = \"r\"\n[fall]\nheight = 3.0\n[body]\nurdf = \"robot.urdf\"\n",
-    )
-    .unwrap();
+        )
+    });
     let reasons = |sets: &[&str]| {
         let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
         let spec = Config::load(&toml, &sets).unwrap().design_spec();

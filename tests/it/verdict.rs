@@ -88,3 +88,45 @@ fn optimize_and_run_give_the_same_verdict_on_every_bundled_config() {
     }
     assert!(checked >= 6, "{checked} methods checked");
 }
+
+/// A phased design under the universal joint that tilts beyond the
+/// tolerance says that its family does not correct the tilt (F4), and which
+/// design does; a no-twist one that misses by a tolerance set tighter than
+/// its flip does not say so.
+#[test]
+fn a_tilting_phased_design_under_the_universal_joint_names_the_design_that_corrects_it() {
+    let dir = util::temp_dir();
+    let reason = |joint: &str| {
+        let v = json(
+            &[
+                "run",
+                "configs/seed.toml",
+                "--set",
+                &format!("cat.joint={joint}"),
+                "--set",
+                "simulate.flip_tolerance=1e-9",
+            ],
+            dir.path(),
+        )
+        .expect("run prints its summary");
+        let m = v["methods"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|m| m["method"] == "phased")
+            .unwrap();
+        assert_eq!(
+            (m["method"].as_str(), m["verdict"].as_str()),
+            (Some("phased"), Some("flagged")),
+            "{m}"
+        );
+        m["reason"].as_str().unwrap().to_string()
+    };
+    let universal = reason("universal");
+    assert!(
+        universal.contains("tilts the spine by")
+            && universal.ends_with("(the phased family does not correct the tilt under the universal joint, F4; the free-form design does)"),
+        "{universal}"
+    );
+    assert!(!reason("no-twist").contains("phased family"));
+}
