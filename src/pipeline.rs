@@ -273,21 +273,7 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
         method: method.name(),
         status: design.status(),
         verdict: verdict.grade(),
-        reason: verdict.reason().map(|r| {
-            // the phased family root-finds the twist on the simulated flip but
-            // does not correct the tilt (F4): say which design does
-            let tilts = verdict.misses.iter().any(|m| matches!(m, Miss::Tilt { .. }));
-            if method == Method::Phased
-                && spec.cat.joint == crate::model::Joint::Universal
-                && tilts
-            {
-                format!(
-                    "{r} (the phased family does not correct the tilt under the universal joint, F4; the free-form design does)"
-                )
-            } else {
-                r
-            }
-        }),
+        reason: verdict.reason(),
         beyond_the_motors: method == Method::Analytic && verdict.misses.iter().any(Miss::is_limit),
         approximate_for_the_joint: method == Method::Analytic
             && spec.cat.joint == crate::model::Joint::Universal

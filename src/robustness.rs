@@ -203,8 +203,6 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     Ok(Status::Ok)
 }
 
-/// `robustness --trial K`: trial `k` of the study `args` describes flown
-/// again under each controller, its flights written and shown.
 /// Says on stderr when the controllers predict over another delay than the
 /// simulated robot has (a study and a trial flown again alike).
 fn warn_of_delay_mismatch(cfg: &catflip::config::Config) {
@@ -216,6 +214,8 @@ fn warn_of_delay_mismatch(cfg: &catflip::config::Config) {
     }
 }
 
+/// `robustness --trial K`: trial `k` of the study `args` describes flown
+/// again under each controller, its flights written and shown.
 pub fn cmd_trial(c: &Common, args: StudyArgs, k: usize) -> Result<Status> {
     use catflip::control::replay;
     if k >= args.trials {

@@ -897,14 +897,15 @@ const FALL_HEIGHT_SERIES: &str = "fall.height (the drop asked)";
 /// The motor limits of a sweep's config (its `[limits]` as JSON) in words,
 /// for the least-height figure's title: every limit that bounds the answer
 /// (a speed-limited robot's answer is its no-load speed's, not its stall
-/// torque's).
-pub fn motor_words(limits: &serde_json::Value) -> String {
+/// torque's), but the swept `key`, which the axis gives.
+pub fn motor_words(limits: &serde_json::Value, key: &str) -> String {
     [
         ("max_torque", "stall torque", "N m"),
         ("no_load_speed", "no-load speed", "rad/s"),
         ("max_speed", "speed limit", "rad/s"),
     ]
     .iter()
+    .filter(|(k, ..)| key.strip_prefix("limits.") != Some(k))
     .filter_map(|(k, what, unit)| Some(format!("{what} {} {unit}", limits[*k].as_f64()?)))
     .collect::<Vec<_>>()
     .join(", ")
@@ -989,7 +990,11 @@ pub fn figures(
         figs.push((
             format!("sweep-{file_key}-least-height.svg"),
             crate::report::lines_styled(
-                &format!("Least drop height within the motor limits ({motor}) against {key}"),
+                &if motor.is_empty() {
+                    format!("Least drop height within the motor limits against {key}")
+                } else {
+                    format!("Least drop height within the motor limits ({motor}) against {key}")
+                },
                 &xdesc,
                 "least drop height (m)",
                 &x,
@@ -1017,11 +1022,19 @@ mod tests {
     #[test]
     fn the_least_height_figures_title_names_every_motor_limit() {
         let limits = serde_json::json!({"max_torque": 1.4, "no_load_speed": 5.969});
-        let words = motor_words(&limits);
+        let words = motor_words(&limits, "cat.length");
         assert_eq!(words, "stall torque 1.4 N m, no-load speed 5.969 rad/s");
         assert_eq!(
-            motor_words(&serde_json::json!({"max_torque": 2.0, "max_speed": 3.0})),
+            motor_words(
+                &serde_json::json!({"max_torque": 2.0, "max_speed": 3.0}),
+                "fall.height"
+            ),
             "stall torque 2 N m, speed limit 3 rad/s"
+        );
+        // the swept limit is the axis's, not the config's one value
+        assert_eq!(
+            motor_words(&limits, "limits.no_load_speed"),
+            "stall torque 1.4 N m"
         );
         let points = [SweepPoint {
             value: 0.2,

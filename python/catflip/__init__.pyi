@@ -300,7 +300,9 @@ def size(config: Config, height: float, points: int = 8, gear_evaluations: int =
     --json`` in memory (nothing written), GIL released. The CLI's ``size.json`` as a dict:
     ``curve`` (stall torque against no-load speed that just makes it), ``gear`` (the best gear
     ratio for the config's motor, ``best_ratio``, and the least height it gives), the
-    asymptotes. Needs ``limits.max_torque`` and ``limits.no_load_speed``; raises
+    asymptotes. Needs ``limits.max_torque`` and ``limits.no_load_speed``; the config's
+    ``design.objective`` is not used (least-time designs). A point whose design failed is
+    left out of ``curve`` and named in ``failed`` (the CLI warns and exits 3). Raises
     ConfigError for a bad height, count or config."""
 
 def sweep(config: Config, key: str, values: Union[Sequence[float], F64],

@@ -82,7 +82,7 @@ fn dict_error(text: &str, message: &str) -> String {
 
 /// The library's advice in the package's words: its messages name the
 /// command line's flags and commands where Python has arguments and functions.
-const PYTHONIC: [(&str, &str); 4] = [
+const PYTHONIC: [(&str, &str); 5] = [
     (
         "another seed (--seed)",
         "another seed (seed=\"analytic\" or \"phased\")",
@@ -96,6 +96,10 @@ const PYTHONIC: [(&str, &str); 4] = [
         "`catflip.least_height(config)` finds the least drop height",
     ),
     ("`catflip run`", "`catflip.run(config)`"),
+    (
+        "(catflip size names them for a height)",
+        "(catflip.size(config, height) names them)",
+    ),
 ];
 
 /// The library's advice in this package's words: [`PYTHONIC`], and `catflip
@@ -1377,7 +1381,9 @@ fn least_height(py: Python<'_>, config: &Config) -> PyResult<Option<LeastHeight>
 /// released: the CLI's `size.json` as a dict (`curve`, the stall torque against no-load
 /// speed that just makes it; `gear`, the best gear ratio for the config's motor and the
 /// least height it gives; the asymptotes). The config needs `limits.max_torque` and
-/// `limits.no_load_speed`; `height` replaces its `fall.height`.
+/// `limits.no_load_speed`; `height` replaces its `fall.height`; its `design.objective` is
+/// not used (the curve is of least-time designs). A point whose design failed is left out
+/// of `curve` and named in `failed` (the CLI warns and exits 3 then).
 #[pyfunction]
 #[pyo3(signature = (config, height, points = 8, gear_evaluations = 6))]
 fn size<'py>(
@@ -1397,8 +1403,11 @@ fn size<'py>(
         e => err(e),
     };
     let count = |name: &str, n: i64| {
-        usize::try_from(n)
-            .map_err(|_| ConfigError::new_err(format!("{name}={n}: give a count, 0 or more")))
+        usize::try_from(n).map_err(|_| {
+            ConfigError::new_err(format!(
+                "{name}={n}: give a count (points: 2 to 40, gear_evaluations: 0 to 20)"
+            ))
+        })
     };
     let settings = catflip::size::SizeSettings {
         points: count("points", points)?,

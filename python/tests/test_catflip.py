@@ -55,6 +55,7 @@ PYTHONIC = [
     ("`--seed analytic` starts it", '`seed="analytic"` starts it'),
     ("`catflip run` finds the least drop height", "`catflip.least_height(config)` finds the least drop height"),
     ("`catflip run`", "`catflip.run(config)`"),
+    ("(catflip size names them for a height)", "(catflip.size(config, height) names them)"),
 ]
 
 
@@ -438,6 +439,8 @@ def test_a_motor_too_weak_for_any_fall_has_no_schedule():
     assert h.beyond_longest_fall and not h.possible
     assert h.least_time_s > 30 and h.t.shape == (0,)
     assert "nor from any drop catflip designs" in h.sentence()
+    # the pointer to the motors that would do it, as this package's call
+    assert "stronger or faster motors would do (catflip.size(config, height) names them)" in h.sentence()
 
 
 def test_sweep_equals_the_cli(tmp_path):

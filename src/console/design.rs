@@ -40,7 +40,7 @@ pub fn analysis(a: &Analysis, written: &[PathBuf]) -> Rows {
     .row(
         "seed's omega (section 7)",
         format!(
-            "{:.4} rad/s (with sin(theta/2) where the seed's section 7 has sin^2, E2; the whole fall as the twist's time, E8)",
+            "{:.4} rad/s (E2 corrected: sin(theta/2), not the seed's sin^2; E8 kept, as the seed does: the whole fall as the twist's time)",
             cf.seed_omega_rad_s
         ),
     )

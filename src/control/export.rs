@@ -73,9 +73,9 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
     ];
     if r.is_held() {
         s.push_str(
-            "# The nominal holds the planned shape: its feed-forward is the\n\
-             # schedule's torque plus the joint PD (pd_kp, pd_kd) on the planned shape along the nominal\n\
-             # (nominal_held = 1); the schedule's controls alone lack it (the Python package's feedforward has it).\n",
+            "# The nominal holds the planned shape (nominal_held = 1): catflip flies it under the schedule's torque plus the\n\
+             # joint PD (pd_kp, pd_kd) on the planned shape along the nominal. The schedule's controls lack that holding torque\n\
+             # (the Python package's Controller.feedforward has it); run from these files, u supplies it as feedback.\n",
         );
     }
     s.push_str(

@@ -48,8 +48,8 @@ pub struct Online {
     pub reference: Reference,
     /// The design's, what a new flight starts on.
     pub design: Reference,
-    /// The open loop's ([`Reference::unheld`]; the design's but from a
-    /// start with momentum).
+    /// The open loop's ([`Reference::unheld`]: the design's feed-forward
+    /// without the holding torque, to which the open loop adds its PD).
     pub open_loop: Reference,
     pub tvlqr: Tvlqr,
     pub motor: Motor,

@@ -54,21 +54,21 @@ pub struct LimitOrigin {
 }
 
 impl LimitOrigin {
-    /// How a message names the limit `key` (`limits.max_speed`): the key,
-    /// or the file's attribute it was read from and the key that replaces it.
+    /// How a message names the limit `key` (`limits.max_speed`, or bare
+    /// `max_speed`): the key, or the file's attribute it was read from and
+    /// the key that replaces it.
     pub fn name(&self, key: &str) -> String {
-        let Some(file) = self.file.filter(|_| {
-            self.keys
-                .iter()
-                .any(|k| key.strip_prefix("limits.") == Some(k))
-        }) else {
-            return key.to_string();
+        let bare = key.strip_prefix("limits.").unwrap_or(key);
+        let key = format!("limits.{bare}");
+        let Some(file) = self.file.filter(|_| self.keys.contains(&bare)) else {
+            return key;
         };
-        let what = match (file, key) {
+        let what = match (file, bare) {
             ("body.mjcf", _) => "its actuators' ctrlrange or forcerange",
-            (_, "limits.max_torque") => "its joints' effort",
-            (_, "limits.max_speed") => "its joints' velocity",
-            _ => "its joints' range",
+            (_, "max_torque") => "its joints' effort",
+            (_, "max_speed") => "its joints' velocity",
+            (_, "max_bend_deg") => "its joints' lower and upper limits",
+            _ => "its joints' limits",
         };
         format!("{file} ({what}, read as {key})")
     }
@@ -421,10 +421,12 @@ impl DesignSpec {
         s
     }
 
-    /// The same problem with other motors.
+    /// The same problem with other motors (their limits the caller's, not
+    /// a robot file's).
     pub fn with_motor(&self, motor: Motor) -> DesignSpec {
         let mut s = self.clone();
         s.motor = motor;
+        s.limits_from = LimitOrigin::default();
         s
     }
 

@@ -51,7 +51,8 @@ fn inline(md: &str) -> String {
     out
 }
 
-/// `[text](target)` as `text`.
+/// `[text](target)` as `text`; a link to another of catflip's documents
+/// as `catflip's docs/text`, which the page's reader can find.
 fn link_texts(s: &str) -> String {
     let mut out = String::new();
     let mut rest = s;
@@ -63,7 +64,11 @@ fn link_texts(s: &str) -> String {
             break;
         };
         out.push_str(&rest[..open]);
-        out.push_str(&rest[open + 1..close]);
+        let (text, target) = (&rest[open + 1..close], &rest[close + 2..end]);
+        if target.split('#').next().is_some_and(|f| f.ends_with(".md")) {
+            out.push_str("catflip's docs/");
+        }
+        out.push_str(text);
         rest = &rest[end + 1..];
     }
     out.push_str(rest);
@@ -90,7 +95,9 @@ mod tests {
         assert!(h.contains("<code>|q|</code>, how far"));
         assert!(!h.contains("\\|") && !h.contains("]("), "{h}");
         assert!(
-            h.contains("<code>min_envelope_margin</code> in the JSON; configuration.md)"),
+            h.contains(
+                "<code>min_envelope_margin</code> in the JSON; catflip's docs/configuration.md)"
+            ),
             "{h}"
         );
     }
@@ -98,8 +105,8 @@ mod tests {
     #[test]
     fn links_read_as_their_text() {
         assert_eq!(
-            link_texts("see [model.md](model.md) and [a](b#c)."),
-            "see model.md and a."
+            link_texts("see [model.md](model.md#f4) and [a](https://b#c)."),
+            "see catflip's docs/model.md and a."
         );
         assert_eq!(link_texts("no [link here"), "no [link here");
     }

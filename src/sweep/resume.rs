@@ -158,7 +158,7 @@ impl SweepState {
         if !(interrupted && points.is_empty()) {
             let mut names = Vec::new();
             let height = self.config["fall"]["height"].as_f64().unwrap_or(f64::NAN);
-            let motor = limit.map(|_| super::motor_words(&self.config["limits"]));
+            let motor = limit.map(|_| super::motor_words(&self.config["limits"], key));
             for (name, svg) in super::figures(file_key, key, &points, motor.as_deref(), height)? {
                 names.push(name.clone());
                 out.add(name, svg);

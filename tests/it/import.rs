@@ -606,7 +606,7 @@ fn a_verdict_names_a_limit_where_the_robot_file_gave_it() {
     for (m, what) in from_file.iter().zip([
         "its joints' effort, read as limits.max_torque) = 1.4 N m",
         "its joints' velocity, read as limits.max_speed) = 5.969 rad/s",
-        "its joints' range, read as limits.max_bend_deg) = ",
+        "its joints' lower and upper limits, read as limits.max_bend_deg) = ",
     ]) {
         assert!(m.contains(&format!("above body.urdf ({what}")), "{m}");
     }
