@@ -28,8 +28,9 @@ they are `catflip.Controller` (the study's design, its feed-forward at every
 RK4 stage); without it (or with --route csv) the TVLQR runs from the gains
 CSV `catflip export mjcf --schedule` writes (`<stem>.tvlqr.csv`), predicting
 over its delay with MuJoCo's own model of the robot, and the feed-forward is
-the exported `<stem>.mujoco.csv` (that route's nominal lands up to 1e-2 deg
-from catflip's and fails the check below: docs/control.md).
+the exported `<stem>.mujoco.csv`, which lacks the holding torque of catflip's
+nominal (that route's TVLQR nominal lands about 1e-2 deg from catflip's and fails
+the check below: docs/control.md).
 
 Prints each controller's success rate (95 % Wilson interval) in MuJoCo beside
 catflip's, and the per-trial landing errors' largest difference. Exits 1 when
