@@ -726,7 +726,7 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     assert!(
         html.contains("is the least height of a motor that never gives more than its stall torque")
     );
-    assert!(!html.contains("FAILED:"), "nothing errored");
+    assert!(!html.contains("<td>FAILED: "), "nothing errored");
     assert!(html.contains("<td>least-height</td>"));
     // and points to the command that answers the next question
     let sizing =
