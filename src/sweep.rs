@@ -1016,9 +1016,8 @@ pub fn figures(
 mod tests {
     use super::*;
 
-    /// The least-height figure draws the question's height: a level line
-    /// at the configured drop, the diagonal in a sweep of the drop itself;
-    /// without a motor limit there is no such figure.
+    /// The least-height figure's title names each motor limit but the
+    /// swept one.
     #[test]
     fn the_least_height_figures_title_names_every_motor_limit() {
         let limits = serde_json::json!({"max_torque": 1.4, "no_load_speed": 5.969});
@@ -1051,6 +1050,9 @@ mod tests {
         );
     }
 
+    /// The least-height figure draws the question's height: a level line
+    /// at the configured drop, the diagonal in a sweep of the drop itself;
+    /// without a motor limit there is no such figure.
     #[test]
     fn the_least_height_figure_draws_the_questions_height() {
         let points: Vec<SweepPoint> = [2.0, 3.0, 4.0]

@@ -1394,7 +1394,7 @@ fn size<'py>(
     gear_evaluations: i64,
 ) -> PyResult<Bound<'py, PyAny>> {
     // the CLI's options, as this function names them
-    let pythonic = |e: catflip::Error| match e {
+    let in_call_names = |e: catflip::Error| match e {
         catflip::Error::Usage(m) => err(catflip::Error::Usage(
             m.replace("--height ", "height=")
                 .replace("--points ", "points=")
@@ -1413,12 +1413,12 @@ fn size<'py>(
         points: count("points", points)?,
         gear_evaluations: count("gear_evaluations", gear_evaluations)?,
     };
-    settings.validate().map_err(pythonic)?;
+    settings.validate().map_err(in_call_names)?;
     let (source, _) = config.snapshot();
     let cfg = source
         .load(Some(&format!("fall.height={height}")))
-        .map_err(|e| pythonic(catflip::size::height_error(height, e)))?;
-    let q = catflip::size::question(&cfg, height).map_err(pythonic)?;
+        .map_err(|e| in_call_names(catflip::size::height_error(height, e)))?;
+    let q = catflip::size::question(&cfg, height).map_err(in_call_names)?;
     let json = interruptible(
         py,
         || {},

@@ -494,7 +494,6 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
     }
     // a speed the robot file gave is named there, not as a key the user never typed
     let origin = cfg.limits_from();
-    let from_file = |key: &str| origin.name(key);
     for (key, w) in [
         ("limits.no_load_speed", cfg.limits.no_load_speed),
         ("limits.max_speed", cfg.limits.max_speed),
@@ -503,7 +502,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             && w > SERVO_SPEED_SLIP
         {
             warn(
-                &from_file(key),
+                &origin.name(key),
                 format!(
                     "{w} rad/s ({:.0} rev/min) is faster than the geared servos of small robots (5 to 15 rad/s): a datasheet's rev/min typed as rad/s? ({w} rev/min = {:.4} rad/s)",
                     w / RPM,
@@ -521,7 +520,7 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             * (cat.rear.length + cat.front.length);
         if t > TORQUE_SLIP * mgl {
             warn(
-                &from_file("limits.max_torque"),
+                &origin.name("limits.max_torque"),
                 format!(
                     "{t} N m is over {TORQUE_SLIP} times the torque that holds the whole body out at arm's length (m g L = {mgl:.3} N m): N mm or kg cm typed as N m? ({t} N mm = {:.4} N m, {t} kg cm = {:.4} N m)",
                     t * 1e-3,

@@ -167,9 +167,8 @@ fn touchdown(
     end: &Frame,
     (count, margin): (usize, f64),
 ) -> Vec<Frame> {
-    use crate::model::so3::{flip_and_tilt, wrap};
+    use crate::model::so3::{flip_and_tilt, quat_from, wrap};
     let steps = ((count as f64 * margin / end.t.max(1e-9)).ceil() as usize).clamp(2, count);
-    use crate::model::so3::quat_from;
     let r0 = *quat_from(&sim.final_attitude).to_rotation_matrix().matrix();
     let held = &sim.landing_trace;
     // (attitude of A, shape, torque) `dt` after the manoeuvre

@@ -22,7 +22,7 @@ pub fn section() -> String {
 }
 
 /// The table's rows as (word, meaning), in the markdown's text.
-pub fn entries() -> Vec<(String, String)> {
+fn entries() -> Vec<(String, String)> {
     GLOSSARY
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("| word ") && !l.starts_with("| ---"))
