@@ -171,11 +171,7 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
             // (every method; files not written)
             let path = format!("{}/configs/{name}.toml", env!("CARGO_MANIFEST_DIR"));
             let spec: catflip::sweep::SweepSpec = format!("{key}={from}:{to}:{count}").parse()?;
-            let methods = catflip::sweep::Methods {
-                analytic: true,
-                phased: true,
-                free: true,
-            };
+            let methods = catflip::sweep::Methods::ALL;
             let points = catflip::sweep::sweep(
                 std::path::Path::new(&path),
                 extra,

@@ -8,11 +8,7 @@ fn main() -> anyhow::Result<()> {
         .nth(1)
         .unwrap_or_else(|| "configs/seed.toml".into());
     let spec: SweepSpec = "fall.height=1:10:5".parse()?;
-    let methods = Methods {
-        analytic: true,
-        phased: true,
-        free: true,
-    };
+    let methods = Methods::ALL;
     let points = sweep(
         std::path::Path::new(&path),
         &[],

@@ -66,6 +66,11 @@ enum Command {
         /// config) from the partial set it published.
         #[arg(long)]
         resume: bool,
+        /// Compute only the least drop heights (the robot builder's
+        /// question), not the peak columns (each method's design without
+        /// the motor limits); needs limits.max_torque.
+        #[arg(long)]
+        least_height_only: bool,
     },
     /// Write the cat as a URDF (pyBullet) or MJCF (MuJoCo) model, and a schedule's controls for it.
     Export {
@@ -324,6 +329,7 @@ pub fn run() -> Result<Status> {
             threads,
             shard,
             resume,
+            least_height_only,
         } => cmd_sweep(
             &common,
             &range,
@@ -331,6 +337,7 @@ pub fn run() -> Result<Status> {
                 analytic: methods.contains(&MethodArg::Analytic),
                 phased: methods.contains(&MethodArg::Phased),
                 free: methods.contains(&MethodArg::Free),
+                peaks: !least_height_only,
             },
             threads_or_cores(threads),
             shard.unwrap_or(Shard::ALL),

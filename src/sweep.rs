@@ -136,6 +136,53 @@ pub struct Methods {
     pub analytic: bool,
     pub phased: bool,
     pub free: bool,
+    /// The peak columns: each method's least-peak design without the motor
+    /// limits. Off (`--least-height-only`), a point computes its least
+    /// heights alone where they are designed inside the motor envelope
+    /// ([`designs_least_heights`]); under a stall torque alone they come
+    /// from the phased and free-form peaks (F7), which are then computed.
+    pub peaks: bool,
+}
+
+impl Methods {
+    /// Every method, every column (the command line's default).
+    pub const ALL: Methods = Methods {
+        analytic: true,
+        phased: true,
+        free: true,
+        peaks: true,
+    };
+
+    /// Why these columns cannot be computed on `configs` (the sweep's
+    /// points, `arg` naming the sweep), before any work: least heights
+    /// alone need a method that has them and a stall torque at every point.
+    fn check(&self, arg: &str, configs: &[Result<Config>]) -> Result<()> {
+        if self.peaks {
+            return Ok(());
+        }
+        let usage = |m: String| Err(Error::Usage(format!("--least-height-only: {m}")));
+        if !self.phased && !self.free {
+            return usage(
+                "only the phased and free-form designs have least heights, and --methods names neither; add phased or free to --methods".into(),
+            );
+        }
+        let unlimited = configs
+            .iter()
+            .flatten()
+            .filter(|c| c.limits.max_torque.is_none())
+            .count();
+        if unlimited > 0 {
+            let which = if unlimited == configs.len() {
+                "the config sets".to_string()
+            } else {
+                format!("{unlimited} of the {} points of {arg} set", configs.len())
+            };
+            return usage(format!(
+                "{which} no stall torque (limits.max_torque), so there is no least drop height (without a motor limit any height will do); set limits.max_torque, or sweep without --least-height-only"
+            ));
+        }
+        Ok(())
+    }
 }
 
 /// One point of a sweep. Peaks are computed without the torque limit; with a
@@ -226,11 +273,40 @@ const FALL_ONLY: [&str; 3] = ["fall.height", "fall.gravity", "fall.margin"];
 #[derive(Default)]
 struct Continuation {
     free: Neighbours,
+    /// The last point's peak columns, taken by a point whose peak designs
+    /// are the same problem.
+    peaks: Option<PeakColumns>,
     /// `Some` in a sweep of the fall alone: the chunk's first phased design
     /// and its manoeuvre time, once computed.
     phased: Option<Option<(f64, crate::design::phased::PhasedResult)>>,
     bends: Vec<f64>,
     height: HeightChain,
+}
+
+/// A point's peak columns (its `SweepPoint`'s peaks, bends and free-form
+/// status, and their `error` words), the free-form design it continues
+/// from, and the problem they were designed for: the least-peak problem
+/// without the motor limits, which a sweep of a motor limit leaves the
+/// same at every point. A point whose problem equals it takes these
+/// columns instead of designing them again (the same problem, the same
+/// answer, to the bit; designed again from a neighbour's design, the same
+/// problem moved the robot's free-form peak by up to 5e-4 of itself).
+struct PeakColumns {
+    spec: DesignSpec,
+    columns: SweepPoint,
+    errors: Vec<String>,
+    free: Option<FreeResult>,
+}
+
+/// The peak columns' problem, as [`PeakColumns`] compares it: `spec`
+/// without its no-load speed, which draws no line without a stall torque
+/// (the designs keep it: it sets the envelope program's units).
+fn peak_problem(spec: &DesignSpec) -> DesignSpec {
+    let mut p = spec.clone();
+    if p.motor.max_torque.is_none() {
+        p.motor.no_load_speed = None;
+    }
+    p
 }
 
 /// A chunk's last two free-form designs of consecutive points (the start
@@ -374,6 +450,7 @@ fn point(
 ) -> (SweepPoint, Option<FreeResult>) {
     let Continuation {
         free,
+        peaks: last_peaks,
         phased: phased_warm,
         bends,
         height,
@@ -386,6 +463,8 @@ fn point(
     let mut kept = None;
     let limit = cfg.limits.max_torque;
     let envelope = designs_least_heights(cfg);
+    // the peaks are computed where asked, and where the least heights are theirs (F7)
+    let peaks = methods.peaks || !envelope;
     let limited_cfg = cfg;
     let mut cfg = cfg.clone();
     // the peak columns are the least-peak designs without the torque and
@@ -397,7 +476,7 @@ fn point(
     }
     let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);
-    if methods.analytic {
+    if methods.analytic && methods.peaks {
         p.analytic_peak_nm = Some(
             peak_along(
                 &spec,
@@ -410,7 +489,17 @@ fn point(
     // a method that fails leaves its columns empty and its reason in `error`;
     // the other methods' numbers are kept
     let mut errors = Vec::new();
-    if methods.phased || methods.free {
+    let problem = peak_problem(&spec);
+    let same = last_peaks.as_ref().filter(|m| peaks && m.spec == problem);
+    if let Some(m) = same {
+        let c = &m.columns;
+        (p.analytic_peak_nm, p.phased_peak_nm, p.phased_bend_deg) =
+            (c.analytic_peak_nm, c.phased_peak_nm, c.phased_bend_deg);
+        (p.free_peak_nm, p.free_bend_deg, p.free_status) =
+            (c.free_peak_nm, c.free_bend_deg, c.free_status);
+        errors.clone_from(&m.errors);
+        kept.clone_from(&m.free);
+    } else if peaks && (methods.phased || methods.free) {
         // within a chunk the free-form design continues from its neighbour
         // and needs no phased seed
         let reuse = phased_warm
@@ -462,9 +551,6 @@ fn point(
                 ));
                 p.phased_peak_nm = Some(ph.peak_torque_nm);
                 p.phased_bend_deg = Some(ph.bend_deg);
-                p.least_height_phased_m = limit
-                    .filter(|_| !envelope)
-                    .map(|l| least_height(&spec, ph.peak_torque_nm * t2, l));
             }
             Err(e) if methods.phased => errors.push(format!("phased: {e}")),
             _ => {}
@@ -494,15 +580,26 @@ fn point(
                     ));
                     p.free_peak_nm = Some(fr.peak_torque_nm);
                     p.free_bend_deg = Some(fr.bend_deg);
-                    p.least_height_free_m = limit
-                        .filter(|_| !envelope)
-                        .map(|l| least_height(&spec, fr.peak_torque_nm * t2, l));
                     p.free_status = Some(fr.status.into());
                     kept = Some(fr);
                 }
                 Err(e) => errors.push(format!("free: {e}")),
             }
         }
+    }
+    if peaks && same.is_none() {
+        *last_peaks = Some(PeakColumns {
+            spec: problem,
+            columns: p.clone(),
+            errors: errors.clone(),
+            free: kept.clone(),
+        });
+    }
+    // F7: under a stall torque alone the least height is the peak's
+    if let Some(l) = limit.filter(|_| !envelope) {
+        let f7 = |peak: f64| least_height(&spec, peak * t2, l);
+        p.least_height_phased_m = p.phased_peak_nm.map(f7);
+        p.least_height_free_m = p.free_peak_nm.map(f7);
     }
     if let Some(families) = height_families(limited_cfg, methods) {
         let limited = limited_cfg.design_spec();
@@ -666,6 +763,7 @@ impl SweepRun<'_> {
             });
         }
         let configs = checked_configs(&spec.key, &spec.arg(), "FROM and TO", &all, load)?;
+        methods.check(&spec.arg(), &configs)?;
         let never = std::sync::atomic::AtomicBool::new(false);
         let grid = Grid {
             values,
@@ -766,6 +864,7 @@ pub fn sweep_values(
             .join(", ")
     );
     let configs = checked_configs(key, &arg, "the values", values, load)?;
+    methods.check(&arg, &configs)?;
     let store = Mutex::new(Vec::new());
     let grid = Grid {
         values,
@@ -923,9 +1022,10 @@ pub fn caption(file: &str) -> Option<&'static str> {
     })
 }
 
-/// Peak against the swept value, one line per method; and, with motor
-/// limits (`motor`, in words: [`motor_words`]), the least drop height.
-/// `file_key` names the files, `key` labels the axes.
+/// Peak against the swept value, one line per method (no figure without a
+/// peak: a sweep of the least heights alone, or every method failed); and,
+/// with motor limits (`motor`, in words: [`motor_words`]), the least drop
+/// height. `file_key` names the files, `key` labels the axes.
 pub fn figures(
     file_key: &str,
     key: &str,
@@ -955,16 +1055,19 @@ pub fn figures(
         }
     }
     let xdesc = crate::config::key_label(key);
-    let mut figs = vec![(
-        format!("sweep-{file_key}.svg"),
-        crate::report::lines(
-            &format!("Peak joint torque against {key}"),
-            &xdesc,
-            "peak torque (N m)",
-            &x,
-            &series,
-        )?,
-    )];
+    let mut figs = Vec::new();
+    if !series.is_empty() {
+        figs.push((
+            format!("sweep-{file_key}.svg"),
+            crate::report::lines(
+                &format!("Peak joint torque against {key}"),
+                &xdesc,
+                "peak torque (N m)",
+                &x,
+                &series,
+            )?,
+        ));
+    }
     if let Some(motor) = motor {
         let mut hs = Vec::new();
         for (name, f) in [
@@ -1041,12 +1144,12 @@ mod tests {
             ..Default::default()
         }];
         let figs = figures("k", "cat.length", &points, Some(&words), 2.0).unwrap();
+        let svg = least_height_svg(&figs).expect("a least-height figure");
         assert!(
-            figs[1].1.contains(
+            svg.contains(
                 "Least drop height within the motor limits (stall torque 1.4 N m, no-load speed 5.969 rad/s)"
             ),
-            "{}",
-            figs[1].1
+            "{svg}"
         );
     }
 
@@ -1066,7 +1169,7 @@ mod tests {
         // the level line's y in pixels equals across the points; the diagonal's rises
         let line_ys = |key: &str| -> Vec<f64> {
             let figs = figures("k", key, &points, Some("stall torque 1.4 N m"), 2.5).unwrap();
-            let svg = &figs[1].1;
+            let svg = least_height_svg(&figs).expect("a least-height figure");
             assert!(svg.contains(FALL_HEIGHT_SERIES), "{key}");
             // the line's dashes, in its style's colour (the legend's sample last)
             let colour = format!(
@@ -1101,12 +1204,40 @@ mod tests {
             .iter()
             .fold((f64::MAX, f64::MIN), |(a, b), y| (a.min(*y), b.max(*y)));
         assert!(hi - lo > 100.0, "the diagonal spans the plot: {diagonal:?}");
-        assert_eq!(
-            figures("k", "cat.length", &points, None, 2.5)
-                .unwrap()
-                .len(),
-            1
+        assert!(
+            least_height_svg(&figures("k", "cat.length", &points, None, 2.5).unwrap()).is_none()
         );
+    }
+
+    /// `figures`' least-height figure, by its file name.
+    fn least_height_svg(figs: &[(String, String)]) -> Option<&str> {
+        figs.iter()
+            .find(|(name, _)| name.ends_with("-least-height.svg"))
+            .map(|(_, svg)| svg.as_str())
+    }
+
+    /// A sweep of the least heights alone draws no empty peak figure; a
+    /// point with a peak draws it.
+    #[test]
+    fn the_peak_figure_is_drawn_where_a_point_has_a_peak() {
+        let names = |points: &[SweepPoint]| -> Vec<String> {
+            figures("k", "cat.length", points, Some("stall torque 1.4 N m"), 2.5)
+                .unwrap()
+                .into_iter()
+                .map(|(name, _)| name)
+                .collect()
+        };
+        let mut points = vec![
+            SweepPoint {
+                value: 0.2,
+                least_height_free_m: Some(3.0),
+                ..Default::default()
+            };
+            2
+        ];
+        assert_eq!(names(&points), ["sweep-k-least-height.svg"]);
+        points[1].free_peak_nm = Some(0.5);
+        assert_eq!(names(&points), ["sweep-k.svg", "sweep-k-least-height.svg"]);
     }
 
     /// A point's error sentence holds commas, quotes and a line break: the

@@ -85,7 +85,15 @@ def _restore_config(text, origin, overrides, base):
     return Config._from_state(text, origin, overrides, base)
 
 
-def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
+def sweep(
+    config,
+    key,
+    values,
+    methods=SWEEP_METHODS,
+    threads=None,
+    frame=None,
+    least_height_only=False,
+):
     """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``.
 
     ``methods`` is a list, or one comma-separated string (``"phased,free"``).
@@ -109,14 +117,20 @@ def sweep(config, key, values, methods=SWEEP_METHODS, threads=None, frame=None):
     the limits (the torque each method needs), as in the CLI's sweep; whether
     the motors can do it at a point is read from the least-height columns
     (where the lower is below the point's ``fall.height``), not from
-    ``free_status``.
+    ``free_status``. With ``least_height_only=True`` (``--least-height-only``)
+    only the least heights are computed: inside a motor envelope the peak
+    columns are then NaN (under a stall torque alone the least heights come
+    from the peaks, which are given); a config without ``limits.max_torque``
+    is a ``ConfigError``.
     """
     import numpy as np
 
     if isinstance(methods, str):
         methods = [m.strip() for m in methods.split(",")]
     values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
-    columns, csv = _sweep_columns(config, key, values, list(methods), threads)
+    columns, csv = _sweep_columns(
+        config, key, values, list(methods), threads, bool(least_height_only)
+    )
     if frame is None or frame:
         try:
             import pandas as pd

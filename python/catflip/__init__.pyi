@@ -307,7 +307,7 @@ def size(config: Config, height: float, points: int = 8, gear_evaluations: int =
 
 def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
           methods: Union[str, Sequence[str]] = ..., threads: Optional[int] = None,
-          frame: Optional[bool] = None) -> Any:
+          frame: Optional[bool] = None, least_height_only: bool = False) -> Any:
     """Sweeps the numeric config key ``key`` over ``values``, as ``catflip sweep``
     (``methods``: a list, or one comma-separated string such as ``"phased,free"``).
 
@@ -317,7 +317,9 @@ def sweep(config: Config, key: str, values: Union[Sequence[float], F64],
     also holds ``"csv"``, the CLI's ``sweep-<key>.csv`` text. Under motor limits the peak
     columns are the least-peak designs *without* the limits (the torque each method needs),
     as in the CLI's sweep; whether the motors can do it at a point is read from the
-    least-height columns (where the lower is below the point's ``fall.height``)."""
+    least-height columns (where the lower is below the point's ``fall.height``). With
+    ``least_height_only=True`` only the least heights are computed (the peak columns NaN
+    inside a motor envelope; a config without ``limits.max_torque`` is a ``ConfigError``)."""
 
 class Run:
     """A whole ``catflip run``, kept in memory: the summary and every file it would write."""

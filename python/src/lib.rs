@@ -82,7 +82,14 @@ fn dict_error(text: &str, message: &str) -> String {
 
 /// The library's advice in the package's words: its messages name the
 /// command line's flags and commands where Python has arguments and functions.
-const PYTHONIC: [(&str, &str); 5] = [
+const PYTHONIC: [(&str, &str); 9] = [
+    ("--methods names neither", "methods names neither"),
+    ("to --methods", "to methods"),
+    (
+        "or sweep without --least-height-only",
+        "or sweep with least_height_only=False",
+    ),
+    ("--least-height-only", "least_height_only=True"),
     (
         "another seed (--seed)",
         "another seed (seed=\"analytic\" or \"phased\")",
@@ -1433,7 +1440,7 @@ fn size<'py>(
 /// Columns of a sweep: floats (NaN where a method gave none) and texts.
 /// The columns of `catflip.sweep` (use that).
 #[pyfunction]
-#[pyo3(signature = (config, key, values, methods, threads = None))]
+#[pyo3(signature = (config, key, values, methods, threads = None, least_height_only = false))]
 fn sweep_columns<'py>(
     py: Python<'py>,
     config: &Config,
@@ -1441,12 +1448,14 @@ fn sweep_columns<'py>(
     values: Vec<f64>,
     methods: Vec<String>,
     threads: Option<i64>,
+    least_height_only: bool,
 ) -> PyResult<(Bound<'py, PyDict>, String)> {
     let (source, _) = config.snapshot();
     let mut m = catflip::sweep::Methods {
         analytic: false,
         phased: false,
         free: false,
+        peaks: !least_height_only,
     };
     for name in &methods {
         match name.as_str() {

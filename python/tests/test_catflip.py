@@ -443,6 +443,28 @@ def test_a_motor_too_weak_for_any_fall_has_no_schedule():
     assert "stronger or faster motors would do (catflip.size(config, height) names them)" in h.sentence()
 
 
+def test_a_sweep_of_least_heights_alone_equals_the_cli(tmp_path):
+    seed = ROOT / "configs" / "seed.toml"
+    status, _, err = cli("sweep", seed, "--set", "limits.max_torque=0.5", "--set-range", "fall.height=1:3:3",
+                         "--least-height-only", out=tmp_path)
+    assert status == 0, err
+    cfg = catflip.Config.from_toml(seed)
+    cfg.set("limits.max_torque", 0.5)
+    cols = catflip.sweep(cfg, "fall.height", [1, 2, 3], least_height_only=True, frame=False)
+    (written,) = (tmp_path / "seed").glob("sweep-fall_height*/sweep-fall_height.csv")
+    assert cols["csv"] == written.read_text()
+    # under a stall torque alone the least heights are the peaks' (F7); the analytic one has none
+    assert np.isnan(cols["analytic_peak_nm"]).all()
+    assert np.isfinite(cols["least_height_free_m"]).all()
+    # F7: the least height does not depend on the drop
+    assert cols["least_height_phased_m"][0] == pytest.approx(cols["least_height_phased_m"][2], rel=1e-9)
+    with pytest.raises(catflip.ConfigError,
+                       match=r"least_height_only=True: the config sets no stall torque.*least_height_only=False"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [1, 2], least_height_only=True, frame=False)
+    with pytest.raises(catflip.ConfigError, match="methods names neither; add phased or free to methods"):
+        catflip.sweep(cfg, "fall.height", [1, 2], methods=("analytic",), least_height_only=True, frame=False)
+
+
 def test_sweep_equals_the_cli(tmp_path):
     seed = ROOT / "configs" / "seed.toml"
     status, stdout, _ = cli("sweep", seed, "--set-range", "fall.height=1:3:3", "--methods", "analytic,phased",

@@ -27,6 +27,9 @@ pub struct SweepState {
     /// `K/N`.
     pub shard: String,
     pub methods: Vec<String>,
+    /// Whether only the least heights were computed (`--least-height-only`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub least_height_only: bool,
     /// The config the points were computed from, as resolved (file and `--set`).
     pub config: serde_json::Value,
     /// One slot a point of the shard, in grid order.
@@ -68,6 +71,11 @@ pub fn config_differences(old: &serde_json::Value, new: &serde_json::Value) -> V
     let mut out = Vec::new();
     walk("", Some(old), Some(new), &mut out);
     out
+}
+
+/// A flag's presence, for [`differences`].
+fn given(on: bool) -> String {
+    if on { "given" } else { "not given" }.into()
 }
 
 /// A refused `--resume`'s list (a sweep's or a study's): each setting that
@@ -113,6 +121,7 @@ impl SweepState {
             range: spec.arg(),
             shard: format!("{}/{}", shard.index, shard.count),
             methods: methods.names(),
+            least_height_only: !methods.peaks,
             config: serde_json::to_value(cfg).expect("a config serialises"),
             points: vec![None; shard.points(spec.count).len()],
         }
@@ -202,7 +211,11 @@ impl SweepState {
             .collect();
         let name = self.config["name"].as_str().unwrap_or("config");
         let limited = self.config["limits"]["max_torque"].is_number();
-        let what = if limited {
+        let what = if limited && self.least_height_only {
+            format!(
+                "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left empty; under a stall torque alone they come from the peaks (F7), which are then given. Below the configured {height} m (fall.height) the flip is possible there"
+            )
+        } else if limited {
             format!(
                 "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: below the configured {height} m (fall.height) the flip is possible there. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)"
             )
@@ -295,6 +308,11 @@ impl SweepState {
                 ("--set-range", old.range.clone(), self.range.clone()),
                 ("--shard", old.shard.clone(), self.shard.clone()),
                 ("--methods", old.methods.join(","), self.methods.join(",")),
+                (
+                    "--least-height-only",
+                    given(old.least_height_only),
+                    given(self.least_height_only),
+                ),
                 (
                     "points",
                     old.points.len().to_string(),

@@ -168,11 +168,7 @@ fn run_writes_a_complete_consistent_report() {
 fn sweep_agrees_with_single_runs() {
     let cfg_path = configs().join("seed.toml");
     let spec: catflip::sweep::SweepSpec = "fall.height=5:10:2".parse().unwrap();
-    let methods = catflip::sweep::Methods {
-        analytic: true,
-        phased: true,
-        free: true,
-    };
+    let methods = catflip::sweep::Methods::ALL;
     let points = catflip::sweep::sweep(&cfg_path, &[], &spec, methods, 2, |_, _| {}).unwrap();
     assert_eq!(points.len(), 2);
     for p in &points {
