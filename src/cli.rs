@@ -62,13 +62,14 @@ enum Command {
         /// whole sweep's.
         #[arg(long, value_name = "K/N", value_parser = parsed::<Shard>)]
         shard: Option<Shard>,
-        /// Continue an interrupted sweep (same range, shard, methods and
-        /// config) from the partial set it published.
+        /// Continue an interrupted sweep (same range, shard, methods,
+        /// --least-height-only and config) from the partial set it published.
         #[arg(long)]
         resume: bool,
         /// Compute only the least drop heights (the robot builder's
-        /// question), not the peak columns (each method's design without
-        /// the motor limits); needs limits.max_torque.
+        /// question): inside a motor envelope not the peak columns (each
+        /// method's design without the motor limits), from which a stall
+        /// torque alone takes them (F7); needs limits.max_torque.
         #[arg(long)]
         least_height_only: bool,
     },
@@ -685,13 +686,12 @@ fn cmd_sweep(
     let slots = store.lock().unwrap_or_else(|p| p.into_inner()).clone();
     let state = state.with_points(slots);
     let points = state.finished();
-    let limit = cfg.limits.max_torque;
     if let catflip::interrupt::Outcome::Finished(r) = outcome {
         r?;
     } else {
         // published as a partial set, the unfinished points left running
         let dir = publisher.link();
-        publisher.publish(state.output(&key, &spec.key, limit, true)?)?;
+        publisher.publish(state.output(&key, &spec.key, true)?)?;
         if c.json {
             say!("{}", serde_json::to_string_pretty(&points)?);
         }
@@ -703,7 +703,7 @@ fn cmd_sweep(
         );
         return Ok(Status::Interrupted);
     }
-    let written = publisher.publish(state.output(&key, &spec.key, limit, false)?)?;
+    let written = publisher.publish(state.output(&key, &spec.key, false)?)?;
     let warning = console::sweep::partial_warning(&points);
     if let Some(w) = &warning {
         eprintln!("{w}");

@@ -178,7 +178,7 @@ impl Methods {
                 format!("{unlimited} of the {} points of {arg} set", configs.len())
             };
             return usage(format!(
-                "{which} no stall torque (limits.max_torque), so there is no least drop height (without a motor limit any height will do); set limits.max_torque, or sweep without --least-height-only"
+                "{which} no stall torque (limits.max_torque), and a sweep's least drop heights are those of a stall torque; set limits.max_torque, or sweep without --least-height-only"
             ));
         }
         Ok(())
@@ -290,7 +290,8 @@ struct Continuation {
 /// same at every point. A point whose problem equals it takes these
 /// columns instead of designing them again (the same problem, the same
 /// answer, to the bit; designed again from a neighbour's design, the same
-/// problem moved the robot's free-form peak by up to 5e-4 of itself).
+/// problem moved the robot's free-form peak by up to 5e-4 of itself). A
+/// point that takes them passes their free-form design on as its own.
 struct PeakColumns {
     spec: DesignSpec,
     columns: SweepPoint,
@@ -476,7 +477,9 @@ fn point(
     }
     let spec = cfg.design_spec();
     let t2 = cfg.available_time().powi(2);
-    if methods.analytic && methods.peaks {
+    let problem = peak_problem(&spec);
+    let same = last_peaks.as_ref().filter(|m| peaks && m.spec == problem);
+    if methods.analytic && methods.peaks && same.is_none() {
         p.analytic_peak_nm = Some(
             peak_along(
                 &spec,
@@ -489,8 +492,6 @@ fn point(
     // a method that fails leaves its columns empty and its reason in `error`;
     // the other methods' numbers are kept
     let mut errors = Vec::new();
-    let problem = peak_problem(&spec);
-    let same = last_peaks.as_ref().filter(|m| peaks && m.spec == problem);
     if let Some(m) = same {
         let c = &m.columns;
         (p.analytic_peak_nm, p.phased_peak_nm, p.phased_bend_deg) =

@@ -158,7 +158,6 @@ impl SweepState {
         &self,
         file_key: &str,
         key: &str,
-        limit: Option<f64>,
         interrupted: bool,
     ) -> Result<crate::output::Output> {
         let points = self.finished();
@@ -167,7 +166,9 @@ impl SweepState {
         if !(interrupted && points.is_empty()) {
             let mut names = Vec::new();
             let height = self.config["fall"]["height"].as_f64().unwrap_or(f64::NAN);
-            let motor = limit.map(|_| super::motor_words(&self.config["limits"], key));
+            let motor = self
+                .limited(key)
+                .then(|| super::motor_words(&self.config["limits"], key));
             for (name, svg) in super::figures(file_key, key, &points, motor.as_deref(), height)? {
                 names.push(name.clone());
                 out.add(name, svg);
@@ -179,6 +180,12 @@ impl SweepState {
         }
         out.add(Self::file_name(file_key), self.to_json());
         Ok(out)
+    }
+
+    /// Whether the points have a stall torque (the config's, or the swept
+    /// one), and so least drop heights.
+    fn limited(&self, key: &str) -> bool {
+        key == "limits.max_torque" || self.config["limits"]["max_torque"].is_number()
     }
 
     /// The sweep's page: a row a finished point, and the figures.
@@ -210,7 +217,7 @@ impl SweepState {
             })
             .collect();
         let name = self.config["name"].as_str().unwrap_or("config");
-        let limited = self.config["limits"]["max_torque"].is_number();
+        let limited = self.limited(key);
         let what = if limited && self.least_height_only {
             format!(
                 "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left empty; under a stall torque alone they come from the peaks (F7), which are then given. Below the configured {height} m (fall.height) the flip is possible there"

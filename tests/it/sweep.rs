@@ -247,10 +247,19 @@ fn robot_sweep(range: &str, phased: bool) -> (std::path::PathBuf, Vec<catflip::s
 fn a_robot_sweeps_least_heights_are_the_ones_run_answers_with() {
     let (path, points) = robot_least_heights("limits.no_load_speed=6.1:5.9:3");
     let peaks = |p: &catflip::sweep::SweepPoint| {
-        (p.phased_peak_nm, p.phased_bend_deg, p.free_peak_nm, p.free_bend_deg, p.free_status)
+        (
+            p.phased_peak_nm,
+            p.phased_bend_deg,
+            p.free_peak_nm,
+            p.free_bend_deg,
+            p.free_status,
+        )
     };
     assert!(peaks(&points[0]).2.is_some());
-    assert!(points.iter().all(|p| peaks(p) == peaks(&points[0])), "{points:?}");
+    assert!(
+        points.iter().all(|p| peaks(p) == peaks(&points[0])),
+        "{points:?}"
+    );
     let mut last = 0.0;
     for (i, p) in points.iter().enumerate() {
         let cfg =
@@ -402,6 +411,67 @@ fn a_sweep_without_the_phased_method_gives_the_same_free_least_heights() {
         err.contains("--least-height-only given (now not given)"),
         "{err}"
     );
+}
+
+/// A sweep of the stall torque itself, from a config without one: the
+/// peak columns (without the motor limits) are one problem, taken from the
+/// chunk's first point, while each point's least heights (F7 from those
+/// peaks) are its own torque's, those of a sweep of that point alone to the
+/// bit; the page draws the least heights and does not call the sweep
+/// unlimited.
+#[test]
+fn a_sweep_of_the_stall_torque_gives_each_point_its_own_least_height() {
+    let seed = util::seed_toml();
+    let sweep = |range: &str, dir: &std::path::Path| -> Vec<catflip::sweep::SweepPoint> {
+        let (ok, out, err) = run_written(
+            &[
+                "sweep",
+                seed.to_str().unwrap(),
+                "--set-range",
+                range,
+                "--least-height-only",
+                "--json",
+            ],
+            dir,
+        );
+        assert!(ok, "{range}: {err}");
+        serde_json::from_str(&out).unwrap()
+    };
+    let dir = temp_dir();
+    let points = sweep("limits.max_torque=0.5:0.7:3", dir.path());
+    assert_eq!(points.len(), 3);
+    let peaks = |p: &catflip::sweep::SweepPoint| (p.phased_peak_nm, p.free_peak_nm);
+    for (i, p) in points.iter().enumerate() {
+        assert!(
+            p.free_peak_nm.is_some() && p.analytic_peak_nm.is_none(),
+            "{p:?}"
+        );
+        assert_eq!(peaks(p), peaks(&points[0]), "{}", p.value);
+        if i > 0 {
+            let alone = &sweep(
+                &format!("limits.max_torque={0}:{0}:1", p.value),
+                temp_dir().path(),
+            )[0];
+            assert_eq!(
+                p.least_height_phased_m, alone.least_height_phased_m,
+                "{}",
+                p.value
+            );
+            assert_eq!(
+                p.least_height_free_m, alone.least_height_free_m,
+                "{}",
+                p.value
+            );
+            assert!(p.least_height_free_m < points[i - 1].least_height_free_m);
+        }
+    }
+    let set = dir.path().join("output/seed/sweep-limits_max_torque");
+    assert!(
+        set.join("sweep-limits_max_torque-least-height.svg")
+            .exists()
+    );
+    let page = std::fs::read_to_string(set.join("index.html")).unwrap();
+    assert!(!page.contains("(no motor limits)"), "{page}");
 }
 
 /// Least heights alone need a stall torque at every point and a method
