@@ -598,11 +598,13 @@ fn cmd_run(c: &Common) -> Result<Status> {
         say!("{}", serde_json::to_string_pretty(&r.summary)?);
         return Ok(outcome.into());
     }
-    say_lines(console::run::summary(
-        &r.summary,
-        &dir.join("index.html"),
-        written.len(),
-    ));
+    // the sizing advice names this config and its `--set`s
+    let sizing = format!("{} --height", c.command("size"));
+    say_lines(
+        console::run::summary(&r.summary, &dir.join("index.html"), written.len())
+            .into_iter()
+            .map(|l| l.replace("catflip size CONFIG --height", &sizing)),
+    );
     if let Some(word) = console::run::closing(&r.summary) {
         eprintln!("{word}");
     }

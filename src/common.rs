@@ -91,6 +91,32 @@ pub(crate) struct Common {
     pub(crate) out: PathBuf,
 }
 
+impl Common {
+    /// The command line of `command` on the same config and `--set`s, as a
+    /// shell takes it: what a message advises the user to run next.
+    pub(crate) fn command(&self, command: &str) -> String {
+        let mut words = vec![
+            "catflip".to_string(),
+            command.to_string(),
+            shell_word(&self.config.display().to_string()),
+        ];
+        for s in &self.set {
+            words.extend(["--set".to_string(), shell_word(s)]);
+        }
+        words.join(" ")
+    }
+}
+
+/// `word` quoted for a POSIX shell where it needs quoting (`'it'\''s'`).
+fn shell_word(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_./=:,@+-%".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', "'\\''"))
+    }
+}
+
 /// The key of a `--set KEY=VALUE`, as the config reads it (spaces dropped).
 pub(crate) fn set_key(arg: &str) -> &str {
     arg.split('=').next().unwrap_or(arg).trim()
@@ -183,4 +209,33 @@ pub(crate) fn flag(what: &str, reason: Option<String>) -> bool {
         eprintln!("warning: {what} is FLAGGED: {r}");
     }
     reason.is_some()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The advised command reads back as the same words in a shell.
+    #[test]
+    fn an_advised_command_quotes_what_a_shell_would_split() {
+        let c = Common {
+            config: PathBuf::from("my robot's.toml"),
+            set: vec!["fall.height=3".into(), "name=a b".into()],
+            json: false,
+            out: PathBuf::from("output"),
+        };
+        assert_eq!(
+            c.command("size"),
+            "catflip size 'my robot'\\''s.toml' --set fall.height=3 --set 'name=a b'"
+        );
+        let words = std::process::Command::new("sh")
+            .args(["-c", &format!("printf '%s|' {}", c.command("size"))])
+            .output()
+            .unwrap()
+            .stdout;
+        assert_eq!(
+            String::from_utf8(words).unwrap(),
+            "catflip|size|my robot's.toml|--set|fall.height=3|--set|name=a b|"
+        );
+    }
 }

@@ -741,12 +741,16 @@ impl SizeAnswer {
         }
         let range = match g.working_range {
             Some(r) => format!(
-                " Gear ratios from N = {}{:.4} to {:.4}{} make it from {} m (between the ratios designed, the least height interpolated in log N).",
-                if r.low_untried_beyond { "at most " } else { "" },
+                " Gear ratios from N = {:.4}{} to {:.4}{} make it from {} m (between the ratios designed, the least height interpolated in log N).",
                 r.low,
+                if r.low_untried_beyond {
+                    " or less (the lowest ratio tried)"
+                } else {
+                    ""
+                },
                 r.high,
                 if r.high_untried_beyond {
-                    " or more"
+                    " or more (the highest ratio tried)"
                 } else {
                     ""
                 },

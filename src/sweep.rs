@@ -832,8 +832,9 @@ fn checked_configs(
                 format!("every point is invalid; {message}")
             } else {
                 format!(
-                    "{bad} of {} points are invalid, the first {message}; choose {what} inside the key's range",
-                    configs.len()
+                    "{bad} of {} points {} invalid, the first {message}; choose {what} inside the key's range",
+                    configs.len(),
+                    if bad == 1 { "is" } else { "are" }
                 )
             },
         });

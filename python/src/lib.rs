@@ -115,6 +115,21 @@ fn pythonic(message: String) -> String {
     let mut m = PYTHONIC
         .iter()
         .fold(message, |m, (cli, py)| m.replace(cli, py));
+    // `with --set KEY=VALUE` (a key to set) as the call that sets it
+    const SET: &str = "with --set ";
+    let mut from = 0;
+    while let Some(at) = m[from..].find(SET).map(|i| from + i) {
+        let rest = &m[at + SET.len()..];
+        let len = rest.find(char::is_whitespace).unwrap_or(rest.len());
+        let token = rest[..len].trim_end_matches(['.', ',', ';', ')']);
+        let Some((key, value)) = token.split_once('=') else {
+            from = at + SET.len();
+            continue;
+        };
+        let call = format!("with config.set(\"{key}\", {value})");
+        m.replace_range(at..at + SET.len() + token.len(), &call);
+        from = at + call.len();
+    }
     const SIZE: &str = "catflip size CONFIG --height ";
     while let Some(at) = m.find(SIZE) {
         let rest = &m[at + SIZE.len()..];
@@ -1476,6 +1491,11 @@ fn sweep_columns<'py>(
             "threads={t}: at least one point must be computed at a time; give 1 or more, or None for one per core"
         )));
     }
+    if values.is_empty() {
+        return Err(ConfigError::new_err(
+            "values is empty: give at least one value to sweep",
+        ));
+    }
     let threads = threads.map(|t| t as usize);
     let threads =
         threads.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()));
@@ -1494,7 +1514,13 @@ fn sweep_columns<'py>(
                 &stop,
                 |_, _| {},
             )
-            .map_err(err)?
+            .map_err(|e| match e {
+                // the values named as given, not as a `--set-range`
+                catflip::Error::Range { arg, message } => {
+                    ConfigError::new_err(pythonic(format!("{arg}: {message}")))
+                }
+                e => err(e),
+            })?
             .into_iter()
             .flatten()
             .collect();

@@ -51,6 +51,10 @@ def message(e):
 
 # the CLI's advice as the package words it (python/src/lib.rs PYTHONIC)
 PYTHONIC = [
+    ("--methods names neither", "methods names neither"),
+    ("to --methods", "to methods"),
+    ("or sweep without --least-height-only", "or sweep with least_height_only=False"),
+    ("--least-height-only", "least_height_only=True"),
     ("another seed (--seed)", 'another seed (seed="analytic" or "phased")'),
     ("`--seed analytic` starts it", '`seed="analytic"` starts it'),
     ("`catflip run` finds the least drop height", "`catflip.least_height(config)` finds the least drop height"),
@@ -62,6 +66,8 @@ PYTHONIC = [
 def in_python_words(cli_message):
     for cli_words, py_words in PYTHONIC:
         cli_message = cli_message.replace(cli_words, py_words)
+    # a key to set is set on the config
+    cli_message = re.sub(r"with --set ([a-z_.]+)=([^\s,;)]*[^\s,;).])", r'with config.set("\1", \2)', cli_message)
     # the pointer to `catflip size` is the call here
     return re.sub(r"catflip size CONFIG --height ([0-9.e+-]*[0-9])", r"catflip.size(config, \1)", cli_message)
 
@@ -484,7 +490,11 @@ def test_sweep_equals_the_cli(tmp_path):
     with pytest.raises(catflip.ConfigError, match="every point is invalid"):
         catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, -2], frame=False)
     # one invalid value refuses the whole sweep before any point, in Python's words
-    with pytest.raises(catflip.ConfigError, match="1 of 2 points are invalid.*choose the values"):
+    with pytest.raises(catflip.ConfigError, match=r"^limits\.max_torque=\[-0\.5, 1\]: 1 of 2 points is invalid"):
+        catflip.sweep(catflip.Config.from_toml(seed), "limits.max_torque", [-0.5, 1.0], frame=False)
+    with pytest.raises(catflip.ConfigError, match="values is empty"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [], frame=False)
+    with pytest.raises(catflip.ConfigError, match="1 of 2 points is invalid.*choose the values"):
         catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, 2], frame=False)
     try:
         import pandas  # noqa: F401

@@ -15,8 +15,17 @@ pub fn points(
     written: &[PathBuf],
 ) -> Vec<String> {
     let chunks = points.len().div_ceil(crate::sweep::CHUNK);
+    // fewer chunks than threads leave threads idle: say why
+    let why = if threads > chunks {
+        format!(
+            "; a chunk's up to {} points continue one from another on one thread",
+            crate::sweep::CHUNK
+        )
+    } else {
+        String::new()
+    };
     let mut lines = vec![format!(
-        "catflip sweep: {} over {} ({} in {}, {} at a time)",
+        "catflip sweep: {} over {} ({} in {}, {} at a time{why})",
         name,
         spec.key,
         super::count(points.len(), "point"),
@@ -107,8 +116,13 @@ mod tests {
             points("seed", &spec, &pts, threads, &[]).remove(0)
         };
         // a chunk's points run one after another: three points are one chunk
-        assert!(header(3, 2).ends_with("(3 points in 1 chunk, 1 at a time)"));
+        assert!(header(3, 2).ends_with(
+            "(3 points in 1 chunk, 1 at a time; a chunk's up to 10 points continue one from another on one thread)"
+        ));
         assert!(header(25, 2).ends_with("(25 points in 3 chunks, 2 at a time)"));
-        assert!(header(40, 8).ends_with("(40 points in 4 chunks, 4 at a time)"));
+        assert!(header(40, 8).ends_with(
+            "(40 points in 4 chunks, 4 at a time; a chunk's up to 10 points continue one from another on one thread)"
+        ));
+        assert!(header(3, 1).ends_with("(3 points in 1 chunk, 1 at a time)"));
     }
 }

@@ -73,6 +73,29 @@ pub fn config_differences(old: &serde_json::Value, new: &serde_json::Value) -> V
     out
 }
 
+/// The sweeps of the same key (and shard) published beside `set_dir`, for
+/// a `--resume` that finds none there: each `--set` names its own folder.
+fn others_beside(set_dir: &Path, file_key: &str) -> String {
+    let prefix = format!("sweep-{file_key}");
+    let Some(Ok(entries)) = set_dir.parent().map(std::fs::read_dir) else {
+        return String::new();
+    };
+    let mut names: Vec<String> = entries
+        .flatten()
+        .filter(|e| e.path().join(SweepState::file_name(file_key)).is_file())
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|n| n == &prefix || n.starts_with(&format!("{prefix}@")))
+        .collect();
+    if names.is_empty() {
+        return String::new();
+    }
+    names.sort();
+    format!(
+        ". Published beside it: {} (a folder's name after `@` gives the --set it was made with: give the same to resume it)",
+        names.join(", ")
+    )
+}
+
 /// A flag's presence, for [`differences`].
 fn given(on: bool) -> String {
     if on { "given" } else { "not given" }.into()
@@ -300,8 +323,9 @@ impl SweepState {
         let usage = |m: String| Error::Usage(format!("--resume: {m}"));
         let text = std::fs::read_to_string(&path).map_err(|e| {
             usage(format!(
-                "no sweep to resume at {} ({e}); run the sweep without --resume",
-                path.display()
+                "no sweep to resume at {} ({e}); run the sweep without --resume{}",
+                path.display(),
+                others_beside(set_dir, file_key)
             ))
         })?;
         let old: SweepState = serde_json::from_str(&text).map_err(|e| {

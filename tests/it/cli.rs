@@ -728,18 +728,17 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     );
     assert!(!html.contains("<td>FAILED: "), "nothing errored");
     assert!(html.contains("<td>least-height</td>"));
-    // and points to the command that answers the next question
-    let sizing =
-        "The motors (or the gear ratio) that would do it from 2 m: catflip size CONFIG --height 2.";
-    assert!(html.contains(sizing));
-    let (_, out, _) = util::run(
-        &[
-            "run",
-            util::config_path("robot-universal").to_str().unwrap(),
-        ],
-        dir.path(),
-    );
-    assert!(out.contains(sizing), "{out}");
+    // and points to the command that answers the next question: on the
+    // terminal the one to type, on this config and its --set
+    let sizing = |command: &str| {
+        format!("The motors (or the gear ratio) that would do it from 2 m: {command} --height 2.")
+    };
+    assert!(html.contains(&sizing("catflip size CONFIG")));
+    let config = util::config_path("robot-universal");
+    let config = config.to_str().unwrap();
+    let (_, out, _) = util::run(&["run", config, "--set", "cat.mass=0.46"], dir.path());
+    let command = format!("catflip size {config} --set cat.mass=0.46");
+    assert!(out.contains(&sizing(&command)), "{out}");
     let svg = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     assert!(svg.contains("least-height"), "the torque figure draws it");
 }

@@ -199,12 +199,25 @@ fn the_gear_ratios_that_make_it_are_named_and_hold() {
         g.possible && r.low < g.best_ratio && g.best_ratio < r.high,
         "{r:?}"
     );
+    // an end past which no ratio was tried says so after its number
     let said = a.sentences()[2].clone();
-    assert!(
-        said.contains(&format!("{:.4} to {:.4}", r.low, r.high))
-            && said.contains("make it from 2 m"),
-        "{said}"
+    let end = |n: f64, untried: bool, beyond: &str| {
+        format!("{n:.4}{}", if untried { beyond } else { "" })
+    };
+    let range = format!(
+        "N = {} to {} make it from 2 m",
+        end(
+            r.low,
+            r.low_untried_beyond,
+            " or less (the lowest ratio tried)"
+        ),
+        end(
+            r.high,
+            r.high_untried_beyond,
+            " or more (the highest ratio tried)"
+        )
     );
+    assert!(said.contains(&range), "{said}\n{range}");
     let design = |n: f64| design_motor(&q, t0 * n, w0 / n).unwrap().least_height_m;
     let inside = (r.low * r.high).sqrt();
     assert!(

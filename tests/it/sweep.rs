@@ -411,6 +411,24 @@ fn a_sweep_without_the_phased_method_gives_the_same_free_least_heights() {
         err.contains("--least-height-only given (now not given)"),
         "{err}"
     );
+    // another --set names another folder: the refusal names the one beside it
+    let (code, _, err) = util::run(
+        &[
+            "sweep",
+            path.to_str().unwrap(),
+            "--set-range",
+            range,
+            "--set",
+            "fall.height=3",
+            "--resume",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("Published beside it: sweep-limits_no_load_speed (a folder's name after `@`"),
+        "{err}"
+    );
 }
 
 /// A sweep of the stall torque itself, from a config without one: the
