@@ -393,42 +393,30 @@ fn a_sweep_without_the_phased_method_gives_the_same_free_least_heights() {
     assert!(!set.join("sweep-limits_no_load_speed.svg").exists());
     let page = std::fs::read_to_string(set.join("index.html")).unwrap();
     assert!(page.contains("(--least-height-only)"), "{page}");
-    // a resume names the flag it was made with
-    let (code, _, err) = util::run(
-        &[
+    // a resume names the flag it was made with; another --set names
+    // another folder, and the refusal names the one beside it
+    for (extra, words) in [
+        (
+            ["--methods", "free"],
+            "--least-height-only given (now not given)",
+        ),
+        (
+            ["--set", "fall.height=3"],
+            "Published beside it: sweep-limits_no_load_speed (a folder's name after `@`",
+        ),
+    ] {
+        let mut args = vec![
             "sweep",
             path.to_str().unwrap(),
             "--set-range",
             range,
-            "--methods",
-            "free",
             "--resume",
-        ],
-        dir.path(),
-    );
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("--least-height-only given (now not given)"),
-        "{err}"
-    );
-    // another --set names another folder: the refusal names the one beside it
-    let (code, _, err) = util::run(
-        &[
-            "sweep",
-            path.to_str().unwrap(),
-            "--set-range",
-            range,
-            "--set",
-            "fall.height=3",
-            "--resume",
-        ],
-        dir.path(),
-    );
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("Published beside it: sweep-limits_no_load_speed (a folder's name after `@`"),
-        "{err}"
-    );
+        ];
+        args.extend(extra);
+        let (code, _, err) = util::run(&args, dir.path());
+        assert_eq!(code, Some(2), "{extra:?}: {err}");
+        assert!(err.contains(words), "{extra:?}: {err}");
+    }
 }
 
 /// A sweep of the stall torque itself, from a config without one: the
