@@ -73,7 +73,10 @@ pub struct RunSummary {
     /// Peak ratios between methods (absent when either failed).
     pub phased_over_analytic: Option<f64>,
     pub free_over_phased: Option<f64>,
-    pub scp_iterations: usize,
+    /// The free-form design's SCP iterations, every mesh (absent when it
+    /// was not attempted or failed).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub scp_iterations: Option<usize>,
     pub nodes: usize,
     /// The free-form design's meshes (mesh continuation), coarse to fine.
     pub mesh_levels: Vec<crate::design::free::MeshLevel>,
@@ -499,9 +502,8 @@ fn report_of(cfg: &Config, spec: &DesignSpec, done: Methods, question: Question)
     let figures = figures(cfg, &traces, &iterations, &mesh_levels, &mut notes);
     let peak = |name: &str| methods.iter().find(|m| m.method == name)?.peak();
     let ratio = |a: &str, b: &str| Some(peak(a)? / peak(b)?);
-    let (scp_iterations, nodes) = free
-        .map(|fr| (fr.scp_iterations, fr.nodes))
-        .unwrap_or((0, cfg.free.nodes));
+    let scp_iterations = free.map(|fr| fr.scp_iterations);
+    let nodes = free.map_or(cfg.free.nodes, |fr| fr.nodes);
     let answer = question.answer;
     let summary = RunSummary {
         name: cfg.name.clone(),

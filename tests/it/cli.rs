@@ -660,6 +660,8 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
         assert!(l["peak_torque_nm"].is_null(), "{l}");
         assert!(l["reason"].as_str().unwrap().contains("fall.height"), "{l}");
     }
+    // no free-form design, so no count of its iterations
+    assert!(s.get("scp_iterations").is_none(), "{s}");
     // the reference: flagged beyond the motors
     let an = method_line(&s, "analytic");
     assert!(
@@ -798,6 +800,17 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
         assert!(l.get("beyond_the_motors").is_none(), "{l}");
     }
     assert_eq!(s["answer"]["possible"], true);
+    // the free-form design's iterations, every mesh's
+    let levels: u64 = s["mesh_levels"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| l["scp_iterations"].as_u64().unwrap())
+        .sum();
+    assert!(
+        s["scp_iterations"].as_u64().is_some_and(|n| n > 0 && n >= levels),
+        "{s}"
+    );
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();
     let lead = html
         .find("<section id=\"answer\" class=\"possible\">")
