@@ -33,32 +33,16 @@ pub fn points(
         threads.min(chunks).max(1)
     )];
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
-    // the least drop heights, when a torque limit gives them
-    let heights = points
-        .iter()
-        .any(|p| p.least_height_phased_m.is_some() || p.least_height_free_m.is_some());
-    let mut head = format!(
-        "  {:>12} {:>12} {:>12} {:>12}",
-        spec.key, "analytic N m", "phased N m", "free N m"
-    );
-    if heights {
-        head += &format!(" {:>14} {:>14}", "phased h_min m", "free h_min m");
+    let columns = columns(points);
+    let mut head = format!("  {:>12}", spec.key);
+    for c in &columns {
+        head += &format!(" {:>w$}", c.console, w = c.console.len().max(12));
     }
     lines.push(head);
     for p in points {
-        let mut line = format!(
-            "  {:>12.5} {:>12} {:>12} {:>12}",
-            p.value,
-            show(p.analytic_peak_nm),
-            show(p.phased_peak_nm),
-            show(p.free_peak_nm),
-        );
-        if heights {
-            line += &format!(
-                " {:>14} {:>14}",
-                show(p.least_height_phased_m),
-                show(p.least_height_free_m)
-            );
+        let mut line = format!("  {:>12.5}", p.value);
+        for c in &columns {
+            line += &format!(" {:>w$}", show((c.get)(p)), w = c.console.len().max(12));
         }
         if let Some(e) = &p.error {
             line += &format!("  error: {e}");
@@ -69,6 +53,51 @@ pub fn points(
     t.wrote(written);
     lines.extend(t.into_lines());
     lines
+}
+
+/// A numeric column of a sweep's table: its heading on the console and on
+/// the page, and its number at a point.
+pub struct Column {
+    pub console: &'static str,
+    pub page: &'static str,
+    pub get: fn(&SweepPoint) -> Option<f64>,
+}
+
+/// The numeric columns of a sweep's tables (the console's and the page's;
+/// the CSV keeps every column): those with a number at some point. A method
+/// not asked for, the peaks under `--least-height-only` and the least
+/// heights without a stall torque leave theirs empty everywhere.
+pub fn columns(points: &[SweepPoint]) -> Vec<Column> {
+    let all = [
+        Column {
+            console: "analytic N m",
+            page: "analytic peak N m",
+            get: |p| p.analytic_peak_nm,
+        },
+        Column {
+            console: "phased N m",
+            page: "phased peak N m",
+            get: |p| p.phased_peak_nm,
+        },
+        Column {
+            console: "free N m",
+            page: "free peak N m",
+            get: |p| p.free_peak_nm,
+        },
+        Column {
+            console: "phased h_min m",
+            page: "least height, phased, m",
+            get: |p| p.least_height_phased_m,
+        },
+        Column {
+            console: "free h_min m",
+            page: "least height, free, m",
+            get: |p| p.least_height_free_m,
+        },
+    ];
+    all.into_iter()
+        .filter(|c| points.iter().any(|p| (c.get)(p).is_some()))
+        .collect()
 }
 
 /// The warning of a sweep some of whose points have errors.
@@ -102,6 +131,47 @@ pub fn progress_line(key: &str, done: usize, total: usize, elapsed: f64) -> Stri
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_table_leaves_out_the_columns_no_point_has_a_number_in() {
+        let spec: SweepSpec = "limits.no_load_speed=5:6:2".parse().unwrap();
+        let heights_only = SweepPoint {
+            value: 5.0,
+            least_height_free_m: Some(3.5),
+            ..Default::default()
+        };
+        let lines = points("robot", &spec, &[heights_only.clone()], 1, &[]);
+        assert!(lines[1].ends_with(" free h_min m"), "{}", lines[1]);
+        assert!(!lines[1].contains("N m"), "{}", lines[1]);
+        assert!(lines[2].ends_with(" 3.50000"), "{}", lines[2]);
+        // a column with a number at one point is shown, "-" at the others
+        let every = SweepPoint {
+            value: 6.0,
+            analytic_peak_nm: Some(1.0),
+            phased_peak_nm: Some(0.9),
+            free_peak_nm: Some(0.8),
+            least_height_phased_m: Some(4.0),
+            least_height_free_m: Some(3.0),
+            ..Default::default()
+        };
+        let lines = points("robot", &spec, &[heights_only, every], 1, &[]);
+        let at: Vec<Option<usize>> = [
+            "analytic N m",
+            "phased N m",
+            "free N m",
+            "phased h_min m",
+            "free h_min m",
+        ]
+        .iter()
+        .map(|h| lines[1].find(h))
+        .collect();
+        assert!(
+            at.iter().all(Option::is_some) && at.is_sorted(),
+            "{}",
+            lines[1]
+        );
+        assert_eq!(lines[2].split_whitespace().filter(|c| *c == "-").count(), 4);
+    }
 
     #[test]
     fn the_header_counts_the_chunks_that_can_run_at_once() {

@@ -222,28 +222,49 @@ impl SweepState {
     ) -> String {
         let cell =
             |x: Option<f64>, digits: usize| x.map_or(String::new(), |x| format!("{x:.digits$}"));
+        // the numeric columns some point has a number in, then the free-form
+        // status and the error where some point has one
+        let columns = crate::console::sweep::columns(points);
+        let status = points.iter().any(|p| p.free_status.is_some());
+        let errors = points.iter().any(|p| p.error.is_some());
         let rows: Vec<Vec<String>> = points
             .iter()
             .map(|p| {
-                vec![
-                    format!("{}", p.value),
-                    cell(p.analytic_peak_nm, 5),
-                    cell(p.phased_peak_nm, 5),
-                    cell(p.free_peak_nm, 5),
-                    cell(p.least_height_phased_m, 3),
-                    cell(p.least_height_free_m, 3),
-                    p.free_status
-                        .map_or("", crate::verdict::Status::name)
-                        .to_string(),
-                    p.error.clone().unwrap_or_default(),
-                ]
+                let mut row = vec![format!("{}", p.value)];
+                for c in &columns {
+                    let digits = if c.page.starts_with("least height") {
+                        3
+                    } else {
+                        5
+                    };
+                    row.push(cell((c.get)(p), digits));
+                }
+                if status {
+                    row.push(
+                        p.free_status
+                            .map_or("", crate::verdict::Status::name)
+                            .to_string(),
+                    );
+                }
+                if errors {
+                    row.push(p.error.clone().unwrap_or_default());
+                }
+                row
             })
             .collect();
+        let mut header = vec![key];
+        header.extend(columns.iter().map(|c| c.page));
+        if status {
+            header.push("free status");
+        }
+        if errors {
+            header.push("error");
+        }
         let name = self.config["name"].as_str().unwrap_or("config");
         let limited = self.limited(key);
         let what = if limited && self.least_height_only {
             format!(
-                "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left empty; under a stall torque alone they come from the peaks (F7), which are then given. Below the configured {height} m (fall.height) the flip is possible there"
+                "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left out (empty in the CSV); under a stall torque alone they come from the peaks (F7), which are then given. Below the configured {height} m (fall.height) the flip is possible there"
             )
         } else if limited {
             format!(
@@ -292,16 +313,7 @@ impl SweepState {
         crate::report::index_html(&crate::report::Page {
             title: &format!("catflip sweep: {name}, {key}"),
             lead: None,
-            header: &[
-                key,
-                "analytic peak N m",
-                "phased peak N m",
-                "free peak N m",
-                "least height, phased, m",
-                "least height, free, m",
-                "free status",
-                "error",
-            ],
+            header: &header,
             rows: &rows,
             notes: &notes,
             warnings: &warnings,

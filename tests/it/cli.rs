@@ -808,7 +808,9 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
         .map(|l| l["scp_iterations"].as_u64().unwrap())
         .sum();
     assert!(
-        s["scp_iterations"].as_u64().is_some_and(|n| n > 0 && n >= levels),
+        s["scp_iterations"]
+            .as_u64()
+            .is_some_and(|n| n > 0 && n >= levels),
         "{s}"
     );
     let html = std::fs::read_to_string(base.join("index.html")).unwrap();

@@ -393,6 +393,16 @@ fn a_sweep_without_the_phased_method_gives_the_same_free_least_heights() {
     assert!(!set.join("sweep-limits_no_load_speed.svg").exists());
     let page = std::fs::read_to_string(set.join("index.html")).unwrap();
     assert!(page.contains("(--least-height-only)"), "{page}");
+    // the table shows the column that has numbers, not the empty ones
+    assert!(page.contains("<th>least height, free, m</th>"), "{page}");
+    for empty in [
+        "peak N m",
+        "least height, phased, m",
+        "free status",
+        "error",
+    ] {
+        assert!(!page.contains(&format!("{empty}</th>")), "{empty}: {page}");
+    }
     // a resume names the flag it was made with; another --set names
     // another folder, and the refusal names the one beside it
     for (extra, words) in [
