@@ -140,7 +140,7 @@ mod tests {
             least_height_free_m: Some(3.5),
             ..Default::default()
         };
-        let lines = points("robot", &spec, &[heights_only.clone()], 1, &[]);
+        let lines = points("robot", &spec, std::slice::from_ref(&heights_only), 1, &[]);
         assert!(lines[1].ends_with(" free h_min m"), "{}", lines[1]);
         assert!(!lines[1].contains("N m"), "{}", lines[1]);
         assert!(lines[2].ends_with(" 3.50000"), "{}", lines[2]);
