@@ -86,8 +86,8 @@ impl SizeSettings {
 /// When a point's design lands more than this far (relative) from the
 /// question's manoeuvre time, the point is designed again at the scaled
 /// motor: the designs' local optima move a little with the problem's
-/// numbers (issue 30: 1.4 % of least time over drops of 1 to 10 m), so the
-/// curve is designed where it is read.
+/// numbers (measured: docs/benchmarks.md, "Design settings: the
+/// measurements behind them"), so the curve is designed where it is read.
 pub const RESCALE: f64 = 0.03;
 
 /// How close (relative) a motor on the curve comes to needing exactly the

@@ -203,10 +203,11 @@ pub struct SweepPoint {
 }
 
 /// Points per continuation chunk (fixed, so results do not depend on the
-/// number of threads or shards). Ten: a chunk's first point costs about
-/// three continued ones, and the 40-point sweeps of issue 11 split into
-/// four chunks, two per core on a 2-core machine (eight left one core with
-/// three of five chunks: 60 % of the two cores used).
+/// number of threads or shards). Ten: a chunk's first point costs several
+/// continued ones, so chunks are long, and a 40-point sweep splits into
+/// four chunks, two per core on a 2-core machine (eight would leave one
+/// core with three of five chunks; measured: docs/benchmarks.md, "Design
+/// settings: the measurements behind them").
 pub const CHUNK: usize = 10;
 
 /// `K/N`: the K-th (1-based) of N disjoint slices of a sweep's grid.

@@ -1,5 +1,5 @@
-//! `[control]` and `[robustness]`: the closed loop along a design (issue 27)
-//! and the Monte Carlo study that perturbs it. The defaults are the issue's
+//! `[control]` and `[robustness]`: the closed loop along a design and the
+//! Monte Carlo study that perturbs it. The defaults are the closed loop's
 //! target set: spin up to 0.5 rad/s about any axis, tilt up to 20 deg, +-10 %
 //! inertia on each half, 5 ms actuator delay, 5 % torque noise.
 

@@ -1,4 +1,4 @@
-//! Closed loop along a design (issue 27): catflip's fixed-step plant with
+//! Closed loop along a design: catflip's fixed-step plant with
 //! delay, noise and model error ([`plant`], [`closed_loop`]), the nominal a
 //! controller tracks ([`reference`](mod@reference)), the time-varying LQR ([`tvlqr`]) and
 //! the Monte Carlo study of `catflip robustness` ([`robustness`]) and one

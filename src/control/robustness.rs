@@ -24,8 +24,9 @@ pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 /// The design a study flies: the free-form one from the phased seed, as
 /// `run` makes it, or from the analytic seed where the phased family cannot fit
 /// (not from the least-height answer's manoeuvre, as `optimize` and `run`
-/// start there: from it the robot's nominal at 4.25 m, replanned every 3rd
-/// period, was corrected by 2.8e-3 N m, its replans leaving the envelope),
+/// start there: the replans from it left the motor envelope and were
+/// corrected; measured: docs/benchmarks.md, "Design settings: the
+/// measurements behind them"),
 /// with a continuous torque (`free.torque_jumps` off): the replans are
 /// solved on a grid whose acceleration is continuous, and must be able to
 /// reproduce the plan in flight (with steps at the nodes, the replans of

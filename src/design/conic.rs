@@ -279,24 +279,21 @@ impl Default for ConicSettings {
 
 impl ConicSettings {
     /// The SCP's subproblems and corrections: models of the problem, whose
-    /// predicted decrease needs ~1e-6 of the merit. Without refinement and
-    /// with a 1e-7 gap, the 16 SCP runs of `examples/bench_scp_suite` (three
-    /// configs, both norms, both seeds, and the seed at 30 and 50 nodes)
-    /// took 427 SCP iterations instead of 481 and 38 % fewer instructions
-    /// than with the defaults; every run converged, to peaks within 0.3 %
-    /// (measured when chosen, before the later trust-region and correction
-    /// rules).
+    /// predicted decrease needs ~1e-6 of the merit, so they are solved
+    /// without refinement and to a looser gap than Clarabel's default: fewer
+    /// iterations and instructions, to about the same peaks (measured:
+    /// docs/benchmarks.md, "Design settings: the measurements behind them").
     pub const MODEL: Self = Self {
         refine: false,
         gap_tolerance: 1e-7,
     };
 
     /// The subproblems of a coarse mesh of the continuation, whose design
-    /// only starts the finer one (to a criticality of 1e-3): a 1e-5 gap.
-    /// On issue 11's six cases (`examples/bench_free`) 2077 interior-point
-    /// iterations instead of 2484 (1e-4: 2056), 6 % fewer instructions,
-    /// the same or lower peaks but one (+0.02 %); the finer meshes keep
-    /// [`ConicSettings::MODEL`], so the designs keep their accuracy.
+    /// only starts the finer one (to a criticality of 1e-3), so they are
+    /// solved to a looser gap, 1e-5 (looser still saves little more); the
+    /// finer meshes keep [`ConicSettings::MODEL`], so the designs keep their
+    /// accuracy (measured: docs/benchmarks.md, "Design settings: the
+    /// measurements behind them").
     pub const COARSE: Self = Self {
         refine: false,
         gap_tolerance: 1e-5,
@@ -312,9 +309,9 @@ impl ConicSettings {
 
 /// Iterative-refinement stopping tolerance (relative and absolute) of the
 /// KKT solves when refining (Clarabel's defaults: 1e-13 relative, 1e-12
-/// absolute); 1e-10 cut the free-form design's instructions by 14 %
-/// (Euclidean) and 21 % (per-motor) with the same iterations and peaks to
-/// 1e-5 (issue 11).
+/// absolute): the designs need no more, and the tighter defaults cost work
+/// for the same iterations and peaks (measured: docs/benchmarks.md,
+/// "Design settings: the measurements behind them").
 pub const REFINE_TOL: f64 = 1e-10;
 
 fn clarabel_settings(s: ConicSettings) -> DefaultSettings<f64> {
@@ -335,8 +332,9 @@ fn clarabel_settings(s: ConicSettings) -> DefaultSettings<f64> {
 /// Compressed-column pattern of the triplets `(rows[k], cols[k])`:
 /// `(colptr, rowval, slot)`, rows ascending within each column, duplicates
 /// merged, `slot[k]` the position of triplet `k`. The slots are bucketed by
-/// column (a counting sort) and each column's few entries sorted by row: a
-/// KKT pattern of 40k triplets took 3.3 ms with one comparison sort of all.
+/// column (a counting sort) and each column's few entries sorted by row,
+/// which is cheaper than one comparison sort of all the triplets (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 fn csc(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> (Vec<usize>, Vec<usize>, Vec<usize>) {
     let mut start = vec![0usize; n + 1];
     for &c in cols {

@@ -787,8 +787,10 @@ pub fn dense_margin(spec: &DesignSpec, plan: &dyn ShapePlan) -> impl Fn(f64) -> 
 /// to be inside the motor envelope: the
 /// same path slowed down (F3: torque falls as `1 / k^2`, speed as `1 / k`),
 /// found by bisection on the rows themselves to a relative `1e-9` (1 when
-/// they are inside already). The returned factor is always inside; a first
-/// guess `1 - 1.5 margin` overshot the robot's least time by 0.5 to 0.9 %.
+/// they are inside already). The returned factor is always inside, and no
+/// larger than it needs to be: a first guess from the margin alone
+/// overshot the least time (measured: docs/benchmarks.md, "Design
+/// settings: the measurements behind them").
 pub fn least_stretch(spec: &DesignSpec, plan: &dyn ShapePlan) -> f64 {
     least_stretch_of(&dense_margin(spec, plan))
 }
@@ -829,7 +831,9 @@ pub fn height_for(spec: &DesignSpec, time: f64) -> f64 {
 /// it the plan is only rescaled to the fall time: that costs the objective at
 /// second order in the mismatch where time scaling (F3) holds, and the
 /// envelope is checked after; near the least time, where the objective is
-/// steep in the budget, a looser 1e-2 cost the robot's peak design 2 %.
+/// steep in the budget, a looser tolerance cost the peak design noticeably
+/// (measured: docs/benchmarks.md, "Design settings: the measurements
+/// behind them").
 const ON_TIME: f64 = 1e-3;
 
 /// Solves at `bend` and makes the result exact where the program is not:

@@ -62,9 +62,10 @@ type CheckPoint = (usize, [f64; 2], [f64; 2], [f64; 2], [[f64; 4]; 3]);
 
 /// Trust-region scale of the phase durations relative to the start's
 /// manoeuvre: the cost of the `time` objective is linear in them, so their
-/// steps are bounded by the trust region alone (0.3 took half the
-/// iterations of 0.1 on the seed's least-time problem, and no more on the
-/// peak problems).
+/// steps are bounded by the trust region alone, and a wide scale lets a
+/// least-time design move its durations in fewer iterations without
+/// costing the peak designs any (measured: docs/benchmarks.md, "Design
+/// settings: the measurements behind them").
 const DURATION_SCALE: f64 = 0.3;
 
 /// Magnus sub-steps per collocation interval.
@@ -125,12 +126,13 @@ pub struct FreeProblem {
 
 /// Torque check points per interval on the design's own mesh: the node and
 /// the quarter points. With the node and midpoint only, the torque between
-/// them broke the limits by the mesh's second-order error: the seed's
-/// per-motor design peaked 0.55 % above its check points, and the robot's
-/// least time was stretched from 0.7428 to 0.7496 s to bring its written
-/// rows back inside the torque-speed line. Four (a spacing of `h / 4`, the
-/// five points a quarter apart of an IPOPT reference) cut that excess
-/// sixteen-fold from the node's spacing.
+/// them broke the limits by the mesh's second-order error, enough to raise
+/// the peak above its check points and to stretch a least-time design to
+/// bring its written rows back inside the torque-speed line. Four (a
+/// spacing of `h / 4`, the five points a quarter apart of an IPOPT
+/// reference) cut that excess sixteen-fold from the node's spacing
+/// (measured: docs/benchmarks.md, "Design settings: the measurements
+/// behind them").
 pub const CHECKS_PER_INTERVAL: usize = 4;
 
 /// A torque limit above this many torque units (`I_t / T^2`) is dropped
@@ -227,19 +229,11 @@ impl FreeProblem {
 
     /// The problem with the torque checked at the nodes only: half the
     /// torque rows, for a coarse mesh of the continuation, whose design only
-    /// starts the finer one (which checks the midpoints again). Over issue
-    /// 11's six `bench_free` cases 16.4 G instructions instead of 19.9 G,
-    /// seeding and verification included (the robot's design from the
-    /// analytic seed 13 SCP iterations instead of 18). The finer meshes end
-    /// in other local optima of the peak, mostly lower. Of
-    /// `examples/convergence_matrix`'s eight continued peak designs, seven
-    /// lower (the seed's per-motor design from the analytic seed 0.320877
-    /// instead of 0.324756 N m, the domestic cat's from the phased seed
-    /// 1.5101 instead of 1.5346), one higher (the seed's Euclidean design
-    /// from the analytic seed, +0.17 %). Of `bench_free`'s, also the robot's
-    /// two higher (+0.07 % and +0.17 %, 0.052989 and 0.053020 N m); the
-    /// seed's per-motor design at 120 nodes per phase lower (0.317146
-    /// instead of 0.317362).
+    /// starts the finer one (which checks the midpoints again), so the
+    /// limits between its nodes are left to the finer mesh. That saves
+    /// work, and the finer meshes then end in other local optima of the
+    /// peak, mostly lower (measured: docs/benchmarks.md, "Design settings:
+    /// the measurements behind them").
     pub fn at_nodes_only(mut self) -> Self {
         self.checks = 1;
         self
@@ -962,8 +956,9 @@ impl ScpProblem for FreeProblem {
             })
             .collect();
         // an interior-point dual of an inactive row is tiny, not zero: its
-        // curvature is left out (a third of the work; the same iterations
-        // and peaks on examples/bench_scp_suite)
+        // curvature is left out (it costs work, and leaving it out changes
+        // neither the iterations nor the peaks; measured: docs/benchmarks.md,
+        // "Design settings: the measurements behind them")
         let cut = NEGLIGIBLE_MULTIPLIER * y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let mut out = Vec::new();
         for p in 0..3 {
@@ -1458,24 +1453,18 @@ fn stage(
     }
 }
 
-/// The coarsest mesh of the continuation, nodes per phase: 20 took the
-/// same work as 15 on issue 11's cases, and the robot from 15 (its 60
-/// halved twice) took 30 iterations instead of 12.
+/// The coarsest mesh of the continuation, nodes per phase: a coarser one
+/// saved no work and cost the robot's design more iterations (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 const COARSEST_NODES: usize = 20;
 
 /// The mesh below `nodes` in the continuation: a third of the nodes while
 /// that leaves [`COARSEST_NODES`], else half, else none. A coarse iteration
 /// at a third costs about half one at a half, and the finer mesh still
-/// took 3 or 4 iterations from it: with a third, the robot's design (60 to
-/// 20 nodes per phase instead of 30) from the phased seed took 4.0 G
-/// instructions instead of 4.6 G (14 iterations instead of 12), from the
-/// analytic seed 3.8 G instead of 4.0 G (18 instead of 14), both to lower
-/// peaks (0.052961 and 0.052932 N m instead of 0.053005 and 0.052967); the
-/// seed's per-motor design at 120 nodes per phase (40 and 20 before it
-/// instead of 60 and 30) 5.4 G instead of 8.6 G, 0.317362 N m instead of
-/// 0.317229. Straight to 20 took 6.8 G there, and a quarter first 6.0 G;
-/// at 80 nodes per phase a third (26) took 4.5 G, half (40 and 20) 4.8 G,
-/// a quarter (20) 5.0 G.
+/// takes only a few iterations from it, so a third costs less in all than
+/// a half, a quarter, or going straight to the coarsest mesh, to about the
+/// same peaks (measured: docs/benchmarks.md, "Design settings: the
+/// measurements behind them").
 fn coarser(nodes: usize) -> Option<usize> {
     [3, 2]
         .into_iter()
@@ -1484,9 +1473,9 @@ fn coarser(nodes: usize) -> Option<usize> {
 }
 
 /// The stopping tolerance on the coarser meshes (the finest keeps
-/// `free.tolerance`): a start needs no more. On issue 11's six cases
-/// (`examples/bench_free`) 1e-2, 3e-3 and 1e-3 took the same work within
-/// 3 %, 3e-4 12 % more; 1e-3 gave the lowest peaks.
+/// `free.tolerance`): a start needs no more. A looser one saves no work, a
+/// tighter one costs more, and this one gave the lowest peaks (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 const COARSE_TOLERANCE: f64 = 1e-3;
 
 /// Which mesh of the continuation a design is solved on.
@@ -1531,14 +1520,14 @@ impl MeshLevel {
     }
 }
 
-/// The iteration limit of a coarse mesh: it only starts the finer one
-/// (the coarse meshes of issue 11's cases took 7 to 16; the seed's per-motor
-/// design from the analytic seed, on a path since left, crawled past 50).
-/// A coarse design stopped by the limit still starts the finer mesh: it is
-/// nearer than the seed, from which a fine iteration costs about ten coarse
-/// ones (docs/benchmarks.md, `bench_robot`). A limit of 60 made the box
-/// robot's least-height stage 40 % cheaper but, with the added check
-/// points, its least time 0.12 % longer, so it stays at 25.
+/// The iteration limit of a coarse mesh: it only starts the finer one, and
+/// most coarse meshes converge well below it (one that runs far past it is
+/// on a poor path). A coarse design stopped by the limit still starts the
+/// finer mesh: it is nearer than the seed, from which a fine iteration costs
+/// about ten coarse ones (docs/benchmarks.md, `bench_robot`). A higher
+/// limit made the box robot's least-height stage cheaper but, with the
+/// added check points, its least time longer, so it stays at 25 (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 const COARSE_MAX_ITERATIONS: usize = 25;
 
 /// "17 SCP iterations, 8 at 20 and 9 at 40 nodes per phase", or "9 SCP
@@ -1574,22 +1563,15 @@ fn recorded(levels: &[Coarse]) -> usize {
 /// Mesh continuation: the start at `nodes` per phase, the design on the
 /// mesh below ([`coarser`], itself started the same way) solved to
 /// [`COARSE_TOLERANCE`] and sampled on the finer mesh; for the peak-torque objective without a torque-speed line
-/// or speed limit (`Config::uses_envelope`). On
-/// `examples/convergence_matrix` the time and energy designs took more
-/// iterations with it (the robot's least time from the analytic seed 62
-/// instead of 37) and the robot's least time rose 0.5 % (0.7540 s against
-/// 0.7497 s); the robot's envelope peak design from 6 m took 7.7 s instead
-/// of 5.2 s (its 30-node mesh did not converge in 25 iterations). Designs
-/// inside the envelope have a coarse mesh of their own
-/// ([`envelope_coarse_start`]). From the coarse design the fine one takes 2
-/// to 4 iterations. When the continuation was introduced (half the nodes,
-/// midpoints checked; since then [`coarser`] and
-/// [`FreeProblem::at_nodes_only`] made the coarse meshes cheaper), a
-/// coarse iteration cost about a third of a fine one (`examples/bench_free`:
-/// the robot's design from the phased seed 12 iterations and 6.1 G
-/// instructions, seeding included, instead of 15 and 10.9 G on one mesh;
-/// the seed's per-motor design at 120 nodes per phase 13.1 G instead of
-/// 54.5 G, 0.317201 N m instead of 0.317395). A coarse design that fails,
+/// or speed limit (`Config::uses_envelope`): the time and energy designs
+/// took more iterations with it and the robot's least time rose, and
+/// inside the envelope a peak design's coarse mesh did not converge and
+/// the design took longer.
+/// Designs inside the envelope have a coarse mesh of their own
+/// ([`envelope_coarse_start`]). From the coarse design the fine one takes a
+/// few iterations, and a coarse iteration costs a fraction of a fine one
+/// (measured: docs/benchmarks.md, "Design settings: the measurements
+/// behind them"). A coarse design that fails,
 /// or ends neither converged nor at its iteration limit, leaves the seed
 /// itself as the start. Returns the start and whether a coarse design
 /// made it.
@@ -1748,17 +1730,11 @@ const ENVELOPE_COARSE_MAX_ITERATIONS: usize = 60;
 
 /// The other starts of the coarsest mesh: the configured analytic schedule
 /// (`configured`, unless it is the seed), whose designs end in another
-/// local optimum of the peak than the phased seed's: the seed's per-motor
-/// design ended at 0.3281 N m from the phased seed and 0.3209 from the
-/// analytic one. The lower coarse design is continued, so the two seeds
-/// share a basin. Two more analytic starts (bends of 30 and 90 degrees
-/// between the halves, the twist given 70 % of the time) lowered the seed's
-/// designs further (per motor 0.318833 N m, Euclidean 0.405018, against
-/// 0.319627 and 0.406166 with the analytic start alone) but made them 3
-/// to 4 times slower (`bench_free`: 1.9 to 3.0 s a case instead of 0.5 to
-/// 1.0 s on a loaded machine); from twelve analytic schedules (bends of 30
-/// to 90 degrees, three splits) the 40-node design ended between 0.31883
-/// and 0.32372 N m.
+/// local optimum of the peak than the phased seed's. The lower coarse
+/// design is continued, so the two seeds share a basin. More analytic
+/// starts (other bends and splits) lowered the designs a little further
+/// but made them several times slower, so there is one (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 fn other_starts(spec: &DesignSpec, configured: bool) -> Vec<DesignSpec> {
     if configured {
         vec![spec.clone()]
@@ -1970,8 +1946,8 @@ fn inside_envelope(
         if margin >= -1e-7 {
             break;
         }
-        // the least slow-down that brings every sample inside (one guess of
-        // 1 - 1.5 margin overshot the robot's least time by 0.9 %)
+        // the least slow-down that brings every sample inside (a guess from
+        // the margin alone overshot the least time: docs/benchmarks.md)
         let stretch = crate::design::envelope::least_stretch_of(&margins);
         let total: f64 = solved.plan.phase_bounds()[3];
         // slowing the same path down keeps its attitude only at zero
@@ -2026,12 +2002,13 @@ const BETWEEN_TOLERANCE: f64 = 1e-4;
 /// design's check points breaks the torque limit (with the torque-speed
 /// line), a check point is added there and the design solved again from
 /// itself ([`REFINE_ROUNDS`] at most). With the node and the quarter points
-/// alone the robot's least-time design left the torque-speed line by 1.2 %
-/// between the last two checks of its twist, where the second motor
-/// reverses, and was slowed down by 1.05 % to bring it inside. Not for the
-/// peak above its check points (the peak cost without a binding limit):
-/// that cut the seed's per-motor peak by 0.1 % for 3 to 4 more SCP
-/// iterations, and the reported peak is the dense one either way.
+/// alone a least-time design can leave the torque-speed line between two
+/// checks where a motor reverses, and would then be slowed down as a whole
+/// to bring it inside. Not for the peak above its check points (the peak
+/// cost without a binding limit): that gained little for more SCP
+/// iterations, and the reported peak is the dense one either way
+/// (measured: docs/benchmarks.md, "Design settings: the measurements
+/// behind them").
 fn refine_checks(
     spec: &DesignSpec,
     mut solved: Solved,

@@ -201,9 +201,10 @@ fn reference_time(spec: &DesignSpec) -> Option<f64> {
     let t0 = spec.available_time();
     let motor = spec.motor;
     // the torque alone when there is one: a start that is too fast for the
-    // line (the SCP slows it down) found the shorter manoeuvres; the
-    // no-load speed in the reference (0.94 s for the robot against 0.15 s)
-    // took every start to 1.26 s instead of 0.75 s
+    // line (the SCP slows it down) found the shorter manoeuvres; with the
+    // no-load speed in the reference every start ended in a slower one
+    // (measured: docs/benchmarks.md, "Design settings: the measurements
+    // behind them")
     // the analytic plan slowed until its top speed is the motor's
     let speed = motor
         .max_speed
@@ -216,9 +217,9 @@ fn reference_time(spec: &DesignSpec) -> Option<f64> {
             let dense = crate::verify::analyze::dense_samples(spec);
             let (peak, _) = crate::verify::analyze::peak_along(spec, &plan, dense);
             // a strong motor's torque time alone is far too fast for its
-            // speed (1000 N m on the robot: a 7 cm reference drop, from which
-            // every start failed and the answer was the phased design, above
-            // the 1.4 N m servo's)
+            // speed: every start from so short a reference drop failed
+            // (measured: docs/benchmarks.md, "Design settings: the
+            // measurements behind them")
             (t0 * (peak / t).sqrt()).max(SPEED_FLOOR * speed.unwrap_or(0.0))
         }
         (None, Some(s)) => s,
@@ -328,10 +329,10 @@ impl Families {
 /// `fall.height`: the stall-only design ([`stall_only`], on [`STALL_ONLY_NODES`]) at the stall-only
 /// least time (too fast for the line: the SCP slows it down), and the
 /// analytic plan. Both are solved on the coarse mesh and the better one
-/// finished ([`finished`]). The free-form design from the phased time
-/// design, also tried, ended at 0.7595 s on the robot (against 0.7468 s and
-/// 0.7516 s from these two), and a start from the stall-only design slowed
-/// into the envelope (1.88 s) crawled to 0.7559 s in 72 iterations.
+/// finished ([`finished`]). Two other starts, the phased time design and
+/// the stall-only design slowed into the envelope, were tried and ended in
+/// slower designs (measured: docs/benchmarks.md, "Design settings: the
+/// measurements behind them").
 /// `observe` sees the stall-only start's coarse iterations, then the fine
 /// iterations of the start finished first. The stall-only least time is the
 /// answer's lower bound where the motor has a torque-speed line or a speed
@@ -508,11 +509,9 @@ fn rank(outcomes: &[Option<free::CoarseOutcome>]) -> Finish {
 }
 
 /// Coarse times closer than this (relative) do not rank two starts: the
-/// fine mesh reordered two of the robot's that were 0.16 % apart there.
-/// Wider, it finishes both more often for little: at 0.3 %, three of the
-/// four cold starts of the robot's 40-point `cat.length` sweep (0.20 to
-/// 0.29 % apart), with the same answers; at 0.5 %, the box robot's too
-/// (0.41 % apart, ranked right). A start ranked wrongly costs at most the
+/// fine mesh can reorder starts that close. Wider, it finishes both more
+/// often for little (measured: docs/benchmarks.md, "Design settings: the
+/// measurements behind them"). A start ranked wrongly costs at most the
 /// gap, not the answer: a failed or unverified one has the others finished.
 const START_TIE: f64 = 2e-3;
 

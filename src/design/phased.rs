@@ -72,11 +72,12 @@ impl BendDesign {
 }
 
 /// The same for the free-form design's phased seed ([`seed_plan`]): the
-/// free-form design corrects the attitude itself. 1e-8 cut the robot's
-/// seed under its stall torque alone (issue 11's bench case) by a third of
-/// its instructions (`universal` joint, whose twist is root-found at every
-/// bend the search tries). A config with a motor envelope is seeded by the
-/// envelope design, which keeps 1e-11.
+/// free-form design corrects the attitude itself, so the seed's twist
+/// (`universal` joint, root-found at every bend the search tries) need not
+/// be found as tightly, which makes the seed cheaper (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them"). A
+/// config with a motor envelope is seeded by the envelope design, which
+/// keeps 1e-11.
 const SEED_TWIST_TOL: f64 = 1e-8;
 
 /// Designs the phases at one bend.
@@ -303,18 +304,11 @@ pub fn optimize_near(
 
 /// Grid intervals per phase of the free-form design's phased seed: the free-form
 /// design resamples the plan on its own mesh and optimises every node, so
-/// the seed needs the shape of the schedule, not its certified peak. 20
-/// instead of 40 cut the seed's time by half on the seed config and 40 %
-/// on the domestic cat, with the same SCP iterations within one or two and
-/// the same free-form peaks to 0.1 % (issue 11). 15 instead of 20: over
-/// the phased seeds' peak designs of the seed, the robot (stall torque)
-/// and the domestic cat (without its speed limit), in both norms where
-/// the robot is one, 15.1 G instructions instead of 17.3 G, seeding
-/// included, the same peaks to 0.03 % (the domestic cat's per-motor one
-/// 1.5112 instead of 1.5125 N m). The SCP's iteration count moves with
-/// the seed's small differences (the robot's 9 at 15 intervals, 14 at
-/// 20): 14 and 16 took 15.0 G and 14.9 G but raised a peak (14: the domestic
-/// cat's per-motor one by 1.1 %; 16: the seed's per-motor one by 0.23 %).
+/// the seed needs the shape of the schedule, not its certified peak. Fewer
+/// intervals make the seed cheaper, down to 15 with the same free-form
+/// peaks. The SCP's iteration count moves with the seed's small
+/// differences, and 14 and 16 raised a peak (measured: docs/benchmarks.md,
+/// "Design settings: the measurements behind them").
 pub const SEED_NODES: usize = 15;
 
 /// Bend tolerance of the free-form design's phased seed, deg (the free-form

@@ -1852,7 +1852,7 @@ impl<'a> Scp<'a> {
     /// conic one fails or is disabled: it took the path to worse points.
     /// Returns the point kept and its merit.
     // the trial's three parts (point, values, merit) travel together; the
-    // SCP's own layout (issue 25 item 2) owns this signature
+    // SCP's own layout owns this signature
     #[allow(clippy::too_many_arguments)]
     fn correct(
         &self,

@@ -76,9 +76,8 @@ impl Simulator {
 }
 
 /// Fewest steps per schedule. A held torque misses the schedule's shape by
-/// `O(dt^2)` over the run: on the robot config the free-form design's
-/// feed-forward-only MuJoCo flip misses by 0.061 / 0.018 / 0.0027 deg at
-/// 0.5 / 0.25 / 0.125 ms, so short manoeuvres get a finer step.
+/// `O(dt^2)` over the run, so short manoeuvres get a finer step (measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 pub const MIN_STEPS: usize = 4000;
 
 /// `(dt, n)`: `n` equal steps, at least [`MIN_STEPS`], of at most `target`, covering `duration`.

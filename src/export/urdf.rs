@@ -8,10 +8,10 @@ use crate::model::Joint;
 /// Mass and inertia of the universal joint's `cross` link (massless in the
 /// model) as fractions of a half's mass and axial inertia: simulators refuse
 /// (MuJoCo) or replace with 1 kg (pyBullet) a moving link without mass. The
-/// effect is linear in the fraction: in MuJoCo on the robot config, 1e-6 of a
-/// half's mass and transverse inertia moved the flip by 2.6e-4 deg, 1e-4 by
-/// 2.6e-2 deg; at 1e-8 of mass and axial inertia the URDF and the cross-less
-/// MJCF flip within 1e-6 deg of each other (examples/replay_mujoco.py prints it).
+/// effect on the flip is linear in the fraction, so a fraction this small
+/// leaves the URDF and the cross-less MJCF flipping alike
+/// (examples/replay_mujoco.py prints the difference; measured:
+/// docs/benchmarks.md, "Design settings: the measurements behind them").
 pub const CROSS_FRACTION: f64 = 1e-8;
 
 /// Speed limit written for joints when the config has none, rad/s (URDF needs one).

@@ -433,9 +433,10 @@ pub struct ShapeTerms {
 
 impl ShapeTerms {
     /// Value and first derivatives (forward dynamics, path timing): one
-    /// pass of scalar duals per direction, three to five times faster than
-    /// one pass of num-dual's gradient type (`DualSVec64<2>`, whose
-    /// derivative is an optional nalgebra vector) and the same numbers.
+    /// pass of scalar duals per direction, faster than one pass of
+    /// num-dual's gradient type (`DualSVec64<2>`, whose derivative is an
+    /// optional nalgebra vector) and the same numbers (measured:
+    /// docs/benchmarks.md, "Design settings: the measurements behind them").
     pub fn first(cat: &Cat, q: [f64; 2]) -> Self {
         let pass = |k: usize| {
             let x = [0, 1].map(|i| Dual64::new(q[i], if i == k { 1.0 } else { 0.0 }));

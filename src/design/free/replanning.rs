@@ -1,4 +1,4 @@
-//! Replanning in flight (issue 27): the free-form design re-solved from a
+//! Replanning in flight: the free-form design re-solved from a
 //! state measured mid-flight over the time the fall still leaves, to the
 //! landing set, seeded by the rest of the plan being flown.
 //!
