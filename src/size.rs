@@ -822,6 +822,21 @@ impl SizeAnswer {
             } + &range,
         ]
     }
+
+    /// [`Self::sentences`] in the order the answer is read, on the terminal
+    /// and the page: the headline, the sentence after it, then the curve's
+    /// ends. The best gear ratio leads where it alone makes it (after "the
+    /// configured motor does not make it", a possible answer read as a
+    /// contradiction); otherwise the configured motor does.
+    pub fn lead(&self) -> [String; 3] {
+        let [ends, configured, gear]: [String; 3] =
+            self.sentences().try_into().expect("three sentences");
+        if self.gear.possible && !self.gear.configured_possible {
+            [gear, configured, ends]
+        } else {
+            [configured, gear, ends]
+        }
+    }
 }
 
 #[cfg(test)]

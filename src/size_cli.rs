@@ -95,7 +95,7 @@ fn print_table(a: &SizeAnswer) {
             p.scale
         );
     }
-    for s in a.sentences() {
+    for s in a.lead() {
         say!("  {s}");
     }
     say!("  {} designs in {:.1} s", a.designs, a.solve_time_s);

@@ -280,16 +280,9 @@ pub fn page(a: &SizeAnswer) -> String {
         .collect();
     // the answer's block, as `run`'s: green when the configured motor, or
     // the best gear ratio of it, makes the flip
-    let said = a.sentences();
+    let [first, second, ends] = a.lead();
     let g = &a.gear;
-    // (the best gear ratio leads where it alone makes it: a green block
-    // under "the configured motor does not make it" read as a contradiction)
-    let (first, second) = if g.possible && !g.configured_possible {
-        (&said[2], &said[1])
-    } else {
-        (&said[1], &said[2])
-    };
-    let lead = super::answer::block(g.configured_possible || g.possible, first, second, &said[0]);
+    let lead = super::answer::block(g.configured_possible || g.possible, &first, &second, &ends);
     let mut notes = Vec::new();
     notes.push(format!(
         "{} designs in {:.1} s. Each point is one least-time design scaled by time scaling (F3): a motor (T, w0) whose least time is t also fits (k^2 T, k w0) in t / k; see docs/usage.md.",

@@ -480,6 +480,22 @@ fn the_ends_are_named_as_designs_and_a_point_past_one_is_said() {
     let a = answer();
     let plain = a.sentences()[0].clone();
     assert!(plain.contains("local optima, not a proof"), "{plain}");
+    // read in the answer's order, on the terminal and the page: the best
+    // gear ratio first where it alone makes it, else the configured motor;
+    // the ends last
+    let said = a.sentences();
+    let order = |x: &SizeAnswer| -> Vec<usize> {
+        let said = x.sentences();
+        x.lead()
+            .iter()
+            .map(|l| said.iter().position(|s| s == l).unwrap())
+            .collect()
+    };
+    assert!(!a.gear.configured_possible && a.gear.possible, "{said:?}");
+    assert_eq!(order(a), [2, 1, 0]);
+    let mut configured = a.clone();
+    configured.gear.configured_possible = true;
+    assert_eq!(order(&configured), [1, 2, 0]);
     assert!(!plain.contains("the curve's point at"), "{plain}");
     let slowest = a.curve[0].no_load_speed_rad_s;
     let mut past = a.clone();
