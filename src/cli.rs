@@ -171,7 +171,7 @@ enum Command {
         common: Common,
         #[arg(long, value_enum, default_value = "phased")]
         mode: Mode,
-        /// Seed of the free-form optimiser (default: phased; where no phased schedule fits the motors in this fall, the least-height answer's shortest manoeuvre, as `run`; only with `--mode free`).
+        /// Seed of the free-form optimiser (default: phased; where no phased schedule fits the motors in this fall, and for the least time, the least-height answer's shortest manoeuvre, as `run`; only with `--mode free`).
         #[arg(long, value_enum)]
         seed: Option<SeedArg>,
         /// Print each iteration (bend evaluations, SCP iterations).

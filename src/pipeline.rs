@@ -601,23 +601,36 @@ pub fn free_start(spec: &DesignSpec, mut note: impl FnMut(&str)) -> Result<FreeS
         plan,
         name,
         least_height_m: None,
+        design: None,
     };
-    match Seed::Phased.plan(spec) {
-        Ok(plan) => return Ok(start(plan, Seed::Phased.name())),
-        Err(Error::BeyondMotors { .. }) => {}
-        Err(Error::Unreachable { reason }) => return Err(Error::SeedUnfit { reason }),
-        Err(e) => return Err(e),
+    let phased = || match Seed::Phased.plan(spec) {
+        Ok(plan) => Ok(Some(start(plan, Seed::Phased.name()))),
+        Err(Error::BeyondMotors { .. }) => Ok(None),
+        Err(Error::Unreachable { reason }) => Err(Error::SeedUnfit { reason }),
+        Err(e) => Err(e),
+    };
+    // the least time is the least-height stage's own question
+    let time = spec.objective == crate::design::objective::Objective::Time;
+    if time {
+        note(
+            "a least-time design: finding the least drop height first, as `catflip run` does (its shortest manoeuvre answers the same question)",
+        );
+    } else {
+        if let Some(s) = phased()? {
+            return Ok(s);
+        }
+        note(
+            "no phased schedule fits the motors in this fall: finding the least drop height first, as `catflip run` does",
+        );
     }
-    note(
-        "no phased schedule fits the motors in this fall: finding the least drop height first, as `catflip run` does",
-    );
     // (the least height failing leaves the analytic seed, as in `run`)
     if let Ok(Some(h)) = crate::design::least_height::heights(
         spec,
         crate::design::least_height::Families::Both,
         |_| {},
     ) {
-        if let Some(e) = out_of_reach(&h.answer) {
+        // (a least time answers "from what height", not "in this fall")
+        if let Some(e) = out_of_reach(&h.answer).filter(|_| !time) {
             return Err(e);
         }
         let a = &h.answer;
@@ -627,11 +640,16 @@ pub fn free_start(spec: &DesignSpec, mut note: impl FnMut(&str)) -> Result<FreeS
                 a.least_height_m, fr.manoeuvre_time_s
             ));
             return Ok(FreeStart {
-                plan: Box::new(fr.plan),
+                plan: Box::new(fr.plan.clone()),
                 name: FREE_LEAST_TIME,
                 least_height_m: a.possible.then_some(a.least_height_m),
+                design: time.then_some(fr),
             });
         }
+    }
+    if time && let Some(s) = phased()? {
+        note("the free-form design starts from the phased design");
+        return Ok(s);
     }
     note("the free-form design starts from the analytic schedule");
     Ok(start(Seed::Analytic.plan(spec)?, Seed::Analytic.name()))
@@ -647,6 +665,23 @@ pub struct FreeStart {
     /// design and the flip is possible in this fall ([`short_of_answer`]'s
     /// `least_height_m`).
     pub least_height_m: Option<f64>,
+    /// That design itself, for a least-time design: the same question, so
+    /// the design continues from it ([`FreeStart::design`]).
+    pub design: Option<crate::design::free::FreeResult>,
+}
+
+impl FreeStart {
+    /// The free-form design from this start: continued from the
+    /// least-height design itself where it answers the same question (on
+    /// its mesh, with its check points, penalty weight and trust radius),
+    /// else from the start's schedule.
+    pub fn free_design<'a>(&'a self, spec: &'a DesignSpec) -> crate::design::free::FreeDesign<'a> {
+        let d = crate::design::free::FreeDesign::new(spec);
+        match &self.design {
+            Some(fr) => d.warm(fr, None).named(self.name),
+            None => d.from_plan(self.plan.as_ref(), self.name),
+        }
+    }
 }
 
 /// The free-form design `optimize` and Python's `design` make, with its
@@ -661,13 +696,17 @@ pub fn free_design(
     observer: &mut dyn crate::design::free::Observer,
     where_: &str,
 ) -> Result<FreeResult> {
-    let design = crate::design::free::FreeDesign::new(spec).check_mesh();
     if let Some(seed) = seed {
-        return design.seed(seed).observe(observer).solve();
+        return crate::design::free::FreeDesign::new(spec)
+            .check_mesh()
+            .seed(seed)
+            .observe(observer)
+            .solve();
     }
     let start = free_start(spec, note)?;
-    let r = design
-        .from_plan(start.plan.as_ref(), start.name)
+    let r = start
+        .free_design(spec)
+        .check_mesh()
         .observe(observer)
         .solve();
     short_of_answer(spec, start.least_height_m, r, where_)

@@ -351,9 +351,7 @@ impl Origin {
         at_rest.start = Default::default();
         let spec = at_rest.design_spec();
         let start = crate::pipeline::free_start(&spec, |_| {})?;
-        let design = FreeDesign::new(&spec)
-            .from_plan(start.plan.as_ref(), start.name)
-            .solve();
+        let design = start.free_design(&spec).solve();
         let design = crate::pipeline::short_of_answer(
             &spec,
             start.least_height_m,

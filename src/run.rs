@@ -430,7 +430,9 @@ impl Methods {
 
     /// The free-form step: seeded by the phased design, or by the free-form
     /// least-time design when no phased one fits, or by the analytic plan
-    /// when that failed; not attempted when no schedule found fits.
+    /// when that failed; not attempted when no schedule found fits. A
+    /// least-time design continues from the least-height stage's shortest
+    /// one, which answers the same question.
     fn free<F: FnMut(Progress)>(
         &mut self,
         spec: &DesignSpec,
@@ -438,7 +440,11 @@ impl Methods {
         stages: &mut Stages<F>,
     ) {
         let clock = stages.begin(
-            "free-form optimiser (collocation + SCP, seeded by the phased design, else by the least-height design, else by the analytic schedule)",
+            if spec.objective == crate::design::objective::Objective::Time {
+                "free-form optimiser (collocation + SCP, continued from the least-height design, else seeded by the phased design, else by the analytic schedule)"
+            } else {
+                "free-form optimiser (collocation + SCP, seeded by the phased design, else by the least-height design, else by the analytic schedule)"
+            },
         );
         if let Some(reason) = q.free_impossible() {
             (stages.progress)(Progress::StageSkipped { reason: &reason });
@@ -446,8 +452,13 @@ impl Methods {
             return;
         }
         let analytic_seed;
+        let time = spec.objective == crate::design::objective::Objective::Time;
         let (seed_plan, seed_name): (&dyn ShapePlan, &str) =
             match (self.design(Method::Phased), &q.fastest_free) {
+                // the least time: the least-height stage's shortest design
+                // answers the same question (a time design has no budget,
+                // so the reference drop it was made for does not bind)
+                (_, Some(fr)) if time => (&fr.plan, crate::pipeline::FREE_LEAST_TIME),
                 (Some(ph), _) => (ph.plan(), "phased"),
                 (None, Some(fr)) => (&fr.plan, crate::pipeline::FREE_LEAST_TIME),
                 (None, None) => {
@@ -456,8 +467,16 @@ impl Methods {
                 }
             };
         let progress = &mut stages.progress;
-        let free = crate::design::free::FreeDesign::new(spec)
-            .from_plan(seed_plan, seed_name)
+        let design = crate::design::free::FreeDesign::new(spec);
+        let design = match &q.fastest_free {
+            // continued from that design itself, on its mesh, with what it
+            // carries (its check points, weight and radius)
+            Some(fr) if seed_name == crate::pipeline::FREE_LEAST_TIME && time => {
+                design.warm(fr, None).named(seed_name)
+            }
+            _ => design.from_plan(seed_plan, seed_name),
+        };
+        let free = design
             .on_iteration(&mut |it| progress(Progress::Scp(it)))
             .solve();
         // from the least-height design, in a fall the answer says it does:

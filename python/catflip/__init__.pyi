@@ -171,8 +171,9 @@ def design(config: Config, method: Method = "free", objective: Optional[Objectiv
     (``analyze`` for ``method="analytic"``), with the GIL released.
 
     ``objective`` overrides ``design.objective``; ``seed`` (``"phased"``, ``"analytic"``;
-    None: the phased design, or where no phased one fits the motors in this fall the
-    least-height answer's shortest manoeuvre, as ``run`` and ``optimize``) applies to
+    None: the phased design, or where no phased one fits the motors in this fall, and
+    always for the ``"time"`` objective, the least-height answer's shortest manoeuvre, as
+    ``run`` and ``optimize``) applies to
     ``method="free"`` only. Raises ConfigError, ImpossibleError
     (the motors cannot flip the cat from ``fall.height``) or DesignError (also a named phased
     seed that does not fit), with the CLI's messages."""

@@ -799,8 +799,8 @@ fn run_design(
 ///
 /// `objective` (`"peak-torque"`, `"time"`, `"energy"`) overrides `design.objective`;
 /// `seed` (`"phased"`, `"analytic"`; None: the phased design, or where no phased one fits
-/// the motors in this fall the least-height answer's shortest manoeuvre, as `run` and
-/// `optimize`) applies to `method="free"` only.
+/// the motors in this fall, and always for the `"time"` objective, the least-height
+/// answer's shortest manoeuvre, as `run` and `optimize`) applies to `method="free"` only.
 /// Raises ConfigError, ImpossibleError (the motors cannot flip the cat from
 /// `fall.height`) or DesignError, with the CLI's messages.
 #[pyfunction]

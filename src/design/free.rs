@@ -2435,6 +2435,8 @@ pub enum Start<'a> {
 pub struct FreeDesign<'a> {
     spec: &'a DesignSpec,
     start: Start<'a>,
+    /// The start's name in the result, where the caller names it.
+    named: Option<&'a str>,
     nodes: usize,
     mesh_check: bool,
     observer: Option<&'a mut dyn Observer>,
@@ -2445,6 +2447,7 @@ impl<'a> FreeDesign<'a> {
         FreeDesign {
             spec,
             start: Start::Seed(Seed::Phased),
+            named: None,
             nodes: spec.free.nodes,
             mesh_check: false,
             observer: None,
@@ -2467,6 +2470,13 @@ impl<'a> FreeDesign<'a> {
     /// (continuation; the mesh is always `free.nodes`).
     pub fn warm(mut self, prev: &'a FreeResult, before: Option<&'a FreeResult>) -> Self {
         self.start = Start::Warm(prev, before);
+        self
+    }
+
+    /// The start's name in the result (`continuation` from
+    /// [`FreeDesign::warm`], the seed's or the plan's name otherwise).
+    pub fn named(mut self, name: &'a str) -> Self {
+        self.named = Some(name);
         self
     }
 
@@ -2539,6 +2549,9 @@ impl<'a> FreeDesign<'a> {
                 continue_from(spec, prev, before, |it| observe.iteration(it))?
             }
         };
+        if let Some(name) = self.named {
+            r.seed = name.to_string();
+        }
         if self.mesh_check {
             r.mesh_check = Some(mesh_check(spec, &r)?);
         }
