@@ -516,11 +516,12 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
 
 fn cmd_optimize(c: &Common, optimizer: Optimizer, verbose: bool) -> Result<Status> {
     let cfg = load(c)?;
-    // each named seed its own set: a design from `--seed analytic` does not
-    // replace the one without `--seed` (`pipeline::free_start`'s)
+    // each named seed its own set: a design from `--seed` does not replace
+    // the one without (`pipeline::free_start`'s, which may start elsewhere)
     let set = match optimizer {
         Optimizer::Phased => "optimize-phased",
-        Optimizer::Free(None | Some(catflip::design::free::Seed::Phased)) => "optimize-free",
+        Optimizer::Free(None) => "optimize-free",
+        Optimizer::Free(Some(catflip::design::free::Seed::Phased)) => "optimize-free-phased",
         Optimizer::Free(Some(catflip::design::free::Seed::Analytic)) => "optimize-free-analytic",
     };
     let publisher = publisher(c, &cfg, set)?;

@@ -609,8 +609,10 @@ pub fn free_start(spec: &DesignSpec, mut note: impl FnMut(&str)) -> Result<FreeS
         Err(Error::Unreachable { reason }) => Err(Error::SeedUnfit { reason }),
         Err(e) => Err(e),
     };
-    // the least time is the least-height stage's own question
-    let time = spec.objective == crate::design::objective::Objective::Time;
+    // the least time is the least-height stage's own question (asked, as
+    // in `run`, where the motors are limited)
+    let time =
+        spec.objective == crate::design::objective::Objective::Time && spec.motor.is_limited();
     if time {
         note(
             "a least-time design: finding the least drop height first, as `catflip run` does (its shortest manoeuvre answers the same question)",

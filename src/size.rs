@@ -777,7 +777,7 @@ impl SizeAnswer {
             if g.evaluations.len() > 1 {
                 let [lo, hi] = g.bracket;
                 format!(
-                    "Its best gear ratio is N = {:.4}{} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m ({}). The search ended between N = {:.4} and {:.4}{}.",
+                    "The configured motor's best gear ratio is N = {:.4}{} (torque x N, speed / N: {:.4} N m, {:.3} rad/s): {:.3} m ({:.4} s of manoeuvre), so it {} from {} m ({}). The search ended between N = {:.4} and {:.4}{}.",
                     g.best_ratio,
                     // (N < 1: the speed is what the flip lacks)
                     if g.best_ratio < 1.0 {

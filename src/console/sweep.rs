@@ -34,13 +34,15 @@ pub fn points(
     )];
     let show = |x: Option<f64>| x.map(|v| format!("{v:.5}")).unwrap_or_else(|| "-".into());
     let columns = columns(points);
-    let mut head = format!("  {:>12}", spec.key);
+    // the key's column as wide as the key
+    let kw = spec.key.len().max(12);
+    let mut head = format!("  {:>kw$}", spec.key);
     for c in &columns {
         head += &format!(" {:>w$}", c.console, w = c.console.len().max(12));
     }
     lines.push(head);
     for p in points {
-        let mut line = format!("  {:>12.5}", p.value);
+        let mut line = format!("  {:>kw$.5}", p.value);
         for c in &columns {
             line += &format!(" {:>w$}", show((c.get)(p)), w = c.console.len().max(12));
         }

@@ -22,9 +22,10 @@ pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
 pub const CONTROLLERS: [&str; 3] = ["open-loop", "tvlqr", "replan"];
 
 /// The design a study flies: the free-form one from the phased seed, as
-/// `run` makes it, or from the analytic seed where the phased family cannot fit
-/// (not from the least-height answer's manoeuvre, as `optimize` and `run`
-/// start there: the replans from it left the motor envelope and were
+/// `run` makes a peak or energy design, or from the analytic seed where the
+/// phased family cannot fit (not from the least-height answer's manoeuvre,
+/// where `optimize` and `run` start a least time or a fall no phased
+/// design fits: the replans from it left the motor envelope and were
 /// corrected; measured: docs/benchmarks.md, "Design settings: the
 /// measurements behind them"),
 /// with a continuous torque (`free.torque_jumps` off): the replans are

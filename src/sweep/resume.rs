@@ -275,7 +275,7 @@ impl SweepState {
                 .to_string()
         };
         let mut notes = vec![format!(
-            "{}{} of {key} ({}, shard {}), methods {}: {what}. A row's error names what failed there. sweep-{file_key}.csv has every number; docs/outputs.md the columns.",
+            "{}{} of {key} ({}, shard {}), methods {}: {what}. sweep-{file_key}.csv has every number; docs/outputs.md the columns.",
             if self.status == SweepStatus::Partial {
                 "Partial sweep: "
             } else {
@@ -291,7 +291,10 @@ impl SweepState {
             self.methods.join(", "),
         )];
         if points.iter().any(|p| p.error.is_some()) {
-            notes.push("A point whose method failed keeps the other methods' numbers.".into());
+            notes.push(
+                "A row's error names what failed there; a point whose method failed keeps the other methods' numbers."
+                    .into(),
+            );
         }
         // a shard of a job array wider than the grid: nothing failed here
         let warnings: Vec<String> = self

@@ -373,6 +373,18 @@ fn optimize_free_reports_iterations_and_nodes() {
             .exists()
     );
     assert!(!dir.path().join("output/seed/optimize-free").exists());
+    // so has the phased seed's named: without --seed the design may start
+    // elsewhere (the least time from the least-height answer)
+    let mut phased = free_from_analytic(cfg.to_str().unwrap(), &[]);
+    *phased.last_mut().unwrap() = "phased";
+    let v = run_json(&phased, dir.path());
+    assert_eq!(v["seed"], "phased");
+    assert!(
+        dir.path()
+            .join("output/seed/optimize-free-phased/free.csv")
+            .exists()
+    );
+    assert!(!dir.path().join("output/seed/optimize-free").exists());
 }
 
 #[test]

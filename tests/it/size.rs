@@ -457,7 +457,7 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
         .unwrap()
         .clone();
     assert!(
-        !html.contains("Its best gear ratio"),
+        !html.contains("best gear ratio is"),
         "no search, no best ratio"
     );
     assert!(
@@ -555,7 +555,7 @@ fn the_page_leads_with_what_makes_it() {
         .unwrap();
     assert!(page.contains("<section id=\"answer\" class=\"possible\">"));
     assert!(
-        headline.starts_with("Its best gear ratio is N = "),
+        headline.starts_with("The configured motor's best gear ratio is N = "),
         "{headline}"
     );
     assert!(
