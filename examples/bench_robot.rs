@@ -14,7 +14,8 @@
 //!   other in one thread, each timed (wall/CPU s);
 //! - `free:CONFIG:OBJECTIVE:SEED`: the free-form design inside the motor
 //!   envelope from 6 m (`peak-torque`, `time`, `energy`; `phased`,
-//!   `analytic`), the seeding design not counted;
+//!   `analytic`, the seeding design not counted; or `default`, the start
+//!   `optimize --mode free` takes without `--seed`, counted);
 //! - `sweep:CONFIG:KEY:FROM:TO:COUNT`: `catflip sweep CONFIG --set-range
 //!   KEY=FROM:TO:COUNT --threads 2` with every method (files not written),
 //!   e.g. `sweep:robot-universal:cat.length:0.18:0.24:40`.
@@ -142,6 +143,27 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
                 ],
                 extra,
             )?;
+            if *seed == "default" {
+                // what `optimize --mode free` does without `--seed`: its start
+                // (for the least time, the least-height stage) counted
+                let spec = cfg.design_spec();
+                let (t, c) = (Instant::now(), cpu_s());
+                let start = catflip::pipeline::free_start(&spec, |_| {})?;
+                let r = start.free_design(&spec).solve()?;
+                return Ok((
+                    format!(
+                        "{:.6} ({}), from {}, {} SCP iterations ({}), {}",
+                        r.objective_value,
+                        cfg.design.objective.name(),
+                        r.seed,
+                        r.scp_iterations,
+                        catflip::design::free::iterations_text(&r.mesh_levels),
+                        catflip::verdict::Status::from(r.status),
+                    ),
+                    t.elapsed().as_secs_f64(),
+                    cpu_s() - c,
+                ));
+            }
             let seed = match *seed {
                 "phased" => Seed::Phased,
                 "analytic" => Seed::Analytic,
