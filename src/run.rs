@@ -234,7 +234,12 @@ pub fn run(cfg: &Config, progress: impl FnMut(Progress)) -> Result<RunResult> {
     } else {
         Question::default()
     };
-    done.phased(&spec, question.phased_impossible(&spec), &mut stages);
+    done.phased(
+        &spec,
+        question.phased_impossible(&spec),
+        question.phased_hint(&spec),
+        &mut stages,
+    );
     done.free(&spec, &question, &mut stages);
     question.settle(&spec, &mut done);
     if done.lines.iter().all(|m| m.verdict == Grade::Failed) {
@@ -261,6 +266,8 @@ struct Question {
     answer: Option<HeightAnswer>,
     fastest_free: Option<crate::design::free::FreeResult>,
     phased_short: Option<(f64, bool)>,
+    /// The bend of the stage's phased time design, rad.
+    phased_bend: Option<f64>,
     seconds: f64,
     notes: Vec<String>,
 }
@@ -286,6 +293,7 @@ impl Question {
                 q.phased_short = (!crate::design::least_height::fits(spec, h.phased_m))
                     .then_some((h.phased_m, h.phased_verified));
                 q.fastest_free = h.free;
+                q.phased_bend = Some(h.phased_bend);
                 // its schedule becomes the least-height method (`settle`)
                 q.answer = Some(h.answer);
             }
@@ -298,6 +306,16 @@ impl Question {
     }
 
     /// Why the phased design is not attempted, if no phased schedule fits.
+    /// Where the phased least-time design's bend search starts: at the
+    /// least-height stage's phased time design, which answers the same
+    /// question (no other objective's).
+    fn phased_hint(&self, spec: &DesignSpec) -> Option<crate::design::phased::BendHint> {
+        let time = spec.objective == crate::design::objective::Objective::Time;
+        self.phased_bend
+            .filter(|b| time && b.is_finite())
+            .and_then(|b| crate::design::phased::BendHint::from_chain(&[b]))
+    }
+
     fn phased_impossible(&self, spec: &DesignSpec) -> Option<String> {
         if let Some(a) = self.answer.as_ref().filter(|a| a.beyond_longest_fall) {
             return Some(crate::pipeline::beyond_reach(a));
@@ -416,6 +434,7 @@ impl Methods {
         &mut self,
         spec: &DesignSpec,
         impossible: Option<String>,
+        hint: Option<crate::design::phased::BendHint>,
         stages: &mut Stages<F>,
     ) {
         let clock = stages.begin("phased optimiser (path-timing SOCPs, bend search)");
@@ -426,7 +445,7 @@ impl Methods {
         }
         let mut evaluations = 0;
         let progress = &mut stages.progress;
-        let phased = crate::design::phased::optimize(spec, |e| {
+        let phased = crate::design::phased::optimize_near(spec, hint, |e| {
             evaluations += 1;
             progress(Progress::Bend {
                 evaluations,

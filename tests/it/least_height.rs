@@ -285,7 +285,8 @@ fn the_start_just_above_the_least_height_carries_that_height() {
 /// from the stage's shortest design, in a few iterations, to the same
 /// design, no slower than the stage's, and `run`'s answer is that design
 /// (one least time). From the phased seed the robot's design from 6 m took
-/// 95 iterations to a least time 0.09 % longer.
+/// 95 iterations to a least time 0.09 % longer. The phased row is the
+/// stage's phased time design found again from its bend.
 #[test]
 fn a_least_time_design_continues_from_the_least_height_answer() {
     let dir = crate::util::temp_dir();
@@ -336,6 +337,16 @@ fn a_least_time_design_continues_from_the_least_height_answer() {
         (t - free).abs() <= 1e-12 * free,
         "optimize {t} s, run {free} s"
     );
+    // the phased row's bend search starts at the stage's phased time design
+    // (a local bracket, not the scan): the design `optimize` finds with the
+    // whole scan, to the bit
+    args[3] = "phased";
+    let (code, out, err) = crate::util::run(&args, dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let ph = crate::util::method_line(&s, "phased");
+    assert_eq!(ph["bend_deg"], v["bend_deg"], "{ph} {v}");
+    assert_eq!(manoeuvre("phased"), v["manoeuvre_time_s"].as_f64().unwrap());
 }
 
 /// A least-time design continued at a neighbour with another reference
