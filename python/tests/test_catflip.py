@@ -632,3 +632,16 @@ def test_size_refuses_what_the_cli_refuses(config, height, points, gear_evaluati
         said = said.replace(flag, arg)
     assert message(e) == said
     assert not any(tmp_path.iterdir())
+
+
+def test_a_least_time_design_continues_from_the_least_height_answer():
+    # the least time is the least-height stage's own question: the design starts from that
+    # answer's shortest manoeuvre (not the phased design) and ends no slower than it
+    cfg = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml", ["fall.height=6"])
+    d = catflip.design(cfg, "free", objective="time")
+    assert d.to_dict()["seed"] == "free least-time"
+    answer = catflip.least_height(cfg)
+    assert answer is not None and answer.possible
+    assert d.duration <= answer.least_time_s * (1 + 1e-9)
+    # a named seed still starts there
+    assert catflip.design(cfg, "free", objective="time", seed="phased").to_dict()["seed"] == "phased"
