@@ -668,7 +668,7 @@ pub struct FreeStart {
     /// `least_height_m`).
     pub least_height_m: Option<f64>,
     /// That design itself, for a least-time design: the same question, so
-    /// the design continues from it ([`FreeStart::design`]).
+    /// the design continues from it ([`FreeStart::free_design`]).
     pub design: Option<crate::design::free::FreeResult>,
 }
 
