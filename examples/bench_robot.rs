@@ -143,42 +143,32 @@ fn once(case: &str, extra: &[String]) -> anyhow::Result<(String, f64, f64)> {
                 ],
                 extra,
             )?;
-            if *seed == "default" {
-                // what `optimize --mode free` does without `--seed`: its start
-                // (for the least time, the least-height stage) counted
-                let spec = cfg.design_spec();
-                let (t, c) = (Instant::now(), cpu_s());
-                let start = catflip::pipeline::free_start(&spec, |_| {})?;
-                let r = start.free_design(&spec).solve()?;
-                return Ok((
-                    format!(
-                        "{:.6} ({}), from {}, {} SCP iterations ({}), {}",
-                        r.objective_value,
-                        cfg.design.objective.name(),
-                        r.seed,
-                        r.scp_iterations,
-                        catflip::design::free::iterations_text(&r.mesh_levels),
-                        catflip::verdict::Status::from(r.status),
-                    ),
-                    t.elapsed().as_secs_f64(),
-                    cpu_s() - c,
-                ));
-            }
+            let spec = cfg.design_spec();
+            // `default`: what `optimize --mode free` does without `--seed`,
+            // its start (for the least time, the least-height stage) counted;
+            // a named seed's making is not
             let seed = match *seed {
-                "phased" => Seed::Phased,
-                "analytic" => Seed::Analytic,
+                "default" => None,
+                "phased" => Some(Seed::Phased),
+                "analytic" => Some(Seed::Analytic),
                 s => anyhow::bail!("unknown seed {s}"),
             };
-            let plan = seed.plan(&cfg.design_spec())?;
+            let plan = seed.map(|s| s.plan(&spec)).transpose()?;
             let (t, c) = (Instant::now(), cpu_s());
-            let r = FreeDesign::new(&cfg.design_spec())
-                .from_plan(plan.as_ref(), seed.name())
-                .solve()?;
+            let r = match (seed, &plan) {
+                (Some(seed), Some(plan)) => FreeDesign::new(&spec)
+                    .from_plan(plan.as_ref(), seed.name())
+                    .solve()?,
+                _ => catflip::pipeline::free_start(&spec, |_| {})?
+                    .free_design(&spec)
+                    .solve()?,
+            };
             return Ok((
                 format!(
-                    "{:.6} ({}), {} SCP iterations ({}), {}, SCP and envelope {:.3} s wall",
+                    "{:.6} ({}), from {}, {} SCP iterations ({}), {}, SCP and envelope {:.3} s wall",
                     r.objective_value,
                     cfg.design.objective.name(),
+                    r.seed,
                     r.scp_iterations,
                     catflip::design::free::iterations_text(&r.mesh_levels),
                     catflip::verdict::Status::from(r.status),

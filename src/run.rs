@@ -485,29 +485,22 @@ impl Methods {
         }
         let analytic_seed;
         let time = spec.objective == crate::design::objective::Objective::Time;
-        let (seed_plan, seed_name): (&dyn ShapePlan, &str) =
-            match (self.design(Method::Phased), &q.fastest_free) {
-                // the least time: the least-height stage's shortest design
-                // answers the same question (a time design has no budget,
-                // so the reference drop it was made for does not bind)
-                (_, Some(fr)) if time => (&fr.plan, crate::pipeline::FREE_LEAST_TIME),
-                (Some(ph), _) => (ph.plan(), "phased"),
-                (None, Some(fr)) => (&fr.plan, crate::pipeline::FREE_LEAST_TIME),
-                (None, None) => {
-                    analytic_seed = crate::design::analytic::analytic_plan(spec);
-                    (&analytic_seed, "analytic")
-                }
-            };
-        let progress = &mut stages.progress;
+        let least_time = crate::pipeline::FREE_LEAST_TIME;
         let design = crate::design::free::FreeDesign::new(spec);
-        let design = match &q.fastest_free {
-            // continued from that design itself, on its mesh, with what it
-            // carries (its check points, weight and radius)
-            Some(fr) if seed_name == crate::pipeline::FREE_LEAST_TIME && time => {
-                design.warm(fr, None).named(seed_name)
+        let (design, seed_name) = match (self.design(Method::Phased), &q.fastest_free) {
+            // the least time: the least-height stage's shortest design answers
+            // the same question (a time design has no budget, so the reference
+            // drop it was made for does not bind); continued from that design
+            // itself, on its mesh, with its check points, weight and radius
+            (_, Some(fr)) if time => (design.warm(fr, None).named(least_time), least_time),
+            (Some(ph), _) => (design.from_plan(ph.plan(), "phased"), "phased"),
+            (None, Some(fr)) => (design.from_plan(&fr.plan, least_time), least_time),
+            (None, None) => {
+                analytic_seed = crate::design::analytic::analytic_plan(spec);
+                (design.from_plan(&analytic_seed, "analytic"), "analytic")
             }
-            _ => design.from_plan(seed_plan, seed_name),
         };
+        let progress = &mut stages.progress;
         let free = design
             .on_iteration(&mut |it| progress(Progress::Scp(it)))
             .solve();

@@ -62,6 +62,8 @@ pub fn points(
 pub struct Column {
     pub console: &'static str,
     pub page: &'static str,
+    /// Decimals on the page (the terminal shows five).
+    pub digits: usize,
     pub get: fn(&SweepPoint) -> Option<f64>,
 }
 
@@ -74,26 +76,31 @@ pub fn columns(points: &[SweepPoint]) -> Vec<Column> {
         Column {
             console: "analytic N m",
             page: "analytic peak N m",
+            digits: 5,
             get: |p| p.analytic_peak_nm,
         },
         Column {
             console: "phased N m",
             page: "phased peak N m",
+            digits: 5,
             get: |p| p.phased_peak_nm,
         },
         Column {
             console: "free N m",
             page: "free peak N m",
+            digits: 5,
             get: |p| p.free_peak_nm,
         },
         Column {
             console: "phased h_min m",
             page: "least height, phased, m",
+            digits: 3,
             get: |p| p.least_height_phased_m,
         },
         Column {
             console: "free h_min m",
             page: "least height, free, m",
+            digits: 3,
             get: |p| p.least_height_free_m,
         },
     ];

@@ -232,12 +232,7 @@ impl SweepState {
             .map(|p| {
                 let mut row = vec![format!("{}", p.value)];
                 for c in &columns {
-                    let digits = if c.page.starts_with("least height") {
-                        3
-                    } else {
-                        5
-                    };
-                    row.push(cell((c.get)(p), digits));
+                    row.push(cell((c.get)(p), c.digits));
                 }
                 if status {
                     row.push(
