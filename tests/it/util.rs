@@ -220,13 +220,28 @@ pub fn number_after(text: &str, phrase: &str) -> f64 {
 }
 
 /// The least-height stage's answer for `cfg` (both design families), as
-/// `run` makes it; `cfg` must limit its motors.
+/// `run` makes it; `cfg` must limit its motors. Made once per design
+/// problem in the test run (the stage is deterministic: several tests ask
+/// it of the same robot, about 2 s of CPU each time).
 pub fn least(cfg: &Config) -> catflip::design::least_height::Heights {
-    catflip::design::least_height::heights(
-        &cfg.design_spec(),
-        catflip::design::least_height::Families::Both,
-        |_| {},
-    )
-    .unwrap()
-    .expect("a config with motor limits")
+    use catflip::design::least_height::{Families, Heights, heights};
+    use std::collections::HashMap;
+    use std::sync::{Arc, Mutex, OnceLock};
+    type Slot = Arc<OnceLock<Heights>>;
+    static MADE: OnceLock<Mutex<HashMap<String, Slot>>> = OnceLock::new();
+    let spec = cfg.design_spec();
+    // (the spec's every field is in its debug text: equal texts, equal problems)
+    let slot: Slot = MADE
+        .get_or_init(Default::default)
+        .lock()
+        .unwrap()
+        .entry(format!("{spec:?}"))
+        .or_default()
+        .clone();
+    slot.get_or_init(|| {
+        heights(&spec, Families::Both, |_| {})
+            .unwrap()
+            .expect("a config with motor limits")
+    })
+    .clone()
 }
