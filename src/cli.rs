@@ -599,8 +599,8 @@ fn cmd_run(c: &Common) -> Result<Status> {
         say!("{}", serde_json::to_string_pretty(&r.summary)?);
         return Ok(outcome.into());
     }
-    // the sizing advice names this config and its `--set`s
-    let sizing = format!("{} --height", c.command("size"));
+    // the sizing advice names this config and the `--set`s `size` takes
+    let sizing = crate::size_cli::advised(c);
     say_lines(
         console::run::summary(&r.summary, &dir.join("index.html"), written.len())
             .into_iter()

@@ -5,13 +5,24 @@ use anyhow::Result;
 use catflip::output::Output;
 use catflip::size::{SizeAnswer, SizeSettings, files};
 
+/// Keys `catflip size` sets itself, so a `--set` of them is refused:
+/// `--height` replaces `fall.height` (the configured drop is not used, and
+/// the margin is judged against this one), and it designs least-time
+/// schedules (another objective would be ignored, yet name the set).
+const SETS_ITSELF: [(&str, &str); 2] = [
+    ("fall.height", "--height"),
+    ("design.objective", "`catflip size`"),
+];
+
 pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Result<Status> {
-    // `--height` replaces `fall.height` before the config is checked: the
-    // configured drop is not used, and the margin is judged against this one
-    crate::cli::refuse_set_of(c, "fall.height", &format!("--height {height}"))?;
-    // (it designs least-time schedules: another objective would be ignored,
-    // yet name the set)
-    crate::cli::refuse_set_of(c, "design.objective", "`catflip size`")?;
+    for (key, by) in SETS_ITSELF {
+        let by = if by == "--height" {
+            format!("--height {height}")
+        } else {
+            by.to_string()
+        };
+        crate::cli::refuse_set_of(c, key, &by)?;
+    }
     let with_height = Common {
         set: [c.set.clone(), vec![format!("fall.height={height}")]].concat(),
         ..c.clone()
@@ -99,4 +110,82 @@ fn print_table(a: &SizeAnswer) {
         say!("  {s}");
     }
     say!("  {} designs in {:.1} s", a.designs, a.solve_time_s);
+}
+
+/// The `catflip size` command line that asks `run`'s question backwards
+/// (up to its `--height`), as a message advises it: the config and its
+/// `--set`s, without those `size` refuses (the keys it sets itself, a
+/// spin), and at rest where the config's release spins (`size` sizes the
+/// motors for a release at rest: time scaling, F9).
+pub(crate) fn advised(c: &Common) -> String {
+    let refused = |s: &String| {
+        let key = crate::common::set_key(s);
+        SETS_ITSELF.iter().any(|(k, _)| *k == key) || key == "start.angular_velocity"
+    };
+    let mut kept = Common {
+        set: c.set.iter().filter(|s| !refused(s)).cloned().collect(),
+        ..c.clone()
+    };
+    // (the spin may be the config file's own, which a dropped `--set` held
+    // at rest)
+    if load(&kept).is_ok_and(|cfg| cfg.design_spec().has_momentum()) {
+        kept.set.push("start.angular_velocity=[0, 0, 0]".into());
+    }
+    format!("{} --height", kept.command("size"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::PathBuf;
+
+    /// The advice leaves out what `size` refuses and sizes a spinning
+    /// release at rest, whether the spin was a `--set` or the file's own.
+    #[test]
+    fn the_advised_size_command_holds_only_what_size_takes() {
+        let dir = tempfile::tempdir().unwrap();
+        let robot = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("configs/robot-universal.toml");
+        let spinning = dir.path().join("spinning.toml");
+        let text = std::fs::read_to_string(&robot).unwrap();
+        // (the robot's own `[start]` table, or a new one)
+        let text = if text.contains("[start]") {
+            text.replace("[start]", "[start]\nangular_velocity = [0.0, 0.0, 0.5]")
+        } else {
+            format!("{text}\n[start]\nangular_velocity = [0.0, 0.0, 0.5]\n")
+        };
+        std::fs::write(&spinning, text).unwrap();
+        let common = |config: &PathBuf, set: &[&str]| Common {
+            config: config.clone(),
+            set: set.iter().map(|s| s.to_string()).collect(),
+            json: false,
+            out: PathBuf::from("output"),
+        };
+        let advised_for = |c: &Common| advised(c);
+        let sets = [
+            "fall.height=1",
+            "design.objective=time",
+            "cat.mass=0.46",
+            "start.angular_velocity=[0, 0, 1]",
+        ];
+        let at = |path: &PathBuf| path.display().to_string();
+        assert_eq!(
+            advised_for(&common(&robot, &sets)),
+            format!("catflip size {} --set cat.mass=0.46 --height", at(&robot))
+        );
+        assert_eq!(
+            advised_for(&common(&spinning, &sets)),
+            format!(
+                "catflip size {} --set cat.mass=0.46 --set 'start.angular_velocity=[0, 0, 0]' --height",
+                at(&spinning)
+            )
+        );
+        // the file's spin held at rest by the user: at rest still
+        assert_eq!(
+            advised_for(&common(&spinning, &["start.angular_velocity=[0,0,0]"])),
+            format!(
+                "catflip size {} --set 'start.angular_velocity=[0, 0, 0]' --height",
+                at(&spinning)
+            )
+        );
+    }
 }

@@ -180,7 +180,7 @@ fn bad_input_gives_a_clear_error_nonzero_exit_and_no_output() {
             "bad split",
             seed.clone(),
             vec!["--set", "analytic.split=[0.2, 0.2, 0.2]"],
-            "analytic.split",
+            "`analytic.split` = [0.2, 0.2, 0.2] is invalid: fractions that sum to 1 (these sum to 0.6)",
         ),
         (
             "bad override",
@@ -750,9 +750,38 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     assert!(html.contains(&sizing("catflip size CONFIG")));
     let config = util::config_path("robot-universal");
     let config = config.to_str().unwrap();
-    let (_, out, _) = util::run(&["run", config, "--set", "cat.mass=0.46"], dir.path());
+    // (without the --sets `size` refuses: it sets the drop and the objective
+    // itself)
+    let (_, out, _) = util::run(
+        &[
+            "run",
+            config,
+            "--set",
+            "fall.height=2",
+            "--set",
+            "cat.mass=0.46",
+            "--set",
+            "design.objective=time",
+        ],
+        dir.path(),
+    );
     let command = format!("catflip size {config} --set cat.mass=0.46");
     assert!(out.contains(&sizing(&command)), "{out}");
+    // which `size` takes as printed (given an impossible --height: refused
+    // for the height alone, after its --sets were accepted)
+    let printed = out
+        .split("from 2 m: catflip ")
+        .nth(1)
+        .and_then(|l| l.split(" --height 2.").next())
+        .unwrap();
+    let mut args: Vec<&str> = printed.split(' ').collect();
+    args.extend(["--height", "0"]);
+    let (code, _, err) = util::run(&args, dir.path());
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--height") && !err.contains("conflicts"),
+        "{err}"
+    );
     let svg = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     assert!(svg.contains("least-height"), "the torque figure draws it");
 }
