@@ -398,7 +398,9 @@ impl Verdict {
 
     /// The misses worth naming: a simulation failure alone (nothing else is
     /// known then), else all of them, the envelope only when no torque or
-    /// speed limit already explains it.
+    /// speed limit already explains it (its margin is the smaller of the
+    /// torque line's and the speed's: below the speed's, the line is broken
+    /// too).
     pub fn reasons(&self) -> Vec<String> {
         if let Some(e) = &self.error {
             return vec![e.clone()];
@@ -410,13 +412,18 @@ impl Verdict {
         {
             return vec![m.to_string()];
         }
-        let named = self
-            .misses
-            .iter()
-            .any(|m| matches!(m, Miss::Torque { .. } | Miss::Speed { .. }));
+        let explained = |margin: f64| {
+            self.misses.iter().any(|m| match m {
+                Miss::Torque { .. } => true,
+                Miss::Speed {
+                    speed_rad_s, limit, ..
+                } => margin >= (1.0 - speed_rad_s / limit) - tolerance::ENVELOPE_MARGIN,
+                _ => false,
+            })
+        };
         self.misses
             .iter()
-            .filter(|m| !(named && matches!(m, Miss::Envelope { .. })))
+            .filter(|m| !matches!(m, Miss::Envelope { margin, .. } if explained(*margin)))
             .map(Miss::to_string)
             .collect()
     }
@@ -764,6 +771,21 @@ mod tests {
         assert_eq!(v.reasons().len(), 1, "{:?}", v.reasons());
         assert!(v.reasons()[0].contains("above limits.max_torque"));
         assert!(!v.within_envelope());
+        // above the speed limit: the envelope is named only where its margin
+        // is below the speed's (the line broken too)
+        t.no_load_speed = Some(6.0);
+        d.max_speed_rad_s = Some(15.0); // the speed's margin: 1 - 15 / 10 = -0.5
+        for (margin, named) in [(-0.5, false), (-0.5 - 1e-3, true), (-7.9, true)] {
+            d.envelope_margin = Some(margin);
+            let why = verdict(&t, &d, &FLIPS).reasons();
+            assert!(why[0].contains("above limits.max_speed"), "{why:?}");
+            assert_eq!(why.len(), 1 + usize::from(named), "{margin}: {why:?}");
+            assert_eq!(
+                why.iter().any(|w| w.contains("leaves the motor envelope")),
+                named,
+                "{margin}: {why:?}"
+            );
+        }
     }
 
     /// From another start the landing is judged at its tolerance and the flip is not.
