@@ -68,6 +68,8 @@ impl Motor {
         let k = self.slope();
         let c = [-k * qd[0], -k * qd[1]];
         match self.norm {
+            // (a speed that is not a number has no envelope: NaN, not a panic)
+            TorqueNorm::PerMotor if c.iter().any(|x| x.is_nan()) => [f64::NAN; 2],
             TorqueNorm::PerMotor => [0, 1].map(|i| tau[i].clamp(c[i] - t, c[i] + t)),
             TorqueNorm::Euclidean => {
                 let e = [tau[0] - c[0], tau[1] - c[1]];
@@ -135,6 +137,17 @@ mod tests {
             no_load_speed: Some(6.0),
             max_speed: Some(5.0),
             norm,
+        }
+    }
+
+    /// A speed that is not a number has no envelope: the torque given is
+    /// NaN under either norm, never a panic (a diverged state fed to a
+    /// controller reached `f64::clamp`'s).
+    #[test]
+    fn a_speed_that_is_not_a_number_gives_nan_not_a_panic() {
+        for norm in [TorqueNorm::PerMotor, TorqueNorm::Euclidean] {
+            let t = servo(norm).clip([0.5, 0.5], [f64::NAN, 0.0]);
+            assert!(t.iter().all(|x| x.is_nan()), "{norm:?}: {t:?}");
         }
     }
 
