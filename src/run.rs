@@ -65,6 +65,9 @@ pub struct RunSummary {
     pub joint: &'static str,
     pub peak_norm: crate::model::TorqueNorm,
     pub max_torque_nm: Option<f64>,
+    /// The limits the designs were held to, as resolved from the config and
+    /// its robot file.
+    pub limits: LimitsUsed,
     /// `ok` when every method is ok, `partial` when some are flagged or
     /// failed, `impossible` when the motors cannot flip the cat from
     /// `fall.height` (exit 4; `answer` says from what height they can).
@@ -90,6 +93,64 @@ pub struct RunSummary {
     /// With motor limits: can the motors flip the cat from `fall.height`, and
     /// the least drop height at which they can (absent without limits).
     pub answer: Option<HeightAnswer>,
+}
+
+/// The motor and bend limits a run's designs were held to, and where a robot
+/// file gave them (`summary.json`'s `limits`).
+#[derive(Debug, Clone, Serialize)]
+pub struct LimitsUsed {
+    pub max_torque_nm: Option<f64>,
+    pub no_load_speed_rad_s: Option<f64>,
+    pub max_speed_rad_s: Option<f64>,
+    pub max_bend_deg: Option<f64>,
+    /// `body.urdf` or `body.mjcf` when it gave any of them.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub file: Option<&'static str>,
+    /// The `limits.*` keys the file gave (`max_torque`, ...).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub from_file: Vec<&'static str>,
+}
+
+impl LimitsUsed {
+    pub fn of(cfg: &Config) -> Self {
+        let l = &cfg.limits;
+        let origin = cfg.limits_from();
+        Self {
+            max_torque_nm: l.max_torque,
+            no_load_speed_rad_s: l.no_load_speed,
+            max_speed_rad_s: l.max_speed,
+            max_bend_deg: l.max_bend_deg,
+            file: origin.file.filter(|_| !origin.keys.is_empty()),
+            from_file: origin.keys,
+        }
+    }
+
+    /// One line for the terminal (`None` without limits): each limit, the
+    /// file's marked.
+    pub fn line(&self) -> Option<String> {
+        let mark = |key: &str| {
+            if self.from_file.contains(&key) {
+                format!(" (from {})", self.file.unwrap_or("the robot file"))
+            } else {
+                String::new()
+            }
+        };
+        let parts: Vec<String> = [
+            ("max_torque", "stall torque", self.max_torque_nm, "N m"),
+            (
+                "no_load_speed",
+                "no-load speed",
+                self.no_load_speed_rad_s,
+                "rad/s",
+            ),
+            ("max_speed", "speed limit", self.max_speed_rad_s, "rad/s"),
+            ("max_bend_deg", "bend limit", self.max_bend_deg, "deg"),
+        ]
+        .into_iter()
+        .filter_map(|(key, what, v, unit)| Some(format!("{what} {} {unit}{}", v?, mark(key))))
+        .collect();
+        (!parts.is_empty()).then(|| format!("limits: {}", parts.join(", ")))
+    }
 }
 
 impl RunSummary {
@@ -554,6 +615,7 @@ fn report_of(cfg: &Config, spec: &DesignSpec, done: Methods, question: Question)
         joint: cfg.cat.joint.name(),
         peak_norm: cfg.norm(),
         max_torque_nm: cfg.limits.max_torque,
+        limits: LimitsUsed::of(cfg),
         outcome: if answer.as_ref().is_some_and(|a| !a.possible) {
             Outcome::Impossible
         } else if methods.iter().any(MethodSummary::counts_against) {

@@ -15,6 +15,7 @@ pub fn summary(s: &RunSummary, report: &Path, files: usize) -> Vec<String> {
             s.peak_norm.name()
         ),
     ];
+    lines.extend(s.limits.line().map(|l| format!("  {l}")));
     let rows = s.methods.iter().map(crate::table::table_row).collect();
     lines.extend(super::Columns::new(&crate::table::TABLE_HEADER, rows).lines());
     let ratios = crate::table::peak_ratios(s.free_over_phased, s.phased_over_analytic);

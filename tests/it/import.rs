@@ -510,6 +510,23 @@ fn the_bundled_box_robot_is_read_from_its_urdf_and_answered() {
     assert_eq!(cfg.limits.max_torque, Some(1.4));
     assert_eq!(cfg.limits.max_speed, Some(5.969));
     assert_eq!(cfg.limits.no_load_speed, Some(5.969));
+    // and `run` says so: summary.json's `limits`, and a line under the title
+    let used = catflip::run::LimitsUsed::of(&cfg);
+    assert_eq!(
+        serde_json::to_value(&used).unwrap(),
+        serde_json::json!({
+            "max_torque_nm": 1.4,
+            "no_load_speed_rad_s": 5.969,
+            "max_speed_rad_s": 5.969,
+            "max_bend_deg": null,
+            "file": "body.urdf",
+            "from_file": ["max_torque", "max_speed"],
+        })
+    );
+    assert_eq!(
+        used.line().unwrap(),
+        "limits: stall torque 1.4 N m (from body.urdf), no-load speed 5.969 rad/s, speed limit 5.969 rad/s (from body.urdf)"
+    );
     // the robot question: the phased family (made for symmetric halves)
     // flips this lopsided body but tilts its spine, so its answer alone
     // verifies nothing and claims no height
