@@ -735,8 +735,14 @@ impl SizeAnswer {
             "rad/s",
         );
         if let Some(r) = self.speed_limit_ratio {
+            // (this sentence is read last: [`Self::lead`])
+            let keys = if g.evaluations.len() > 1 {
+                "the best gear ratio's sentence above gives them"
+            } else {
+                "limits.max_speed in that ratio"
+            };
             ends += &format!(
-                " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} times limits.no_load_speed): to check a motor with `catflip run`, set all three keys (the gear ratio's line below gives them)."
+                " Each motor keeps the configured hard speed limit's ratio to its no-load speed (limits.max_speed = {r:.4} times limits.no_load_speed): to check a motor with `catflip run`, set all three keys ({keys})."
             );
         }
         let range = match g.working_range {

@@ -10,7 +10,7 @@
 //! `Config::validate` checks their ranges.
 
 use crate::design::objective::Objective;
-use crate::error::{Result, check};
+use crate::error::{Error, Result, check};
 use crate::model::momentum::Start;
 use crate::model::motor::Motor;
 use crate::model::{Cat, TorqueNorm};
@@ -267,12 +267,18 @@ impl AnalyticSettings {
             )?;
         }
         let sum: f64 = self.split.iter().sum();
-        check(
-            "analytic.split",
-            sum,
-            (sum - 1.0).abs() < 1e-9,
-            "fractions must sum to 1 (sum shown)",
-        )?;
+        if (sum - 1.0).abs() >= 1e-9 {
+            return Err(Error::Invalid {
+                key: "analytic.split".into(),
+                value: format!("{:?}", self.split),
+                expected: format!(
+                    "fractions that sum to 1 (these sum to {})",
+                    format!("{sum:.9}")
+                        .trim_end_matches('0')
+                        .trim_end_matches('.')
+                ),
+            });
+        }
         Ok(())
     }
 }

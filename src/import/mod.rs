@@ -209,7 +209,7 @@ pub fn resolve(
             return Err(invalid(
                 &format!("cat.{key}"),
                 v,
-                "[body] gives the halves: remove cat.mass, cat.length, cat.radius and [cat.front] (cat.joint may stay)",
+                "[body] gives the halves, so the cylinders' cat.mass, cat.length, cat.radius and [cat.front] do not apply: leave them out of the config and its --set (cat.joint may stay); with [body], set (or sweep) its own keys, e.g. body.front.mass",
             ));
         }
     }
@@ -236,6 +236,20 @@ pub fn resolve(
         (Some(f), _) => f.joint,
         (None, j) => j.unwrap_or(Joint::NoTwist),
     };
+    // a motor axis belongs to the universal joint: with no joint named
+    // anywhere, the default no-twist joint would drop it unseen (a joint
+    // named no-twist ignores it knowingly)
+    if file.is_none() && joint_given.is_none() {
+        for (key, half) in [("rear", &body.rear), ("front", &body.front)] {
+            if let Some(axis) = half.as_ref().and_then(|h| h.axis) {
+                return Err(invalid(
+                    &format!("body.{key}.axis"),
+                    format!("{axis:?}"),
+                    "a motor axis of the universal joint, but no joint is named and the default is no-twist: set cat.joint = \"universal\" (or \"no-twist\" to ignore the axes)",
+                ));
+            }
+        }
+    }
     let halves = Halves { rear, front };
     if joint == Joint::Universal
         && let Some(p) = halves.axes_problem()

@@ -80,7 +80,12 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
     // a [cat] cylinder key beside a [body], named with its value
     refused(
         &["analyze", &config("box-robot"), "--set", "cat.mass=1"],
-        &["`cat.mass` = 1 is invalid", "[body] gives the halves"],
+        &[
+            "`cat.mass` = 1 is invalid",
+            "[body] gives the halves",
+            "leave them out of the config and its --set",
+            "set (or sweep) its own keys, e.g. body.front.mass",
+        ],
     );
     // a bend limit below the phased design's least bend: refused before any
     // design, by `run` as by `optimize` (run wrote a report of FAILED rows)
@@ -368,6 +373,35 @@ height = 2.0
             && line.contains("set analytic.theta_deg = "),
         "{line}"
     );
+    // a universal joint's motor axis for a body whose joint is the default
+    // no-twist (cat.joint left out) was dropped unseen: refused, naming the
+    // key; with the joint named no-twist it is ignored knowingly
+    let pinned = grams.path().join("pinned.toml");
+    std::fs::write(
+        &pinned,
+        std::fs::read_to_string(&boxes)
+            .unwrap()
+            .replace("joint = \"universal\"\n", ""),
+    )
+    .unwrap();
+    let pinned = pinned.to_str().unwrap();
+    assert!(run(&["analyze", pinned], grams.path()).status.success());
+    refused(
+        &["analyze", pinned, "--set", "body.front.axis=[0, 1, 0]"],
+        &[
+            "`body.front.axis` = [0.0, 1.0, 0.0] is invalid",
+            "set cat.joint = \"universal\" (or \"no-twist\" to ignore the axes)",
+        ],
+    );
+    let named = [
+        "analyze",
+        pinned,
+        "--set",
+        "body.front.axis=[0, 1, 0]",
+        "--set",
+        "cat.joint=no-twist",
+    ];
+    assert!(run(&named, grams.path()).status.success());
     warns(
         &["analyze", &seed, "--set", "cat.length=23"],
         &["cat.length", "centimetres"],

@@ -348,6 +348,8 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
         "limits.max_torque=0.5",
         "--set",
         "limits.no_load_speed=4",
+        "--set",
+        "limits.max_speed=3.5",
         "--points",
         "2",
         "--gear-evaluations",
@@ -363,9 +365,9 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let set = dir
-        .path()
-        .join("out/seed/size-10m@limits.max_torque=0.5,limits.no_load_speed=4");
+    let set = dir.path().join(
+        "out/seed/size-10m@limits.max_torque=0.5,limits.no_load_speed=4,limits.max_speed=3.5",
+    );
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(set.join("size.json")).unwrap()).unwrap();
     // --json prints what size.json holds
@@ -437,6 +439,13 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
     let html = std::fs::read_to_string(set.join("index.html")).unwrap();
     assert!(html.contains("size.svg") && html.contains("size-gear.svg"));
     assert!(html.contains("No motor weaker than"));
+    // the hard speed limit kept in its ratio, and with no gear search no
+    // sentence that names the keys: the ratio does
+    assert!(
+        html.contains("limits.max_speed = 0.8750 times limits.no_load_speed")
+            && html.contains("set all three keys (limits.max_speed in that ratio)"),
+        "{html}"
+    );
     // the answer leads: its block above the curve's table
     let (block, table) = (
         html.find("id=\"answer\"").unwrap(),
