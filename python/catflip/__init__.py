@@ -127,6 +127,9 @@ def sweep(
 
     if isinstance(methods, str):
         methods = [m.strip() for m in methods.split(",")]
+    if values is None or isinstance(values, (str, bytes)):
+        # (numpy reads None as NaN, which the key would refuse as a value)
+        raise TypeError(f"values = {values!r}: give the values to sweep, a sequence of numbers")
     values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
     columns, csv = _sweep_columns(
         config, key, values, list(methods), threads, bool(least_height_only)

@@ -353,7 +353,8 @@ def robustness(config: Config, trials: int = 1000, seed: int = 1,
     (``"open-loop"``, ``"tvlqr"``, ``"replan"``), ``success_rate`` and ``ci95``, ...) and
     ``"csv"``, the text of its ``robustness.csv``. ``trials`` 1 to 1,000,000; ``seed`` 0 to
     2**64 - 1; ``threads`` at least 1 (None: one per core). Ctrl-C stops it after the trials
-    in flight. Raises ConfigError, DesignError."""
+    in flight. Raises ConfigError, DesignError; warns (RuntimeWarning, the CLI's ``warning:``
+    line) when the replans' p99 wall time on this machine is over the control period."""
 
 def run(config: Config) -> Run:
     """The CLI's main job, ``catflip run``, in memory (nothing written), with the GIL released.
@@ -465,7 +466,9 @@ class Controller:
         ``floor(t / period)``. It acts from ``t + delay`` until the next command; the motor is
         given ``clip(feedforward + correction + noise, qd)``. After the last control step the
         last correction holds. GIL released; ConfigError for a bad ``t`` or state (a value
-        that is not finite, an attitude that is not a unit quaternion to 1 %)."""
+        that is not finite, an attitude that is not a unit quaternion to 1 %); DesignError
+        when the prediction over the delay diverges from a state far outside the model (the
+        flight is then reset)."""
     def reset(self) -> None:
         """Forgets the corrections sent (a new flight)."""
     def sensed(self, attitude: ArrayLike, q: ArrayLike, qd: ArrayLike, gyro: ArrayLike) -> F64:
@@ -475,7 +478,8 @@ class Controller:
         inertias, as the closed loop's sensors estimate it."""
     def clip(self, tau: ArrayLike, qd: ArrayLike) -> F64:
         """The motor envelope of ``[limits]`` (saturation, back-EMF line) on joint torques
-        ``tau`` at joint speed ``qd``: shape (2,), as catflip's plant applies it."""
+        ``tau`` at joint speed ``qd``: shape (2,), as catflip's plant applies it; ConfigError
+        for a value that is not finite."""
     @property
     def step(self) -> float:
         """Simulator step h, s: touchdown is at ``steps * h``."""
@@ -553,4 +557,7 @@ class Flight:
         """The correction sent from each measurement, N m: shape (K, 2)."""
     @property
     def draw(self) -> Optional[Dict[str, Any]]:
-        """The trial's draws (``robustness.csv``'s columns) as a dict; None for the nominal."""
+        """The trial's draws as a dict, ``robustness.csv``'s draw columns grouped: ``trial``,
+        ``spin_rad_s`` (x, y, z), ``tilt_deg``, ``tilt_axis_deg``, ``mass_error``,
+        ``inertia_error``, ``length_error`` (rear, front each) and ``pd_gain_factor``; None
+        for the nominal."""

@@ -82,7 +82,7 @@ fn dict_error(text: &str, message: &str) -> String {
 
 /// The library's advice in the package's words: its messages name the
 /// command line's flags and commands where Python has arguments and functions.
-const PYTHONIC: [(&str, &str); 9] = [
+const PYTHONIC: [(&str, &str); 11] = [
     ("--methods names neither", "methods names neither"),
     ("to --methods", "to methods"),
     (
@@ -102,6 +102,11 @@ const PYTHONIC: [(&str, &str); 9] = [
         "`catflip run` finds the least drop height",
         "`catflip.least_height(config)` finds the least drop height",
     ),
+    (
+        "`catflip run` writes its schedule as least-height.csv",
+        "`catflip.least_height(config).to_csv()` gives its schedule",
+    ),
+    (" in least-height.csv)", ": least_height(config).to_csv())"),
     ("`catflip run`", "`catflip.run(config)`"),
     (
         "(catflip size names them for a height)",
@@ -1370,7 +1375,7 @@ impl LeastHeight {
         self.answer.schedule.to_csv()
     }
     fn __repr__(&self) -> String {
-        format!("LeastHeight({})", self.answer.sentence())
+        format!("LeastHeight({})", self.sentence())
     }
 }
 
@@ -1472,6 +1477,11 @@ fn sweep_columns<'py>(
         free: false,
         peaks: !least_height_only,
     };
+    if methods.is_empty() {
+        return Err(ConfigError::new_err(
+            "methods is empty: give one or more of analytic, phased and free",
+        ));
+    }
     for name in &methods {
         match name.as_str() {
             "analytic" => m.analytic = true,
@@ -1580,7 +1590,7 @@ fn robustness<'py>(
     seed: i128,
     threads: Option<i64>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    use catflip::control::robustness::{Study, summarise, to_csv};
+    use catflip::control::robustness::{Study, replan_timing, summarise, to_csv};
     use std::sync::atomic::{AtomicBool, Ordering};
     let (_, cfg) = config.snapshot();
     let max = catflip::config::MAX_TRIALS;
@@ -1602,7 +1612,7 @@ fn robustness<'py>(
     };
     let stop = std::sync::Arc::new(AtomicBool::new(false));
     let asked = stop.clone();
-    let json = interruptible(
+    let (json, late) = interruptible(
         py,
         move || asked.store(true, Ordering::SeqCst),
         move || {
@@ -1629,9 +1639,20 @@ fn robustness<'py>(
             })
             .expect("serialises");
             json["csv"] = to_csv(&results, true).into();
-            Ok(json)
+            // (the CLI's warning: there is no budget here)
+            let timing = replan_timing(&results, cfg.control.period());
+            let late = catflip::console::robustness::late_replans(&timing, None);
+            Ok((json, late))
         },
     )?;
+    if let Some(text) = late {
+        PyErr::warn(
+            py,
+            &py.get_type::<pyo3::exceptions::PyRuntimeWarning>(),
+            &std::ffi::CString::new(text).expect("no NUL"),
+            1,
+        )?;
+    }
     json_loads(py, &json)
 }
 
@@ -2067,8 +2088,17 @@ impl Controller {
         let u = py.detach(|| {
             let mut o = self.lock();
             let k = o.step_at(t);
-            o.correction(k, &from_sim(&s))
+            let u = o.correction(k, &from_sim(&s));
+            if !u.iter().all(|x| x.is_finite()) {
+                o.reset();
+            }
+            u
         });
+        if !u.iter().all(|x| x.is_finite()) {
+            return Err(DesignError::new_err(format!(
+                "the correction at t = {t} s is not finite ({u:?}): the controller's prediction over the actuator delay diverged from the state {s:?}, far outside its model (check the state's units: lambda in N m s, qd in rad/s); the controller's flight was reset"
+            )));
+        }
         Ok(vector(py, u.to_vec()))
     }
 
@@ -2118,7 +2148,13 @@ impl Controller {
         tau: Vec<f64>,
         qd: Vec<f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let c = self.lock().motor.clip(pair(tau, "tau")?, pair(qd, "qd")?);
+        let (tau, qd) = (pair(tau, "tau")?, pair(qd, "qd")?);
+        if tau.iter().chain(&qd).any(|v| !v.is_finite()) {
+            return Err(ConfigError::new_err(format!(
+                "tau {tau:?} or qd {qd:?} has a value that is not finite"
+            )));
+        }
+        let c = self.lock().motor.clip(tau, qd);
         Ok(vector(py, c.to_vec()))
     }
 
@@ -2342,7 +2378,8 @@ impl Flight {
     fn correction<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f64>> {
         matrix(py, &self.correction)
     }
-    /// The trial's draws (the `robustness.csv` columns) as a dict; None for the nominal.
+    /// The trial's draws as a dict (`robustness.csv`'s draw columns grouped: `spin_rad_s`,
+    /// `mass_error`, ... as pairs and triples); None for the nominal.
     #[getter]
     fn draw<'py>(&self, py: Python<'py>) -> PyResult<Option<Bound<'py, PyAny>>> {
         self.draw.as_ref().map(|d| json_loads(py, d)).transpose()

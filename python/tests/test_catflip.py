@@ -58,6 +58,8 @@ PYTHONIC = [
     ("another seed (--seed)", 'another seed (seed="analytic" or "phased")'),
     ("`--seed analytic` starts it", '`seed="analytic"` starts it'),
     ("`catflip run` finds the least drop height", "`catflip.least_height(config)` finds the least drop height"),
+    ("`catflip run` writes its schedule as least-height.csv", "`catflip.least_height(config).to_csv()` gives its schedule"),
+    (" in least-height.csv)", ": least_height(config).to_csv())"),
     ("`catflip run`", "`catflip.run(config)`"),
     ("(catflip size names them for a height)", "(catflip.size(config, height) names them)"),
 ]
@@ -430,6 +432,9 @@ def test_least_height_is_runs_answer():
     # not possible from its 2 m: the sentence points to the call that sizes the motors for it
     assert h.sentence().endswith(" The motors (or the gear ratio) that would do it from 2 m: catflip.size(config, 2)."), \
         h.sentence()
+    # and names the schedule as Python gives it (no file is written), as its repr does
+    assert "schedule: least_height(config).to_csv())" in h.sentence(), h.sentence()
+    assert repr(h) == f"LeastHeight({h.sentence()})"
     # F7's relation between the least time and height, with the robot's margin
     g, margin = robot.to_dict()["fall"]["gravity"], robot.to_dict()["fall"]["margin"]
     assert h.least_height_m == pytest.approx(g * (h.least_time_s + margin) ** 2 / 2, rel=1e-9)
@@ -494,6 +499,11 @@ def test_sweep_equals_the_cli(tmp_path):
         catflip.sweep(catflip.Config.from_toml(seed), "limits.max_torque", [-0.5, 1.0], frame=False)
     with pytest.raises(catflip.ConfigError, match="values is empty"):
         catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [], frame=False)
+    # no values at all, and no methods (they gave a row of NaN, and a point at NaN)
+    with pytest.raises(TypeError, match="values = None: give the values to sweep"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", None, frame=False)
+    with pytest.raises(catflip.ConfigError, match="methods is empty"):
+        catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [5], methods=[], frame=False)
     with pytest.raises(catflip.ConfigError, match="1 of 2 points is invalid.*choose the values"):
         catflip.sweep(catflip.Config.from_toml(seed), "fall.height", [-1, 2], frame=False)
     try:

@@ -210,6 +210,29 @@ def test_bad_arguments_raise_config_errors():
         catflip.Controller(config("seed"), kind="tvlqr", budget_s=0.01)
 
 
+def test_a_state_far_outside_the_model_raises_not_panics():
+    # the robot's motor envelope on a speed that is not a number, and a state
+    # whose prediction over the delay diverges: errors a simulation loop's
+    # `except catflip.CatflipError` catches (they were Rust panics, a
+    # BaseException)
+    for kind in ("tvlqr", "replan"):
+        c = catflip.Controller(config("robot"), kind=kind)
+        with pytest.raises(catflip.ConfigError, match="not finite"):
+            c.clip([0.5, 0.5], [math.nan, 0])
+        far = np.array(c.nominal[0], dtype=float)
+        far[4:7] = 10.0  # 10 N m s of angular momentum about every axis
+        with pytest.raises(catflip.DesignError, match="not finite"):
+            c.torque(0.0, far)
+        # the flight was reset: from the nominal state the correction is zero again
+        assert np.allclose(c.torque(0.0, c.nominal[0]), 0.0, atol=1e-9)
+    # the seed's envelope-free controller does the same (it returned NaN)
+    c = catflip.Controller(config("seed"))
+    far = np.array(c.nominal[0], dtype=float)
+    far[9:11] = 1e4  # joint rates, rad/s
+    with pytest.raises(catflip.DesignError, match="not finite"):
+        c.torque(0.0, far)
+
+
 def test_below_the_least_height_the_studys_design_names_it():
     # as `run` answers: neither the phased nor the analytic start fits from 2 m
     robot = catflip.Config.from_toml(ROOT / "configs" / "robot-universal.toml")
