@@ -160,6 +160,14 @@ def test_the_studys_trials_land_as_the_cli_says(tmp_path):
     assert controller("seed", "open-loop").fly(trial=0).draw["tilt_deg"] == float(row["tilt_deg"])
 
 
+def test_replans_slower_than_the_control_period_are_warned_about():
+    # the CLI's `warning:` line, as a RuntimeWarning: no replan takes under a
+    # millisecond here (the seed's from 3 m at 1 kHz: about 700 replans)
+    cfg = catflip.Config.from_toml(SEED, ["control.rate_hz=1000", "fall.height=3"])
+    with pytest.warns(RuntimeWarning, match=r"replans took longer than the 1\.0 ms control period"):
+        catflip.robustness(cfg, trials=1, threads=1)
+
+
 def test_a_replan_over_its_budget_leaves_the_tvlqr_flying():
     # no replan finishes in no time: every one is dropped, the TVLQR about the design flies
     late = catflip.Controller(config("seed"), kind="replan", budget_s=0.0)
