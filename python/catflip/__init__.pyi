@@ -62,7 +62,8 @@ class Config:
         (one string or a list; as ``catflip CMD FILE --set ...``); raises ConfigError."""
     @staticmethod
     def from_text(text: str, origin: str = "<string>") -> Config:
-        """Checks a config given as TOML text; ``origin`` names it in messages."""
+        """Checks a config given as TOML text; ``origin`` names it in messages. A relative
+        robot file (``body.urdf``) is read from the current folder."""
     @staticmethod
     def from_dict(d: Dict[str, Any]) -> Config:
         """Checks a config given as a dict of the TOML's tables
@@ -170,7 +171,8 @@ def design(config: Config, method: Method = "free", objective: Optional[Objectiv
     """Designs a torque schedule, as the CLI's ``optimize --mode METHOD [--seed SEED]``
     (``analyze`` for ``method="analytic"``), with the GIL released.
 
-    ``objective`` overrides ``design.objective``; ``seed`` (``"phased"``, ``"analytic"``;
+    ``objective`` overrides ``design.objective`` (phased and free only: the analytic schedule
+    optimises nothing); ``seed`` (``"phased"``, ``"analytic"``;
     None: the phased design, or where no phased one fits the motors in this fall, and
     always for the ``"time"`` objective, the least-height answer's shortest manoeuvre, as
     ``run`` and ``optimize``) applies to

@@ -244,7 +244,23 @@ impl Source {
     fn load(&self, extra: Option<&str>) -> catflip::Result<Cfg> {
         let mut ov = self.overrides.clone();
         ov.extend(extra.map(String::from));
-        Cfg::from_toml_at(&self.text, &self.origin, &ov, &self.base)
+        Cfg::from_toml_at(&self.text, &self.origin, &ov, &self.base).map_err(|e| match e {
+            // the folder itself: a config from text or a dict has no file,
+            // and reads its robot file from the folder it was made in
+            catflip::Error::Invalid {
+                key,
+                value,
+                expected,
+            } => catflip::Error::Invalid {
+                key,
+                value,
+                expected: expected.replace(
+                    "relative to the config file",
+                    &format!("relative to {}", self.base.display()),
+                ),
+            },
+            e => e,
+        })
     }
 }
 
@@ -478,7 +494,8 @@ impl Config {
         )
     }
 
-    /// Checks a config given as TOML text; `origin` names it in messages.
+    /// Checks a config given as TOML text; `origin` names it in messages. A relative robot
+    /// file (`body.urdf`) is read from the current folder.
     #[staticmethod]
     #[pyo3(signature = (text, origin = "<string>"))]
     fn from_text(py: Python<'_>, text: String, origin: &str) -> PyResult<Config> {
@@ -841,6 +858,14 @@ fn design(
             )));
         }
     };
+    if method == "analytic"
+        && let Some(o) = objective
+    {
+        // (as a seed for the phased design: refused, not ignored)
+        return Err(ConfigError::new_err(format!(
+            "objective=\"{o}\" applies to the phased and free designs: the analytic schedule is the seed's closed form and optimises nothing; leave objective out or use method=\"phased\" or \"free\""
+        )));
+    }
     let seed = seed.map(String::from);
     interruptible(
         py,
@@ -2071,8 +2096,14 @@ impl Controller {
         &self,
         py: Python<'py>,
         t: f64,
-        state: Vec<f64>,
+        state: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        // (numpy's own error for a 2-D array named neither the argument nor its shape)
+        let state: Vec<f64> = state.extract().map_err(|e| {
+            ConfigError::new_err(format!(
+                "state: give 11 numbers, a flat sequence or an array of shape (11,) ({e})"
+            ))
+        })?;
         if !(t.is_finite() && t >= 0.0) {
             return Err(ConfigError::new_err(format!(
                 "t = {t}: the time since release, s, is finite and not negative"

@@ -234,13 +234,16 @@ def test_set_and_objective_apply_like_the_cli(tmp_path):
     assert d.config.to_dict()["design"]["objective"] == "energy"
     with pytest.raises(catflip.ConfigError, match="seed applies to"):
         catflip.design(cfg, "phased", seed="analytic")
+    # the analytic schedule optimises nothing: an objective is refused, not ignored
+    with pytest.raises(catflip.ConfigError, match='objective="time" applies to the phased and free designs'):
+        catflip.design(cfg, "analytic", objective="time")
     with pytest.raises(catflip.ConfigError, match="unknown method"):
         catflip.design(cfg, "fast")
     with pytest.raises(catflip.ConfigError, match='unknown objective `speed`; use "peak-torque"'):
         catflip.design(cfg, objective="speed")
 
 
-def test_from_dict_and_from_text_read_as_the_file():
+def test_from_dict_and_from_text_read_as_the_file(monkeypatch):
     tomllib = pytest.importorskip("tomllib")
     seed = ROOT / "configs" / "seed.toml"
     a = catflip.Config.from_toml(seed)
@@ -260,6 +263,14 @@ def test_from_dict_and_from_text_read_as_the_file():
     without_fall = {k: v for k, v in base.items() if k != "fall"}
     with pytest.raises(catflip.ConfigError, match=r"missing section `\[fall\]`"):
         catflip.Config.from_dict(without_fall)
+    # a relative robot file is read from the current folder, and a missing one
+    # says that folder (not "the config file", which a dict has not)
+    monkeypatch.chdir(ROOT)  # (the robot's URDF is in configs/)
+    text = (ROOT / "configs" / "box-robot.toml").read_text()
+    for make in (lambda: catflip.Config.from_dict(tomllib.loads(text)), lambda: catflip.Config.from_text(text)):
+        with pytest.raises(catflip.ConfigError) as e:
+            make()
+        assert f"the path is relative to {ROOT}" in str(e.value), str(e.value)
 
 
 @pytest.mark.parametrize("path", CONFIGS, ids=lambda p: p.stem)

@@ -200,6 +200,8 @@ def test_bad_arguments_raise_config_errors():
     c = controller("seed")
     with pytest.raises(catflip.ConfigError, match="state has 10 values; give 11"):
         c.torque(0.0, np.zeros(10))
+    with pytest.raises(catflip.ConfigError, match=r"state: give 11 numbers, a flat sequence or an array of shape \(11,\)"):
+        c.torque(0.0, c.nominal[:2])
     with pytest.raises(catflip.ConfigError, match="t = -1"):
         c.torque(-1.0, c.nominal[0])
     with pytest.raises(catflip.ConfigError, match="not finite"):
