@@ -66,7 +66,13 @@ impl Motor {
             return tau;
         };
         let k = self.slope();
-        let c = [-k * qd[0], -k * qd[1]];
+        // (without a torque-speed line the speed does not move the envelope,
+        // even one that is not finite)
+        let c = if k == 0.0 {
+            [0.0; 2]
+        } else {
+            [-k * qd[0], -k * qd[1]]
+        };
         match self.norm {
             // (a speed that is not a number has no envelope: NaN, not a panic)
             TorqueNorm::PerMotor if c.iter().any(|x| x.is_nan()) => [f64::NAN; 2],
@@ -148,6 +154,17 @@ mod tests {
         for norm in [TorqueNorm::PerMotor, TorqueNorm::Euclidean] {
             let t = servo(norm).clip([0.5, 0.5], [f64::NAN, 0.0]);
             assert!(t.iter().all(|x| x.is_nan()), "{norm:?}: {t:?}");
+            // a stall torque alone: the speed does not matter, whatever it is
+            let stall = Motor {
+                no_load_speed: None,
+                ..servo(norm)
+            };
+            for w in [f64::NAN, f64::INFINITY] {
+                assert_eq!(
+                    stall.clip([0.5, 2.0], [w, 0.0]),
+                    stall.clip([0.5, 2.0], [0.0, 0.0])
+                );
+            }
         }
     }
 
