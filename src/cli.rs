@@ -600,12 +600,15 @@ fn cmd_run(c: &Common) -> Result<Status> {
         return Ok(outcome.into());
     }
     // the sizing advice names this config and the `--set`s `size` takes
-    let sizing = crate::size_cli::advised(c);
-    say_lines(
-        console::run::summary(&r.summary, &dir.join("index.html"), written.len())
-            .into_iter()
-            .map(|l| l.replace("catflip size CONFIG --height", &sizing)),
-    );
+    const ADVICE: &str = "catflip size CONFIG --height";
+    let mut lines = console::run::summary(&r.summary, &dir.join("index.html"), written.len());
+    if lines.iter().any(|l| l.contains(ADVICE)) {
+        let sizing = crate::size_cli::advised(c, cfg.fall.height);
+        for l in &mut lines {
+            *l = l.replace(ADVICE, &sizing);
+        }
+    }
+    say_lines(lines);
     if let Some(word) = console::run::closing(&r.summary) {
         eprintln!("{word}");
     }

@@ -117,7 +117,7 @@ fn print_table(a: &SizeAnswer) {
 /// `--set`s, without those `size` refuses (the keys it sets itself, a
 /// spin), and at rest where the config's release spins (`size` sizes the
 /// motors for a release at rest: time scaling, F9).
-pub(crate) fn advised(c: &Common) -> String {
+pub(crate) fn advised(c: &Common, height: f64) -> String {
     let refused = |s: &String| {
         let key = crate::common::set_key(s);
         SETS_ITSELF.iter().any(|(k, _)| *k == key) || key == "start.angular_velocity"
@@ -127,8 +127,12 @@ pub(crate) fn advised(c: &Common) -> String {
         ..c.clone()
     };
     // (the spin may be the config file's own, which a dropped `--set` held
-    // at rest)
-    if load(&kept).is_ok_and(|cfg| cfg.design_spec().has_momentum()) {
+    // at rest; loaded as size would, at a drop of its own, without warning
+    // again about what the run's load warned of)
+    let with_drop = [kept.set.clone(), vec![format!("fall.height={height}")]].concat();
+    let spins = catflip::Config::load(&kept.config, &with_drop)
+        .is_ok_and(|cfg| cfg.start.angular_velocity.iter().any(|w| *w != 0.0));
+    if spins {
         kept.set.push("start.angular_velocity=[0, 0, 0]".into());
     }
     format!("{} --height", kept.command("size"))
@@ -160,7 +164,7 @@ mod tests {
             json: false,
             out: PathBuf::from("output"),
         };
-        let advised_for = |c: &Common| advised(c);
+        let advised_for = |c: &Common| advised(c, 2.0);
         let sets = [
             "fall.height=1",
             "design.objective=time",

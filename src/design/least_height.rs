@@ -66,6 +66,10 @@ pub struct HeightAnswer {
     /// The least-height schedule.
     #[serde(skip)]
     pub schedule: Schedule,
+    /// The `[limits]` keys `catflip size` needs that the motor lacks (a DC
+    /// motor's stall torque and no-load speed), `None` when it has both.
+    #[serde(skip)]
+    pub size_needs: Option<&'static str>,
 }
 
 /// Answers the question when the motors are limited (`None` otherwise: an
@@ -110,6 +114,19 @@ pub fn beyond_any_fall(spec: &DesignSpec) -> Option<HeightAnswer> {
     })
 }
 
+/// The `[limits]` keys of a DC motor that `catflip size` needs and `spec`'s
+/// `motor` lacks ([`HeightAnswer::size_needs`]).
+fn size_needs(motor: &Motor) -> Option<&'static str> {
+    match (motor.max_torque, motor.no_load_speed) {
+        (Some(_), Some(_)) => None,
+        (Some(_), None) => Some("no-load speed (limits.no_load_speed)"),
+        (None, Some(_)) => Some("stall torque (limits.max_torque)"),
+        (None, None) => {
+            Some("stall torque and no-load speed (limits.max_torque, limits.no_load_speed)")
+        }
+    }
+}
+
 /// [`answer`] with the phased `time` design made for `reference`, its bend
 /// search started at `hint` when given; and that design's bend, rad.
 fn answer_for(
@@ -139,6 +156,7 @@ fn answer_for(
         from_start: spec.is_default_start(),
         beyond_longest_fall: false,
         schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
+        size_needs: size_needs(&spec.motor),
     };
     answer.bound(spec);
     Ok((answer, r.bend_deg.to_radians()))
@@ -733,6 +751,7 @@ impl HeightAnswer {
             from_start: spec.is_default_start(),
             beyond_longest_fall: false,
             schedule: Schedule { rows: Vec::new() },
+            size_needs: size_needs(&spec.motor),
         }
     }
 
@@ -790,10 +809,16 @@ impl HeightAnswer {
     /// One plain sentence for the terminal and the report.
     /// Where to ask for the motors that would flip it from this height.
     pub fn sizing(&self) -> String {
-        format!(
-            "The motors (or the gear ratio) that would do it from {} m: catflip size CONFIG --height {}.",
-            self.height_m, self.height_m
-        )
+        match self.size_needs {
+            None => format!(
+                "The motors (or the gear ratio) that would do it from {} m: catflip size CONFIG --height {}.",
+                self.height_m, self.height_m
+            ),
+            Some(keys) => format!(
+                "The motors that would do it from {} m: catflip size CONFIG --height {}, once the config gives a DC motor's {keys} (catflip size scales its torque-speed line).",
+                self.height_m, self.height_m
+            ),
+        }
     }
 
     pub fn sentence(&self) -> String {
@@ -883,6 +908,7 @@ mod tests {
             from_start: true,
             beyond_longest_fall: false,
             schedule: Schedule { rows: Vec::new() },
+            size_needs: None,
         };
         let s = a.sentence();
         assert!(s.starts_with("No verified design found"), "{s}");
@@ -891,6 +917,19 @@ mod tests {
         assert!(
             a.sentence()
                 .contains("from 62.514 m (at least 1.700 m within the stall torque; the motor's speed, not its torque, needs the rest) it is")
+        );
+        assert!(a.sentence().ends_with(
+            "The motors (or the gear ratio) that would do it from 20 m: catflip size CONFIG --height 20."
+        ));
+        // a motor catflip size cannot scale: the sentence says what it needs
+        a.size_needs = size_needs(&Motor {
+            max_torque: Some(1.4),
+            ..Motor::unlimited(crate::model::TorqueNorm::PerMotor)
+        });
+        assert!(
+            a.sentence().ends_with("catflip size CONFIG --height 20, once the config gives a DC motor's no-load speed (limits.no_load_speed) (catflip size scales its torque-speed line)."),
+            "{}",
+            a.sentence()
         );
     }
 
