@@ -384,9 +384,23 @@ pub fn trace(
     let b = plan.phase_bounds();
     let (mut t, mut q, mut tau) = (Vec::new(), Vec::new(), Vec::new());
     let (mut qd, mut tau_xy) = (Vec::new(), Vec::new());
+    // the dense peak's own instant among the samples: evenly spaced ones
+    // can straddle a narrow spike (a least-height design's 1.685 N m was
+    // drawn and circled at 1.596)
+    let (pi, pt) = crate::verify::analyze::peak_instant(
+        spec,
+        plan,
+        crate::verify::analyze::dense_samples(spec),
+    );
     for i in 0..3 {
-        for k in 0..=per_phase {
-            let tt = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+        let mut times: Vec<f64> = (0..=per_phase)
+            .map(|k| b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64)
+            .collect();
+        if i == pi && !times.contains(&pt) {
+            let at = times.partition_point(|&x| x < pt);
+            times.insert(at, pt);
+        }
+        for tt in times {
             t.push(tt);
             let s = plan.state_in(i, tt);
             q.push(s.q);

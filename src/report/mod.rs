@@ -582,9 +582,13 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
                     keys.push((limit_name(l, motor), Key::Level));
                 }
                 (Some(l), None) => {
-                    keys.push((format!("{} (above)", limit_name(l, motor)), Key::Level))
+                    keys.push((format!("{}, above", limit_name(l, motor)), Key::Level))
                 }
                 _ => {}
+            }
+            // (a line of its own: beside the limit's it ran off the figure)
+            if limit.is_some() && motor.slope() > 0.0 {
+                keys.push(("(more while braking)".into(), Key::Note));
             }
             legend(&side, &keys)?;
         }
@@ -596,7 +600,7 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
 /// line the stall torque, which a braking joint may pass.
 fn limit_name(l: f64, motor: &Motor) -> String {
     if motor.slope() > 0.0 {
-        format!("stall torque {l} N m (more while braking)")
+        format!("stall torque {l} N m")
     } else {
         format!("torque limit {l} N m")
     }

@@ -31,6 +31,24 @@ pub fn peak_along(spec: &DesignSpec, plan: &dyn ShapePlan, per_phase: usize) -> 
     (per.iter().cloned().fold(0.0, f64::max), per)
 }
 
+/// Where [`peak_along`] finds the peak: the phase and the instant, s.
+pub fn peak_instant(spec: &DesignSpec, plan: &dyn ShapePlan, per_phase: usize) -> (usize, f64) {
+    let cat = spec.cat;
+    let b = plan.phase_bounds();
+    let norm = spec.norm();
+    let mut best = (0, b[0], f64::NEG_INFINITY);
+    for i in 0..3 {
+        for k in 0..=per_phase {
+            let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+            let v = norm.of(plan.torque_in(&cat, i, t));
+            if v > best.2 {
+                best = (i, t, v);
+            }
+        }
+    }
+    (best.0, best.1)
+}
+
 #[derive(Debug, Clone, Serialize)]
 pub struct Analysis {
     pub name: String,

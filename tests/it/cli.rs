@@ -784,6 +784,16 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     );
     let svg = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     assert!(svg.contains("least-height"), "the torque figure draws it");
+    // its curves reach the table's (dense) peak: one motor's largest torque
+    // in the torque-speed figure is the per-motor peak (evenly spaced
+    // samples straddled a spike, 1.596 against 1.685 N m)
+    let peak = lh["peak_torque_nm"].as_f64().unwrap();
+    let speed = std::fs::read_to_string(base.join("torque_speed.svg")).unwrap();
+    assert!(
+        speed.contains(&format!("least-height ({peak:.3} N m")),
+        "{peak:.3} N m: {}",
+        speed.matches("least-height (").count()
+    );
 }
 
 /// The seed under the universal joint: its analytic schedule misses the
