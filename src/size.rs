@@ -183,8 +183,8 @@ pub struct GearAnswer {
 pub struct GearRange {
     pub low: f64,
     pub high: f64,
-    /// The end is the smallest (largest) ratio designed: smaller (larger)
-    /// ratios were not tried and may make it too.
+    /// The end is the smallest (largest) ratio designed or predicted from
+    /// the curve: smaller (larger) ratios were not tried and may make it too.
     pub low_untried_beyond: bool,
     pub high_untried_beyond: bool,
 }
@@ -747,16 +747,16 @@ impl SizeAnswer {
         }
         let range = match g.working_range {
             Some(r) => format!(
-                " Gear ratios from N = {:.4}{} to {:.4}{} make it from {} m (between the ratios designed, the least height interpolated in log N).",
+                " Gear ratios from N = {:.4}{} to {:.4}{} make it from {} m (between the ratios designed or predicted from the curve, the least height interpolated in log N).",
                 r.low,
                 if r.low_untried_beyond {
-                    " or less (the lowest ratio tried)"
+                    " or less (the lowest ratio designed or predicted)"
                 } else {
                     ""
                 },
                 r.high,
                 if r.high_untried_beyond {
-                    " or more (the highest ratio tried)"
+                    " or more (the highest ratio designed or predicted)"
                 } else {
                     ""
                 },

@@ -209,12 +209,12 @@ fn the_gear_ratios_that_make_it_are_named_and_hold() {
         end(
             r.low,
             r.low_untried_beyond,
-            " or less (the lowest ratio tried)"
+            " or less (the lowest ratio designed or predicted)"
         ),
         end(
             r.high,
             r.high_untried_beyond,
-            " or more (the highest ratio tried)"
+            " or more (the highest ratio designed or predicted)"
         )
     );
     assert!(said.contains(&range), "{said}\n{range}");
