@@ -408,7 +408,16 @@ class PackageController:
         self.replans = c.kind == "replan"
         for k in ("step", "steps", "period_steps", "control_steps", "peak_torque"):
             setattr(self, k, getattr(self.c, k))
-        self.torque, self.sensed, self.clip, self.reset = self.c.torque, self.c.sensed, self.c.clip, self.c.reset
+        self.sensed, self.clip, self.reset = self.c.sensed, self.c.clip, self.c.reset
+
+    def torque(self, t, state):
+        import catflip
+        try:
+            return self.c.torque(t, state)
+        except catflip.DesignError:
+            # the prediction over the delay diverged from a state far outside the
+            # model: NaN, which loses the flight as catflip's own simulator does
+            return np.full(2, np.nan)
 
     @property
     def feedforward(self):

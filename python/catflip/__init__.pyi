@@ -480,8 +480,8 @@ class Controller:
         inertias, as the closed loop's sensors estimate it."""
     def clip(self, tau: ArrayLike, qd: ArrayLike) -> F64:
         """The motor envelope of ``[limits]`` (saturation, back-EMF line) on joint torques
-        ``tau`` at joint speed ``qd``: shape (2,), as catflip's plant applies it; ConfigError
-        for a value that is not finite."""
+        ``tau`` at joint speed ``qd``: shape (2,), as catflip's plant applies it; a speed that
+        is not a number gives NaN under a torque-speed line (a diverged simulation's step)."""
     @property
     def step(self) -> float:
         """Simulator step h, s: touchdown is at ``steps * h``."""

@@ -82,7 +82,11 @@ fn dict_error(text: &str, message: &str) -> String {
 
 /// The library's advice in the package's words: its messages name the
 /// command line's flags and commands where Python has arguments and functions.
-const PYTHONIC: [(&str, &str); 11] = [
+const PYTHONIC: [(&str, &str); 12] = [
+    (
+        "out of the config and its --set",
+        "out of the config and its config.set calls",
+    ),
     ("--methods names neither", "methods names neither"),
     ("to --methods", "to methods"),
     (
@@ -1605,7 +1609,8 @@ fn sweep_columns<'py>(
 /// --json`, in memory (nothing written), with the GIL released: the CLI's `robustness.json`
 /// as a dict (`trials`, `controllers` with each one's `name`, `success_rate` and `ci95`,
 /// ...) and `"csv"`, the text of its `robustness.csv`. Ctrl-C stops it after the trials in
-/// flight.
+/// flight. A RuntimeWarning (the CLI's `warning:` line) when the replans' p99 wall time on
+/// this machine is over the control period.
 #[pyfunction]
 #[pyo3(signature = (config, trials = 1000, seed = 1, threads = None))]
 fn robustness<'py>(
@@ -2091,7 +2096,9 @@ impl Controller {
     /// of the control step `floor(t / period)`. It acts from `t + delay` to the next
     /// command. After the last control step (touchdown) the last correction holds; a
     /// command at an earlier step forgets the later ones. GIL released; ConfigError for a
-    /// bad `t` or state (not finite, an attitude that is not a unit quaternion to 1 %).
+    /// bad `t` or state (not finite, an attitude that is not a unit quaternion to 1 %);
+    /// DesignError when the prediction over the delay diverges from a state far outside
+    /// the model (the flight is then reset).
     fn torque<'py>(
         &self,
         py: Python<'py>,
@@ -2172,20 +2179,17 @@ impl Controller {
     }
 
     /// The motor envelope (saturation and the back-EMF line of `[limits]`) on joint
-    /// torques `tau` at joint speed `qd`, as catflip's plant applies it.
+    /// torques `tau` at joint speed `qd`, as catflip's plant applies it; a speed that is
+    /// not a number gives NaN under a torque-speed line.
     fn clip<'py>(
         &self,
         py: Python<'py>,
         tau: Vec<f64>,
         qd: Vec<f64>,
     ) -> PyResult<Bound<'py, PyArray1<f64>>> {
-        let (tau, qd) = (pair(tau, "tau")?, pair(qd, "qd")?);
-        if tau.iter().chain(&qd).any(|v| !v.is_finite()) {
-            return Err(ConfigError::new_err(format!(
-                "tau {tau:?} or qd {qd:?} has a value that is not finite"
-            )));
-        }
-        let c = self.lock().motor.clip(tau, qd);
+        // (NaN in, NaN out: a simulation that diverged between two steps
+        // calls this inside its own step)
+        let c = self.lock().motor.clip(pair(tau, "tau")?, pair(qd, "qd")?);
         Ok(vector(py, c.to_vec()))
     }
 

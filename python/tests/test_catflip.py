@@ -51,6 +51,7 @@ def message(e):
 
 # the CLI's advice as the package words it (python/src/lib.rs PYTHONIC)
 PYTHONIC = [
+    ("out of the config and its --set", "out of the config and its config.set calls"),
     ("--methods names neither", "methods names neither"),
     ("to --methods", "to methods"),
     ("or sweep without --least-height-only", "or sweep with least_height_only=False"),
@@ -287,6 +288,12 @@ def test_a_configs_keys_read_back_and_pickle(path, tmp_path, monkeypatch):
               pickle.loads(pickled), pickle.loads(pickle.dumps(a)), copy.deepcopy(a), copy.copy(a)):
         assert b.to_dict() == a.to_dict()
     assert pickle.loads(pickle.dumps(a)).overrides == a.overrides == ["fall.height=7"]
+
+
+def test_a_cylinder_key_beside_a_body_is_refused_in_python_words():
+    box = catflip.Config.from_toml(ROOT / "configs" / "box-robot.toml")
+    with pytest.raises(catflip.ConfigError, match="leave them out of the config and its config.set calls"):
+        box.set("cat.mass", 1.0)
 
 
 def test_numpy_values_and_none_as_config_values():
