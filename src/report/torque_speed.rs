@@ -50,7 +50,7 @@ pub fn caption_without_limits(file: &str) -> Option<&'static str> {
             "Joint torque against time, each curve's peak circled (no motor limits are configured).",
         ),
         FILE => Some(
-            "Torque-speed plane, the figure a motor is sized with: each method's trajectory from its schedule (no motor limits are configured, so no envelope is drawn). Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed.",
+            "Torque-speed plane, the figure a motor is sized with: each method's trajectory from its schedule (no motor limits are configured, so no envelope is drawn). Per-motor joints: one panel per motor, four quadrants. Euclidean (no-twist) joints: the torque component along the motion against the speed. Where a trajectory's torque is under an eighth of the largest one's, a detail panel follows with the trajectories that fit a quarter above the largest of them.",
         ),
         _ => caption(file),
     }
@@ -182,11 +182,11 @@ fn scale(p: &Panel, motor: &Motor) -> f64 {
 }
 
 /// The detail panel's torque half-range, N m: a quarter more than the
-/// largest torque of the trajectories under [`SMALL`] of the panel's scale;
-/// `None` when there is none, or without a torque limit (the scale is then
-/// the trajectories' own, and the figure compares designs, not a motor).
+/// largest torque of the trajectories under [`SMALL`] of the panel's scale
+/// (the envelope's, or without limits the largest trajectory's: the seed's
+/// analytic schedule, 21 N m, flattened the optimised ones, under 1 N m);
+/// `None` when there is none.
 fn detail(p: &Panel, motor: &Motor) -> Option<f64> {
-    motor.max_torque?;
     let scale = scale(p, motor);
     let small = p
         .curves

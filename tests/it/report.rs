@@ -162,6 +162,22 @@ fn run_writes_a_complete_consistent_report() {
             "peak {p} missing from the torque figure's legends"
         );
     }
+    // the optimised designs (under 1 N m) are flat under the analytic
+    // schedule's 21 N m: a detail panel draws them, up to a quarter above
+    // the larger, without the analytic's trajectory
+    let speed = std::fs::read_to_string(base.join("torque_speed.svg")).unwrap();
+    let optimised = peaks[1].max(peaks[2]);
+    assert!(peaks[0] > 8.0 * optimised, "{peaks:?}");
+    let detail = speed.find(", detail: |tau| up to ").expect("a detail panel");
+    let window: f64 = speed[detail..]
+        .trim_start_matches(", detail: |tau| up to ")
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!(window >= optimised && window <= 1.3 * optimised, "{window} N m");
+    assert!(!speed[detail..].contains("analytic ("), "the analytic is not in the detail");
 }
 
 #[test]
