@@ -1141,6 +1141,9 @@ pub fn index_html(page: &Page) -> String {
         "td:last-child,th:last-child{white-space:normal;text-align:left;min-width:12em}",
         ".warn{border-left:4px solid #b00;padding:2px 8px;background:#fee}",
         "#views{display:flex;flex-wrap:wrap;gap:12px}.view h3{margin:4px 0}",
+        // (a view as wide as its canvas: a long status wraps instead of
+        // pushing the others onto rows of their own)
+        ".view{width:min-content}",
         ".view canvas{border:1px solid #bbb;cursor:grab;touch-action:none}",
         ".readout{font-family:monospace;font-size:13px}.status{font-size:13px;color:#444}",
         ".controls{display:flex;gap:14px;align-items:center;margin:8px 0}#time{width:320px}",
