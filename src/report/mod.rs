@@ -204,19 +204,32 @@ fn chart<'a, 'b>(
         .y_label_area_size(70)
         .build_cartesian_2d(x.0..x.1, y.0..y.1)
         .map_err(perr)?;
-    let plain = |v: &f64| format!("{v}");
-    let xf: &dyn Fn(&f64) -> String = if whole_x { &whole } else { &plain };
+    let xf: &dyn Fn(&f64) -> String = if whole_x { &whole } else { &axis_number };
     let mut mesh = c.configure_mesh();
     mesh.x_desc(desc.0)
         .y_desc(desc.1)
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 15))
-        .light_line_style(WHITE.mix(0.0));
-    if whole_x {
-        mesh.x_label_formatter(xf);
-    }
+        .light_line_style(WHITE.mix(0.0))
+        .x_label_formatter(xf)
+        .y_label_formatter(&axis_number);
     mesh.draw().map_err(perr)?;
     Ok(c)
+}
+
+/// A tick's number as plotters prints it, without the sign of a zero (a
+/// tick at -1e-17 read "-0.0" on a detail panel).
+fn axis_number(v: &f64) -> String {
+    let s = plotters::data::float::FloatPrettyPrinter {
+        allow_scientific: false,
+        min_decimal: 1,
+        max_decimal: 5,
+    }
+    .print(*v);
+    match s.strip_prefix('-') {
+        Some(rest) if rest.chars().all(|c| c == '0' || c == '.') => rest.to_string(),
+        _ => s,
+    }
 }
 
 /// A marker at `at` (data or pixel coordinates), a fixed size in pixels.
@@ -1195,6 +1208,14 @@ pub fn index_html(page: &Page) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_tick_at_zero_has_no_sign() {
+        assert_eq!(axis_number(&-1e-17), "0.0");
+        assert_eq!(axis_number(&-0.0), "0.0");
+        assert_eq!(axis_number(&-0.2), "-0.2");
+        assert_eq!(axis_number(&1.5), "1.5");
+    }
     use crate::design::objective::Objective;
 
     /// Separate cases are drawn apart: every line of the figure is vertical

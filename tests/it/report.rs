@@ -168,7 +168,9 @@ fn run_writes_a_complete_consistent_report() {
     let speed = std::fs::read_to_string(base.join("torque_speed.svg")).unwrap();
     let optimised = peaks[1].max(peaks[2]);
     assert!(peaks[0] > 8.0 * optimised, "{peaks:?}");
-    let detail = speed.find(", detail: |tau| up to ").expect("a detail panel");
+    let detail = speed
+        .find(", detail: |tau| up to ")
+        .expect("a detail panel");
     let window: f64 = speed[detail..]
         .trim_start_matches(", detail: |tau| up to ")
         .split(' ')
@@ -176,8 +178,14 @@ fn run_writes_a_complete_consistent_report() {
         .unwrap()
         .parse()
         .unwrap();
-    assert!(window >= optimised && window <= 1.3 * optimised, "{window} N m");
-    assert!(!speed[detail..].contains("analytic ("), "the analytic is not in the detail");
+    assert!(
+        window >= optimised && window <= 1.3 * optimised,
+        "{window} N m"
+    );
+    assert!(
+        !speed[detail..].contains("analytic ("),
+        "the analytic is not in the detail"
+    );
 }
 
 #[test]
