@@ -582,8 +582,11 @@ pub fn torque(methods: &[MethodTrace], norm_name: &str, motor: &Motor) -> Result
             keys.push(("peak of each curve".into(), Key::Peak));
             keys.push(boundary_key());
             if limit.is_some() && motor.slope() > 0.0 {
-                keys.push(("thin: T - k|w| at the method's".into(), Key::Level));
-                keys.push(("speed (motoring limit)".into(), Key::Note));
+                // (in each method's colour, not the limit's black: a line
+                // sample here read as one more black level)
+                keys.push(("thin, in each method's colour:".into(), Key::Note));
+                keys.push(("T - k|w| at its speed, the".into(), Key::Note));
+                keys.push(("motoring limit (cut at the top)".into(), Key::Note));
             }
             match (limit, lim_on_scale) {
                 (Some(l), Some(_)) => {
