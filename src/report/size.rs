@@ -282,7 +282,19 @@ pub fn page(a: &SizeAnswer) -> String {
     // the best gear ratio of it, makes the flip
     let [first, second, ends] = a.lead();
     let g = &a.gear;
-    let lead = super::answer::block(g.configured_possible || g.possible, &first, &second, &ends);
+    // the headline is the first sentence alone: the gear sentence goes on
+    // with its search and its working ratios, which set in the headline's
+    // large bold type buried the answer
+    let (headline, second) = match first.split_once(". ") {
+        Some((h, rest)) => (format!("{h}."), format!("{rest} {second}")),
+        None => (first, second),
+    };
+    let lead = super::answer::block(
+        g.configured_possible || g.possible,
+        &headline,
+        &second,
+        &ends,
+    );
     let mut notes = Vec::new();
     notes.push(format!(
         "{} designs in {:.1} s. Each point is one least-time design scaled by time scaling (F3): a motor (T, w0) whose least time is t also fits (k^2 T, k w0) in t / k; see docs/usage.md.",

@@ -567,6 +567,14 @@ fn the_page_leads_with_what_makes_it() {
         headline.starts_with("The configured motor's best gear ratio is N = "),
         "{headline}"
     );
+    // one sentence: the search and the working ratios follow in the text
+    assert!(
+        headline.ends_with('.') && !headline.contains(". "),
+        "{headline}"
+    );
+    let rest = &a.lead()[0][headline.len()..];
+    assert!(rest.contains("The search ended between N = "), "{rest}");
+    assert!(page.contains(rest.trim()), "the rest follows: {rest}");
     assert!(
         page.contains("The configured motor ("),
         "the configured motor still said"
