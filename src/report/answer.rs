@@ -125,6 +125,20 @@ pub fn block(possible: bool, headline: &str, second: &str, more: &str) -> String
         "<section id=\"answer\" class=\"{class}\">\n<p class=\"headline\">{}</p>\n<p class=\"height\">{}</p>\n<p>{}</p>\n</section>\n",
         esc(headline),
         esc(second),
-        esc(more)
+        linked(&esc(more))
     )
+}
+
+/// The least-height schedule's files, beside the page, as links where the
+/// (escaped) text names them: a reader goes on to open them.
+fn linked(html: &str) -> String {
+    let mut out = html.to_string();
+    for f in [
+        "least-height.csv",
+        "least-height.mujoco.csv",
+        "least-height.pybullet.csv",
+    ] {
+        out = out.replace(f, &format!("<a href=\"{f}\">{f}</a>"));
+    }
+    out
 }

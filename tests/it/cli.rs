@@ -742,6 +742,15 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     );
     assert!(!html.contains("<td>FAILED: "), "nothing errored");
     assert!(html.contains("<td>least-height</td>"));
+    // the answer links the schedule's files, which are beside the page
+    for f in [
+        "least-height.csv",
+        "least-height.mujoco.csv",
+        "least-height.pybullet.csv",
+    ] {
+        assert!(html.contains(&format!("<a href=\"{f}\">{f}</a>")), "{f}");
+        assert!(base.join(f).is_file(), "{f}");
+    }
     // and points to the command that answers the next question: on the
     // terminal the one to type, on this config and its --set
     let sizing = |command: &str| {
