@@ -819,7 +819,18 @@ fn page(
         .filter(|m| m.verdict != Grade::Impossible)
         .filter_map(crate::table::warning)
         .collect();
-    let lead = summary.answer.as_ref().map(report::answer::lead);
+    // what to fly from this height leads with the answer (it read after the table)
+    let fly = notes.iter().position(|n| n.starts_with("To fly from "));
+    let lead = summary
+        .answer
+        .as_ref()
+        .map(|a| report::answer::lead_with(a, fly.map(|i| notes[i].as_str())));
+    let notes: Vec<String> = notes
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| Some(*i) != fly)
+        .map(|(_, n)| n.clone())
+        .collect();
     report::index_html(&report::Page {
         // (the height tells apart the pages of one body asked from two)
         title: &format!(
@@ -829,7 +840,7 @@ fn page(
         lead: lead.as_deref(),
         header: &TABLE_HEADER,
         rows: &rows,
-        notes,
+        notes: &notes,
         warnings: &warnings,
         animation: &report::animation::section(&scene),
         figures: figure_names,

@@ -114,7 +114,18 @@ fn shown_text(a: &HeightAnswer) -> String {
 /// The block: headline, least height (and bound), and where the
 /// least-height schedule is shown and written.
 pub fn lead(a: &HeightAnswer) -> String {
-    block(a.possible, &headline(a), &height_text(a), &shown_text(a))
+    lead_with(a, None)
+}
+
+/// [`lead`] with what to fly from the configured height (`fly`) first in
+/// its paragraph: for a possible answer, the next thing a reader does.
+pub fn lead_with(a: &HeightAnswer, fly: Option<&str>) -> String {
+    let shown = shown_text(a);
+    let more = match fly {
+        Some(f) => format!("{f} {shown}"),
+        None => shown,
+    };
+    block(a.possible, &headline(a), &height_text(a), &more)
 }
 
 /// The answer's block (green when `possible`, else red): a headline, a
@@ -129,16 +140,20 @@ pub fn block(possible: bool, headline: &str, second: &str, more: &str) -> String
     )
 }
 
-/// The least-height schedule's files, beside the page, as links where the
-/// (escaped) text names them: a reader goes on to open them.
+/// The schedules' files, beside the page, as links where the (escaped) text
+/// names them: a reader goes on to open them.
 fn linked(html: &str) -> String {
     let mut out = html.to_string();
-    for f in [
-        "least-height.csv",
-        "least-height.mujoco.csv",
-        "least-height.pybullet.csv",
-    ] {
-        out = out.replace(f, &format!("<a href=\"{f}\">{f}</a>"));
+    for m in ["least-height", "free", "phased"] {
+        for f in [
+            format!("{m}.csv"),
+            format!("{m}.mujoco.csv"),
+            format!("{m}.pybullet.csv"),
+        ] {
+            // (a whole name: `free.csv` is not the end of another)
+            out = out.replace(&format!(" {f}"), &format!(" <a href=\"{f}\">{f}</a>"));
+            out = out.replace(&format!("({f}"), &format!("(<a href=\"{f}\">{f}</a>"));
+        }
     }
     out
 }

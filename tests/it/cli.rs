@@ -889,11 +889,20 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
     // summary and the page say
     assert_eq!(s["free_seed"], "phased");
     assert!(html.contains("Free-form design: from the phased design, "));
-    // what to fly from 6 m, and that least-height.csv is not it
+    // what to fly from 6 m, and that least-height.csv is not it: in the
+    // answer's block, above the table (it came after it), the files linked
     let free = method_line(&s, "free")["peak_torque_nm"].as_f64().unwrap();
-    assert!(html.contains(&format!(
-        "To fly from 6 m: free.csv (free.mujoco.csv and free.pybullet.csv for the simulators), the free-form design for design.objective = peak-torque (peak {free:.4} N m); least-height.csv is made for its own"
-    )), "{html}");
+    let link = |f: &str| format!("<a href=\"{f}\">{f}</a>");
+    let fly = format!(
+        "To fly from 6 m: {} ({} and {} for the simulators), the free-form design for design.objective = peak-torque (peak {free:.4} N m); {} is made for its own",
+        link("free.csv"),
+        link("free.mujoco.csv"),
+        link("free.pybullet.csv"),
+        link("least-height.csv")
+    );
+    let at = html.find(&fly).unwrap_or_else(|| panic!("{html}"));
+    assert!(lead < at && at < html.find("<table>").unwrap());
+    assert_eq!(html.matches("To fly from").count(), 1);
     // the least-height schedule (2.0 N m for its 3.5 m drop) has its own
     // torque axes, apart from the 6 m designs' (under 0.1 N m)
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
