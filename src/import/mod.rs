@@ -236,16 +236,21 @@ pub fn resolve(
         (Some(f), _) => f.joint,
         (None, j) => j.unwrap_or(Joint::NoTwist),
     };
-    // a motor axis belongs to the universal joint: with no joint named
-    // anywhere, the default no-twist joint would drop it unseen (a joint
+    // a motor axis belongs to the universal joint: for the default no-twist
+    // joint, or a robot file's, it would be dropped unseen (a cat.joint
     // named no-twist ignores it knowingly)
-    if file.is_none() && joint_given.is_none() {
+    if joint == Joint::NoTwist && joint_given != Some(Joint::NoTwist) {
+        let fix = if file.is_some() {
+            "a motor axis of the universal joint, but the robot description's joint is no-twist (a ball joint): leave the axes out"
+        } else {
+            "a motor axis of the universal joint, but no joint is named and the default is no-twist: set cat.joint = \"universal\" (or \"no-twist\" to ignore the axes)"
+        };
         for (key, half) in [("rear", &body.rear), ("front", &body.front)] {
             if let Some(axis) = half.as_ref().and_then(|h| h.axis) {
                 return Err(invalid(
                     &format!("body.{key}.axis"),
                     format!("{axis:?}"),
-                    "a motor axis of the universal joint, but no joint is named and the default is no-twist: set cat.joint = \"universal\" (or \"no-twist\" to ignore the axes)",
+                    fix,
                 ));
             }
         }

@@ -119,6 +119,34 @@ fn export_then_import_gives_the_same_model() {
     assert!(model_difference(&seed(&[]).cat(), &other.cat()) > 1e-4);
 }
 
+/// A universal joint's motor axis typed beside a robot file whose joint is
+/// no-twist (a ball) was dropped unseen: refused, naming the key; named
+/// no-twist in cat.joint, ignored knowingly.
+#[test]
+fn a_motor_axis_for_a_ball_joint_is_refused() {
+    let dir = temp_dir();
+    let cfg = seed(&[]);
+    for (key, text) in [("urdf", urdf(&cfg)), ("mjcf", mjcf(&cfg))] {
+        std::fs::write(dir.path().join(format!("r.{key}")), text).unwrap();
+        let toml = |extra: &str| {
+            let t = format!(
+                "name = \"r\"\n{extra}[fall]\nheight = 3.0\n[body]\n{key} = \"r.{key}\"\n[body.front]\naxis = [0, 1, 0]\n"
+            );
+            std::fs::write(dir.path().join("r.toml"), t).unwrap();
+            Config::load(&dir.path().join("r.toml"), &[])
+        };
+        let e = toml("").expect_err(key).to_string();
+        assert!(
+            e.contains("`body.front.axis` = [0.0, 1.0, 0.0] is invalid")
+                && e.contains(
+                    "the robot description's joint is no-twist (a ball joint): leave the axes out"
+                ),
+            "{key}: {e}"
+        );
+        assert!(toml("[cat]\njoint = \"no-twist\"\n").is_ok(), "{key}");
+    }
+}
+
 #[test]
 fn a_config_key_replaces_the_files_value_and_the_config_limits_win() {
     let dir = temp_dir();
