@@ -16,37 +16,40 @@ pub fn dense_samples(spec: &DesignSpec) -> usize {
     n * 2000usize.div_ceil(n)
 }
 
+/// The plan's joint torque (peak norm) at `per_phase + 1` evenly spaced
+/// instants of each phase: `(phase, t, |tau|)`.
+fn torques_along<'a>(
+    spec: &'a DesignSpec,
+    plan: &'a dyn ShapePlan,
+    per_phase: usize,
+) -> impl Iterator<Item = (usize, f64, f64)> + 'a {
+    let pb = plan.phase_bounds();
+    let b = [pb[0], pb[1], pb[2], pb[3]];
+    let norm = spec.norm();
+    (0..3).flat_map(move |i| {
+        (0..=per_phase).map(move |k| {
+            let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
+            (i, t, norm.of(plan.torque_in(&spec.cat, i, t)))
+        })
+    })
+}
+
 /// Peak joint torque along a plan, sampled densely in every phase, N m.
 pub fn peak_along(spec: &DesignSpec, plan: &dyn ShapePlan, per_phase: usize) -> (f64, [f64; 3]) {
-    let cat = spec.cat;
-    let b = plan.phase_bounds();
-    let norm = spec.norm();
     let mut per = [0.0f64; 3];
-    for i in 0..3 {
-        for k in 0..=per_phase {
-            let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
-            per[i] = per[i].max(norm.of(plan.torque_in(&cat, i, t)));
-        }
+    for (i, _, v) in torques_along(spec, plan, per_phase) {
+        per[i] = per[i].max(v);
     }
     (per.iter().cloned().fold(0.0, f64::max), per)
 }
 
 /// Where [`peak_along`] finds the peak: the phase and the instant, s.
 pub fn peak_instant(spec: &DesignSpec, plan: &dyn ShapePlan, per_phase: usize) -> (usize, f64) {
-    let cat = spec.cat;
-    let b = plan.phase_bounds();
-    let norm = spec.norm();
-    let mut best = (0, b[0], f64::NEG_INFINITY);
-    for i in 0..3 {
-        for k in 0..=per_phase {
-            let t = b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64;
-            let v = norm.of(plan.torque_in(&cat, i, t));
-            if v > best.2 {
-                best = (i, t, v);
-            }
-        }
-    }
-    (best.0, best.1)
+    let (i, t, _) =
+        torques_along(spec, plan, per_phase).fold((0, f64::NAN, f64::NEG_INFINITY), |best, s| {
+            if s.2 > best.2 { s } else { best }
+        });
+    (i, t)
 }
 
 #[derive(Debug, Clone, Serialize)]
