@@ -5,22 +5,20 @@ use anyhow::Result;
 use catflip::output::Output;
 use catflip::size::{SizeAnswer, SizeSettings, files};
 
-/// Keys `catflip size` sets itself, so a `--set` of them is refused:
-/// `--height` replaces `fall.height` (the configured drop is not used, and
-/// the margin is judged against this one), and it designs least-time
-/// schedules (another objective would be ignored, yet name the set).
-const SETS_ITSELF: [(&str, &str); 2] = [
-    ("fall.height", "--height"),
-    ("design.objective", "`catflip size`"),
-];
+/// The keys `catflip size` sets itself, so a `--set` of them is refused,
+/// each with what sets it: `--height` replaces `fall.height` (the configured
+/// drop is not used, and the margin is judged against this one), and it
+/// designs least-time schedules (another objective would be ignored, yet
+/// name the set).
+fn sets_itself(height: f64) -> [(&'static str, String); 2] {
+    [
+        ("fall.height", format!("--height {height}")),
+        ("design.objective", "`catflip size`".into()),
+    ]
+}
 
 pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Result<Status> {
-    for (key, by) in SETS_ITSELF {
-        let by = if by == "--height" {
-            format!("--height {height}")
-        } else {
-            by.to_string()
-        };
+    for (key, by) in sets_itself(height) {
         crate::cli::refuse_set_of(c, key, &by)?;
     }
     let with_height = Common {
@@ -120,7 +118,7 @@ fn print_table(a: &SizeAnswer) {
 pub(crate) fn advised(c: &Common, height: f64) -> String {
     let refused = |s: &String| {
         let key = crate::common::set_key(s);
-        SETS_ITSELF.iter().any(|(k, _)| *k == key) || key == "start.angular_velocity"
+        sets_itself(height).iter().any(|(k, _)| *k == key) || key == "start.angular_velocity"
     };
     let mut kept = Common {
         set: c.set.iter().filter(|s| !refused(s)).cloned().collect(),
