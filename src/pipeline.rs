@@ -186,6 +186,7 @@ pub fn judge(
             bend_deg,
             max_speed_rad_s: motor.map(|m| m.max_speed_rad_s),
             envelope_margin: motor.and_then(|m| m.min_margin),
+            line_margin: motor.and_then(|m| m.min_line_margin),
         },
         simulated,
     )

@@ -31,6 +31,16 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
     })?;
     settings.validate()?;
     let q = catflip::size::question(&cfg, height)?;
+    // (not a --set, refused above: the file's own)
+    let objective = cfg.design.objective;
+    if objective != catflip::design::objective::Objective::default() {
+        eprintln!(
+            "warning: {} sets design.objective = \"{}\", which `catflip size` does not use: \
+             it sizes the motors for the least height, a least-time design",
+            c.config.display(),
+            objective.name()
+        );
+    }
     let publisher = publisher(c, &cfg, &format!("size-{height}m"))?;
     let dir = publisher.link();
     let progress = crate::common::Progress::new(c.json);

@@ -184,6 +184,10 @@ pub struct DesignNumbers {
     pub max_speed_rad_s: Option<f64>,
     /// Smallest motor-envelope margin of the written schedule.
     pub envelope_margin: Option<f64>,
+    /// Smallest margin of its torque part alone (the torque-speed line):
+    /// the envelope is named from it even where a speed limit is broken
+    /// worse (`None`: not known, the envelope is named from its margin).
+    pub line_margin: Option<f64>,
 }
 
 /// How the simulation of a design turned out, as the verdict needs it.
@@ -238,8 +242,13 @@ pub enum Miss {
         limit: f64,
         name: String,
     },
-    /// Outside the motor envelope (the keys that set it).
-    Envelope { margin: f64, keys: String },
+    /// Outside the motor envelope (the keys that set it); `line`: whether
+    /// its torque part is broken (`None`: not known).
+    Envelope {
+        margin: f64,
+        keys: String,
+        line: Option<bool>,
+    },
     Bend {
         bend_deg: f64,
         limit: f64,
@@ -306,7 +315,7 @@ impl fmt::Display for Miss {
                 f,
                 "moves at {speed_rad_s:.4} rad/s, above {name} = {limit} rad/s"
             ),
-            Miss::Envelope { margin, keys } => write!(
+            Miss::Envelope { margin, keys, .. } => write!(
                 f,
                 "leaves the motor envelope (smallest margin {margin:.3}; {keys})"
             ),
@@ -398,9 +407,9 @@ impl Verdict {
 
     /// The misses worth naming: a simulation failure alone (nothing else is
     /// known then), else all of them, the envelope only when no torque or
-    /// speed limit already explains it (its margin is the smaller of the
-    /// torque line's and the speed's: below the speed's, the line is broken
-    /// too).
+    /// speed limit already explains it: a broken speed limit explains it
+    /// when its torque line holds (where that is not known, when its margin
+    /// is the speed's: below the speed's, the line is broken too).
     pub fn reasons(&self) -> Vec<String> {
         if let Some(e) = &self.error {
             return vec![e.clone()];
@@ -412,18 +421,23 @@ impl Verdict {
         {
             return vec![m.to_string()];
         }
-        let explained = |margin: f64| {
+        let explained = |margin: f64, line: Option<bool>| {
             self.misses.iter().any(|m| match m {
                 Miss::Torque { .. } => true,
                 Miss::Speed {
                     speed_rad_s, limit, ..
-                } => margin >= (1.0 - speed_rad_s / limit) - tolerance::ENVELOPE_MARGIN,
+                } => line.map_or(
+                    margin >= (1.0 - speed_rad_s / limit) - tolerance::ENVELOPE_MARGIN,
+                    |broken| !broken,
+                ),
                 _ => false,
             })
         };
         self.misses
             .iter()
-            .filter(|m| !matches!(m, Miss::Envelope { margin, .. } if explained(*margin)))
+            .filter(
+                |m| !matches!(m, Miss::Envelope { margin, line, .. } if explained(*margin, *line)),
+            )
             .map(Miss::to_string)
             .collect()
     }
@@ -491,9 +505,17 @@ pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
     if let Some(m) = d.envelope_margin
         && (m.is_nan() || m < -tolerance::ENVELOPE_MARGIN)
     {
+        let line = d
+            .line_margin
+            .map(|l| l.is_nan() || l < -tolerance::ENVELOPE_MARGIN);
         why.push(Miss::Envelope {
-            margin: m,
+            // the line's own margin where it is the breach named
+            margin: match (line, d.line_margin) {
+                (Some(true), Some(l)) => l,
+                _ => m,
+            },
             keys: targets.envelope_keys.clone(),
+            line,
         });
     }
     if let Some(limit) = targets.max_bend_deg
@@ -608,6 +630,7 @@ mod tests {
             bend_deg: 45.0,
             max_speed_rad_s: Some(5.0),
             envelope_margin: Some(0.5),
+            line_margin: None,
         }
     }
 
@@ -785,6 +808,18 @@ mod tests {
                 named,
                 "{margin}: {why:?}"
             );
+        }
+        // where the line's own margin is known, it decides: broken less than
+        // the speed limit, the line is still named, with its margin
+        d.envelope_margin = Some(-0.5);
+        for (line, named) in [(0.2, false), (-1e-7, false), (-0.3, true)] {
+            d.line_margin = Some(line);
+            let why = verdict(&t, &d, &FLIPS).reasons();
+            assert!(why[0].contains("above limits.max_speed"), "{why:?}");
+            assert_eq!(why.len(), 1 + usize::from(named), "{line}: {why:?}");
+            if named {
+                assert!(why[1].contains("smallest margin -0.300"), "{why:?}");
+            }
         }
     }
 

@@ -716,6 +716,7 @@ pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
             bend_deg: fr.bend_deg,
             max_speed_rad_s: Some(usage.max_speed_rad_s),
             envelope_margin: usage.min_margin,
+            line_margin: usage.min_line_margin,
         },
         &if spec.is_default_start() {
             Simulated::Flip {

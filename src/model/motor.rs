@@ -94,15 +94,22 @@ impl Motor {
     /// motor). 1 means unused, 0 on the envelope, negative outside it
     /// (violated); `None` when nothing is limited.
     pub fn margin(&self, tau: [f64; 2], qd: [f64; 2]) -> Option<f64> {
-        let k = self.slope();
-        let torque = self
-            .max_torque
-            .map(|t| 1.0 - self.norm.of([tau[0] + k * qd[0], tau[1] + k * qd[1]]) / t);
+        let torque = self.line_margin(tau, qd);
         let speed = self.max_speed.map(|w| 1.0 - self.speed(qd) / w);
         match (torque, speed) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
+    }
+
+    /// The torque part of [`Motor::margin`]: `1 - |tau + k qd| / T` (the
+    /// stall torque alone without a torque-speed line), `None` without a
+    /// torque limit. A verdict names the line from it even where a speed
+    /// limit is broken worse.
+    pub fn line_margin(&self, tau: [f64; 2], qd: [f64; 2]) -> Option<f64> {
+        let k = self.slope();
+        self.max_torque
+            .map(|t| 1.0 - self.norm.of([tau[0] + k * qd[0], tau[1] + k * qd[1]]) / t)
     }
 }
 
@@ -114,6 +121,9 @@ pub struct MotorUse {
     pub max_speed_rad_s: f64,
     /// Smallest [`Motor::margin`] over the rows (`None` without limits).
     pub min_margin: Option<f64>,
+    /// Smallest [`Motor::line_margin`] over the rows (`None` without a
+    /// torque limit).
+    pub min_line_margin: Option<f64>,
 }
 
 impl Motor {
@@ -122,11 +132,16 @@ impl Motor {
         let mut u = MotorUse {
             max_speed_rad_s: 0.0,
             min_margin: None,
+            min_line_margin: None,
         };
+        let least = |x: Option<f64>, m: f64| Some(x.map_or(m, |x: f64| x.min(m)));
         for (tau, qd) in rows {
             u.max_speed_rad_s = u.max_speed_rad_s.max(self.speed(qd));
             if let Some(m) = self.margin(tau, qd) {
-                u.min_margin = Some(u.min_margin.map_or(m, |x: f64| x.min(m)));
+                u.min_margin = least(u.min_margin, m);
+            }
+            if let Some(m) = self.line_margin(tau, qd) {
+                u.min_line_margin = least(u.min_line_margin, m);
             }
         }
         u
@@ -181,8 +196,13 @@ mod tests {
         assert!((m.margin([0.0, 0.0], [0.0, 0.0]).unwrap() - 1.0).abs() < 1e-15);
         // at the no-load speed no motoring torque is left
         assert!(m.clip([1.0, 0.0], [6.0, 0.0])[0].abs() < 1e-15);
-        // a speed past the limit is a negative margin
+        // a speed past the limit is a negative margin, the line's still positive
         assert!(m.margin([0.0, 0.0], [5.5, 0.0]).unwrap() < 0.0);
+        assert!(m.line_margin([0.0, 0.0], [5.5, 0.0]).unwrap() > 0.0);
+        // over rows: the line's smallest margin apart from the speed's
+        let u = m.usage([([0.0, 0.0], [5.5, 0.0]), ([1.5, 0.0], [0.0, 0.0])]);
+        assert!((u.min_margin.unwrap() - (1.0 - 5.5 / 5.0)).abs() < 1e-15);
+        assert!((u.min_line_margin.unwrap() - (1.0 - 1.5 / 1.4)).abs() < 1e-15);
     }
 
     #[test]

@@ -640,6 +640,7 @@ fn a_verdict_names_a_limit_where_the_robot_file_gave_it() {
             bend_deg: 170.0,
             max_speed_rad_s: Some(100.0),
             envelope_margin: None,
+            line_margin: None,
         };
         limit_misses(&Targets::of(&spec), &over)
             .iter()

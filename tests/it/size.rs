@@ -336,9 +336,16 @@ fn a_height_out_of_range_or_a_bad_point_count_is_refused_and_nothing_written() {
 
 #[test]
 fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
-    // the seed's body with a DC motor: a cheap sizing (2 points, no gear search)
+    // the seed's body with a DC motor: a cheap sizing (2 points, no gear
+    // search); its file asks for an objective size does not use, and is
+    // told so
     let dir = util::temp_dir();
-    let cfg = util::seed_toml();
+    let cfg = dir.path().join("seed.toml");
+    std::fs::write(
+        &cfg,
+        util::config_text("seed") + "\n[design]\nobjective = \"energy\"\n",
+    )
+    .unwrap();
     let args = [
         "size",
         cfg.to_str().unwrap(),
@@ -359,11 +366,11 @@ fn size_writes_the_curve_the_gear_ratios_the_json_and_the_report() {
         "--json",
     ];
     let out = util::output(&args, dir.path());
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("sets design.objective = \"energy\", which `catflip size` does not use"),
+        "{err}"
     );
     let set = dir.path().join(
         "out/seed/size-10m@limits.max_torque=0.5,limits.no_load_speed=4,limits.max_speed=3.5",
