@@ -73,7 +73,8 @@ class Config:
         folder."""
     def set(self, key: str, value: Value) -> None:
         """Sets one key, e.g. ``set("fall.height", 6)``, with the CLI's ``--set`` checks and
-        messages; on a ConfigError the config is left as it was."""
+        messages (a whole float such as ``40.0`` sets a whole-number key, as ``sweep``
+        takes its values); on a ConfigError the config is left as it was."""
     def copy(self) -> Config:
         """An independent copy (later ``set``s on either leave the other alone)."""
     def to_dict(self) -> Dict[str, Any]:

@@ -454,6 +454,18 @@ fn toml_text(v: &Bound<'_, PyAny>, key: &str) -> PyResult<String> {
     }
 }
 
+/// A float with no fractional part as a whole number's text (`40.0` as
+/// `40`); `None` for anything else.
+fn whole_number(v: &Bound<'_, PyAny>) -> Option<String> {
+    if v.is_instance_of::<PyString>() || v.is_instance_of::<pyo3::types::PyBool>() {
+        return None;
+    }
+    let x: f64 = v.extract().ok()?;
+    // (below 2^53 every whole float is an exact integer)
+    (x.is_finite() && x.fract() == 0.0 && x.abs() < 9.007_199_254_740_992e15)
+        .then(|| format!("{}", x as i64))
+}
+
 /// A TOML value as typed after `--set KEY=` (a float as Rust writes it, so
 /// the recorded overrides read as the CLI's).
 fn text_of(x: &toml::Value) -> String {
@@ -541,13 +553,28 @@ impl Config {
         }
     }
 
-    /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages;
+    /// Sets one key, e.g. `set("fall.height", 6)`, with the CLI's `--set` checks and messages
+    /// (a whole float such as `40.0` sets a whole-number key, as `sweep` takes its values);
     /// on a ConfigError the config is left as it was.
     fn set(&self, py: Python<'_>, key: &str, value: &Bound<'_, PyAny>) -> PyResult<()> {
-        let arg = format!("{key}={}", toml_text(value, key)?);
+        let mut arg = format!("{key}={}", toml_text(value, key)?);
         let cfg = {
             let mut s = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-            let cfg = s.source.load(Some(&arg)).map_err(err)?;
+            let cfg = match s.source.load(Some(&arg)) {
+                Ok(cfg) => cfg,
+                // a whole float (numpy's 40.0) where a whole number is
+                // expected, as `sweep` takes its values; else the first error
+                Err(e) => match whole_number(value).and_then(|w| {
+                    let whole = format!("{key}={w}");
+                    s.source.load(Some(&whole)).ok().map(|c| (whole, c))
+                }) {
+                    Some((whole, cfg)) => {
+                        arg = whole;
+                        cfg
+                    }
+                    None => return Err(err(e)),
+                },
+            };
             s.source.overrides.push(arg);
             s.cfg = cfg.clone();
             cfg

@@ -154,6 +154,20 @@ def test_bad_keys_raise_config_error_with_the_cli_message(key, value, cli_value,
     assert isinstance(e.value, catflip.CatflipError)
 
 
+def test_a_whole_float_sets_a_whole_number_key_as_sweep_takes_it():
+    seed = ROOT / "configs" / "seed.toml"
+    by_int, by_float = catflip.Config.from_toml(seed), catflip.Config.from_toml(seed)
+    by_int.set("phased.nodes", 40)
+    by_float.set("phased.nodes", np.float64(40.0))
+    assert by_float.to_dict() == by_int.to_dict()
+    assert by_float.overrides == by_int.overrides == ["phased.nodes=40"]
+    # a float key keeps its float, and a fraction is still refused
+    by_float.set("fall.height", 4.0)
+    assert by_float.to_dict()["fall"]["height"] == 4.0
+    with pytest.raises(catflip.ConfigError, match="phased.nodes=40.5"):
+        by_float.set("phased.nodes", 40.5)
+
+
 def test_bad_files_raise_config_error_with_the_cli_message(tmp_path):
     broken = tmp_path / "broken.toml"
     broken.write_text('name = "x"\n[cat]\nmass = 1\n')
