@@ -1085,15 +1085,25 @@ pub fn brackets(
     })
 }
 
-/// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`: the
-/// chart's own log ticks left a 1.6-decade axis's ends without a number.
+/// Ticks at 1, 2, 3 and 5 times each power of ten inside `(lo, hi)`, at
+/// every digit where that gives fewer than four: the chart's own log ticks
+/// left a 1.6-decade axis's ends without a number.
 pub(crate) fn log_ticks((lo, hi): (f64, f64)) -> Vec<f64> {
     let first = lo.log10().floor() as i32;
     let last = hi.log10().ceil() as i32;
-    (first..=last)
-        .flat_map(|d| [1.0, 2.0, 3.0, 5.0].map(|m| m * 10f64.powi(d)))
-        .filter(|v| (lo..=hi).contains(v))
-        .collect()
+    let at = |mantissas: &[f64]| -> Vec<f64> {
+        (first..=last)
+            .flat_map(|d| mantissas.iter().map(move |m| m * 10f64.powi(d)))
+            .filter(|v| (lo..=hi).contains(v))
+            .collect()
+    };
+    let ticks = at(&[1.0, 2.0, 3.0, 5.0]);
+    // a narrow range (within a decade or so) reads from every digit
+    if ticks.len() >= 4 {
+        ticks
+    } else {
+        at(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+    }
 }
 
 /// A log axis's label: the number without float noise (`0.3`, not
@@ -1211,6 +1221,26 @@ pub fn index_html(page: &Page) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn log_ticks_number_both_ends_of_the_axis() {
+        // the gear figure's axis: a tick left of its first point (0.065)
+        let t = log_ticks((0.046, 1.4));
+        let want = [0.05, 0.1, 0.2, 0.3, 0.5, 1.0];
+        assert_eq!(t.len(), want.len(), "{t:?}");
+        assert!(
+            t.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{t:?}"
+        );
+        // within a decade: every digit
+        let t = log_ticks((0.15, 0.45));
+        let want = [0.2, 0.3, 0.4];
+        assert_eq!(t.len(), want.len(), "{t:?}");
+        assert!(
+            t.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-12),
+            "{t:?}"
+        );
+    }
 
     #[test]
     fn a_tick_at_zero_has_no_sign() {

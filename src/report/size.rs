@@ -186,7 +186,10 @@ pub fn gear(a: &SizeAnswer) -> Result<String> {
             .margin(12)
             .x_label_area_size(42)
             .y_label_area_size(70)
-            .build_cartesian_2d((xr.0..xr.1).log_scale(), (lo - pad).max(0.0)..hi + pad)
+            .build_cartesian_2d(
+                (xr.0..xr.1).log_scale().with_key_points(log_ticks(xr)),
+                (lo - pad).max(0.0)..hi + pad,
+            )
             .map_err(perr)?;
         c.configure_mesh()
             .x_desc("gear ratio N (torque x N, speed / N), log scale")

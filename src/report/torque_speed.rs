@@ -364,24 +364,28 @@ fn draw_panel(
         } else {
             keys.push((format!("envelope |tau| <= T = {t} N m"), Key::Band));
         }
-        // the named points: stall (rest, full torque) and no-load (no torque left)
-        let mut named = vec![(0.0, t, format!("stall T = {t} N m"), 8, -18)];
+        // the named points: stall (rest, full torque) and no-load (no torque
+        // left), by their symbols beside the dots and their values in the key
+        // (written out beside the dots they crossed the curves and the frame)
+        let mut named = vec![(0.0, t, "T", 8, -18)];
         if p.signed {
-            named.push((0.0, -t, format!("stall -T = {} N m", -t), 8, 4));
+            // (below left: outside the band, mirroring T above right)
+            named.push((0.0, -t, "-T", -24, 6));
         }
+        keys.push((format!("stall T = {t} N m"), Key::Dot));
         if let Some(w0) = motor.no_load_speed {
-            named.push((w0, 0.0, format!("no-load w0 = {w0} rad/s"), 6, 16));
+            named.push((w0, 0.0, "w0", 6, 16));
             if p.signed {
-                named.push((-w0, 0.0, format!("no-load -w0 = {} rad/s", -w0), 6, -32));
+                named.push((-w0, 0.0, "-w0", 6, -32));
             }
+            keys.push((format!("no-load w0 = {w0} rad/s"), Key::Dot));
         }
         for (w, s, label, dx, dy) in named.into_iter().filter(|n| n.1.abs() <= y.1.max(-y.0)) {
             c.draw_series(std::iter::once(Circle::new((w, s), 5, BLACK.filled())))
                 .map_err(perr)?;
-            c.draw_series(std::iter::once(text(label, (w, s), dx, dy)))
+            c.draw_series(std::iter::once(text(label.into(), (w, s), dx, dy)))
                 .map_err(perr)?;
         }
-        keys.push(("stall / no-load point".into(), Key::Dot));
     }
     if let Some(wm) = motor.max_speed {
         let at: &[f64] = if p.signed { &[wm, -wm] } else { &[wm] };

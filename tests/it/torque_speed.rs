@@ -93,6 +93,12 @@ fn torque_speed_figure_draws_the_configured_envelope_and_the_schedules_in_it() {
     let (t, w0) = (1.4, 5.969);
     let k = t / w0;
     assert!(svg.contains("stall T = 1.4 N m") && svg.contains("no-load w0 = 5.969 rad/s"));
+    // beside the dots, their symbols only (the values, written there, crossed
+    // the curves and ran past the frame)
+    for symbol in ["T", "-T", "w0", "-w0"] {
+        assert!(svg.lines().any(|l| l.trim() == symbol), "{symbol}");
+    }
+    assert!(!svg.contains("stall / no-load point"));
     // the reference cut to the plot says so in its legend; the designs are whole
     let cut = svg.matches("rad/s, cut)").count();
     assert!(cut >= 2, "the analytic's, per motor: {cut}");
