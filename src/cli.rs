@@ -489,10 +489,10 @@ fn cmd_simulate(c: &Common, schedule: Option<&Path>) -> Result<Status> {
             ("analytic schedule".to_string(), verify(&spec, &plan)?)
         }
     };
-    let reason = verdict::flip_reason(
-        report.flip_error_rad,
-        report.tilt_deg,
-        cfg.simulate.flip_tolerance,
+    // the landing too, from another start, as `run` judges it
+    let reason = verdict::flight_reason(
+        &verdict::Targets::of(&cfg.design_spec()),
+        &verdict::Simulated::of(Ok(&report)),
     );
     catflip::output::ensure_finite(&serde_json::to_value(&report)?, &[])?;
     let mut out = Output::default();

@@ -211,9 +211,12 @@ impl Simulated {
         sim: std::result::Result<&crate::verify::simulate::SimReport, &crate::Error>,
     ) -> Self {
         match sim {
-            Ok(s) => Simulated::Flip {
+            // the landing too: judged where the targets ask for it (from
+            // another start, or with land.max_tilt_deg), as in `run`
+            Ok(s) => Simulated::Landing {
                 flip_error_rad: s.flip_error_rad,
                 tilt_deg: s.tilt_deg,
+                landing_error_deg: s.landing_error_deg,
             },
             Err(e) => Simulated::Failed(e.to_string()),
         }
@@ -470,16 +473,6 @@ pub fn flip_misses(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Vec<Miss> {
     why
 }
 
-/// [`flip_misses`] in one line (`None` when the flip lands): the verdict
-/// on a replayed schedule, which has no solver and no limits of its own.
-pub fn flip_reason(flip_error_rad: f64, tilt_deg: f64, tol: f64) -> Option<String> {
-    let why: Vec<String> = flip_misses(flip_error_rad, tilt_deg, tol)
-        .iter()
-        .map(ToString::to_string)
-        .collect();
-    (!why.is_empty()).then(|| why.join("; "))
-}
-
 /// Which limits a design breaks.
 pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
     let mut why = Vec::new();
@@ -540,6 +533,20 @@ pub fn verdict(targets: &Targets, design: &DesignNumbers, simulation: &Simulated
     if !design.status.is_proven() {
         misses.push(Miss::Status(design.status));
     }
+    misses.extend(flight_misses(targets, simulation));
+    misses.extend(limit_misses(targets, design));
+    Verdict {
+        status: design.status,
+        misses,
+        error: None,
+    }
+}
+
+/// What a flight misses: the flip (at the default start) and the landing
+/// (from another start, or with `land.max_tilt_deg`), as [`Targets`] say;
+/// nothing for a failed simulation (the verdict names that).
+pub fn flight_misses(targets: &Targets, simulation: &Simulated) -> Vec<Miss> {
+    let mut misses = Vec::new();
     if let Simulated::Flip {
         flip_error_rad,
         tilt_deg,
@@ -575,12 +582,17 @@ pub fn verdict(targets: &Targets, design: &DesignNumbers, simulation: &Simulated
             });
         }
     }
-    misses.extend(limit_misses(targets, design));
-    Verdict {
-        status: design.status,
-        misses,
-        error: None,
-    }
+    misses
+}
+
+/// [`flight_misses`] in one line (`None` when it lands): the verdict on a
+/// replayed schedule, which has no solver and no limits of its own.
+pub fn flight_reason(targets: &Targets, simulation: &Simulated) -> Option<String> {
+    let why: Vec<String> = flight_misses(targets, simulation)
+        .iter()
+        .map(ToString::to_string)
+        .collect();
+    (!why.is_empty()).then(|| why.join("; "))
 }
 
 /// A result's JSON with its verdict (`"verdict": "ok" | "flagged" | ...`)
@@ -853,5 +865,37 @@ mod tests {
             ..targets()
         };
         assert!(!verdict(&today, &design(Status::Converged), &land(0.1)).flips());
+    }
+
+    /// A simulation's report is judged by its landing where the targets ask
+    /// for it (`sweep` and `simulate` judged the flip and tilt alone, and
+    /// flagged a design from a spinning start that `run` found landing).
+    #[test]
+    fn a_report_is_judged_by_its_landing_from_another_start() {
+        let report = crate::verify::simulate::SimReport {
+            flip_error_rad: 1e-8,
+            tilt_deg: 44.5,
+            landing_error_deg: 1e-6,
+            ..crate::verify::simulate::SimReport::failed()
+        };
+        let from_a_start = Targets {
+            landing_tolerance: Some((0.5, "land.max_tilt_deg")),
+            judge_flip: false,
+            ..targets()
+        };
+        let sim = Simulated::of(Ok(&report));
+        assert_eq!(flight_reason(&from_a_start, &sim), None);
+        let missed = crate::verify::simulate::SimReport {
+            landing_error_deg: 3.0,
+            ..report.clone()
+        };
+        let why = flight_reason(&from_a_start, &Simulated::of(Ok(&missed))).unwrap();
+        assert!(
+            why.contains("land.max_tilt_deg") && !why.contains("tilts"),
+            "{why}"
+        );
+        // at today's start the tilt is the flip's, judged as before
+        let why = flight_reason(&targets(), &sim).unwrap();
+        assert!(why.contains("tilts the spine"), "{why}");
     }
 }

@@ -1179,15 +1179,10 @@ fn simulate(
         // as the CLI's `simulate`
         catflip::output::ensure_finite(&serde_json::to_value(&report).expect("serialises"), &[])
             .map_err(err)?;
-        let why: Vec<String> = catflip::verdict::flip_misses(
-            report.flip_error_rad,
-            report.tilt_deg,
-            cfg.simulate.flip_tolerance,
-        )
-        .iter()
-        .map(ToString::to_string)
-        .collect();
-        let reason = (!why.is_empty()).then(|| why.join("; "));
+        let reason = catflip::verdict::flight_reason(
+            &catflip::verdict::Targets::of(&cfg.design_spec()),
+            &catflip::verdict::Simulated::of(Ok(&report)),
+        );
         Ok(Simulation {
             report,
             source,

@@ -2106,12 +2106,12 @@ fn optimize_start(
         Carried::Coarse(w) => Some(w),
     };
     let solved = design_problem(spec, problem, z0, warm, Mesh::Final, first, &mut observe)?;
-    if solved.res.status == ScpStatus::Infeasible {
+    if solved.res.status == ScpStatus::Infeasible && !lands_anyway(spec, &solved) {
         return Err(infeasible(spec, &solved));
     }
     let solved = refine_checks(spec, solved, nodes, first, &mut observe)?;
     let solved = inside_envelope(spec, solved, nodes, first, &mut observe)?;
-    if solved.res.status == ScpStatus::Infeasible {
+    if solved.res.status == ScpStatus::Infeasible && !lands_anyway(spec, &solved) {
         return Err(infeasible(spec, &solved));
     }
     let Solved {
@@ -2175,6 +2175,23 @@ fn optimize_start(
     })
 }
 
+/// Whether a design the SCP left infeasible from another start misses
+/// only the landing, and by no more than the landing's tolerance
+/// (`land.max_tilt_deg`, else `simulate.flip_tolerance`): the start may
+/// leave nothing better (a no-twist cat cannot tilt its spine at zero
+/// momentum, F1). Such a design is kept, its status `infeasible` (so the
+/// verdict flags it), rather than answered as unlandable.
+fn lands_anyway(spec: &DesignSpec, solved: &Solved) -> bool {
+    let within_motors = spec.motor.no_load_speed.is_some()
+        || spec.motor.max_speed.is_some()
+        || spec
+            .motor
+            .max_torque
+            .is_none_or(|t| solved.node_peak <= t * (1.0 + crate::verdict::tolerance::LIMIT));
+    let tolerance = crate::verdict::Targets::of(spec).landing_tolerance;
+    within_motors && tolerance.is_some_and(|(deg, _)| solved.attitude_error.to_degrees() <= deg)
+}
+
 /// The error when the SCP cannot meet the motor limits in the fall: with a
 /// torque limit alone, F7's least height for the design's peak; otherwise
 /// the pointer to the `time` objective.
@@ -2190,8 +2207,11 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
                 if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() {
                     // no height helps: the spine's tilt is out of its reach
                     "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
-                } else {
+                } else if spec.has_momentum() {
                     "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
+                } else {
+                    // at rest, a universal joint: its reach, not a spin
+                    "Within its bend limit, its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height, a larger limits.max_bend_deg or a start closer to upside down"
                 }
             ),
         };

@@ -111,6 +111,45 @@ fn a_pitched_start_is_answered_as_unlandable() {
     assert!(e.contains("cat.joint = \"universal\""), "{e}");
 }
 
+/// A tilt the body cannot undo (a no-twist cat pitched at zero momentum,
+/// F1) but which the landing's tolerance admits is a design, kept with its
+/// status (`infeasible`: the verdict flags it), not an unlandable start:
+/// its flight lands within `land.max_tilt_deg` (else
+/// `simulate.flip_tolerance`), as the phased design's does.
+#[test]
+fn a_pitch_within_the_landing_tolerance_is_designed_not_refused() {
+    for (sets, tolerance_deg) in [
+        (vec!["start.rotation_deg=[0, 0.5, 0]"], 1e-2f64.to_degrees()),
+        (
+            vec!["start.rotation_deg=[0, 2, 0]", "land.max_tilt_deg=5"],
+            5.0,
+        ),
+    ] {
+        let (cfg, r) = design(&sets);
+        assert_eq!(r.status, ScpStatus::Infeasible, "{sets:?}");
+        let spec = cfg.design_spec();
+        let flown = dynamic_landing(
+            &cfg.cat(),
+            &r.plan,
+            &Controller::from_spec(&spec),
+            &tight(),
+            &cfg.start.start(),
+            cfg.fall.margin,
+        )
+        .unwrap();
+        assert!(
+            flown.landing_error_deg <= tolerance_deg,
+            "{sets:?}: lands {} deg off",
+            flown.landing_error_deg
+        );
+        // the start's tilt is what remains: the body could not undo it
+        assert!(
+            flown.landing_error_deg > 0.4 * tolerance_deg.min(2.0),
+            "{sets:?}"
+        );
+    }
+}
+
 /// The default start keeps today's problem (full attitude `Rz(pi)`), bit for bit.
 #[test]
 fn the_default_start_is_todays_problem() {
