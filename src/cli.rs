@@ -764,7 +764,7 @@ fn cmd_export(c: &Common, format: ExportFormat, schedule: Option<&Path>) -> Resu
         // flown first, as `simulate` flies it: a schedule the model cannot
         // follow gives no controls or gains (it wrote NaN gains)
         catflip::verify::simulate::dynamic_spec(&cfg.design_spec(), &s)?;
-        catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim);
+        catflip::export::add_schedule_files(&cfg, &mut out, &s, &stem, sim)?;
     }
     for w in publisher.publish(out)? {
         say!("wrote {}", w.display());

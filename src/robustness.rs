@@ -83,7 +83,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
         move || -> catflip::Result<()> {
             let design = catflip::control::robustness::design(&cfg)?;
             *flown.lock().unwrap_or_else(|p| p.into_inner()) = Some(described(&design));
-            let mut study = Study::new(&cfg, Arc::new(design.plan), seed);
+            let mut study = Study::new(&cfg, Arc::new(design.plan), seed)?;
             study.replanning.budget_s = replan_budget_ms.map(|b| 1e-3 * b);
             // the trials' own clock: the design before them would make the
             // first trials' rate, and the time left, many times too long
@@ -231,7 +231,7 @@ pub fn cmd_trial(c: &Common, args: StudyArgs, k: usize) -> Result<Status> {
     let publisher = publisher(c, &cfg, &format!("robustness-trial-{k}"))?;
     let design = catflip::control::robustness::design(&cfg)?;
     let flown = described(&design);
-    let mut study = Study::new(&cfg, Arc::new(design.plan), args.seed);
+    let mut study = Study::new(&cfg, Arc::new(design.plan), args.seed)?;
     study.replanning.budget_s = args.replan_budget_ms.map(|b| 1e-3 * b);
     let r = study.replay(k, replay::every(study.reference.h), args.threads > 1);
     let max_tilt_deg = study.max_tilt_deg();

@@ -1669,7 +1669,7 @@ fn robustness<'py>(
         move || asked.store(true, Ordering::SeqCst),
         move || {
             let design = catflip::control::robustness::design(&cfg).map_err(err)?;
-            let study = Study::new(&cfg, std::sync::Arc::new(design.plan), seed);
+            let study = Study::new(&cfg, std::sync::Arc::new(design.plan), seed).map_err(err)?;
             // a few trials a thread at a time, so that a stop leaves little in flight
             let mut results = Vec::with_capacity(trials);
             let chunk = 4 * threads;
@@ -2095,7 +2095,7 @@ impl Controller {
                     )),
                 };
                 catflip::control::online::check_fits(&cfg, plan.plan()).map_err(err)?;
-                let mut online = Online::new(&cfg, plan.shared(), kind);
+                let mut online = Online::new(&cfg, plan.shared(), kind).map_err(err)?;
                 online.replanning.budget_s = budget_s;
                 Ok(Controller {
                     online: Mutex::new(online),
@@ -2318,8 +2318,9 @@ impl Controller {
     }
     /// The gains as the `<stem>.tvlqr.csv` text (`catflip export mjcf CONFIG --schedule S.csv`
     /// writes it for the schedule read back from its CSV). GIL released.
-    fn gains_csv(&self, py: Python<'_>) -> String {
+    fn gains_csv(&self, py: Python<'_>) -> PyResult<String> {
         py.detach(|| catflip::control::export::gains_csv(&self.cfg, self.plan.plan()))
+            .map_err(err)
     }
 
     /// The same design's controller of another `kind`, its gains reused (no new design). GIL released.

@@ -11,8 +11,8 @@ use crate::model::Joint;
 
 /// The design's gains, one row per control step, and in the header the
 /// nominal's landing under the TVLQR and under the open loop.
-pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
-    let r = Reference::new(cfg, plan);
+pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> crate::Result<String> {
+    let r = Reference::checked(cfg, plan)?;
     let tv = Tvlqr::new(&r, &cfg.control);
     let shape = match cfg.cat.joint {
         Joint::Universal => "q = the two hinge angles (qpos of the hinges), qd their rates",
@@ -122,5 +122,5 @@ pub fn gains_csv(cfg: &Config, plan: &dyn ShapePlan) -> String {
         s.push_str(&v.join(","));
         s.push('\n');
     }
-    s
+    Ok(s)
 }

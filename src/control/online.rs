@@ -80,11 +80,11 @@ pub fn check_fits(cfg: &Config, plan: &dyn crate::design::plan::ShapePlan) -> cr
 }
 
 impl Online {
-    pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> Online {
-        let design = Reference::new(cfg, plan.as_ref());
+    pub fn new(cfg: &Config, plan: SharedPlan, kind: Kind) -> crate::Result<Online> {
+        let design = Reference::checked(cfg, plan.as_ref())?;
         let tvlqr = Tvlqr::new(&design, &cfg.control);
         let open_loop = design.for_open_loop(cfg, plan.as_ref());
-        Online {
+        Ok(Online {
             kind,
             reference: if kind == Kind::OpenLoop {
                 open_loop.clone()
@@ -99,7 +99,7 @@ impl Online {
             in_flight: InFlight::new(plan.clone()),
             replanning: Replanning::new(cfg, plan),
             issued: Vec::new(),
-        }
+        })
     }
 
     /// The replans of the flight so far.

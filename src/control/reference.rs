@@ -76,6 +76,26 @@ impl Reference {
         Self::build(cfg, plan, true)
     }
 
+    /// [`Reference::new`], refused where its nominal diverges: a simulator
+    /// step too coarse for the joint PD that holds it (at 100 Hz the held
+    /// seed flies to NaN, and so would every gain and trial along it).
+    pub fn checked(cfg: &Config, plan: &dyn ShapePlan) -> crate::Result<Reference> {
+        let r = Self::new(cfg, plan);
+        if r.nominal.iter().flatten().all(|v| v.is_finite()) {
+            return Ok(r);
+        }
+        Err(crate::Error::Invalid {
+            key: "control.sim_rate_hz".into(),
+            value: format!("{}", cfg.control.sim_rate_hz),
+            expected: format!(
+                "the design's nominal flight diverges at this step ({:.3} ms) under the joint PD that \
+                 holds it (simulate.pd_bandwidth_hz = {} Hz); raise control.sim_rate_hz (default 4000 Hz)",
+                1e3 * r.h,
+                cfg.simulate.pd_bandwidth_hz
+            ),
+        })
+    }
+
     /// The feed-forward's flight from any start, never held: what the joint
     /// PD of the open loop adds its correction to (a held feed-forward would
     /// carry a second PD).

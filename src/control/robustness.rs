@@ -214,11 +214,11 @@ pub struct Study<'a> {
 }
 
 impl<'a> Study<'a> {
-    pub fn new(cfg: &'a Config, plan: SharedPlan, seed: u64) -> Study<'a> {
-        let reference = Reference::new(cfg, plan.as_ref());
+    pub fn new(cfg: &'a Config, plan: SharedPlan, seed: u64) -> crate::Result<Study<'a>> {
+        let reference = Reference::checked(cfg, plan.as_ref())?;
         let tvlqr = Tvlqr::new(&reference, &cfg.control);
         let open_loop = reference.for_open_loop(cfg, plan.as_ref());
-        Study {
+        Ok(Study {
             cfg,
             seed,
             reference,
@@ -226,7 +226,7 @@ impl<'a> Study<'a> {
             tvlqr,
             pd: Controller::from_spec(&cfg.design_spec()),
             replanning: Replanning::new(cfg, plan),
-        }
+        })
     }
 
     /// Landing tolerance, deg.

@@ -48,11 +48,12 @@ pub fn add_schedule_files(
     schedule: &crate::design::plan::Schedule,
     stem: &str,
     sim: controls::Simulator,
-) {
+) -> crate::Result<()> {
     let c = controls::Controls::sample(cfg, schedule, sim);
     out.add(format!("{stem}.{}.csv", sim.name()), c.to_csv(cfg, stem));
     out.add(
         format!("{stem}.tvlqr.csv"),
-        crate::control::export::gains_csv(cfg, schedule),
+        crate::control::export::gains_csv(cfg, schedule)?,
     );
+    Ok(())
 }

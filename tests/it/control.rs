@@ -193,7 +193,7 @@ fn the_study_is_deterministic_and_its_shards_concatenate() {
     let cfg = &cfg;
     let plan: catflip::control::replanning::SharedPlan =
         std::sync::Arc::new(catflip::control::robustness::design(cfg).unwrap().plan);
-    let study = Study::new(cfg, plan.clone(), 7);
+    let study = Study::new(cfg, plan.clone(), 7).unwrap();
     let n = 6;
     let whole = to_csv(&study.run(0..n, 2, |_, _| {}), true);
     let again = to_csv(&study.run(0..n, 1, |_, _| {}), true);
@@ -207,7 +207,7 @@ fn the_study_is_deterministic_and_its_shards_concatenate() {
         .collect();
     assert_eq!(whole, shards);
     // another seed draws other trials
-    let other = Study::new(cfg, plan, 8);
+    let other = Study::new(cfg, plan, 8).unwrap();
     assert_ne!(whole, to_csv(&other.run(0..n, 2, |_, _| {}), true));
 }
 
@@ -285,6 +285,13 @@ fn bad_input_is_refused_before_anything_is_written() {
             "its sign is drawn at random",
         ),
         (vec!["--trials", "1000001"], "--trials", "must be in"),
+        // a step the key admits, too coarse for the PD that holds the
+        // nominal: it flew to NaN, and every trial with it
+        (
+            vec!["--set", "control.sim_rate_hz=100"],
+            "control.sim_rate_hz",
+            "nominal flight diverges at this step",
+        ),
     ] {
         let mut argv = vec!["robustness", &seed, "--out", "."];
         argv.extend(&args);
@@ -303,6 +310,17 @@ fn bad_input_is_refused_before_anything_is_written() {
     // 67 steps of the default 4 kHz, at 59.7 Hz
     let cfg = crate::util::seed(&["control.rate_hz=60"]);
     assert_eq!(cfg.control.rate_hz, 60.0);
+    // the exported gains too: no file of NaN gains (export exited 0 with one)
+    let coarse = crate::util::seed(&["control.sim_rate_hz=100"]);
+    let plan = catflip::design::analytic::analytic_plan(&coarse.design_spec());
+    let e = catflip::control::export::gains_csv(&coarse, &plan).unwrap_err();
+    assert!(
+        e.is_bad_input() && e.to_string().contains("control.sim_rate_hz"),
+        "{e}"
+    );
+    let fine = crate::util::seed(&["control.sim_rate_hz=2000"]);
+    let gains = catflip::control::export::gains_csv(&fine, &plan).unwrap();
+    assert!(!gains.contains("NaN"));
 }
 
 /// A design longer than the fall is refused before any flight, naming the

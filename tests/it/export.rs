@@ -410,7 +410,7 @@ fn gains_along_a_read_back_schedule_hold_the_planned_shape() {
     for rows in [200, 2000] {
         let s = Schedule::sample(&spec.cat, &fr.plan, rows);
         let mut out = catflip::output::Output::default();
-        catflip::export::add_schedule_files(&cfg, &mut out, &s, "free", Simulator::Mujoco);
+        catflip::export::add_schedule_files(&cfg, &mut out, &s, "free", Simulator::Mujoco).unwrap();
         let (_, gains) = out.files().find(|f| f.0 == "free.tvlqr.csv").unwrap();
         let gains = std::str::from_utf8(gains).unwrap();
         let key = |k: &str| {
