@@ -456,6 +456,8 @@ impl Config {
         self.land.validate()?;
         self.control.validate()?;
         self.robustness.validate()?;
+        self.control
+            .check_delay("robustness.delay_ms", self.robustness.delay_ms)?;
         ranges::check_derived(self)?;
         ranges::impossible(self)
     }

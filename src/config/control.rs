@@ -73,6 +73,37 @@ impl Default for ControlConfig {
 const RATE_TOLERANCE: f64 = 0.05;
 
 impl ControlConfig {
+    /// A delay (`key`, ms) in [0, 1000] ms and within [`RATE_TOLERANCE`] of
+    /// a whole number of simulator steps, which is what the simulator and
+    /// the prediction apply (0.1 ms at 4 kHz was no delay at all, reported
+    /// as 0.1 ms).
+    pub fn check_delay(&self, key: &str, delay_ms: f64) -> Result<()> {
+        check(
+            key,
+            delay_ms,
+            (0.0..=1000.0).contains(&delay_ms),
+            if delay_ms < 0.0 {
+                "must be in [0, 1000] ms (a delay is never negative)"
+            } else {
+                "must be in [0, 1000] ms"
+            },
+        )?;
+        let step_ms = 1e3 / self.sim_rate_hz;
+        let applied = (delay_ms / step_ms).round() * step_ms;
+        check(
+            key,
+            delay_ms,
+            (applied - delay_ms).abs() <= RATE_TOLERANCE * delay_ms,
+            &format!(
+                "the delay is applied in whole simulator steps of {step_ms} ms (control.sim_rate_hz = {}): \
+                 this one would be {applied} ms; use e.g. {} or {} ms, or raise control.sim_rate_hz",
+                self.sim_rate_hz,
+                (delay_ms / step_ms).floor() * step_ms,
+                (delay_ms / step_ms).ceil() * step_ms,
+            ),
+        )
+    }
+
     pub fn validate(&self) -> Result<()> {
         check(
             "control.sim_rate_hz",
@@ -109,12 +140,7 @@ impl ControlConfig {
                 self.sim_rate_hz / (self.sim_rate_hz / self.rate_hz).floor().max(1.0),
             ),
         )?;
-        check(
-            "control.delay_ms",
-            self.delay_ms,
-            (0.0..=1000.0).contains(&self.delay_ms),
-            "must be in [0, 1000] ms (a delay is never negative)",
-        )?;
+        self.check_delay("control.delay_ms", self.delay_ms)?;
         for (key, v) in [
             ("control.landing_weight", self.landing_weight),
             ("control.final_shape_weight", self.final_shape_weight),
@@ -245,12 +271,6 @@ impl RobustnessConfig {
                 },
             )?;
         }
-        check(
-            "robustness.delay_ms",
-            self.delay_ms,
-            (0.0..=1000.0).contains(&self.delay_ms),
-            "must be in [0, 1000] ms (a delay is never negative)",
-        )?;
         for (key, v, hi) in [
             ("robustness.torque_noise", self.torque_noise, 10.0),
             (

@@ -259,6 +259,22 @@ fn bad_input_is_refused_before_anything_is_written() {
             "must be in",
         ),
         (
+            vec!["--set", "control.delay_ms=1001"],
+            "must be in [0, 1000] ms",
+            "is invalid",
+        ),
+        // applied in whole 0.25 ms steps: it was no delay at all, reported as 0.1 ms
+        (
+            vec!["--set", "robustness.delay_ms=0.1"],
+            "robustness.delay_ms",
+            "this one would be 0 ms; use e.g. 0 or 0.25 ms",
+        ),
+        (
+            vec!["--set", "control.delay_ms=0.1"],
+            "control.delay_ms",
+            "whole simulator steps of 0.25 ms",
+        ),
+        (
             vec!["--set", "control.rate_hz=5000"],
             "control.rate_hz",
             "must be in",
@@ -288,7 +304,14 @@ fn bad_input_is_refused_before_anything_is_written() {
         // a step the key admits, too coarse for the PD that holds the
         // nominal: it flew to NaN, and every trial with it
         (
-            vec!["--set", "control.sim_rate_hz=100"],
+            vec![
+                "--set",
+                "control.sim_rate_hz=100",
+                "--set",
+                "control.delay_ms=10",
+                "--set",
+                "robustness.delay_ms=10",
+            ],
             "control.sim_rate_hz",
             "nominal flight diverges at this step",
         ),
@@ -300,6 +323,10 @@ fn bad_input_is_refused_before_anything_is_written() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(key), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
+        assert!(
+            !err.contains("1001") || !err.contains("never negative"),
+            "{err}"
+        );
         assert_eq!(
             std::fs::read_dir(dir.path()).unwrap().count(),
             0,
@@ -311,7 +338,11 @@ fn bad_input_is_refused_before_anything_is_written() {
     let cfg = crate::util::seed(&["control.rate_hz=60"]);
     assert_eq!(cfg.control.rate_hz, 60.0);
     // the exported gains too: no file of NaN gains (export exited 0 with one)
-    let coarse = crate::util::seed(&["control.sim_rate_hz=100"]);
+    let coarse = crate::util::seed(&[
+        "control.sim_rate_hz=100",
+        "control.delay_ms=10",
+        "robustness.delay_ms=10",
+    ]);
     let plan = catflip::design::analytic::analytic_plan(&coarse.design_spec());
     let e = catflip::control::export::gains_csv(&coarse, &plan).unwrap_err();
     assert!(
