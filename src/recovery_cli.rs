@@ -116,7 +116,7 @@ pub fn cmd_recovery(
     let mut out = Output::default();
     out.add(
         format!("recovery{suffix}.csv"),
-        to_csv(&results, range.start == 0),
+        to_csv(&results, shard.index == 1),
     );
     out.add(format!("recovery{suffix}.json"), json.clone());
     let figs = figures(&results, &grid)?;

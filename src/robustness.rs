@@ -131,7 +131,7 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     let mut out = Output::default();
     out.add(
         format!("robustness{suffix}.csv"),
-        to_csv(&results, range.start == 0),
+        to_csv(&results, shard.index == 1),
     );
     out.add(format!("robustness{suffix}.json"), json.clone());
     // wall times: beside the study's files, not in them (they differ run to run)

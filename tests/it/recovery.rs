@@ -121,6 +121,20 @@ fn shards_concatenate_to_the_whole_map_and_the_figures_are_svg() {
         joined.push_str(&std::fs::read_to_string(f).unwrap());
     }
     assert_eq!(joined, whole);
+    // more shards than lines: the header in the first shard's alone, empty
+    // here (the second, whose line starts at 0 too, wrote one as well)
+    for k in 1..=2 {
+        let shard = format!("{k}/6");
+        let (code, out, err) = recovery(dir.path(), &["--shard", &shard]);
+        assert_eq!(code, Some(0), "{shard}: {out}{err}");
+        let f = dir
+            .path()
+            .join(format!("out/seed/recovery.shard-{k}-of-6"))
+            .join(format!("recovery.shard-{k}-of-6.csv"));
+        let lines = std::fs::read_to_string(f).unwrap().lines().count();
+        // the header; the second shard's line, two starts
+        assert_eq!(lines, if k == 1 { 1 } else { 2 }, "{shard}");
+    }
     let html = std::fs::read_to_string(set.join("index.html")).unwrap();
     for f in [
         "recovery-spin.svg",
