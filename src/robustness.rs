@@ -136,6 +136,19 @@ pub fn cmd_robustness(c: &Common, args: StudyArgs) -> Result<Status> {
     out.add(format!("robustness{suffix}.json"), json.clone());
     // wall times: beside the study's files, not in them (they differ run to run)
     let timing = replan_timing(&results, cfg.control.period());
+    // a resume that flew no trial keeps the times of the run that did (it
+    // would write none)
+    let timing = match timing.trials_timed {
+        0 if resume => std::fs::read_to_string(
+            publisher
+                .link()
+                .join(format!("robustness{suffix}.timing.json")),
+        )
+        .ok()
+        .and_then(|t| serde_json::from_str(&t).ok())
+        .unwrap_or(timing),
+        _ => timing,
+    };
     out.add(
         format!("robustness{suffix}.timing.json"),
         serde_json::to_string_pretty(&timing)?,

@@ -129,7 +129,15 @@ pub fn replans(timing: &ReplanTiming) -> Option<String> {
             1e3 * timing.solve_max_s,
             timing.over_period,
             1e3 * timing.period_s
-        )
+        ) + &if timing.trials_timed < timing.trials {
+            format!(
+                "; of the {} flown by this run, not the {} a --resume kept",
+                super::count(timing.trials_timed, "trial"),
+                timing.trials - timing.trials_timed
+            )
+        } else {
+            String::new()
+        }
     })
 }
 
@@ -139,6 +147,8 @@ mod tests {
 
     fn timing(p99_ms: f64, over: usize) -> ReplanTiming {
         ReplanTiming {
+            trials_timed: 10,
+            trials: 10,
             replans: 500,
             taken: 40,
             failed: 0,

@@ -13,7 +13,7 @@ use crate::config::Config;
 use crate::model::momentum::Start;
 use crate::model::{Cat, Half};
 use crate::verify::simulate::Controller;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// Landing tolerance of a study when `land.max_tilt_deg` is not set, deg.
 pub const DEFAULT_MAX_TILT_DEG: f64 = 10.0;
@@ -453,8 +453,12 @@ pub fn summarise(results: &[TrialResult], seed: u64, max_tilt_deg: f64, keep: us
 
 /// The replanning controller's replans over a study's flown trials: wall
 /// times on this machine, so outside the study's deterministic files.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct ReplanTiming {
+    /// Trials whose replans are timed here, of `trials`: those a `--resume`
+    /// kept were flown before, their times not kept.
+    pub trials_timed: usize,
+    pub trials: usize,
     pub replans: usize,
     pub taken: usize,
     pub failed: usize,
@@ -481,6 +485,8 @@ pub fn replan_timing(results: &[TrialResult], period_s: f64) -> ReplanTiming {
     let mut solve: Vec<f64> = all.iter().map(|r| r.solve_seconds).collect();
     solve.sort_by(f64::total_cmp);
     ReplanTiming {
+        trials_timed: results.iter().filter(|r| !r.replans.is_empty()).count(),
+        trials: results.len(),
         replans: all.len(),
         taken: count(Outcome::Taken),
         failed: count(Outcome::Failed),

@@ -1151,6 +1151,23 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     let state: serde_json::Value =
         serde_json::from_str(&read(set("part").join("robustness.state.json"))).unwrap();
     assert_eq!(state["status"], "complete");
+    // the replans' times are those of the trials this run flew, and say so
+    let timing = read(set("part").join("robustness.timing.json"));
+    let t: serde_json::Value = serde_json::from_str(&timing).unwrap();
+    assert_eq!(
+        (t["trials_timed"].as_u64(), t["trials"].as_u64()),
+        (Some(40 - done as u64), Some(40))
+    );
+    assert!(t["replans"].as_u64().unwrap() > 0, "{timing}");
+    let said = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        said.contains(&format!("not the {done} a --resume kept")),
+        "{said}"
+    );
+    // resumed when complete: nothing flown, the times kept (they read 0 replans)
+    let o = run(&strs(&resume), dir.path());
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(read(set("part").join("robustness.timing.json")), timing);
 }
 
 /// A command that publishes no partial set (`run`, `size`, the designs)
