@@ -392,6 +392,7 @@ fn page(
         ),
     ];
     notes.extend(catflip::console::robustness::nearest_rank(s.trials));
+    notes.extend(catflip::console::robustness::diverged(s));
     if let Some((_, bins)) = figure {
         notes.extend(catflip::control::figure::bins_note(bins));
     }

@@ -45,6 +45,9 @@ pub fn study(
     if let Some(note) = nearest_rank(trials) {
         lines.push(format!("  {note}"));
     }
+    if let Some(note) = diverged(summary) {
+        lines.push(format!("  {note}"));
+    }
     if let Some(line) = replans(timing) {
         lines.push(format!("  {line}"));
     }
@@ -52,6 +55,23 @@ pub fn study(
         lines.push(format!("  wrote {}", p.display()));
     }
     lines
+}
+
+/// The flights that diverged, per controller, when any did: they count as
+/// 180 deg, which alone cannot tell them from a landing upside down.
+pub fn diverged(summary: &Summary) -> Option<String> {
+    let by: Vec<String> = summary
+        .controllers
+        .iter()
+        .filter(|c| c.diverged > 0)
+        .map(|c| format!("{} {}", c.name, c.diverged))
+        .collect();
+    (!by.is_empty()).then(|| {
+        format!(
+            "Flights that diverged (counted as 180 deg): {}.",
+            by.join(", ")
+        )
+    })
 }
 
 /// What the percentiles of a study of `trials` are, when p99 is its largest

@@ -367,6 +367,8 @@ pub struct ControllerSummary {
     pub successes: usize,
     pub success_rate: f64,
     pub ci95: [f64; 2],
+    /// Flights that diverged (their landing error is not a number).
+    pub diverged: usize,
     /// Landing error percentiles, deg (a diverged flight counts as 180).
     pub landing_error_deg: Percentiles,
     pub worst: Vec<Worst>,
@@ -425,6 +427,10 @@ pub fn summarise(results: &[TrialResult], seed: u64, max_tilt_deg: f64, keep: us
                     k as f64 / results.len() as f64
                 },
                 ci95: wilson(k, results.len()),
+                diverged: results
+                    .iter()
+                    .filter(|r| r.landing_error_deg[c].is_nan())
+                    .count(),
                 landing_error_deg: Percentiles {
                     p50: percentile(&sorted, 0.5),
                     p90: percentile(&sorted, 0.9),
@@ -588,6 +594,29 @@ pub fn shard_range(trials: usize, k: usize, n: usize) -> std::ops::Range<usize> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A diverged flight (NaN) fails, counts as 180 deg, and is counted
+    /// apart, per controller, with a sentence that says so.
+    #[test]
+    fn diverged_flights_are_counted_apart() {
+        let row = |k: usize, open: &str| format!("{k},0,0,0,0,0,0,0,0,0,0,0,1,{open},0.5,0.5");
+        let csv = [row(0, "NaN"), row(1, "1"), row(2, "NaN")].join("\n");
+        let s = summarise(&from_csv(&csv).unwrap(), 1, 10.0, 2);
+        let open = &s.controllers[0];
+        assert_eq!((open.diverged, open.successes), (2, 1));
+        assert_eq!(open.landing_error_deg.max, 180.0);
+        assert_eq!(
+            (s.controllers[1].diverged, s.controllers[1].successes),
+            (0, 3)
+        );
+        let note = crate::console::robustness::diverged(&s).unwrap();
+        assert!(
+            note.contains("open-loop 2") && !note.contains("tvlqr"),
+            "{note}"
+        );
+        let none = summarise(&from_csv(&row(0, "1")).unwrap(), 1, 10.0, 2);
+        assert_eq!(crate::console::robustness::diverged(&none), None);
+    }
 
     /// Wilson's interval against its closed form at the ends and a textbook value.
     #[test]
