@@ -72,6 +72,12 @@ impl Default for ControlConfig {
 /// 59.7 on the default 4 kHz steps; 3000 Hz would run at 4000.
 const RATE_TOLERANCE: f64 = 0.05;
 
+/// `x` to three decimals, as a message suggests a value (1333.333, not
+/// 1333.3333333333333).
+fn round3(x: f64) -> f64 {
+    (x * 1e3).round() / 1e3
+}
+
 impl ControlConfig {
     /// A delay (`key`, ms) in [0, 1000] ms and within [`RATE_TOLERANCE`] of
     /// a whole number of simulator steps, which is what the simulator and
@@ -96,10 +102,11 @@ impl ControlConfig {
             (applied - delay_ms).abs() <= RATE_TOLERANCE * delay_ms,
             &format!(
                 "the delay is applied in whole simulator steps of {step_ms} ms (control.sim_rate_hz = {}): \
-                 this one would be {applied} ms; use e.g. {} or {} ms, or raise control.sim_rate_hz",
+                 this one would be {} ms; use e.g. {} or {} ms, or raise control.sim_rate_hz",
                 self.sim_rate_hz,
-                (delay_ms / step_ms).floor() * step_ms,
-                (delay_ms / step_ms).ceil() * step_ms,
+                round3(applied),
+                round3((delay_ms / step_ms).floor() * step_ms),
+                round3((delay_ms / step_ms).ceil() * step_ms),
             ),
         )
     }
@@ -135,9 +142,9 @@ impl ControlConfig {
                 "the feedback acts every whole simulator step (control.sim_rate_hz = {}): this rate would run at {} Hz; \
                  use a rate that divides the simulator's evenly, e.g. {} or {} Hz, or set control.sim_rate_hz to a multiple of it",
                 self.sim_rate_hz,
-                applied,
-                self.sim_rate_hz / (self.sim_rate_hz / self.rate_hz).ceil(),
-                self.sim_rate_hz / (self.sim_rate_hz / self.rate_hz).floor().max(1.0),
+                round3(applied),
+                round3(self.sim_rate_hz / (self.sim_rate_hz / self.rate_hz).ceil()),
+                round3(self.sim_rate_hz / (self.sim_rate_hz / self.rate_hz).floor().max(1.0)),
             ),
         )?;
         self.check_delay("control.delay_ms", self.delay_ms)?;

@@ -300,6 +300,12 @@ fn bad_input_is_refused_before_anything_is_written() {
             "control.rate_hz",
             "would run at 4000 Hz; use a rate that divides the simulator's evenly, e.g. 2000 or 4000 Hz",
         ),
+        // the rates it suggests as a person would type them
+        (
+            vec!["--set", "control.rate_hz=1500"],
+            "control.rate_hz",
+            "would run at 1333.333 Hz; use a rate that divides the simulator's evenly, e.g. 1333.333 or 2000 Hz",
+        ),
         (
             vec!["--set", "robustness.mass_error=1.0"],
             "robustness.mass_error",
