@@ -126,6 +126,10 @@ pub struct Targets {
     pub no_load_speed: Option<f64>,
     pub max_speed: Option<f64>,
     pub max_bend_deg: Option<f64>,
+    /// Without `limits.max_bend_deg`, the largest bend a two-cylinder cat
+    /// allows, deg: bent further its halves pass through each other (the
+    /// optimisers are free to, the body is not).
+    pub geometric_bend_deg: Option<f64>,
     /// Largest flip error and spine tilt, rad.
     pub flip_tolerance: f64,
     /// Largest landing error, deg, when the landing is judged (`land.max_tilt_deg`,
@@ -147,6 +151,16 @@ impl Targets {
             no_load_speed: spec.motor.no_load_speed,
             max_speed: spec.motor.max_speed,
             max_bend_deg: spec.max_bend_deg,
+            geometric_bend_deg: (spec.max_bend_deg.is_none() && spec.cat.general.is_none()).then(
+                || {
+                    let (rear, front) = (&spec.cat.rear, &spec.cat.front);
+                    let theta = crate::config::ranges::closest_theta_of(
+                        rear.length.min(front.length),
+                        rear.radius + front.radius,
+                    );
+                    180.0 - theta.to_degrees()
+                },
+            ),
             flip_tolerance: spec.simulate.flip_tolerance,
             landing_tolerance: match spec.max_tilt_deg {
                 Some(t) => Some((t, "land.max_tilt_deg")),
@@ -520,6 +534,17 @@ pub fn limit_misses(targets: &Targets, d: &DesignNumbers) -> Vec<Miss> {
             name: targets.limits_from.name("limits.max_bend_deg"),
         });
     }
+    if let Some(limit) = targets.geometric_bend_deg
+        && d.bend_deg > limit * (1.0 + tolerance::LIMIT)
+    {
+        why.push(Miss::Bend {
+            bend_deg: d.bend_deg,
+            limit: (limit * 100.0).floor() / 100.0,
+            name: "the largest bend this cat allows (its halves meet there; \
+                   limits.max_bend_deg keeps the designs inside it)"
+                .into(),
+        });
+    }
     why
 }
 
@@ -627,6 +652,7 @@ mod tests {
             no_load_speed: None,
             max_speed: Some(10.0),
             max_bend_deg: Some(90.0),
+            geometric_bend_deg: None,
             flip_tolerance: 0.01,
             landing_tolerance: None,
             judge_flip: true,
@@ -865,6 +891,37 @@ mod tests {
             ..targets()
         };
         assert!(!verdict(&today, &design(Status::Converged), &land(0.1)).flips());
+    }
+
+    /// Without a bend limit a design past the bend at which the cylinders
+    /// meet is flagged (the seed's: 168.46 deg, the config's own check);
+    /// with a limit, the limit judges alone.
+    #[test]
+    fn a_bend_through_the_body_is_flagged_without_a_limit() {
+        let seed =
+            std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/configs/seed.toml"))
+                .unwrap();
+        let spec = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            crate::test_support::spec_of(&seed, "seed.toml", &sets)
+        };
+        let t = Targets::of(&spec(&[]));
+        let g = t.geometric_bend_deg.unwrap();
+        assert!((g - 168.46).abs() < 0.005, "{g}");
+        let mut d = design(Status::Converged);
+        d.bend_deg = 168.0;
+        assert!(limit_misses(&t, &d).is_empty());
+        d.bend_deg = 175.86;
+        let why: Vec<String> = limit_misses(&t, &d).iter().map(|m| m.to_string()).collect();
+        assert_eq!(why.len(), 1, "{why:?}");
+        assert!(
+            why[0].starts_with("bends 175.86 deg, above the largest bend this cat allows")
+                && why[0].ends_with("= 168.46 deg"),
+            "{why:?}"
+        );
+        let limited = Targets::of(&spec(&["limits.max_bend_deg=160"]));
+        assert_eq!(limited.geometric_bend_deg, None);
+        assert_eq!(limit_misses(&limited, &d).len(), 1);
     }
 
     /// A simulation's report is judged by its landing where the targets ask
