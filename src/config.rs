@@ -147,6 +147,21 @@ const TYPE_WORDS: &[(&str, &str, ValueKind)] = &[
         "expected a list such as [0.25, 0.5, 0.25]",
         ValueKind::List,
     ),
+    (
+        "expected an array of length 3",
+        "expected a list of 3 numbers such as [0, 0, 0.5]",
+        ValueKind::List,
+    ),
+    (
+        "expected fewer elements in array",
+        "expected a list of 3 numbers such as [0, 0, 0.5]",
+        ValueKind::List,
+    ),
+    (
+        "expected a boolean",
+        "expected true or false",
+        ValueKind::Switch,
+    ),
 ];
 
 /// The keys a config must give (every other has a default), by the field
@@ -771,6 +786,17 @@ gravity = 9.8
             ("cat.joint=true", "expected a name", ValueKind::Name),
             ("name=1", "expected a name", ValueKind::Name),
             ("analytic.split=1", "expected a list", ValueKind::List),
+            (
+                "start.angular_velocity=1",
+                "expected a list of 3 numbers such as [0, 0, 0.5]",
+                ValueKind::List,
+            ),
+            (
+                "start.rotation_deg=[0, 0, 0, 1]",
+                "invalid length 4, expected a list of 3 numbers",
+                ValueKind::List,
+            ),
+            ("simulate.pd=1", "expected true or false", ValueKind::Switch),
         ] {
             let e = Config::from_toml(SEED, "t", &[set.into()]).unwrap_err();
             // the kind is typed, for callers such as the sweep
@@ -780,7 +806,15 @@ gravity = 9.8
             );
             let e = e.to_string();
             assert!(e.contains(plain), "{set}: {e}");
-            for rust in ["f64", "usize", "variant", "sequence", "expected a string"] {
+            for rust in [
+                "f64",
+                "usize",
+                "variant",
+                "sequence",
+                "expected a string",
+                "array",
+                "boolean",
+            ] {
                 assert!(!e.contains(rust), "{set}: {e}");
             }
         }

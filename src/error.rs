@@ -130,6 +130,8 @@ pub enum ValueKind {
     Name,
     /// A list, such as `[0.25, 0.5, 0.25]`.
     List,
+    /// `true` or `false`.
+    Switch,
 }
 
 impl ValueKind {
@@ -139,6 +141,7 @@ impl ValueKind {
             ValueKind::Number => "a number",
             ValueKind::Name => "a name",
             ValueKind::List => "a list",
+            ValueKind::Switch => "true or false",
         }
     }
 }

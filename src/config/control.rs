@@ -79,10 +79,11 @@ fn round3(x: f64) -> f64 {
 }
 
 impl ControlConfig {
-    /// A delay (`key`, ms) in [0, 1000] ms and within [`RATE_TOLERANCE`] of
-    /// a whole number of simulator steps, which is what the simulator and
-    /// the prediction apply (0.1 ms at 4 kHz was no delay at all, reported
-    /// as 0.1 ms).
+    /// A delay (`key`, ms) in [0, 1000] ms, and at least half a simulator
+    /// step when not 0: the simulator and the prediction apply it in whole
+    /// steps (0.1 ms at 4 kHz was no delay at all, reported as 0.1 ms). A
+    /// delay further than [`RATE_TOLERANCE`] from whole steps is a warning
+    /// ([`ControlConfig::delay_slip`]).
     pub fn check_delay(&self, key: &str, delay_ms: f64) -> Result<()> {
         check(
             key,
@@ -95,20 +96,35 @@ impl ControlConfig {
             },
         )?;
         let step_ms = 1e3 / self.sim_rate_hz;
-        let applied = (delay_ms / step_ms).round() * step_ms;
         check(
             key,
             delay_ms,
-            (applied - delay_ms).abs() <= RATE_TOLERANCE * delay_ms,
+            delay_ms == 0.0 || (delay_ms / step_ms).round() >= 1.0,
             &format!(
-                "the delay is applied in whole simulator steps of {step_ms} ms (control.sim_rate_hz = {}): \
-                 this one would be {} ms; use e.g. {} or {} ms, or raise control.sim_rate_hz",
+                "the delay is applied in whole simulator steps of {} ms (control.sim_rate_hz = {}): \
+                 this one would be no delay at all; use 0 or {} ms, or raise control.sim_rate_hz",
+                round3(step_ms),
                 self.sim_rate_hz,
-                round3(applied),
-                round3((delay_ms / step_ms).floor() * step_ms),
-                round3((delay_ms / step_ms).ceil() * step_ms),
+                round3(step_ms),
             ),
         )
+    }
+
+    /// A delay (`key`, ms) that whole simulator steps change by more than
+    /// [`RATE_TOLERANCE`]: what is applied, in words (a warning).
+    pub fn delay_slip(&self, delay_ms: f64) -> Option<String> {
+        let step_ms = 1e3 / self.sim_rate_hz;
+        let applied = (delay_ms / step_ms).round() * step_ms;
+        ((applied - delay_ms).abs() > RATE_TOLERANCE * delay_ms).then(|| {
+            format!(
+                "applied in whole simulator steps of {} ms (control.sim_rate_hz = {}), it is {} ms; \
+                 give a multiple of {} ms, or raise control.sim_rate_hz?",
+                round3(step_ms),
+                self.sim_rate_hz,
+                round3(applied),
+                round3(step_ms),
+            )
+        })
     }
 
     pub fn validate(&self) -> Result<()> {

@@ -566,6 +566,14 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             ),
         );
     }
+    for (key, delay_ms) in [
+        ("control.delay_ms", cfg.control.delay_ms),
+        ("robustness.delay_ms", cfg.robustness.delay_ms),
+    ] {
+        if let Some(message) = cfg.control.delay_slip(delay_ms) {
+            warn(key, message);
+        }
+    }
     out
 }
 

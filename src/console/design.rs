@@ -90,8 +90,9 @@ pub fn simulation(title: &str, r: &SimReport) -> Rows {
         "flip",
         format!("{:.6} deg (error {:.2e} rad)", r.flip_deg, r.flip_error_rad),
     )
-    .row("tilt", format!("{:.3e} deg", r.tilt_deg))
-    .row(
+    .row("tilt", format!("{:.3e} deg", r.tilt_deg));
+    landing_row(&mut t, r);
+    t.row(
         "final shape / rate error",
         format!(
             "{:.2e} rad / {:.2e} rad/s",
@@ -127,6 +128,18 @@ pub fn simulation_title(cfg: &Config, source: &str) -> String {
     )
 }
 
+/// The belly's angle from straight down at touchdown, where the flight
+/// has one: from another start it is the verdict's number (the tilt then
+/// includes the heading's turn, which does not matter).
+fn landing_row(t: &mut Rows, sim: &SimReport) {
+    if sim.landing_error_deg.is_finite() {
+        t.row(
+            "landing",
+            format!("{:.3e} deg from belly-down", sim.landing_error_deg),
+        );
+    }
+}
+
 /// The rows both optimisers print: timing, the flight, solve time, files.
 fn design_rows(
     t: &mut Rows,
@@ -147,10 +160,11 @@ fn design_rows(
             sim.flip_deg, sim.flip_error_rad
         ),
     )
-    .row("tilt", format!("{:.3e} deg", sim.tilt_deg))
-    .row("sim peak torque", format!("{:.5} N m", sim.peak_torque_nm))
-    .row("solve time", solve)
-    .wrote(written);
+    .row("tilt", format!("{:.3e} deg", sim.tilt_deg));
+    landing_row(t, sim);
+    t.row("sim peak torque", format!("{:.5} N m", sim.peak_torque_nm))
+        .row("solve time", solve)
+        .wrote(written);
 }
 
 /// The largest change of the objective at twice the nodes for which the

@@ -259,11 +259,11 @@ impl SweepState {
         let limited = self.limited(key);
         let what = if limited && self.least_height_only {
             format!(
-                "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left out (empty in the CSV); under a stall torque alone they come from the peaks (F7), which are then given. Below the configured {height} m (fall.height) the flip is possible there"
+                "only the least drop heights were asked for (--least-height-only): inside a motor envelope they are those of the phased and free-form time designs, each point's answer being the lower one that verifies, and the peak columns are left out (empty in the CSV); under a stall torque alone they come from the peaks (F7), which are then given. Where a point's least height is below the configured {height} m (fall.height), the flip is possible from that height"
             )
         } else if limited {
             format!(
-                "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: below the configured {height} m (fall.height) the flip is possible there. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)"
+                "the peak columns are the least-peak designs without the motor limits (the torque each method needs); the motors enter through the least drop heights, those of the phased and free-form time designs inside the motor envelope, each point's answer being the lower one that verifies: where it is below the configured {height} m (fall.height), the flip is possible from that height. A continued point may find a lower least height than `catflip run` (another local optimum; within 0.5 %, docs/usage.md)"
             )
         } else {
             "each point designed by each method as `catflip run` designs it (no motor limits)"

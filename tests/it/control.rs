@@ -277,7 +277,7 @@ fn bad_input_is_refused_before_anything_is_written() {
         (
             vec!["--set", "robustness.delay_ms=0.1"],
             "robustness.delay_ms",
-            "this one would be 0 ms; use e.g. 0 or 0.25 ms",
+            "this one would be no delay at all; use 0 or 0.25 ms",
         ),
         (
             vec!["--set", "control.delay_ms=0.1"],
@@ -353,6 +353,24 @@ fn bad_input_is_refused_before_anything_is_written() {
     // 67 steps of the default 4 kHz, at 59.7 Hz
     let cfg = crate::util::seed(&["control.rate_hz=60"]);
     assert_eq!(cfg.control.rate_hz, 60.0);
+    // a delay whole steps change by more than 5 % is taken, with a warning
+    // naming what is applied; within 5 %, silently
+    let slips = |sets: &[&str]| -> Vec<String> {
+        crate::util::seed(sets)
+            .slips()
+            .iter()
+            .map(|s| s.to_string())
+            .filter(|s| s.contains("delay_ms"))
+            .collect()
+    };
+    assert!(slips(&["control.delay_ms=4.9"]).is_empty());
+    let w = slips(&["control.delay_ms=0.2"]);
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert!(
+        w[0].starts_with("control.delay_ms: applied in whole simulator steps of 0.25 ms")
+            && w[0].contains("it is 0.25 ms"),
+        "{w:?}"
+    );
     // the exported gains too: no file of NaN gains (export exited 0 with one)
     let coarse = crate::util::seed(&[
         "control.sim_rate_hz=100",
