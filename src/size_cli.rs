@@ -31,9 +31,10 @@ pub(crate) fn cmd_size(c: &Common, height: f64, settings: SizeSettings) -> Resul
     })?;
     settings.validate()?;
     let q = catflip::size::question(&cfg, height)?;
-    // (not a --set, refused above: the file's own)
+    // (not a --set, refused above: the file's own; `time` is size's own)
+    use catflip::design::objective::Objective;
     let objective = cfg.design.objective;
-    if objective != catflip::design::objective::Objective::default() {
+    if !matches!(objective, Objective::PeakTorque | Objective::Time) {
         eprintln!(
             "warning: {} sets design.objective = \"{}\", which `catflip size` does not use: \
              it sizes the motors for the least height, a least-time design",

@@ -72,6 +72,11 @@ impl std::str::FromStr for SweepSpec {
                 "COUNT 1 computes FROM alone, not the range to {to}: give {from}:{from}:1 for one point, or a COUNT of 2 or more"
             )));
         }
+        if count > 1 && from == to {
+            return Err(bad(&format!(
+                "FROM and TO are both {from}: the {count} points would be one point designed {count} times; give {from}:{from}:1, or another TO"
+            )));
+        }
         if count > MAX_POINTS {
             return Err(bad(&format!(
                 "COUNT {count} is more than the {MAX_POINTS} points a sweep may have; split the range into several sweeps"

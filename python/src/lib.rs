@@ -563,12 +563,20 @@ impl Config {
             let cfg = match s.source.load(Some(&arg)) {
                 Ok(cfg) => cfg,
                 // a whole float (numpy's 40.0) where a whole number is
-                // expected, as `sweep` takes its values; else the first error
-                Err(e) => match whole_number(value).and_then(|w| {
-                    let whole = format!("{key}={w}");
-                    s.source.load(Some(&whole)).ok().map(|c| (whole, c))
+                // expected, as `sweep` takes its values; where that is refused
+                // too, its reason (the value's, not its type's)
+                Err(e) => match whole_number(value).filter(|_| {
+                    matches!(
+                        e,
+                        catflip::Error::Override {
+                            expects: Some(catflip::error::ValueKind::Number),
+                            ..
+                        }
+                    )
                 }) {
-                    Some((whole, cfg)) => {
+                    Some(w) => {
+                        let whole = format!("{key}={w}");
+                        let cfg = s.source.load(Some(&whole)).map_err(err)?;
                         arg = whole;
                         cfg
                     }

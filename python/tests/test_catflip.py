@@ -166,6 +166,11 @@ def test_a_whole_float_sets_a_whole_number_key_as_sweep_takes_it():
     assert by_float.to_dict()["fall"]["height"] == 4.0
     with pytest.raises(catflip.ConfigError, match="phased.nodes=40.5"):
         by_float.set("phased.nodes", 40.5)
+    # a whole float the key refuses for its value says why, not its type
+    with pytest.raises(catflip.ConfigError) as e:
+        by_float.set("phased.nodes", 1.0)
+    assert "`phased.nodes` = 1 is invalid: must be" in str(e.value), str(e.value)
+    assert "floating point" not in str(e.value)
 
 
 def test_bad_files_raise_config_error_with_the_cli_message(tmp_path):

@@ -118,7 +118,7 @@ impl ControlConfig {
         ((applied - delay_ms).abs() > RATE_TOLERANCE * delay_ms).then(|| {
             format!(
                 "applied in whole simulator steps of {} ms (control.sim_rate_hz = {}), it is {} ms; \
-                 give a multiple of {} ms, or raise control.sim_rate_hz?",
+                 give a multiple of {} ms, or raise control.sim_rate_hz",
                 round3(step_ms),
                 self.sim_rate_hz,
                 round3(applied),

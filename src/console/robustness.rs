@@ -151,9 +151,8 @@ pub fn replans(timing: &ReplanTiming) -> Option<String> {
             1e3 * timing.period_s
         ) + &if timing.trials_timed < timing.trials {
             format!(
-                "; of the {} flown by this run, not the {} a --resume kept",
-                super::count(timing.trials_timed, "trial"),
-                timing.trials - timing.trials_timed
+                "; timed over {} of the {} (a --resume times the trials it flies, not those it kept)",
+                timing.trials_timed, timing.trials
             )
         } else {
             String::new()

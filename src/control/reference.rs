@@ -89,7 +89,8 @@ impl Reference {
             value: format!("{}", cfg.control.sim_rate_hz),
             expected: format!(
                 "the design's nominal flight diverges at this step ({:.3} ms) under the joint PD that \
-                 holds it (simulate.pd_bandwidth_hz = {} Hz); raise control.sim_rate_hz (default 4000 Hz)",
+                 holds it (simulate.pd_bandwidth_hz = {} Hz); raise control.sim_rate_hz (default 4000 Hz) \
+                 or lower simulate.pd_bandwidth_hz",
                 1e3 * r.h,
                 cfg.simulate.pd_bandwidth_hz
             ),

@@ -2182,14 +2182,27 @@ fn optimize_start(
 /// momentum, F1). Such a design is kept, its status `infeasible` (so the
 /// verdict flags it), rather than answered as unlandable.
 fn lands_anyway(spec: &DesignSpec, solved: &Solved) -> bool {
-    let within_motors = spec.motor.no_load_speed.is_some()
-        || spec.motor.max_speed.is_some()
-        || spec
-            .motor
-            .max_torque
-            .is_none_or(|t| solved.node_peak <= t * (1.0 + crate::verdict::tolerance::LIMIT));
-    let tolerance = crate::verdict::Targets::of(spec).landing_tolerance;
-    within_motors && tolerance.is_some_and(|(deg, _)| solved.attitude_error.to_degrees() <= deg)
+    if spec.is_default_start() {
+        // today's problem: an infeasible design is the motors' answer
+        return false;
+    }
+    let within_tolerance = crate::verdict::Targets::of(spec)
+        .landing_tolerance
+        .is_some_and(|(deg, _)| solved.attitude_error.to_degrees() <= deg);
+    // the motors kept at every written row: the envelope's margin, else the
+    // peak against the stall torque
+    let within_motors = || {
+        if spec.motor.no_load_speed.is_some() || spec.motor.max_speed.is_some() {
+            crate::design::envelope::usage_of(spec, &solved.plan)
+                .min_margin
+                .is_none_or(|m| m >= -crate::verdict::tolerance::ENVELOPE_MARGIN)
+        } else {
+            spec.motor
+                .max_torque
+                .is_none_or(|t| solved.node_peak <= t * (1.0 + crate::verdict::tolerance::LIMIT))
+        }
+    };
+    within_tolerance && within_motors()
 }
 
 /// The error when the SCP cannot meet the motor limits in the fall: with a
@@ -2209,9 +2222,11 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
                     "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
                 } else if spec.has_momentum() {
                     "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
-                } else {
+                } else if spec.max_bend_deg.is_some() {
                     // at rest, a universal joint: its reach, not a spin
                     "Within its bend limit, its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height, a larger limits.max_bend_deg or a start closer to upside down"
+                } else {
+                    "Within its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height or a start closer to upside down"
                 }
             ),
         };

@@ -844,6 +844,11 @@ fn the_small_inconsistencies_are_fixed() {
         &["sweep", &seed, "--set-range", "fall.height=1:10:1"],
         &["--set-range", "COUNT 1", "1:1:1"],
     );
+    // and so is one point given several times (it designed each)
+    refused(
+        &["sweep", &seed, "--set-range", "fall.height=5:5:3"],
+        &["--set-range", "one point designed 3 times", "5:5:1"],
+    );
     let o = run(
         &[
             "sweep",
@@ -1161,7 +1166,7 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     assert!(t["replans"].as_u64().unwrap() > 0, "{timing}");
     let said = String::from_utf8_lossy(&o.stdout);
     assert!(
-        said.contains(&format!("not the {done} a --resume kept")),
+        said.contains(&format!("timed over {} of the 40 (a --resume", 40 - done)),
         "{said}"
     );
     // resumed when complete: nothing flown, the times kept (they read 0 replans)
