@@ -100,7 +100,7 @@ pub struct DesignConfig {
 pub struct LimitsConfig {
     /// N m, largest joint torque the motors can give (default: none).
     pub max_torque: Option<f64>,
-    /// Degrees, largest bend the optimisers may use (default: none: the free-form design is then unbounded, while the phased design's bend search stops at 175).
+    /// Degrees, largest bend the optimisers may use (default: none: the free-form design is then unbounded, while the phased design's bend search stops at `phased.bend_max_deg`, 175 at most).
     pub max_bend_deg: Option<f64>,
     /// Peak norm: `euclidean` or `per-motor` (default: euclidean for no-twist, per-motor for universal).
     pub norm: Option<TorqueNorm>,

@@ -271,7 +271,7 @@ fn round_down_to_digits(x: f64, digits: i32) -> f64 {
 /// from a motor that is speeding up but gives more while braking
 /// (`T + k |w|`), and a joint can outrun the no-load speed through the
 /// other's reaction, so under the line this is a bound only for designs
-/// that stay within the stall torque (the robot's answer brakes with 2.0 N m
+/// that stay within the stall torque (the robot's answer brakes with 1.69 N m
 /// against 1.4; it is 7 times this time); the design is a local optimum,
 /// the bound the best one found. Its torque is continuous (`free.torque_jumps` off): it
 /// seeds the time design, whose grid is continuous (seeded by a design with

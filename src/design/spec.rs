@@ -28,7 +28,7 @@ pub struct DesignSpec {
     pub start: Option<Start>,
     pub objective: Objective,
     /// Largest bend the optimisers may use, deg; `None`: the free-form design
-    /// is unbounded and the phased bend search stops at 175 deg.
+    /// is unbounded and the phased bend search stops at `phased.bend_max_deg` (175 at most).
     pub max_bend_deg: Option<f64>,
     /// Largest angle of the belly from straight down at touchdown, deg
     /// (`None`: the flip judged by `simulate.flip_tolerance`).

@@ -903,7 +903,7 @@ fn the_robot_from_6_m_exits_0_its_analytic_reference_flagged() {
     let at = html.find(&fly).unwrap_or_else(|| panic!("{html}"));
     assert!(lead < at && at < html.find("<table>").unwrap());
     assert_eq!(html.matches("To fly from").count(), 1);
-    // the least-height schedule (2.0 N m for its 3.5 m drop) has its own
+    // the least-height schedule (1.7 N m for its 3.5 m drop) has its own
     // torque axes, apart from the 6 m designs' (under 0.1 N m)
     let torque = std::fs::read_to_string(base.join("torque.svg")).unwrap();
     for panel in [

@@ -29,7 +29,7 @@ fn f1_seed_schedule_flips_by_pi_at_several_bends() {
         let cfg = seed(&[&format!("analytic.theta_deg={theta}")]);
         let r = kinematic(&cfg.cat(), &analytic_plan(&cfg.design_spec()), &tight()).unwrap();
         assert!(
-            r.flip_error_rad.abs() < 1e-8,
+            r.flip_error_rad.abs() < 1e-9,
             "theta {theta}: flip error {}",
             r.flip_error_rad
         );
