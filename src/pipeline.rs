@@ -294,6 +294,14 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
                 .misses
                 .iter()
                 .all(|m| matches!(m, Miss::Flip { .. } | Miss::Tilt { .. }) || m.is_limit()),
+        // (the analytic reference whatever its limits; the phased design,
+        // made for the motors, only for its landing)
+        for_the_start_at_rest: matches!(method, Method::Analytic | Method::Phased)
+            && !spec.is_default_start()
+            && !verdict.misses.is_empty()
+            && verdict.misses.iter().all(|m| {
+                matches!(m, Miss::Landing { .. }) || (method == Method::Analytic && m.is_limit())
+            }),
         result: Some(n),
     };
     Judged {
@@ -519,6 +527,12 @@ pub struct MethodSummary {
     /// (present, `true`, only when that is all it misses beside the limits).
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub approximate_for_the_joint: bool,
+    /// Nor is it, or the phased design, made for another start: from one
+    /// they miss the landing by what the start leaves (the free-form design
+    /// is made for it); reported, but no reason for a partial run (present,
+    /// `true`, only when that is all they miss, beside the analytic's limits).
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub for_the_start_at_rest: bool,
     /// The numbers, absent when the method failed.
     #[serde(flatten)]
     pub result: Option<MethodNumbers>,
@@ -559,6 +573,7 @@ impl MethodSummary {
             reason: Some(e.to_string()),
             beyond_the_motors: false,
             approximate_for_the_joint: false,
+            for_the_start_at_rest: false,
             result: None,
         }
     }
@@ -573,6 +588,7 @@ impl MethodSummary {
             reason: Some(why.to_string()),
             beyond_the_motors: false,
             approximate_for_the_joint: false,
+            for_the_start_at_rest: false,
             result: None,
         }
     }
@@ -597,6 +613,8 @@ impl MethodSummary {
             Some("a reference beyond the motors, not counted")
         } else if self.approximate_for_the_joint {
             Some("the seed's closed form, approximate for the universal joint (F4), not counted")
+        } else if self.for_the_start_at_rest {
+            Some("made for the start at rest, not counted")
         } else {
             None
         }
@@ -866,15 +884,16 @@ mod tests {
     /// reference beyond the motors or approximate for the joint.
     #[test]
     fn a_line_counts_against_the_run_unless_ok_or_a_reference() {
-        for (grade, beyond, approximate, counts) in [
-            (Grade::Ok, false, false, false),
-            (Grade::Ok, true, false, false),
-            (Grade::Flagged, false, false, true),
-            (Grade::Flagged, true, false, false),
-            (Grade::Flagged, false, true, false),
-            (Grade::Flagged, true, true, false),
-            (Grade::Failed, false, false, true),
-            (Grade::Impossible, false, false, true),
+        for (grade, beyond, approximate, at_rest, counts) in [
+            (Grade::Ok, false, false, false, false),
+            (Grade::Ok, true, false, false, false),
+            (Grade::Flagged, false, false, false, true),
+            (Grade::Flagged, true, false, false, false),
+            (Grade::Flagged, false, true, false, false),
+            (Grade::Flagged, true, true, false, false),
+            (Grade::Flagged, false, false, true, false),
+            (Grade::Failed, false, false, false, true),
+            (Grade::Impossible, false, false, false, true),
         ] {
             let m = MethodSummary {
                 method: "analytic",
@@ -883,14 +902,18 @@ mod tests {
                 reason: None,
                 beyond_the_motors: beyond,
                 approximate_for_the_joint: approximate,
+                for_the_start_at_rest: at_rest,
                 result: None,
             };
             assert_eq!(
                 m.counts_against(),
                 counts,
-                "{grade:?} beyond {beyond} approximate {approximate}"
+                "{grade:?} beyond {beyond} approximate {approximate} at rest {at_rest}"
             );
-            assert_eq!(m.reference_note().is_some(), beyond || approximate);
+            assert_eq!(
+                m.reference_note().is_some(),
+                beyond || approximate || at_rest
+            );
         }
         let m = MethodSummary::impossible(Method::Phased, "needs 5 m");
         assert_eq!(

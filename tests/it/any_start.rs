@@ -273,3 +273,47 @@ fn the_closed_loops_nominal_from_a_spinning_start_is_the_designs_motion() {
         "held {held} deg, unheld {unheld} deg"
     );
 }
+
+/// From a spin about the spine `run` exits 0 on the free-form design made
+/// for that start: the analytic and phased schedules, made for the start at
+/// rest, miss the landing, are flagged with it, and are not counted (as the
+/// analytic reference beyond the motors is not).
+#[test]
+fn run_from_a_start_counts_the_design_made_for_it() {
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let (code, out, err) = util::run(
+        &[
+            "run",
+            &seed,
+            "--set",
+            "start.angular_velocity=[0,0,0.5]",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{out}{err}");
+    let summary: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            dir.path()
+                .join("o/seed/run@start.angular_velocity=_0,0,0.5_/summary.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    for m in summary["methods"].as_array().unwrap() {
+        let at_rest = m["for_the_start_at_rest"] == true;
+        match m["method"].as_str().unwrap() {
+            "free" => assert!(m["verdict"] == "ok" && !at_rest, "{m}"),
+            _ => {
+                assert!(m["verdict"] == "flagged" && at_rest, "{m}");
+                assert!(m["reason"].as_str().unwrap().contains("lands"), "{m}");
+            }
+        }
+    }
+    assert!(
+        out.contains("(made for the start at rest, not counted)"),
+        "{out}"
+    );
+}
