@@ -667,7 +667,9 @@ fn height_families(cfg: &Config, methods: Methods) -> Option<Families> {
 /// limit broken) is named in the point's `error` column beside its numbers
 /// ([`crate::pipeline::judge`], the flip from `plan` flown under the motor
 /// model; a sweep's peaks are computed without the torque limit and
-/// samples no schedule, so speed and envelope are not judged here).
+/// samples no schedule, so speed and envelope are not judged here). From
+/// another start the phased design, made for the start at rest, is not
+/// judged by its landing (`run` does not count that miss either).
 fn flagged(
     method: &str,
     spec: &DesignSpec,
@@ -677,7 +679,11 @@ fn flagged(
     plan: &dyn crate::design::plan::ShapePlan,
 ) -> Option<String> {
     let simulated = Simulated::of(crate::verify::simulate::dynamic_spec(spec, plan).as_ref());
-    let v = crate::pipeline::judge(spec, status, (peak_torque_nm, bend_deg), None, &simulated);
+    let mut v = crate::pipeline::judge(spec, status, (peak_torque_nm, bend_deg), None, &simulated);
+    if method == "phased" && !spec.is_default_start() {
+        v.misses
+            .retain(|m| !matches!(m, crate::verdict::Miss::Landing { .. }));
+    }
     let why = v.reasons();
     (!why.is_empty()).then(|| format!("{method} FLAGGED: {}", why.join(", ")))
 }

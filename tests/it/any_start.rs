@@ -317,3 +317,33 @@ fn run_from_a_start_counts_the_design_made_for_it() {
         "{out}"
     );
 }
+
+/// A sweep from a start judges each point as `run` does: the free-form
+/// design by its landing (the tilt is the heading's turn), the phased one,
+/// made for the start at rest, not by its landing.
+#[test]
+fn a_sweep_from_a_start_judges_its_points_as_run_does() {
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let (code, out, err) = util::run(
+        &[
+            "sweep",
+            &seed,
+            "--set",
+            "start.angular_velocity=[0,0,0.5]",
+            "--set-range",
+            "fall.height=10:10:1",
+            "--methods",
+            "phased,free",
+            "--json",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{out}{err}");
+    let points: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let p = &points[0];
+    assert!(p["error"].is_null(), "{p}");
+    assert_eq!(p["free_status"], "converged", "{p}");
+}
