@@ -92,7 +92,7 @@ enum Command {
         #[arg(long, default_value_t = 1000, value_parser = trials, allow_negative_numbers = true)]
         trials: usize,
         /// Seed of the study: each trial's draws follow from it and the trial's index.
-        #[arg(long, default_value_t = 1, allow_negative_numbers = true)]
+        #[arg(long, default_value_t = 1, value_parser = study_seed, allow_negative_numbers = true)]
         seed: u64,
         /// Trials flown at once, at least 1 (default: the machine's cores).
         #[arg(long, value_parser = thread_count, allow_negative_numbers = true)]
@@ -229,6 +229,16 @@ fn trials(s: &str) -> Result<usize, String> {
         Ok(n) if (1..=max).contains(&n) => Ok(n),
         _ => Err(format!("{s}: must be in [1, {max}], a whole number")),
     }
+}
+
+/// `--seed`: the study's seed, a whole number from 0.
+fn study_seed(s: &str) -> Result<u64, String> {
+    s.parse::<u64>().map_err(|_| {
+        format!(
+            "{s}: must be a whole number from 0 to {} (any one: the trials' draws follow from it)",
+            u64::MAX
+        )
+    })
 }
 
 /// `--trial`: a trial's index, 0 or more.

@@ -317,6 +317,11 @@ fn bad_input_is_refused_before_anything_is_written() {
             "its sign is drawn at random",
         ),
         (vec!["--trials", "1000001"], "--trials", "must be in"),
+        (
+            vec!["--seed", "-1"],
+            "--seed",
+            "must be a whole number from 0",
+        ),
         // a step the key admits, too coarse for the PD that holds the
         // nominal: it flew to NaN, and every trial with it
         (
