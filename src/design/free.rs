@@ -2175,12 +2175,13 @@ fn optimize_start(
     })
 }
 
-/// Whether a design the SCP left infeasible from another start misses
-/// only the landing, and by no more than the landing's tolerance
-/// (`land.max_tilt_deg`, else `simulate.flip_tolerance`): the start may
-/// leave nothing better (a no-twist cat cannot tilt its spine at zero
-/// momentum, F1). Such a design is kept, its status `infeasible` (so the
-/// verdict flags it), rather than answered as unlandable.
+/// Whether a design the SCP left infeasible from another start lands
+/// within the landing's tolerance (`land.max_tilt_deg`, else
+/// `simulate.flip_tolerance`) and keeps to the motors: the start may leave
+/// nothing better (a no-twist cat cannot tilt its spine at zero momentum,
+/// F1). Such a design is kept, its status `infeasible`, rather than
+/// answered as unlandable; the verdict flags it, with any other limit it
+/// breaks (a bend limit it could not keep is named there).
 fn lands_anyway(spec: &DesignSpec, solved: &Solved) -> bool {
     if spec.is_default_start() {
         // today's problem: an infeasible design is the motors' answer
