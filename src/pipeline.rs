@@ -65,6 +65,10 @@ pub struct LeastHeightDesign {
     /// Largest bend, deg, and twist of the bend direction, rad, over the rows.
     pub bend_deg: f64,
     pub twist_rad: f64,
+    /// Whether it was designed from the configured start (else for the
+    /// start at rest, as the phased time design is).
+    #[serde(skip)]
+    pub from_start: bool,
 }
 
 impl LeastHeightDesign {
@@ -97,6 +101,7 @@ impl LeastHeightDesign {
             peak_torque_nm: peak,
             bend_deg: bend.to_degrees(),
             twist_rad: twist,
+            from_start: a.from_start,
         }
     }
 }
@@ -210,6 +215,29 @@ pub fn judge_analysis(spec: &DesignSpec, a: &Analysis) -> (Schedule, Verdict) {
     (schedule, v)
 }
 
+/// Whether a line from another start is made for the start at rest (the
+/// analytic schedule, the phased design, a least-height design not made
+/// from the start: `least_height_at_rest`) and misses nothing but the landing (a number:
+/// a flight that diverged counts), beside the analytic reference's limits
+/// (the phased designs are made for the motors: a broken limit counts).
+fn made_for_rest_misses_only_the_landing(
+    method: Method,
+    least_height_at_rest: bool,
+    misses: &[Miss],
+) -> bool {
+    let at_rest = match method {
+        Method::Analytic | Method::Phased => true,
+        Method::LeastHeight => least_height_at_rest,
+        Method::Free => false,
+    };
+    at_rest
+        && !misses.is_empty()
+        && misses.iter().all(|m| match m {
+            Miss::Landing { error_deg, .. } => error_deg.is_finite(),
+            m => method == Method::Analytic && m.is_limit(),
+        })
+}
+
 /// The analytic schedule's verdict without a fold through the halves: the
 /// seed's schedule is the model's mathematics whatever the body (the fold
 /// is the config's warning, `analytic.theta_deg`).
@@ -294,14 +322,12 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
                 .misses
                 .iter()
                 .all(|m| matches!(m, Miss::Flip { .. } | Miss::Tilt { .. }) || m.is_limit()),
-        // (the analytic reference whatever its limits; the phased design,
-        // made for the motors, only for its landing)
-        for_the_start_at_rest: matches!(method, Method::Analytic | Method::Phased)
-            && !spec.is_default_start()
-            && !verdict.misses.is_empty()
-            && verdict.misses.iter().all(|m| {
-                matches!(m, Miss::Landing { .. }) || (method == Method::Analytic && m.is_limit())
-            }),
+        for_the_start_at_rest: !spec.is_default_start()
+            && made_for_rest_misses_only_the_landing(
+                method,
+                matches!(&design, Design::LeastHeight(l) if !l.from_start),
+                &verdict.misses,
+            ),
         result: Some(n),
     };
     Judged {
@@ -605,7 +631,9 @@ impl MethodSummary {
 
     /// Why a flagged reference is not counted, in words (None for a design).
     pub fn reference_note(&self) -> Option<&'static str> {
-        if self.beyond_the_motors && self.approximate_for_the_joint {
+        if self.beyond_the_motors && self.for_the_start_at_rest {
+            Some("a reference beyond the motors, made for the start at rest, not counted")
+        } else if self.beyond_the_motors && self.approximate_for_the_joint {
             Some(
                 "a reference beyond the motors, and the seed's closed form, approximate for the universal joint (F4): not counted",
             )
@@ -882,6 +910,60 @@ mod tests {
     /// Which lines make a run partial, over every grade and the reference
     /// flags: flagged or failed or impossible, unless the flagged line is the
     /// reference beyond the motors or approximate for the joint.
+    /// From another start the schedules made for the start at rest are not
+    /// counted for their landing alone; a phased design's broken limit, a
+    /// failed or unproven solve, a diverged flight still count, and so does
+    /// every miss of the free-form design.
+    #[test]
+    fn only_a_landing_missed_by_a_schedule_made_for_rest_is_not_counted() {
+        let landing = |e: f64| Miss::Landing {
+            error_deg: e,
+            tolerance_deg: 0.5,
+            key: "land.max_tilt_deg",
+        };
+        let torque = Miss::Torque {
+            peak_nm: 3.0,
+            limit: 1.0,
+            name: "limits.max_torque".into(),
+        };
+        let bend = Miss::Bend {
+            bend_deg: 100.0,
+            limit: 90.0,
+            name: "limits.max_bend_deg".into(),
+        };
+        let f = made_for_rest_misses_only_the_landing;
+        use Method::*;
+        for (method, phased_lh, misses, not_counted) in [
+            (Analytic, false, vec![landing(7.0)], true),
+            (Phased, false, vec![landing(7.0)], true),
+            (LeastHeight, true, vec![landing(7.0)], true),
+            (LeastHeight, false, vec![landing(7.0)], false),
+            (Free, false, vec![landing(7.0)], false),
+            (Analytic, false, vec![landing(7.0), torque.clone()], true),
+            (Phased, false, vec![landing(7.0), bend.clone()], false),
+            (
+                Phased,
+                false,
+                vec![landing(7.0), Miss::Status(Status::Infeasible)],
+                false,
+            ),
+            (
+                Phased,
+                false,
+                vec![Miss::Simulation("diverged".into())],
+                false,
+            ),
+            (Phased, false, vec![landing(f64::NAN)], false),
+            (Phased, false, vec![], false),
+        ] {
+            assert_eq!(
+                f(method, phased_lh, &misses),
+                not_counted,
+                "{method:?} {misses:?}"
+            );
+        }
+    }
+
     #[test]
     fn a_line_counts_against_the_run_unless_ok_or_a_reference() {
         for (grade, beyond, approximate, at_rest, counts) in [

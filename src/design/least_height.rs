@@ -860,6 +860,11 @@ impl HeightAnswer {
                 "No verified design found: the phased time design fits the motors from {:.3} m but misses the flip in the simulation (see the least-height row).",
                 self.least_height_m
             )
+        } else if !self.from_start && self.possible {
+            format!(
+                "The flip is possible from {} m: the {} design made for this start fits the motors; the least drop height was found for the start at rest only ({:.3} m there, the least-height row).",
+                self.height_m, self.method, self.least_height_m
+            )
         } else if !self.from_start {
             format!(
                 "No design found lands belly-down from this start in the fall from {} m (at rest the motors would need {:.3} m).",

@@ -347,3 +347,40 @@ fn a_sweep_from_a_start_judges_its_points_as_run_does() {
     assert!(p["error"].is_null(), "{p}");
     assert_eq!(p["free_status"], "converged", "{p}");
 }
+
+/// Under a speed limit from that start, the least-height row is the phased
+/// time design for the start at rest: flagged with its landing, not counted,
+/// and the answer says the flip is possible with the design made for the start.
+#[test]
+fn a_least_height_made_for_rest_is_not_counted_from_a_start() {
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let (code, out, err) = util::run(
+        &[
+            "run",
+            &seed,
+            "--set",
+            "start.angular_velocity=[0,0,0.5]",
+            "--set",
+            "limits.max_speed=3",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{out}{err}");
+    let row = out
+        .lines()
+        .find(|l| l.trim_start().starts_with("least-height"))
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        row.contains("lands") && row.contains("(made for the start at rest, not counted)"),
+        "{row}"
+    );
+    assert!(
+        out.contains(
+            "The flip is possible from 10 m: the free design made for this start fits the motors"
+        ),
+        "{out}"
+    );
+}
