@@ -152,14 +152,7 @@ impl Targets {
             max_speed: spec.motor.max_speed,
             max_bend_deg: spec.max_bend_deg,
             geometric_bend_deg: (spec.max_bend_deg.is_none() && spec.cat.general.is_none()).then(
-                || {
-                    let (rear, front) = (&spec.cat.rear, &spec.cat.front);
-                    let theta = crate::config::ranges::closest_theta_of(
-                        rear.length.min(front.length),
-                        rear.radius + front.radius,
-                    );
-                    180.0 - theta.to_degrees()
-                },
+                || 180.0 - crate::config::ranges::closest_theta_of_cat(&spec.cat).to_degrees(),
             ),
             flip_tolerance: spec.simulate.flip_tolerance,
             landing_tolerance: match spec.max_tilt_deg {

@@ -299,7 +299,11 @@ pub fn check_fall_time(cfg: &Config) -> Result<()> {
 /// reaches the other half (`l sin(theta) = r_A + r_B`, `theta < 90 deg`),
 /// rad: bent further, the halves pass through each other.
 pub fn closest_theta(cfg: &Config) -> f64 {
-    let cat = cfg.cat();
+    closest_theta_of_cat(&cfg.cat())
+}
+
+/// [`closest_theta`] of a cat's two cylinders.
+pub fn closest_theta_of_cat(cat: &crate::model::Cat) -> f64 {
     closest_theta_of(
         cat.rear.length.min(cat.front.length),
         cat.rear.radius + cat.front.radius,

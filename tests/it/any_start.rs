@@ -274,25 +274,25 @@ fn the_closed_loops_nominal_from_a_spinning_start_is_the_designs_motion() {
     );
 }
 
+/// `catflip CMD seed.toml --set start.angular_velocity=[0,0,0.5] ARGS --out o`
+/// in a temp folder: the folder, the exit code, stdout and stderr.
+fn from_a_spin(cmd: &str, args: &[&str]) -> (tempfile::TempDir, Option<i32>, String, String) {
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let mut argv = vec![cmd, &seed, "--set", "start.angular_velocity=[0,0,0.5]"];
+    argv.extend(args);
+    argv.extend(["--out", "o"]);
+    let (code, out, err) = util::run(&argv, dir.path());
+    (dir, code, out, err)
+}
+
 /// From a spin about the spine `run` exits 0 on the free-form design made
 /// for that start: the analytic and phased schedules, made for the start at
 /// rest, miss the landing, are flagged with it, and are not counted (as the
 /// analytic reference beyond the motors is not).
 #[test]
 fn run_from_a_start_counts_the_design_made_for_it() {
-    let dir = util::temp_dir();
-    let seed = util::config_arg("seed");
-    let (code, out, err) = util::run(
-        &[
-            "run",
-            &seed,
-            "--set",
-            "start.angular_velocity=[0,0,0.5]",
-            "--out",
-            "o",
-        ],
-        dir.path(),
-    );
+    let (dir, code, out, err) = from_a_spin("run", &[]);
     assert_eq!(code, Some(0), "{out}{err}");
     let summary: serde_json::Value = serde_json::from_str(
         &std::fs::read_to_string(
@@ -323,23 +323,15 @@ fn run_from_a_start_counts_the_design_made_for_it() {
 /// made for the start at rest, not by its landing.
 #[test]
 fn a_sweep_from_a_start_judges_its_points_as_run_does() {
-    let dir = util::temp_dir();
-    let seed = util::config_arg("seed");
-    let (code, out, err) = util::run(
+    let (_dir, code, out, err) = from_a_spin(
+        "sweep",
         &[
-            "sweep",
-            &seed,
-            "--set",
-            "start.angular_velocity=[0,0,0.5]",
             "--set-range",
             "fall.height=10:10:1",
             "--methods",
             "phased,free",
             "--json",
-            "--out",
-            "o",
         ],
-        dir.path(),
     );
     assert_eq!(code, Some(0), "{out}{err}");
     let points: serde_json::Value = serde_json::from_str(&out).unwrap();
@@ -353,21 +345,7 @@ fn a_sweep_from_a_start_judges_its_points_as_run_does() {
 /// and the answer says the flip is possible with the design made for the start.
 #[test]
 fn a_least_height_made_for_rest_is_not_counted_from_a_start() {
-    let dir = util::temp_dir();
-    let seed = util::config_arg("seed");
-    let (code, out, err) = util::run(
-        &[
-            "run",
-            &seed,
-            "--set",
-            "start.angular_velocity=[0,0,0.5]",
-            "--set",
-            "limits.max_speed=3",
-            "--out",
-            "o",
-        ],
-        dir.path(),
-    );
+    let (_dir, code, out, err) = from_a_spin("run", &["--set", "limits.max_speed=3"]);
     assert_eq!(code, Some(0), "{out}{err}");
     let row = out
         .lines()

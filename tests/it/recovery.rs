@@ -109,31 +109,25 @@ fn shards_concatenate_to_the_whole_map_and_the_figures_are_svg() {
     let whole = std::fs::read_to_string(set.join("recovery.csv")).unwrap();
     // two spin lines and two tilt lines, two starts each, and the header
     assert_eq!(whole.lines().count(), 9, "{whole}");
-    let mut joined = String::new();
-    for k in 1..=3 {
-        let shard = format!("{k}/3");
+    // shard K of N's CSV
+    let shard_csv = |k: usize, n: usize| {
+        let shard = format!("{k}/{n}");
         let (code, out, err) = recovery(dir.path(), &["--shard", &shard]);
         assert_eq!(code, Some(0), "{shard}: {out}{err}");
         let f = dir
             .path()
-            .join(format!("out/seed/recovery.shard-{k}-of-3"))
-            .join(format!("recovery.shard-{k}-of-3.csv"));
-        joined.push_str(&std::fs::read_to_string(f).unwrap());
-    }
+            .join(format!("out/seed/recovery.shard-{k}-of-{n}"))
+            .join(format!("recovery.shard-{k}-of-{n}.csv"));
+        std::fs::read_to_string(f).unwrap()
+    };
+    let joined: String = (1..=3).map(|k| shard_csv(k, 3)).collect();
     assert_eq!(joined, whole);
     // more shards than lines: the header in the first shard's alone, empty
     // here (the second, whose line starts at 0 too, wrote one as well)
     for k in 1..=2 {
-        let shard = format!("{k}/6");
-        let (code, out, err) = recovery(dir.path(), &["--shard", &shard]);
-        assert_eq!(code, Some(0), "{shard}: {out}{err}");
-        let f = dir
-            .path()
-            .join(format!("out/seed/recovery.shard-{k}-of-6"))
-            .join(format!("recovery.shard-{k}-of-6.csv"));
-        let lines = std::fs::read_to_string(f).unwrap().lines().count();
+        let lines = shard_csv(k, 6).lines().count();
         // the header; the second shard's line, two starts
-        assert_eq!(lines, if k == 1 { 1 } else { 2 }, "{shard}");
+        assert_eq!(lines, if k == 1 { 1 } else { 2 }, "{k}/6");
     }
     let html = std::fs::read_to_string(set.join("index.html")).unwrap();
     for f in [
