@@ -1313,7 +1313,81 @@ fn from_plan(
     nodes: usize,
     observe: &mut dyn Observer,
 ) -> Result<FreeResult> {
-    stage(spec, seed_plan, seed, nodes, observe).finish(spec, observe)
+    let design = |plan: &dyn crate::design::plan::ShapePlan, observe: &mut dyn Observer| {
+        stage(spec, plan, seed, nodes, observe).finish(spec, observe)
+    };
+    if spec.is_default_start() {
+        return design(seed_plan, observe);
+    }
+    // from another start, the seed turned the way that leaves less to turn
+    // first; the other way where that design does not land (near
+    // belly-down both ways are far, and either may end straight)
+    let mirrored = crate::design::mirror::Mirrored(seed_plan);
+    let mut ways: [&dyn crate::design::plan::ShapePlan; 2] = [seed_plan, &mirrored];
+    if crate::design::mirror::mirror_is_nearer(spec, seed_plan) {
+        ways.swap(0, 1);
+    }
+    let lands = |r: &Result<FreeResult>| {
+        r.as_ref()
+            .is_ok_and(|r| r.certificate.constraint_violation <= spec.free.attitude_tolerance)
+    };
+    let mut nearer = Recorded::default();
+    let first = design(ways[0], &mut nearer);
+    // a design that lands the short way is kept; one that went more than
+    // half a turn (the SCP may cross to the long way) is kept only if the
+    // other way does no better
+    let long_way = |r: &FreeResult| {
+        crate::design::mirror::left_to_turn(spec, &r.plan)
+            .is_some_and(|t| t.abs() > std::f64::consts::PI + 1e-3)
+    };
+    if lands(&first) && !first.as_ref().is_ok_and(long_way) {
+        nearer.replay(observe);
+        return first;
+    }
+    let mut other = Recorded::default();
+    let second = design(ways[1], &mut other);
+    let better = match (&first, &second) {
+        (Ok(a), Ok(b)) if lands(&first) => lands(&second) && b.objective_value < a.objective_value,
+        _ => lands(&second) || (second.is_ok() && first.is_err()),
+    };
+    // the nearer way's outcome unless the other lands (better), or fails less
+    if better {
+        other.replay(observe);
+        return second;
+    }
+    nearer.replay(observe);
+    first
+}
+
+/// An observer's events kept to be told later, to the observer of the
+/// design that is kept ([`from_plan`]).
+#[derive(Default)]
+struct Recorded(Vec<Event>);
+
+enum Event {
+    Iteration(ScpIteration),
+    Mesh(usize),
+}
+
+impl Observer for Recorded {
+    fn iteration(&mut self, it: &ScpIteration) {
+        self.0.push(Event::Iteration(*it));
+    }
+
+    fn mesh(&mut self, nodes: usize) {
+        self.0.push(Event::Mesh(nodes));
+    }
+}
+
+impl Recorded {
+    fn replay(self, observe: &mut dyn Observer) {
+        for e in self.0 {
+            match e {
+                Event::Iteration(it) => observe.iteration(&it),
+                Event::Mesh(nodes) => observe.mesh(nodes),
+            }
+        }
+    }
 }
 
 /// A free-form design from a schedule, its coarse meshes solved: the fine
@@ -1419,6 +1493,7 @@ fn stage(
     observe: &mut dyn Observer,
 ) -> Staged {
     let clock = std::time::Instant::now();
+    // from another start, the seed turned the way that leaves less to turn
     let seed_z = grid(spec, nodes, Mesh::Final).sample(seed_plan);
     let mut levels = Vec::new();
     // the fine mesh's start, what it carries from a coarse mesh, and
@@ -2212,6 +2287,25 @@ fn lands_anyway(spec: &DesignSpec, solved: &Solved) -> bool {
 fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
     let node_peak = solved.node_peak;
     if !spec.is_default_start() && solved.attitude_error > spec.free.attitude_tolerance.max(1e-6) {
+        let [w, x, y, z] = spec.release().attitude;
+        // the spine's height above level at release: `(R0 e_z) . e_x`
+        let spine_level = (2.0 * (x * z + w * y)).abs() < 1e-9;
+        if spec.cat.joint == crate::model::Joint::NoTwist
+            && !spec.has_momentum()
+            && spine_level
+            && !spec.motor.is_limited()
+            && spec.max_bend_deg.is_none()
+        {
+            // a roll about a level spine is within reach (F1): the optimiser's miss
+            return crate::error::Error::Solver {
+                what: "the free-form design".into(),
+                status: "infeasible".into(),
+                hint: format!(
+                    "It found no landing from this start: it still lands {:.3} deg from belly-down. At rest with a level spine the body can land (F1: its bend circulations turn it about the spine); from near belly-down the seeds' half turns are far from the small turn needed, and the design ended at a local optimum. Try the other seed (`--seed analytic`, or `--seed phased`)",
+                    solved.attitude_error.to_degrees()
+                ),
+            };
+        }
         // the landing, not the motors: what the optimiser could not undo
         return crate::error::Error::Unreachable {
             reason: format!(

@@ -10,6 +10,7 @@ pub mod conic;
 pub mod envelope;
 pub mod free;
 pub mod least_height;
+pub mod mirror;
 pub mod objective;
 pub mod path;
 pub mod phased;

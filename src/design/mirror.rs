@@ -1,0 +1,119 @@
+//! Which way round to turn from another start.
+//!
+//! The seeds (the analytic and phased schedules) turn the body half a turn
+//! about its spine one way. From a start rolled or spinning about the spine
+//! the landing (belly-down, any heading) is nearer one way round than the
+//! other, and the free-form design keeps the way its seed turns: from a
+//! start rolled 20 deg it would turn 200 deg where 160 deg do. The mirror
+//! image of a seed in the plane of the spine and the belly turns the other
+//! way (both joints: `q1 -> -q1`, MODEL.md section 2, reflects `R_rel`
+//! through that plane); the free-form design starts from whichever of the
+//! two leaves the smaller turn about the spine.
+
+use crate::design::plan::{ShapePlan, ShapeState};
+use crate::design::spec::DesignSpec;
+use crate::model::momentum::rigid_turn;
+use nalgebra::{Matrix3, UnitQuaternion};
+
+/// A plan reflected through the plane of the spine and the belly: the
+/// first shape coordinate negated. For a body symmetric about that plane
+/// (the cylinders) it makes the same turn the other way.
+pub struct Mirrored<'a>(pub &'a dyn ShapePlan);
+
+impl ShapePlan for Mirrored<'_> {
+    fn phase_bounds(&self) -> Vec<f64> {
+        self.0.phase_bounds()
+    }
+
+    fn state_in(&self, i: usize, t: f64) -> ShapeState {
+        let s = self.0.state_in(i, t);
+        let flip = |v: [f64; 2]| [-v[0], v[1]];
+        ShapeState {
+            q: flip(s.q),
+            qd: flip(s.qd),
+            qdd: flip(s.qdd),
+            phase: s.phase,
+        }
+    }
+
+    fn breaks(&self) -> Vec<f64> {
+        self.0.breaks()
+    }
+}
+
+/// Whether the free-form design from `spec`'s start should start from the
+/// mirror image of `plan`: the way round that leaves the smaller turn about
+/// the spine (each way flown kinematically from the start to touchdown: its
+/// own half turn from rest, signed, plus the roll that would then point the
+/// belly down). At the default start both ways are the same half turn: no.
+pub fn mirror_is_nearer(spec: &DesignSpec, plan: &dyn ShapePlan) -> bool {
+    if spec.is_default_start() {
+        return false;
+    }
+    let (Some(own), Some(other)) = (
+        left_to_turn(spec, plan),
+        left_to_turn(spec, &Mirrored(plan)),
+    ) else {
+        return false;
+    };
+    // (a margin against rounding: a tie keeps the seed)
+    other.abs() < own.abs() - 1e-6
+}
+
+/// The turn about the spine, rad, that `plan` leaves to the design from
+/// `spec`'s start: `plan`'s own turn from rest (signed) plus the roll that
+/// points the belly down at touchdown after flying it (for a design that
+/// lands, its own turn). `None` when a flight fails.
+pub fn left_to_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
+    let at_rest = DesignSpec {
+        start: None,
+        ..spec.clone()
+    };
+    let own = crate::verify::simulate::kinematic_spec(&at_rest, plan).ok()?;
+    let flown = crate::verify::simulate::kinematic_spec(spec, plan).ok()?;
+    let [w, x, y, z] = flown.final_attitude;
+    let end: Matrix3<f64> = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
+        .to_rotation_matrix()
+        .into_inner();
+    let touchdown = rigid_turn(&spec.cat, &end, flown.final_body_momentum, spec.fall.margin);
+    Some(own.flip_deg.to_radians() + roll_to_belly_down(&touchdown))
+}
+
+/// The roll about the body's spine (A's `z`), in `(-pi, pi]`, after which
+/// the belly (A's `+x`) of attitude `r` points as nearly straight down
+/// (world `-x`) as a roll can make it: `r Rz(d) e_x` has the least world `x`
+/// component at `d = atan2(-r_01, -r_00)`.
+pub fn roll_to_belly_down(r: &Matrix3<f64>) -> f64 {
+    (-r[(0, 1)]).atan2(-r[(0, 0)])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::so3;
+    use nalgebra::Vector3;
+
+    /// The roll found points the belly down for a body only rolled, and
+    /// is the smaller way round.
+    #[test]
+    fn the_roll_to_belly_down_undoes_a_roll_the_shorter_way() {
+        for deg in [-170.0f64, -90.0, -20.0, 1.0, 20.0, 90.0, 179.0] {
+            let r = so3::exp(&(Vector3::z() * deg.to_radians()));
+            let d = roll_to_belly_down(&r);
+            let turned = r * so3::exp(&(Vector3::z() * d));
+            // belly straight down: landing error zero
+            assert!(
+                crate::model::momentum::landing_error(&turned) < 1e-12,
+                "{deg}"
+            );
+            // from a roll a, the belly is down at a + d = 180 deg (mod 360)
+            let want = 180.0 - deg;
+            let want = if want > 180.0 { want - 360.0 } else { want };
+            assert!(
+                (d.to_degrees() - want).abs() < 1e-9,
+                "{deg}: {}",
+                d.to_degrees()
+            );
+        }
+    }
+}
