@@ -471,6 +471,10 @@ impl Config {
         self.land.validate()?;
         self.control.validate()?;
         self.robustness.validate()?;
+        // a design without a limit has no least time: refused before any work
+        self.design
+            .objective
+            .check_bounded(self.motor().is_limited())?;
         self.control
             .check_delay("robustness.delay_ms", self.robustness.delay_ms)?;
         ranges::check_derived(self)?;

@@ -874,18 +874,12 @@ fn design(
     seed: Option<&str>,
 ) -> PyResult<Design> {
     let (mut source, mut cfg) = config.snapshot();
-    if let Some(o) = objective {
-        if !["peak-torque", "time", "energy"].contains(&o) {
-            return Err(ConfigError::new_err(format!(
-                "unknown objective `{o}`; use \"peak-torque\", \"time\" or \"energy\" (or None: design.objective)"
-            )));
-        }
-        let arg = format!(
-            "design.objective={}",
-            serde_json::to_string(o).expect("serialises")
-        );
-        cfg = source.load(Some(&arg)).map_err(err)?;
-        source.overrides.push(arg);
+    if let Some(o) = objective
+        && !["peak-torque", "time", "energy"].contains(&o)
+    {
+        return Err(ConfigError::new_err(format!(
+            "unknown objective `{o}`; use \"peak-torque\", \"time\" or \"energy\" (or None: design.objective)"
+        )));
     }
     let method = match method {
         "free" => "free",
@@ -904,6 +898,14 @@ fn design(
         return Err(ConfigError::new_err(format!(
             "objective=\"{o}\" applies to the phased and free designs: the analytic schedule is the seed's closed form and optimises nothing; leave objective out or use method=\"phased\" or \"free\""
         )));
+    }
+    if let Some(o) = objective {
+        let arg = format!(
+            "design.objective={}",
+            serde_json::to_string(o).expect("serialises")
+        );
+        cfg = source.load(Some(&arg)).map_err(err)?;
+        source.overrides.push(arg);
     }
     let seed = seed.map(String::from);
     interruptible(

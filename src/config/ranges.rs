@@ -376,6 +376,22 @@ const RPM: f64 = 2.0 * PI / 60.0;
 /// the lightly geared motors a `catflip size` speed-up gives stay below.
 const SERVO_SPEED_SLIP: f64 = 40.0;
 
+/// Radian values typed in place of degrees (`start.rotation_deg`): pi/6,
+/// pi/4, pi/3, pi/2, pi and 2 pi.
+const RADIAN_LIKE: [f64; 6] = [PI / 6.0, PI / 4.0, PI / 3.0, PI / 2.0, PI, 2.0 * PI];
+
+/// A start spinning faster than a turn a second (rad/s) is asked about as
+/// deg/s: the studies' spins are 0.5 rad/s.
+const SPIN_SLIP: f64 = 2.0 * PI;
+
+/// A flip tolerance above 10 deg (rad) is asked about as degrees.
+const FLIP_TOLERANCE_SLIP: f64 = 0.1745;
+
+/// A half's radius of gyration above this many times its reach from the
+/// centre of mass to the joint is asked about as kg cm^2 (a long half's is
+/// about 0.6 of it).
+const GYRATION_SLIP: f64 = 5.0;
+
 /// A stall torque above this many times `m g L` (the whole body's weight at
 /// its length) is asked about as N mm or kg cm typed as N m.
 const TORQUE_SLIP: f64 = 10.0;
@@ -569,6 +585,72 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
                 closest.ceil(),
             ),
         );
+    }
+    // a rotation typed in radians: the usual radian values, not degrees anyone types
+    for (i, d) in cfg.start.rotation_deg.iter().enumerate() {
+        if RADIAN_LIKE.iter().any(|r| (d.abs() - r).abs() < 2e-3) {
+            warn(
+                &format!("start.rotation_deg[{i}]"),
+                format!(
+                    "{d} deg is a radian value: radians typed as degrees? ({d} rad = {:.2} deg)",
+                    d.to_degrees()
+                ),
+            );
+        }
+    }
+    let spin = cfg
+        .start
+        .angular_velocity
+        .iter()
+        .map(|w| w * w)
+        .sum::<f64>()
+        .sqrt();
+    if spin > SPIN_SLIP {
+        warn(
+            "start.angular_velocity",
+            format!(
+                "{spin:.4} rad/s is over a turn a second ({:.2} turns/s): degrees per second typed as rad/s? ({spin:.4} deg/s = {:.4} rad/s)",
+                spin / (2.0 * PI),
+                spin.to_radians()
+            ),
+        );
+    }
+    let tol = cfg.simulate.flip_tolerance;
+    if tol > FLIP_TOLERANCE_SLIP {
+        warn(
+            "simulate.flip_tolerance",
+            format!(
+                "{tol} rad is {:.1} deg, a loose flip tolerance (default 0.01 rad): degrees typed as radians? ({tol} deg = {:.4} rad); for a landing tolerance in degrees, land.max_tilt_deg",
+                tol.to_degrees(),
+                tol.to_radians()
+            ),
+        );
+    }
+    // an inertia in kg cm^2: a radius of gyration far beyond the half's own
+    // reach from its centre of mass to the joint
+    if let Some(b) = &cfg.body {
+        for (name, half) in [("rear", &b.rear), ("front", &b.front)] {
+            let Some(h) = half else { continue };
+            let (Some(m), Some(i), Some(com), Some(joint)) = (h.mass, h.inertia, h.com, h.joint)
+            else {
+                continue;
+            };
+            let reach = (0..3)
+                .map(|k| (joint[k] - com[k]).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let largest = (0..3).map(|k| i[k][k]).fold(0.0, f64::max);
+            let gyration = (largest / m).sqrt();
+            if m > 0.0 && reach > 0.0 && gyration > GYRATION_SLIP * reach {
+                warn(
+                    &format!("body.{name}.inertia"),
+                    format!(
+                        "its radius of gyration sqrt(I / m) = {gyration:.3} m is over {GYRATION_SLIP} times the {reach:.3} m from the centre of mass to the joint: kg cm^2 typed as kg m^2? ({largest} kg cm^2 = {:.3e} kg m^2)",
+                        largest * 1e-4
+                    ),
+                );
+            }
+        }
     }
     for (key, delay_ms) in [
         ("control.delay_ms", cfg.control.delay_ms),

@@ -144,6 +144,34 @@ fn a_set_of_the_key_another_option_sets_is_refused() {
     );
 }
 
+/// The least time without a torque or speed limit is zero: a config that
+/// asks for it is refused at load, before any design, not run into a report
+/// of failed methods (exit 3).
+#[test]
+fn a_least_time_design_without_a_limit_is_refused_before_any_work() {
+    let seed = config("seed");
+    for cmd in ["run", "optimize", "analyze"] {
+        refused(
+            &[cmd, &seed, "--set", "design.objective=time"],
+            &["design.objective", "limits.max_torque"],
+        );
+    }
+    // a limit makes it finite
+    let dir = util::temp_dir();
+    let o = run(
+        &[
+            "analyze",
+            &seed,
+            "--set",
+            "design.objective=time",
+            "--set",
+            "limits.max_torque=1",
+        ],
+        dir.path(),
+    );
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+}
+
 #[test]
 fn work_is_bounded_up_front_by_each_keys_range() {
     let robot = config("robot-universal");
@@ -281,6 +309,38 @@ fn unit_slips_are_warned_about_and_impossible_cats_refused() {
         &["analytic.theta_deg", "radians", "44.98 deg"],
     );
     warns(
+        &["analyze", &seed, "--set", "start.rotation_deg=[0,0,3.14]"],
+        &["start.rotation_deg[2]", "radians", "179.91 deg"],
+    );
+    warns(
+        &["analyze", &seed, "--set", "start.angular_velocity=[0,0,30]"],
+        &["start.angular_velocity", "deg/s", "0.5236 rad/s"],
+    );
+    warns(
+        &["analyze", &seed, "--set", "simulate.flip_tolerance=1"],
+        &["simulate.flip_tolerance", "57.3 deg", "0.0175 rad"],
+    );
+    // a plausible start in degrees and rad/s, a tight tolerance: no question
+    let d = util::temp_dir();
+    let o = run(
+        &[
+            "analyze",
+            &seed,
+            "--set",
+            "start.rotation_deg=[0,15,3]",
+            "--set",
+            "start.angular_velocity=[0.5,0,0]",
+            "--set",
+            "simulate.flip_tolerance=0.1",
+        ],
+        d.path(),
+    );
+    let err = stderr(&o);
+    assert!(
+        !err.contains("warning: start.") && !err.contains("warning: simulate."),
+        "{err}"
+    );
+    warns(
         &["analyze", &seed, "--set", "cat.radius=0.6"],
         &["cat.radius", "wider", "diameter"],
     );
@@ -363,6 +423,18 @@ height = 2.0
     .unwrap();
     let o = run(&["analyze", boxes.to_str().unwrap()], grams.path());
     let err = stderr(&o);
+    // a real half's radius of gyration is within its reach: no question
+    assert!(!err.contains("kg cm^2"), "{err}");
+    // the same inertia in kg cm^2 (21.2 kg cm^2 for 0.00212 kg m^2) is asked about
+    warns(
+        &[
+            "analyze",
+            boxes.to_str().unwrap(),
+            "--set",
+            "body.rear.inertia=[21.2,19.4,8.2,0,0,0]",
+        ],
+        &["body.rear.inertia", "kg cm^2", "2.120e-3 kg m^2"],
+    );
     let line = err
         .lines()
         .find(|l| l.starts_with("warning: analytic.theta_deg"))
