@@ -269,8 +269,16 @@ def run_folder(arg, overrides):
 
 
 def load_summary(out):
-    s = json.loads((pathlib.Path(out) / "summary.json").read_text())
-    return s
+    """`catflip run`'s summary.json in `out`, or a plain exit naming what to give."""
+    path = pathlib.Path(out) / "summary.json"
+    if not pathlib.Path(out).is_dir():
+        raise SystemExit(f"{out}: no such folder; give the folder `catflip run` wrote "
+                         "(output/<name>/run) or a .toml config")
+    if not path.is_file():
+        raise SystemExit(f"{out} has no summary.json: it is not a folder `catflip run` wrote "
+                         "(an `export` or `optimize` folder has no methods to compare); give "
+                         "output/<name>/run, or a .toml config")
+    return json.loads(path.read_text())
 
 
 def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_methods=(), land_modes=None):

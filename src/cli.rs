@@ -602,21 +602,22 @@ fn cmd_run(c: &Common) -> Result<Status> {
     let cfg = load(c)?;
     let publisher = publisher(c, &cfg, "run")?;
     let dir = publisher.link();
-    let r = catflip::run::run(&cfg, console::progress::stages(c.json))?;
+    let mut r = catflip::run::run(&cfg, console::progress::stages(c.json))?;
     let outcome = r.summary.outcome;
+    // the sizing advice names this config and the `--set`s `size` takes, on
+    // the terminal and in the report
+    const ADVICE: &str = "catflip size CONFIG --height";
+    let sizing = crate::size_cli::advised(c, cfg.fall.height);
+    r.output
+        .replace_in("index.html", ADVICE, &catflip::report::esc(&sizing));
     let written = publisher.publish(r.output)?;
     if c.json {
         say!("{}", serde_json::to_string_pretty(&r.summary)?);
         return Ok(outcome.into());
     }
-    // the sizing advice names this config and the `--set`s `size` takes
-    const ADVICE: &str = "catflip size CONFIG --height";
     let mut lines = console::run::summary(&r.summary, &dir.join("index.html"), written.len());
-    if lines.iter().any(|l| l.contains(ADVICE)) {
-        let sizing = crate::size_cli::advised(c, cfg.fall.height);
-        for l in &mut lines {
-            *l = l.replace(ADVICE, &sizing);
-        }
+    for l in &mut lines {
+        *l = l.replace(ADVICE, &sizing);
     }
     say_lines(lines);
     if let Some(word) = console::run::closing(&r.summary) {

@@ -135,6 +135,20 @@ impl Output {
         self.files.push((name.into(), contents.into()));
     }
 
+    /// Replaces `from` by `to` in the text file `name`, if it was added
+    /// (the CLI naming the user's own config where the library wrote a
+    /// placeholder).
+    pub fn replace_in(&mut self, name: &str, from: &str, to: &str) {
+        for (n, contents) in &mut self.files {
+            if n == name
+                && let Ok(text) = std::str::from_utf8(contents)
+                && text.contains(from)
+            {
+                *contents = text.replace(from, to).into_bytes();
+            }
+        }
+    }
+
     /// Names of the files added so far.
     pub fn names(&self) -> impl Iterator<Item = &str> {
         self.files.iter().map(|f| f.0.as_str())

@@ -316,12 +316,13 @@ pub fn stage(spec: &DesignSpec, design: Design, solve_time_s: f64) -> Judged {
         reason: verdict.reason(),
         beyond_the_motors: method == Method::Analytic && verdict.misses.iter().any(Miss::is_limit),
         approximate_for_the_joint: method == Method::Analytic
-            && spec.cat.joint == crate::model::Joint::Universal
+            && (spec.cat.joint == crate::model::Joint::Universal || !spec.cat.is_symmetric())
             && !verdict.misses.is_empty()
             && verdict
                 .misses
                 .iter()
                 .all(|m| matches!(m, Miss::Flip { .. } | Miss::Tilt { .. }) || m.is_limit()),
+        unequal_halves: spec.cat.joint == crate::model::Joint::NoTwist && !spec.cat.is_symmetric(),
         for_the_start_at_rest: !spec.is_default_start()
             && made_for_rest_misses_only_the_landing(
                 method,
@@ -551,8 +552,14 @@ pub struct MethodSummary {
     /// Nor is it exact under the universal joint: there it misses the flip
     /// and tilts (F4, MODEL.md); reported, but no reason for a partial run
     /// (present, `true`, only when that is all it misses beside the limits).
+    /// Also true for a no-twist cat of unequal halves, where the closed
+    /// forms (F1, F6) are not exact either.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub approximate_for_the_joint: bool,
+    /// Whether the body is a no-twist cat of unequal halves (which closed
+    /// form is approximate, for the words).
+    #[serde(skip)]
+    pub unequal_halves: bool,
     /// Nor is it, or the phased design, made for another start: from one
     /// they miss the landing by what the start leaves (the free-form design
     /// is made for it); reported, but no reason for a partial run (present,
@@ -599,6 +606,7 @@ impl MethodSummary {
             reason: Some(e.to_string()),
             beyond_the_motors: false,
             approximate_for_the_joint: false,
+            unequal_halves: false,
             for_the_start_at_rest: false,
             result: None,
         }
@@ -614,6 +622,7 @@ impl MethodSummary {
             reason: Some(why.to_string()),
             beyond_the_motors: false,
             approximate_for_the_joint: false,
+            unequal_halves: false,
             for_the_start_at_rest: false,
             result: None,
         }
@@ -633,12 +642,18 @@ impl MethodSummary {
     pub fn reference_note(&self) -> Option<&'static str> {
         if self.beyond_the_motors && self.for_the_start_at_rest {
             Some("a reference beyond the motors, made for the start at rest, not counted")
+        } else if self.beyond_the_motors && self.approximate_for_the_joint && self.unequal_halves {
+            Some(
+                "a reference beyond the motors, and the seed's closed form, exact only for identical halves (F1, F6): not counted",
+            )
         } else if self.beyond_the_motors && self.approximate_for_the_joint {
             Some(
                 "a reference beyond the motors, and the seed's closed form, approximate for the universal joint (F4): not counted",
             )
         } else if self.beyond_the_motors {
             Some("a reference beyond the motors, not counted")
+        } else if self.approximate_for_the_joint && self.unequal_halves {
+            Some("the seed's closed form, exact only for identical halves (F1, F6), not counted")
         } else if self.approximate_for_the_joint {
             Some("the seed's closed form, approximate for the universal joint (F4), not counted")
         } else if self.for_the_start_at_rest {
@@ -984,6 +999,7 @@ mod tests {
                 reason: None,
                 beyond_the_motors: beyond,
                 approximate_for_the_joint: approximate,
+                unequal_halves: false,
                 for_the_start_at_rest: at_rest,
                 result: None,
             };

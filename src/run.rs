@@ -147,9 +147,27 @@ impl LimitsUsed {
             ("max_bend_deg", "bend limit", self.max_bend_deg, "deg"),
         ]
         .into_iter()
-        .filter_map(|(key, what, v, unit)| Some(format!("{what} {} {unit}{}", v?, mark(key))))
+        .filter_map(|(key, what, v, unit)| {
+            Some(format!("{what} {} {unit}{}", significant(v?, 7), mark(key)))
+        })
         .collect();
         (!parts.is_empty()).then(|| format!("limits: {}", parts.join(", ")))
+    }
+}
+
+/// `x` to `digits` significant digits, without trailing zeros: a limit as
+/// typed (1.4, 5.969) stays as typed, one converted from a robot file's
+/// radians (114.59155902616465 deg) is shown as 114.5916.
+fn significant(x: f64, digits: i32) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let decimals = (digits - 1 - x.abs().log10().floor() as i32).clamp(0, 15) as usize;
+    let s = format!("{x:.decimals$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
     }
 }
 
@@ -887,6 +905,16 @@ pub fn braking_words(stall: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Limits print as typed, or to 7 significant digits when converted.
+    #[test]
+    fn a_limit_prints_as_typed_or_to_seven_digits() {
+        assert_eq!(significant(1.4, 7), "1.4");
+        assert_eq!(significant(5.969, 7), "5.969");
+        assert_eq!(significant(114.59155902616465, 7), "114.5916");
+        assert_eq!(significant(175.0, 7), "175");
+        assert_eq!(significant(2.5e-4, 7), "0.00025");
+    }
 
     /// Only a sound design above the stall torque gets the note: a flagged
     /// one breaks its limit (its reason says so), and without a stall

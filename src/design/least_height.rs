@@ -37,10 +37,11 @@ pub struct HeightAnswer {
     /// `iteration-limit` for a verified free-form schedule that is not
     /// proven the shortest).
     pub status: Status,
-    /// A lower bound on the least drop height, m: the least time with the
-    /// stall torque alone ([`stall_only`]; absent without a torque limit,
-    /// before the free-form designs, or from a start with momentum, where
-    /// its time scaling does not hold).
+    /// A lower bound on the least drop height, m: the least time found
+    /// with the stall torque alone ([`stall_only`], a local optimum, so an
+    /// estimate; absent without a torque limit, before the free-form
+    /// designs, from a start with momentum, where its time scaling does not
+    /// hold, and where it is not below the answer).
     pub least_height_lower_bound_m: Option<f64>,
     /// Flip error of the least-height schedule in the motor-model simulation, rad.
     pub flip_error_rad: f64,
@@ -439,7 +440,14 @@ pub fn heights(
     answer.least_height_lower_bound_m = bound
         .filter(|_| !spec.has_momentum() && !torque_alone)
         .map(|t| crate::design::envelope::height_for(spec, t));
-    Ok(Some(concluded(spec, (answer, phased_bend), candidates)))
+    let mut heights = concluded(spec, (answer, phased_bend), candidates);
+    // the stall-only design is a local optimum too (on a coarse mesh): where
+    // it is not below the answer it bounds nothing, and is not given
+    let a = &mut heights.answer;
+    a.least_height_lower_bound_m = a
+        .least_height_lower_bound_m
+        .filter(|&b| b < a.least_height_m);
+    Ok(Some(heights))
 }
 
 /// A free-form design and its flight, when it verifies ([`verified`]).

@@ -59,7 +59,7 @@ pub fn height_text(a: &HeightAnswer) -> String {
     let what = b
         .map(|b| {
             format!(
-                " The bound, {b:.3} m, is the least height of a motor that never gives more than its stall torque and has no speed limit: no schedule within the stall torque needs less (the torque-speed line gives more while braking, T + k |w|, so it is not a proof for this motor). The answer is the best design found, a local optimum; where the two are far apart, the motors' speed, not their torque, is what holds the flip back."
+                " The bound, {b:.3} m, is the least height found for a motor that never gives more than its stall torque and has no speed limit (the best such design found, a local optimum as the answer is, so an estimate, not a proof; and the torque-speed line gives more than the stall torque while braking, T + k |w|); it is given only below the answer. The answer is the best design found, a local optimum; where the two are far apart, the motors' speed, not their torque, is what holds the flip back."
             )
         })
         .unwrap_or_default();

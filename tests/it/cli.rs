@@ -737,9 +737,12 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
     // its animated track says from what drop it is (not the 2 m asked)
     assert!(html.contains(&format!("for a drop from {least:.3} m; ")));
     // the bound far below the answer says what it is, not a contradiction
-    assert!(
-        html.contains("is the least height of a motor that never gives more than its stall torque")
-    );
+    assert!(html.contains(
+        "is the least height found for a motor that never gives more than its stall torque"
+    ));
+    assert!(html.contains("an estimate, not a proof"));
+    // the sizing advice names this config, as the terminal does
+
     assert!(!html.contains("<td>FAILED: "), "nothing errored");
     assert!(html.contains("<td>least-height</td>"));
     // the answer links the schedule's files, which are beside the page
@@ -751,14 +754,17 @@ fn the_robot_from_2_m_exits_4_with_the_least_height_schedule_as_a_method() {
         assert!(html.contains(&format!("<a href=\"{f}\">{f}</a>")), "{f}");
         assert!(base.join(f).is_file(), "{f}");
     }
-    // and points to the command that answers the next question: on the
-    // terminal the one to type, on this config and its --set
+    // and points to the command that answers the next question, the one to
+    // type, on this config and its --set (on the terminal and the page)
     let sizing = |command: &str| {
         format!("The motors (or the gear ratio) that would do it from 2 m: {command} --height 2.")
     };
-    assert!(html.contains(&sizing("catflip size CONFIG")));
     let config = util::config_path("robot-universal");
     let config = config.to_str().unwrap();
+    assert!(
+        html.contains(&sizing(&format!("catflip size {config}"))),
+        "{html}"
+    );
     // (without the --sets `size` refuses: it sets the drop and the objective
     // itself)
     let (_, out, _) = util::run(
@@ -839,6 +845,16 @@ fn under_the_universal_joint_the_analytic_reference_is_flagged_not_counted() {
     let an = method_line(&s, "analytic");
     assert_eq!(an["verdict"], "ok", "{an}");
     assert!(an.get("approximate_for_the_joint").is_none(), "{an}");
+    // a no-twist cat of unequal halves: the closed forms (F1, F6) are exact
+    // only for identical ones, so the same holds (it exited 3 before)
+    let (code, s, base, err) = run_summary("seed", &["cat.front.mass=2"], dir.path());
+    assert_eq!(code, Some(0), "{err}");
+    let an = method_line(&s, "analytic");
+    assert_eq!(an["verdict"], "flagged", "{an}");
+    assert!(an["flip_error_rad"].as_f64().unwrap() > 1e-2, "{an}");
+    assert_eq!(an["approximate_for_the_joint"], true, "{an}");
+    let html = std::fs::read_to_string(base.join("index.html")).unwrap();
+    assert!(html.contains("exact only for identical halves (F1, F6), not counted"));
 }
 
 /// The robot from 6 m: possible, its designs sound; the seed's analytic
