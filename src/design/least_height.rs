@@ -71,6 +71,12 @@ pub struct HeightAnswer {
     /// motor's stall torque and no-load speed), `None` when it has both.
     #[serde(skip)]
     pub size_needs: Option<&'static str>,
+    /// Under a stall torque alone, at rest: the stall torque that would do
+    /// it from `height_m`, N m (F7: the least-height schedule stretched to
+    /// that fall needs `T (T_min / T_H)^2`), which `catflip size` cannot give
+    /// without a torque-speed line.
+    #[serde(skip)]
+    pub torque_alone_for_height_nm: Option<f64>,
 }
 
 /// Answers the question when the motors are limited (`None` otherwise: an
@@ -158,8 +164,10 @@ fn answer_for(
         beyond_longest_fall: false,
         schedule: Schedule::sample(&spec.cat, &r.plan, spec.simulate.samples_per_phase),
         size_needs: size_needs(&spec.motor),
+        torque_alone_for_height_nm: None,
     };
     answer.bound(spec);
+    answer.torque_alone(spec);
     Ok((answer, r.bend_deg.to_radians()))
 }
 
@@ -447,6 +455,7 @@ pub fn heights(
     a.least_height_lower_bound_m = a
         .least_height_lower_bound_m
         .filter(|&b| b < a.least_height_m);
+    a.torque_alone(spec);
     Ok(Some(heights))
 }
 
@@ -761,6 +770,7 @@ impl HeightAnswer {
             beyond_longest_fall: false,
             schedule: Schedule { rows: Vec::new() },
             size_needs: size_needs(&spec.motor),
+            torque_alone_for_height_nm: None,
         }
     }
 
@@ -794,6 +804,27 @@ impl HeightAnswer {
         }
     }
 
+    /// Sets [`HeightAnswer::torque_alone_for_height_nm`] for `spec`'s
+    /// fall (none but under a stall torque alone, at rest, with a verified
+    /// least time).
+    fn torque_alone(&mut self, spec: &DesignSpec) {
+        let m = spec.motor;
+        let fall = spec.available_time();
+        self.torque_alone_for_height_nm = match m.max_torque {
+            Some(t)
+                if m.no_load_speed.is_none()
+                    && m.max_speed.is_none()
+                    && !spec.has_momentum()
+                    && self.verified
+                    && self.least_time_s.is_finite()
+                    && fall > 0.0 =>
+            {
+                Some(t * (self.least_time_s / fall).powi(2))
+            }
+            _ => None,
+        };
+    }
+
     /// What a manoeuvre beyond the longest fall takes, and what to change.
     pub fn beyond_text(&self) -> String {
         let seconds = if self.least_time_s < 1e4 {
@@ -823,10 +854,18 @@ impl HeightAnswer {
                 "The motors (or the gear ratio) that would do it from {} m: catflip size CONFIG --height {}.",
                 self.height_m, self.height_m
             ),
-            Some(keys) => format!(
-                "The motors that would do it from {} m: catflip size CONFIG --height {}, once the config gives a DC motor's {keys} (catflip size scales its torque-speed line).",
-                self.height_m, self.height_m
-            ),
+            Some(keys) => {
+                // under a torque alone F7 answers it without a torque-speed line
+                let alone = self.torque_alone_for_height_nm.map_or(String::new(), |t| {
+                    format!(
+                        "a stall torque of {t:.4} N m, with no speed limit (F7: this least-height schedule stretched to that fall needs its torque times (T_min / T)^2); for a DC motor, "
+                    )
+                });
+                format!(
+                    "The motors that would do it from {} m: {alone}catflip size CONFIG --height {}, once the config gives a DC motor's {keys} (catflip size scales its torque-speed line).",
+                    self.height_m, self.height_m
+                )
+            }
         }
     }
 
@@ -923,6 +962,7 @@ mod tests {
             beyond_longest_fall: false,
             schedule: Schedule { rows: Vec::new() },
             size_needs: None,
+            torque_alone_for_height_nm: None,
         };
         let s = a.sentence();
         assert!(s.starts_with("No verified design found"), "{s}");
@@ -942,6 +982,13 @@ mod tests {
         });
         assert!(
             a.sentence().ends_with("catflip size CONFIG --height 20, once the config gives a DC motor's no-load speed (limits.no_load_speed) (catflip size scales its torque-speed line)."),
+            "{}",
+            a.sentence()
+        ); // under the stall torque alone F7 gives the torque for the height
+        a.torque_alone_for_height_nm = Some(2.5);
+        assert!(
+            a.sentence()
+                .contains("from 20 m: a stall torque of 2.5000 N m, with no speed limit (F7"),
             "{}",
             a.sentence()
         );

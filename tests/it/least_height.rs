@@ -186,6 +186,19 @@ fn under_a_stall_torque_alone_the_answer_is_near_the_peak_optimum_scaled_and_has
         a.least_time_s <= scaled * (1.0 + 5e-3),
         "least time {} s against the scaled peak optimum's {scaled} s",
         a.least_time_s
+    ); // from the configured 10 m the torque F7 names is the peak optimum's
+    // there (the peak design made for this fall), to the answer's accuracy
+    let t = a
+        .torque_alone_for_height_nm
+        .expect("F7's torque for the height");
+    assert!(
+        (t / r.peak_torque_nm - 1.0).abs() < 5e-3,
+        "{t} N m against the peak optimum's {}",
+        r.peak_torque_nm
+    );
+    assert!(
+        a.sentence()
+            .contains(&format!("a stall torque of {t:.4} N m"))
     );
 }
 
