@@ -418,7 +418,16 @@ impl Origin {
                 .warm(warm, before)
                 .solve()
         };
-        let flown = fr.and_then(|fr| flight(&cfg, &fr).map(|f| (fr, f)));
+        let mut flown = fr.and_then(|fr| flight(&cfg, &fr).map(|f| (fr, f)));
+        if magnitude != 0.0 && !lands_the_short_way(&cfg, &flown) {
+            // continued from its neighbour, the design keeps the neighbour's
+            // way round: designed afresh it starts the nearer way
+            // (`design::mirror`), and the better is kept
+            let fresh = FreeDesign::new(&cfg.design_spec())
+                .solve()
+                .and_then(|fr| flight(&cfg, &fr).map(|f| (fr, f)));
+            flown = better_flight(flown, fresh);
+        }
         let kept = match flown {
             Ok((fr, (sim, landed))) => {
                 p.outcome = if landed {
@@ -512,6 +521,34 @@ impl Origin {
 /// A design flown under the motor model, and whether it lands: inside the
 /// motor envelope and within the landing tolerance in the simulation,
 /// whether or not its SCP converged.
+/// A design and its flight ([`flight`]).
+type Flown = Result<(FreeResult, (SimReport, bool))>;
+
+/// Whether a flown design lands, turning at most half a turn about the
+/// spine (one that went the long way round may have a shorter twin).
+fn lands_the_short_way(cfg: &Config, flown: &Flown) -> bool {
+    flown.as_ref().is_ok_and(|(fr, (_, landed))| {
+        *landed
+            && crate::design::mirror::left_to_turn(&cfg.design_spec(), &fr.plan)
+                .is_some_and(|t| t.abs() <= std::f64::consts::PI + 1e-3)
+    })
+}
+
+/// The better of two flown designs of one start: one that lands over one
+/// that does not, then the lower objective; a design over an error.
+fn better_flight(a: Flown, b: Flown) -> Flown {
+    let key = |f: &Flown| {
+        f.as_ref()
+            .ok()
+            .map(|(fr, (_, landed))| (!*landed, fr.objective_value))
+    };
+    match (key(&a), key(&b)) {
+        (Some(ka), Some(kb)) if kb.0 < ka.0 || (kb.0 == ka.0 && kb.1 < ka.1) => b,
+        (None, Some(_)) => b,
+        _ => a,
+    }
+}
+
 fn flight(cfg: &Config, fr: &FreeResult) -> Result<(SimReport, bool)> {
     let spec = cfg.design_spec();
     let sim = crate::verify::simulate::dynamic_spec(&spec, &fr.plan)?;

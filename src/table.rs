@@ -99,6 +99,9 @@ pub fn peak_ratios(free_over_phased: Option<f64>, phased_over_analytic: Option<f
     .join(", ")
 }
 
+/// The suffix of a seed's name taken as its mirror image.
+const MIRRORED: &str = crate::design::mirror::MIRRORED;
+
 /// How the free-form design went, for the lines under the table: its
 /// meshes and iterations and what it started from (`seed`), or that it was
 /// not attempted.
@@ -111,11 +114,19 @@ pub fn free_design_text(
     if free.is_some_and(|m| m.verdict == Grade::Impossible) {
         "not attempted (the motors cannot do it in this fall), see its row".into()
     } else {
-        let from = match seed {
-            Some("phased") => "from the phased design, ",
-            Some(crate::pipeline::FREE_LEAST_TIME) => "from the least-height design, ",
-            Some("analytic") => "from the analytic schedule, ",
+        // (a seed made for the start at rest may be taken mirrored, the
+        // other way round: `design::mirror`)
+        let mirrored = seed.is_some_and(|s| s.ends_with(MIRRORED));
+        let from = match seed.map(|s| s.trim_end_matches(MIRRORED)) {
+            Some("phased") => "from the phased design",
+            Some(crate::pipeline::FREE_LEAST_TIME) => "from the least-height design",
+            Some("analytic") => "from the analytic schedule",
             _ => "",
+        };
+        let from = match (from.is_empty(), mirrored) {
+            (true, _) => String::new(),
+            (false, true) => format!("{from} mirrored (the other way round), "),
+            (false, false) => format!("{from}, "),
         };
         format!(
             "{from}{}",

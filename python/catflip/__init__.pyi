@@ -265,7 +265,8 @@ class LeastHeight:
     @property
     def least_height_lower_bound_m(self) -> Optional[float]:
         """A lower bound on the least drop height, m, or None (the answer's
-        ``least_height_lower_bound_m``: the stall-only design's)."""
+        ``least_height_lower_bound_m``: the best stall-only design's, a local
+        optimum, so an estimate; given only below the answer)."""
     @property
     def phased_least_height_m(self) -> float:
         """The phased time design's least height, m."""

@@ -1358,7 +1358,8 @@ impl LeastHeight {
         self.answer.least_height_m
     }
     /// A lower bound on the least drop height, m, or None (the answer's
-    /// `least_height_lower_bound_m`: the stall-only design's).
+    /// `least_height_lower_bound_m`: the best stall-only design's, a local
+    /// optimum, so an estimate; given only below the answer).
     #[getter]
     fn least_height_lower_bound_m(&self) -> Option<f64> {
         self.answer.least_height_lower_bound_m

@@ -1316,14 +1316,17 @@ fn from_plan(
     let design = |plan: &dyn crate::design::plan::ShapePlan, observe: &mut dyn Observer| {
         stage(spec, plan, seed, nodes, observe).finish(spec, observe)
     };
-    if spec.is_default_start() {
+    // (a design already made for this question, the least-height answer's,
+    // is not turned round)
+    if spec.is_default_start() || seed == crate::pipeline::FREE_LEAST_TIME {
         return design(seed_plan, observe);
     }
     // from another start, the seed turned the way that leaves less to turn
     // first; the other way where that design does not land (near
     // belly-down both ways are far, and either may end straight)
     let mirrored = crate::design::mirror::Mirrored(seed_plan);
-    let mut ways: [&dyn crate::design::plan::ShapePlan; 2] = [seed_plan, &mirrored];
+    let mut ways: [(&dyn crate::design::plan::ShapePlan, bool); 2] =
+        [(seed_plan, false), (&mirrored, true)];
     if crate::design::mirror::mirror_is_nearer(spec, seed_plan) {
         ways.swap(0, 1);
     }
@@ -1331,8 +1334,21 @@ fn from_plan(
         r.as_ref()
             .is_ok_and(|r| r.certificate.constraint_violation <= spec.free.attitude_tolerance)
     };
+    // the kept design names its seed as mirrored, and counts the time of
+    // a design tried before it
+    let kept = |r: Result<FreeResult>, mirrored: bool, before_s: f64| {
+        r.map(|mut r| {
+            if mirrored {
+                r.seed = format!("{}{}", r.seed, crate::design::mirror::MIRRORED);
+            }
+            r.solve_time_s += before_s;
+            r
+        })
+    };
+    let clock = std::time::Instant::now();
     let mut nearer = Recorded::default();
-    let first = design(ways[0], &mut nearer);
+    let first = design(ways[0].0, &mut nearer);
+    let first_s = clock.elapsed().as_secs_f64();
     // a design that lands the short way is kept; one that went more than
     // half a turn (the SCP may cross to the long way) is kept only if the
     // other way does no better
@@ -1342,10 +1358,11 @@ fn from_plan(
     };
     if lands(&first) && !first.as_ref().is_ok_and(long_way) {
         nearer.replay(observe);
-        return first;
+        return kept(first, ways[0].1, 0.0);
     }
     let mut other = Recorded::default();
-    let second = design(ways[1], &mut other);
+    let second = design(ways[1].0, &mut other);
+    let second_s = clock.elapsed().as_secs_f64() - first_s;
     let better = match (&first, &second) {
         (Ok(a), Ok(b)) if lands(&first) => lands(&second) && b.objective_value < a.objective_value,
         _ => lands(&second) || (second.is_ok() && first.is_err()),
@@ -1353,10 +1370,10 @@ fn from_plan(
     // the nearer way's outcome unless the other lands (better), or fails less
     if better {
         other.replay(observe);
-        return second;
+        return kept(second, ways[1].1, first_s);
     }
     nearer.replay(observe);
-    first
+    kept(first, ways[0].1, second_s)
 }
 
 /// An observer's events kept to be told later, to the observer of the
@@ -1493,7 +1510,6 @@ fn stage(
     observe: &mut dyn Observer,
 ) -> Staged {
     let clock = std::time::Instant::now();
-    // from another start, the seed turned the way that leaves less to turn
     let seed_z = grid(spec, nodes, Mesh::Final).sample(seed_plan);
     let mut levels = Vec::new();
     // the fine mesh's start, what it carries from a coarse mesh, and
@@ -2265,20 +2281,21 @@ fn lands_anyway(spec: &DesignSpec, solved: &Solved) -> bool {
     let within_tolerance = crate::verdict::Targets::of(spec)
         .landing_tolerance
         .is_some_and(|(deg, _)| solved.attitude_error.to_degrees() <= deg);
-    // the motors kept at every written row: the envelope's margin, else the
-    // peak against the stall torque
-    let within_motors = || {
-        if spec.motor.no_load_speed.is_some() || spec.motor.max_speed.is_some() {
-            crate::design::envelope::usage_of(spec, &solved.plan)
-                .min_margin
-                .is_none_or(|m| m >= -crate::verdict::tolerance::ENVELOPE_MARGIN)
-        } else {
-            spec.motor
-                .max_torque
-                .is_none_or(|t| solved.node_peak <= t * (1.0 + crate::verdict::tolerance::LIMIT))
-        }
-    };
-    within_tolerance && within_motors()
+    within_tolerance && keeps_to_motors(spec, solved)
+}
+
+/// Whether a design keeps to the motors at every written row: the
+/// envelope's margin, else the peak against the stall torque.
+fn keeps_to_motors(spec: &DesignSpec, solved: &Solved) -> bool {
+    if spec.motor.no_load_speed.is_some() || spec.motor.max_speed.is_some() {
+        crate::design::envelope::usage_of(spec, &solved.plan)
+            .min_margin
+            .is_none_or(|m| m >= -crate::verdict::tolerance::ENVELOPE_MARGIN)
+    } else {
+        spec.motor
+            .max_torque
+            .is_none_or(|t| solved.node_peak <= t * (1.0 + crate::verdict::tolerance::LIMIT))
+    }
 }
 
 /// The error when the SCP cannot meet the motor limits in the fall: with a
@@ -2290,41 +2307,47 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
         let [w, x, y, z] = spec.release().attitude;
         // the spine's height above level at release: `(R0 e_z) . e_x`
         let spine_level = (2.0 * (x * z + w * y)).abs() < 1e-9;
-        if spec.cat.joint == crate::model::Joint::NoTwist
-            && !spec.has_momentum()
-            && spine_level
-            && !spec.motor.is_limited()
-            && spec.max_bend_deg.is_none()
-        {
-            // a roll about a level spine is within reach (F1): the optimiser's miss
-            return crate::error::Error::Solver {
-                what: "the free-form design".into(),
-                status: "infeasible".into(),
-                hint: format!(
-                    "It found no landing from this start: it still lands {:.3} deg from belly-down. At rest with a level spine the body can land (F1: its bend circulations turn it about the spine); from near belly-down the seeds' half turns are far from the small turn needed, and the design ended at a local optimum. Try the other seed (`--seed analytic`, or `--seed phased`)",
-                    solved.attitude_error.to_degrees()
+        if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() && spine_level {
+            // a roll about a level spine is within reach (F1): under motor
+            // limits theirs is the answer (below: the SCP trades the landing
+            // for the limits, 120 deg off under 0.02 N m); without, the
+            // optimiser's miss
+            if !spec.motor.is_limited() {
+                return crate::error::Error::Solver {
+                    what: "the free-form design".into(),
+                    status: "infeasible".into(),
+                    hint: format!(
+                        "It found no landing from this start: it still lands {:.3} deg from belly-down{}. At rest with a level spine the body can land (F1: its bend circulations turn it about the spine); from near belly-down the seeds' half turns are far from the small turn needed, and the design ended at a local optimum. Another seed may find it (`catflip optimize --mode free --seed analytic`, or `--seed phased`), as may a start rolled a little further",
+                        solved.attitude_error.to_degrees(),
+                        if spec.max_bend_deg.is_some() {
+                            ", within the bend limit"
+                        } else {
+                            ""
+                        }
+                    ),
+                };
+            }
+        } else {
+            // the landing, not the motors: what the optimiser could not undo
+            return crate::error::Error::Unreachable {
+                reason: format!(
+                    "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}",
+                    spec.fall.height,
+                    solved.attitude_error.to_degrees(),
+                    if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() {
+                        // no height helps: the spine's tilt is out of its reach
+                        "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
+                    } else if spec.has_momentum() {
+                        "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
+                    } else if spec.max_bend_deg.is_some() {
+                        // at rest, a universal joint: its reach, not a spin
+                        "Within its bend limit, its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height, a larger limits.max_bend_deg or a start closer to upside down"
+                    } else {
+                        "Within its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height or a start closer to upside down"
+                    }
                 ),
             };
         }
-        // the landing, not the motors: what the optimiser could not undo
-        return crate::error::Error::Unreachable {
-            reason: format!(
-                "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}",
-                spec.fall.height,
-                solved.attitude_error.to_degrees(),
-                if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() {
-                    // no height helps: the spine's tilt is out of its reach
-                    "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
-                } else if spec.has_momentum() {
-                    "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
-                } else if spec.max_bend_deg.is_some() {
-                    // at rest, a universal joint: its reach, not a spin
-                    "Within its bend limit, its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height, a larger limits.max_bend_deg or a start closer to upside down"
-                } else {
-                    "Within its motors and the time the fall leaves, the design could not turn the body that far; try a higher fall.height or a start closer to upside down"
-                }
-            ),
-        };
     }
     let motor = spec.motor;
     if motor.no_load_speed.is_none()
@@ -2649,6 +2672,14 @@ impl<'a> FreeDesign<'a> {
             Some(o) => o,
             None => &mut quiet,
         };
+        // from another start, the way round that leaves less to turn (one
+        // way only: the stages are ranked against each other)
+        let mirrored = crate::design::mirror::Mirrored(plan);
+        if crate::design::mirror::mirror_is_nearer(self.spec, plan) {
+            let mut staged = stage(self.spec, &mirrored, name, self.nodes, observe);
+            staged.seed = format!("{name}{}", crate::design::mirror::MIRRORED);
+            return Ok(staged);
+        }
         Ok(stage(self.spec, plan, name, self.nodes, observe))
     }
 

@@ -887,7 +887,7 @@ impl HeightAnswer {
                 } else {
                     ""
                 };
-                format!(" (at least {b:.3} m within the stall torque{gap})")
+                format!(" (at least {b:.3} m within the stall torque, estimated{gap})")
             })
             .unwrap_or_default();
         if self.beyond_longest_fall {
@@ -970,7 +970,7 @@ mod tests {
         a.verified = true;
         assert!(
             a.sentence()
-                .contains("from 62.514 m (at least 1.700 m within the stall torque; the motor's speed, not its torque, needs the rest) it is")
+                .contains("from 62.514 m (at least 1.700 m within the stall torque, estimated; the motor's speed, not its torque, needs the rest) it is")
         );
         assert!(a.sentence().ends_with(
             "The motors (or the gear ratio) that would do it from 20 m: catflip size CONFIG --height 20."

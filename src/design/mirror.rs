@@ -15,6 +15,10 @@ use crate::design::spec::DesignSpec;
 use crate::model::momentum::rigid_turn;
 use nalgebra::{Matrix3, UnitQuaternion};
 
+/// The suffix of a seed's name where the design started from its mirror
+/// image (`phased (mirrored)`).
+pub const MIRRORED: &str = " (mirrored)";
+
 /// A plan reflected through the plane of the spine and the belly: the
 /// first shape coordinate negated. For a body symmetric about that plane
 /// (the cylinders) it makes the same turn the other way.
