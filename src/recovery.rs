@@ -537,13 +537,14 @@ fn lands_the_short_way(cfg: &Config, flown: &Flown) -> bool {
 /// The better of two flown designs of one start: one that lands over one
 /// that does not, then the lower objective; a design over an error.
 fn better_flight(a: Flown, b: Flown) -> Flown {
+    // (landing first: `false` sorts before `true`)
     let key = |f: &Flown| {
         f.as_ref()
             .ok()
             .map(|(fr, (_, landed))| (!*landed, fr.objective_value))
     };
     match (key(&a), key(&b)) {
-        (Some(ka), Some(kb)) if kb.0 < ka.0 || (kb.0 == ka.0 && kb.1 < ka.1) => b,
+        (Some(ka), Some(kb)) if kb.0.cmp(&ka.0).then(kb.1.total_cmp(&ka.1)).is_lt() => b,
         (None, Some(_)) => b,
         _ => a,
     }
