@@ -1324,10 +1324,13 @@ fn from_plan(
     // from another start, the seed turned the way that leaves less to turn
     // first; the other way where that design does not land (near
     // belly-down both ways are far, and either may end straight)
-    let mirrored = crate::design::mirror::Mirrored(seed_plan);
+    let Some(mirrored) = crate::design::mirror::mirrored(spec, seed_plan) else {
+        // (no mirror image of this shape: one way round)
+        return design(seed_plan, observe);
+    };
     let mut ways: [(&dyn crate::design::plan::ShapePlan, bool); 2] =
         [(seed_plan, false), (&mirrored, true)];
-    if crate::design::mirror::mirror_is_nearer(spec, seed_plan) {
+    if crate::design::mirror::mirror_is_nearer(spec, seed_plan, &mirrored) {
         ways.swap(0, 1);
     }
     let lands = |r: &Result<FreeResult>| {
@@ -2674,8 +2677,9 @@ impl<'a> FreeDesign<'a> {
         };
         // from another start, the way round that leaves less to turn (one
         // way only: the stages are ranked against each other)
-        let mirrored = crate::design::mirror::Mirrored(plan);
-        if crate::design::mirror::mirror_is_nearer(self.spec, plan) {
+        if let Some(mirrored) = crate::design::mirror::mirrored(self.spec, plan)
+            && crate::design::mirror::mirror_is_nearer(self.spec, plan, &mirrored)
+        {
             let mut staged = stage(self.spec, &mirrored, name, self.nodes, observe);
             staged.seed = format!("{name}{}", crate::design::mirror::MIRRORED);
             return Ok(staged);

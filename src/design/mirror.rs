@@ -5,10 +5,13 @@
 //! the landing (belly-down, any heading) is nearer one way round than the
 //! other, and the free-form design keeps the way its seed turns: from a
 //! start rolled 20 deg it would turn 200 deg where 160 deg do. The mirror
-//! image of a seed in the plane of the spine and the belly turns the other
-//! way (both joints: `q1 -> -q1`, MODEL.md section 2, reflects `R_rel`
-//! through that plane); the free-form design starts from whichever of the
-//! two leaves the smaller turn about the spine.
+//! image of a seed in the plane of the spine and the belly (A's `x-z`
+//! plane) turns the other way: the reflection `P = diag(1, -1, 1)` maps a
+//! rotation about `a` by `q` to one about `-P a` by `q`, so a shape
+//! coordinate about an axis in that plane changes sign and one about `y`
+//! keeps it (MODEL.md section 2: the no-twist joint's `q1`, the universal
+//! joint's motor about `x`). The free-form design starts from whichever of
+//! the two leaves the smaller turn about the spine.
 
 use crate::design::plan::{ShapePlan, ShapeState};
 use crate::design::spec::DesignSpec;
@@ -19,45 +22,78 @@ use nalgebra::{Matrix3, UnitQuaternion};
 /// image (`phased (mirrored)`).
 pub const MIRRORED: &str = " (mirrored)";
 
-/// A plan reflected through the plane of the spine and the belly: the
-/// first shape coordinate negated. For a body symmetric about that plane
-/// (the cylinders) it makes the same turn the other way.
-pub struct Mirrored<'a>(pub &'a dyn ShapePlan);
+/// A plan reflected through the plane of the spine and the belly: each
+/// shape coordinate multiplied by its sign ([`signs`]). For a body
+/// symmetric about that plane (the cylinders) it makes the same turn the
+/// other way; for another it is a start the design corrects.
+pub struct Mirrored<'a> {
+    pub plan: &'a dyn ShapePlan,
+    pub signs: [f64; 2],
+}
 
 impl ShapePlan for Mirrored<'_> {
     fn phase_bounds(&self) -> Vec<f64> {
-        self.0.phase_bounds()
+        self.plan.phase_bounds()
     }
 
     fn state_in(&self, i: usize, t: f64) -> ShapeState {
-        let s = self.0.state_in(i, t);
-        let flip = |v: [f64; 2]| [-v[0], v[1]];
+        let s = self.plan.state_in(i, t);
+        let k = self.signs;
+        let by = |v: [f64; 2]| [k[0] * v[0], k[1] * v[1]];
         ShapeState {
-            q: flip(s.q),
-            qd: flip(s.qd),
-            qdd: flip(s.qdd),
+            q: by(s.q),
+            qd: by(s.qd),
+            qdd: by(s.qdd),
             phase: s.phase,
         }
     }
 
     fn breaks(&self) -> Vec<f64> {
-        self.0.breaks()
+        self.plan.breaks()
     }
 }
 
-/// Whether the free-form design from `spec`'s start should start from the
-/// mirror image of `plan`: the way round that leaves the smaller turn about
-/// the spine (each way flown kinematically from the start to touchdown: its
-/// own half turn from rest, signed, plus the roll that would then point the
-/// belly down). At the default start both ways are the same half turn: no.
-pub fn mirror_is_nearer(spec: &DesignSpec, plan: &dyn ShapePlan) -> bool {
+/// The signs that reflect `spec`'s shape coordinates through A's `x-z`
+/// plane: `[-1, 1]` for the no-twist joint; for the universal joint `-1`
+/// for a motor axis in that plane and `1` for one along `y`. `None` when a
+/// motor axis is oblique (no reflection of the shape exists) or the
+/// reflection leaves every coordinate as it is.
+pub fn signs(spec: &DesignSpec) -> Option<[f64; 2]> {
+    let signs = match spec.cat.joint {
+        crate::model::Joint::NoTwist => [-1.0, 1.0],
+        crate::model::Joint::Universal => {
+            let h = spec.cat.halves();
+            let sign = |a: [f64; 3]| {
+                if a[1].abs() < 1e-12 {
+                    Some(-1.0)
+                } else if a[0].abs() < 1e-12 && a[2].abs() < 1e-12 {
+                    Some(1.0)
+                } else {
+                    None
+                }
+            };
+            [sign(h.rear.axis)?, sign(h.front.axis)?]
+        }
+    };
+    (signs != [1.0, 1.0]).then_some(signs)
+}
+
+/// `plan`'s mirror image for `spec`, if the shape has one ([`signs`]).
+pub fn mirrored<'a>(spec: &DesignSpec, plan: &'a dyn ShapePlan) -> Option<Mirrored<'a>> {
+    signs(spec).map(|signs| Mirrored { plan, signs })
+}
+
+/// Whether the free-form design from `spec`'s start should start from
+/// `mirror`, `plan`'s mirror image: the way round that leaves the smaller
+/// turn about the spine (each way flown kinematically from the start to
+/// touchdown: its own half turn from rest, signed, plus the roll that would
+/// then point the belly down). At the default start both ways are the same
+/// half turn: no.
+pub fn mirror_is_nearer(spec: &DesignSpec, plan: &dyn ShapePlan, mirror: &Mirrored) -> bool {
     if spec.is_default_start() {
         return false;
     }
-    let (Some(own), Some(other)) = (
-        left_to_turn(spec, plan),
-        left_to_turn(spec, &Mirrored(plan)),
-    ) else {
+    let (Some(own), Some(other)) = (left_to_turn(spec, plan), left_to_turn(spec, mirror)) else {
         return false;
     };
     // (a margin against rounding: a tie keeps the seed)
@@ -96,6 +132,35 @@ mod tests {
     use super::*;
     use crate::model::so3;
     use nalgebra::Vector3;
+
+    /// The reflection's signs follow the joint's axes: the no-twist joint
+    /// and the universal joint's motor about `x` change sign, a motor about
+    /// `y` keeps it, an oblique one has no mirror image.
+    #[test]
+    fn the_mirror_negates_the_coordinates_about_axes_in_the_spines_plane() {
+        let spec = |sets: &[&str]| {
+            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+            crate::config::Config::load(std::path::Path::new("configs/seed.toml"), &sets)
+                .unwrap()
+                .design_spec()
+        };
+        assert_eq!(signs(&spec(&[])), Some([-1.0, 1.0]));
+        assert_eq!(
+            signs(&spec(&["cat.joint=\"universal\""])),
+            Some([-1.0, 1.0])
+        );
+        let body = |rear: &str, front: &str| {
+            let text = format!(
+                "name = \"b\"\n[cat]\njoint = \"universal\"\n[body.rear]\nmass = 0.6\ncom = [0, 0, 0]\ninertia = [0.002, 0.002, 0.001, 0, 0, 0]\njoint = [0, 0, 0.09]\naxis = {rear}\n[body.front]\nmass = 0.4\ncom = [0, 0, 0.07]\ninertia = [0.001, 0.001, 0.0005, 0, 0, 0]\njoint = [0, 0, 0]\naxis = {front}\n[fall]\nheight = 2.0\n"
+            );
+            crate::config::Config::from_toml(&text, "test body", &[])
+                .unwrap()
+                .design_spec()
+        };
+        assert_eq!(signs(&body("[0, 1, 0]", "[1, 0, 0]")), Some([1.0, -1.0]));
+        assert_eq!(signs(&body("[0.6, 0.8, 0]", "[0, 1, 0]")), None);
+        assert_eq!(signs(&body("[0, 1, 0]", "[0, 0, 1]")), Some([1.0, -1.0]));
+    }
 
     /// The roll found points the belly down for a body only rolled, and
     /// is the smaller way round.
