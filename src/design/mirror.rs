@@ -138,24 +138,15 @@ mod tests {
     /// `y` keeps it, an oblique one has no mirror image.
     #[test]
     fn the_mirror_negates_the_coordinates_about_axes_in_the_spines_plane() {
-        let spec = |sets: &[&str]| {
-            let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-            crate::config::Config::load(std::path::Path::new("configs/seed.toml"), &sets)
-                .unwrap()
-                .design_spec()
-        };
-        assert_eq!(signs(&spec(&[])), Some([-1.0, 1.0]));
-        assert_eq!(
-            signs(&spec(&["cat.joint=\"universal\""])),
-            Some([-1.0, 1.0])
-        );
+        let seed = |sets: &[String]| crate::test_support::spec_at("configs/seed.toml", sets);
+        assert_eq!(signs(&seed(&[])), Some([-1.0, 1.0]));
+        let universal = seed(&["cat.joint=\"universal\"".to_string()]);
+        assert_eq!(signs(&universal), Some([-1.0, 1.0]));
         let body = |rear: &str, front: &str| {
             let text = format!(
                 "name = \"b\"\n[cat]\njoint = \"universal\"\n[body.rear]\nmass = 0.6\ncom = [0, 0, 0]\ninertia = [0.002, 0.002, 0.001, 0, 0, 0]\njoint = [0, 0, 0.09]\naxis = {rear}\n[body.front]\nmass = 0.4\ncom = [0, 0, 0.07]\ninertia = [0.001, 0.001, 0.0005, 0, 0, 0]\njoint = [0, 0, 0]\naxis = {front}\n[fall]\nheight = 2.0\n"
             );
-            crate::config::Config::from_toml(&text, "test body", &[])
-                .unwrap()
-                .design_spec()
+            crate::test_support::spec_of(&text, "test body", &[])
         };
         assert_eq!(signs(&body("[0, 1, 0]", "[1, 0, 0]")), Some([1.0, -1.0]));
         assert_eq!(signs(&body("[0.6, 0.8, 0]", "[0, 1, 0]")), None);
