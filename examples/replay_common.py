@@ -325,8 +325,12 @@ def report(engine, summary, results, flip_tol, ff_tol, land_tol=None, land_metho
                 fails.append(f"{name}: PD replay peak torque {r['peak_nm']:.5f} vs catflip "
                              f"{sim:.5f} N m (> 2 %, {held:.5f} N m below it allowed for the "
                              f"controls' step means)")
-            if not saturating and r["shape_error_rad"] > 1e-3:
-                fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight")
+            # as straight as catflip's own flight ends, to 1e-3 rad (the analytic reference
+            # from a spinning start ends 1.6e-3 rad off in both)
+            straight = 1e-3 + (m.get("final_shape_error_rad") or 0.0)
+            if not saturating and r["shape_error_rad"] > straight:
+                fails.append(f"{name}: PD replay ends {r['shape_error_rad']:.2e} rad from straight "
+                             f"(catflip's flight {straight - 1e-3:.2e})")
         elif mode == "ff" and ff_tol is not None and name != "analytic" and not saturating \
                 and not r.get("spinning") and abs(diff) > ff_tol:
             fails.append(f"{name}: feed-forward replay flip differs by {diff:.3e} deg (> {ff_tol:g})")
