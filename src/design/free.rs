@@ -2331,13 +2331,34 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
                 };
             }
         } else {
-            // the landing, not the motors: what the optimiser could not undo
+            // the landing, not the motors: what the optimiser could not undo;
+            // a pitched start is said, with its pitch (a rotation vector's
+            // components mix: [10, 0, 15] pitches the spine 1.3 deg)
+            let pitch = (2.0 * (x * z + w * y)).clamp(-1.0, 1.0).asin().to_degrees();
+            let pitched = if spine_level {
+                String::new()
+            } else {
+                format!(
+                    "The start pitches the spine {:.3} deg from level (start.rotation_deg is one rotation vector: components set together mix). ",
+                    pitch.abs()
+                )
+            };
+            let rate = spec.release().body_rate;
+            let about_the_spine = rate[0] == 0.0 && rate[1] == 0.0;
             return crate::error::Error::Unreachable {
                 reason: format!(
-                    "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {}",
+                    "cannot land belly-down from this start (start.rotation_deg, start.angular_velocity) in the fall from {} m: the free-form design still lands {:.3} deg from belly-down. {pitched}{}",
                     spec.fall.height,
                     solved.attitude_error.to_degrees(),
-                    if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() {
+                    if spec.cat.joint == crate::model::Joint::NoTwist
+                        && spec.has_momentum()
+                        && about_the_spine
+                        && !spine_level
+                    {
+                        // a spin about the spine does not tumble it (F10)
+                        "A spin about the spine turns the body about it (F10); the design did not level the pitched spine with it, and at zero momentum a no-twist cat cannot tilt its spine at all (F1); try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
+                    } else if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum()
+                    {
                         // no height helps: the spine's tilt is out of its reach
                         "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
                     } else if spec.has_momentum() {

@@ -155,6 +155,25 @@ fn a_pitched_start_is_answered_as_unlandable() {
     // and no height helps, so none is suggested: the joint or the start is
     assert!(!e.contains("higher fall.height"), "{e}");
     assert!(e.contains("cat.joint = \"universal\""), "{e}");
+    // the start's own pitch is named
+    assert!(
+        e.contains("The start pitches the spine 5.000 deg from level"),
+        "{e}"
+    );
+    // with a spin about the spine too: not an end-over-end tumble (F8)
+    let cfg = util::seed(&[
+        "start.rotation_deg=[0, 5, 0]",
+        "start.angular_velocity=[0, 0, 0.5]",
+    ]);
+    let e = FreeDesign::new(&cfg.design_spec())
+        .solve()
+        .expect_err("a pitched, spinning no-twist cat")
+        .to_string();
+    assert!(
+        e.contains("A spin about the spine turns the body about it"),
+        "{e}"
+    );
+    assert!(!e.contains("end-over-end"), "{e}");
 }
 
 /// A tilt the body cannot undo (a no-twist cat pitched at zero momentum,
