@@ -387,9 +387,9 @@ const SPIN_SLIP: f64 = 2.0 * PI;
 /// A flip tolerance above 10 deg (rad) is asked about as degrees.
 const FLIP_TOLERANCE_SLIP: f64 = 0.1745;
 
-/// A half's radius of gyration above this many times its reach from the
-/// centre of mass to the joint is asked about as kg cm^2 (a long half's is
-/// about 0.6 of it).
+/// A half's radius of gyration above this many times the body's span (the
+/// halves' centres of mass through the joint) is asked about as kg cm^2 (a
+/// long half's is about 0.3 of it).
 const GYRATION_SLIP: f64 = 5.0;
 
 /// A stall torque above this many times `m g L` (the whole body's weight at
@@ -626,29 +626,37 @@ pub fn slips(cfg: &Config) -> Vec<Slip> {
             ),
         );
     }
-    // an inertia in kg cm^2: a radius of gyration far beyond the half's own
-    // reach from its centre of mass to the joint
+    // an inertia in kg cm^2: a radius of gyration far beyond the body's
+    // span, the two halves' centres of mass through the joint (a half's own
+    // reach may be a centimetre: a motor block at the joint)
     if let Some(b) = &cfg.body {
-        for (name, half) in [("rear", &b.rear), ("front", &b.front)] {
-            let Some(h) = half else { continue };
-            let (Some(m), Some(i), Some(com), Some(joint)) = (h.mass, h.inertia, h.com, h.joint)
-            else {
-                continue;
-            };
-            let reach = (0..3)
-                .map(|k| (joint[k] - com[k]).powi(2))
-                .sum::<f64>()
-                .sqrt();
-            let largest = (0..3).map(|k| i[k][k]).fold(0.0, f64::max);
-            let gyration = (largest / m).sqrt();
-            if m > 0.0 && reach > 0.0 && gyration > GYRATION_SLIP * reach {
-                warn(
-                    &format!("body.{name}.inertia"),
-                    format!(
-                        "its radius of gyration sqrt(I / m) = {gyration:.3} m is over {GYRATION_SLIP} times the {reach:.3} m from the centre of mass to the joint: kg cm^2 typed as kg m^2? ({largest} kg cm^2 = {:.3e} kg m^2)",
-                        largest * 1e-4
-                    ),
-                );
+        let reach = |h: &Option<crate::import::RigidConfig>| {
+            let h = h.as_ref()?;
+            let (com, joint) = (h.com?, h.joint?);
+            Some(
+                (0..3)
+                    .map(|k| (joint[k] - com[k]).powi(2))
+                    .sum::<f64>()
+                    .sqrt(),
+            )
+        };
+        if let (Some(a), Some(f)) = (reach(&b.rear), reach(&b.front)) {
+            let span = a + f;
+            for (name, half) in [("rear", &b.rear), ("front", &b.front)] {
+                let Some((m, i)) = half.as_ref().and_then(|h| Some((h.mass?, h.inertia?))) else {
+                    continue;
+                };
+                let largest = (0..3).map(|k| i[k][k]).fold(0.0, f64::max);
+                let gyration = (largest / m).sqrt();
+                if m > 0.0 && span > 0.0 && gyration > GYRATION_SLIP * span {
+                    warn(
+                        &format!("body.{name}.inertia"),
+                        format!(
+                            "its radius of gyration sqrt(I / m) = {gyration:.3} m is over {GYRATION_SLIP} times the body's {span:.3} m span (the centres of mass through the joint): kg cm^2 typed as kg m^2? ({largest} kg cm^2 = {:.3e} kg m^2)",
+                            largest * 1e-4
+                        ),
+                    );
+                }
             }
         }
     }

@@ -423,8 +423,20 @@ height = 2.0
     .unwrap();
     let o = run(&["analyze", boxes.to_str().unwrap()], grams.path());
     let err = stderr(&o);
-    // a real half's radius of gyration is within its reach: no question
+    // a real half's radius of gyration is within the body's span: no question,
+    // even for a half whose centre of mass is 5 mm from the joint (a motor
+    // block there: its own reach is 10 times less than its gyration)
     assert!(!err.contains("kg cm^2"), "{err}");
+    let o = run(
+        &[
+            "analyze",
+            boxes.to_str().unwrap(),
+            "--set",
+            "body.front.com=[0,0,0.005]",
+        ],
+        grams.path(),
+    );
+    assert!(!stderr(&o).contains("kg cm^2"), "{}", stderr(&o));
     // the same inertia in kg cm^2 (21.2 kg cm^2 for 0.00212 kg m^2) is asked about
     warns(
         &[
