@@ -518,9 +518,6 @@ impl Origin {
     }
 }
 
-/// A design flown under the motor model, and whether it lands: inside the
-/// motor envelope and within the landing tolerance in the simulation,
-/// whether or not its SCP converged.
 /// A design and its flight ([`flight`]).
 type Flown = Result<(FreeResult, (SimReport, bool))>;
 
@@ -528,9 +525,7 @@ type Flown = Result<(FreeResult, (SimReport, bool))>;
 /// spine (one that went the long way round may have a shorter twin).
 fn lands_the_short_way(cfg: &Config, flown: &Flown) -> bool {
     flown.as_ref().is_ok_and(|(fr, (_, landed))| {
-        *landed
-            && crate::design::mirror::left_to_turn(&cfg.design_spec(), &fr.plan)
-                .is_some_and(|t| t.abs() <= std::f64::consts::PI + 1e-3)
+        *landed && !crate::design::mirror::goes_the_long_way(&cfg.design_spec(), &fr.plan)
     })
 }
 
@@ -550,6 +545,9 @@ fn better_flight(a: Flown, b: Flown) -> Flown {
     }
 }
 
+/// A design flown under the motor model, and whether it lands: inside the
+/// motor envelope and within the landing tolerance in the simulation,
+/// whether or not its SCP converged.
 fn flight(cfg: &Config, fr: &FreeResult) -> Result<(SimReport, bool)> {
     let spec = cfg.design_spec();
     let sim = crate::verify::simulate::dynamic_spec(&spec, &fr.plan)?;

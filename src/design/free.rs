@@ -1355,10 +1355,7 @@ fn from_plan(
     // a design that lands the short way is kept; one that went more than
     // half a turn (the SCP may cross to the long way) is kept only if the
     // other way does no better
-    let long_way = |r: &FreeResult| {
-        crate::design::mirror::left_to_turn(spec, &r.plan)
-            .is_some_and(|t| t.abs() > std::f64::consts::PI + 1e-3)
-    };
+    let long_way = |r: &FreeResult| crate::design::mirror::goes_the_long_way(spec, &r.plan);
     if lands(&first) && !first.as_ref().is_ok_and(long_way) {
         nearer.replay(observe);
         return kept(first, ways[0].1, 0.0);

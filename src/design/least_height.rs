@@ -984,7 +984,8 @@ mod tests {
             a.sentence().ends_with("catflip size CONFIG --height 20, once the config gives a DC motor's no-load speed (limits.no_load_speed) (catflip size scales its torque-speed line)."),
             "{}",
             a.sentence()
-        ); // under the stall torque alone F7 gives the torque for the height
+        );
+        // under the stall torque alone F7 gives the torque for the height
         a.torque_alone_for_height_nm = Some(2.5);
         assert!(
             a.sentence()

@@ -100,6 +100,13 @@ pub fn mirror_is_nearer(spec: &DesignSpec, plan: &dyn ShapePlan, mirror: &Mirror
     other.abs() < own.abs() - 1e-6
 }
 
+/// Whether a design that lands from `spec`'s start went the long way round:
+/// its turn about the spine more than half a turn ([`left_to_turn`]), where
+/// the other way round may do with less.
+pub fn goes_the_long_way(spec: &DesignSpec, plan: &dyn ShapePlan) -> bool {
+    left_to_turn(spec, plan).is_some_and(|t| t.abs() > std::f64::consts::PI + 1e-3)
+}
+
 /// The turn about the spine, rad, that `plan` leaves to the design from
 /// `spec`'s start: `plan`'s own turn from rest (signed) plus the roll that
 /// points the belly down at touchdown after flying it (for a design that
