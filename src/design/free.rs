@@ -2305,8 +2305,9 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
     let node_peak = solved.node_peak;
     if !spec.is_default_start() && solved.attitude_error > spec.free.attitude_tolerance.max(1e-6) {
         let [w, x, y, z] = spec.release().attitude;
-        // the spine's height above level at release: `(R0 e_z) . e_x`
-        let spine_level = (2.0 * (x * z + w * y)).abs() < 1e-9;
+        // the spine's rise above level at release: `(R0 e_z) . e_x`
+        let rise = 2.0 * (x * z + w * y);
+        let spine_level = rise.abs() < 1e-9;
         if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum() && spine_level {
             // a roll about a level spine is within reach (F1): under motor
             // limits theirs is the answer (below: the SCP trades the landing
@@ -2331,7 +2332,7 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
             // the landing, not the motors: what the optimiser could not undo;
             // a pitched start is said, with its pitch (a rotation vector's
             // components mix: [10, 0, 15] pitches the spine 1.3 deg)
-            let pitch = (2.0 * (x * z + w * y)).clamp(-1.0, 1.0).asin().to_degrees();
+            let pitch = rise.clamp(-1.0, 1.0).asin().to_degrees();
             let pitched = if spine_level {
                 String::new()
             } else {
