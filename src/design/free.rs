@@ -277,7 +277,7 @@ impl FreeProblem {
     /// phase: interval, fraction in `(0, 1)`); not from a spinning start,
     /// whose attitude map knows the momentum at its sub-steps only.
     fn with_extra_checks(mut self, extra: [Vec<(usize, f64)>; 3]) -> Self {
-        if self.release.is_none() {
+        if !self.spins() {
             self.extra = extra;
         }
         self
@@ -287,13 +287,18 @@ impl FreeProblem {
     /// at most two from a spinning start, whose momentum the attitude map
     /// knows at its sub-steps only (nodes and midpoints, [`Release::path`]).
     pub fn with_checks(mut self, checks: usize) -> Self {
-        let most = if self.release.is_some() {
-            2
-        } else {
-            usize::MAX
-        };
+        let most = if self.spins() { 2 } else { usize::MAX };
         self.checks = checks.clamp(1, most);
         self
+    }
+
+    /// Whether the start has angular momentum: then the torque at a check
+    /// point depends on the attitude there, which the attitude map gives at
+    /// its sub-steps only. From a start at rest (tilted or rolled) the torque
+    /// is the shape's alone, checked as from today's start.
+    fn spins(&self) -> bool {
+        self.release
+            .is_some_and(|r| r.momentum.iter().any(|&c| c != 0.0))
     }
 
     /// Whether the interval midpoints are check points (for the attitude
@@ -532,6 +537,7 @@ impl FreeProblem {
         }
         let mus = self
             .release
+            .filter(|_| self.spins())
             .map(|r| r.path(&self.cat, tr, z, self.midpoints(), false).mu);
         let mut point = 0;
         for p in 0..3 {
@@ -717,7 +723,7 @@ impl FreeProblem {
     /// start ([`FreeProblem::with_extra_checks`]).
     fn between_checks(&self, z: &[f64], tol: f64) -> [Vec<(usize, f64)>; 3] {
         let mut out: [Vec<(usize, f64)>; 3] = Default::default();
-        let Some(limit) = self.max_torque.filter(|_| self.release.is_none()) else {
+        let Some(limit) = self.max_torque.filter(|_| !self.spins()) else {
             return out;
         };
         let tr = &self.tr;
@@ -2042,10 +2048,10 @@ fn inside_envelope(
         let stretch = crate::design::envelope::least_stretch_of(&margins);
         let total: f64 = solved.plan.phase_bounds()[3];
         // slowing the same path down keeps its attitude only at zero
-        // momentum (F2; F10): from another start the problem is solved again
+        // momentum (F2; F10): from a spinning start the problem is solved again
         let room = (spec.objective == Objective::Time
             || total * stretch <= spec.available_time() * (1.0 + 1e-12))
-            && spec.is_default_start();
+            && !spec.has_momentum();
         if room {
             for p in 0..3 {
                 let i = tr.duration(p);
@@ -2480,14 +2486,14 @@ fn continue_from(
 /// least time or energy, nor inside a torque-speed line or speed limit
 /// (slower, for little or no gain: docs/optimisers.md); not from a spinning
 /// start, whose attitude map knows the momentum at the nodes and midpoints
-/// only.
+/// only (a start at rest, tilted or rolled, has them).
 fn grid(spec: &DesignSpec, nodes: usize, mesh: Mesh) -> Transcription {
     let tr = Transcription::new(3, nodes);
     // (`uses_envelope` holds for every objective but the peak torque)
     if spec.free.torque_jumps
         && mesh == Mesh::Final
         && !spec.uses_envelope()
-        && Release::of(spec, 1.0).is_none()
+        && !spec.has_momentum()
     {
         tr.with_jumps()
     } else {
