@@ -102,6 +102,9 @@ pub fn peak_ratios(free_over_phased: Option<f64>, phased_over_analytic: Option<f
 /// The suffix of a seed's name taken as its mirror image.
 const MIRRORED: &str = crate::design::mirror::MIRRORED;
 
+/// The suffix of a seed's name taken turning only as far as the start needs.
+const SCALED: &str = crate::design::mirror::SCALED;
+
 /// How the free-form design went, for the lines under the table: its
 /// meshes and iterations and what it started from (`seed`), or that it was
 /// not attempted.
@@ -117,7 +120,10 @@ pub fn free_design_text(
         // (a seed made for the start at rest may be taken mirrored, the
         // other way round: `design::mirror`)
         let mirrored = seed.is_some_and(|s| s.ends_with(MIRRORED));
-        let from = match seed.map(|s| s.trim_end_matches(MIRRORED)) {
+        let seed = seed.map(|s| s.trim_end_matches(MIRRORED));
+        // (and scaled to the turn the start leaves)
+        let scaled = seed.is_some_and(|s| s.ends_with(SCALED));
+        let from = match seed.map(|s| s.trim_end_matches(SCALED)) {
             Some("phased") => "from the phased design",
             Some(crate::pipeline::FREE_LEAST_TIME) => "from the least-height design",
             Some("analytic") => "from the analytic schedule",
@@ -125,7 +131,12 @@ pub fn free_design_text(
         };
         let from = match (from.is_empty(), mirrored) {
             (true, _) => String::new(),
-            (false, true) => format!("{from} mirrored (the other way round), "),
+            (false, true) => format!("{from} mirrored (the other way round)"),
+            (false, false) => from.to_string(),
+        };
+        let from = match (from.is_empty(), scaled) {
+            (true, _) => from,
+            (false, true) => format!("{from}, its twist scaled to the turn the start leaves, "),
             (false, false) => format!("{from}, "),
         };
         format!(

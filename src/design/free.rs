@@ -1339,6 +1339,11 @@ fn from_plan(
     if crate::design::mirror::mirror_is_nearer(spec, seed_plan, &mirrored) {
         ways.swap(0, 1);
     }
+    // the nearer way only as far as the start needs (near belly-down)
+    let scaled = crate::design::mirror::scaled_to_the_turn(spec, ways[0].0);
+    if let Some(s) = &scaled {
+        ways[0].0 = s.as_ref();
+    }
     let lands = |r: &Result<FreeResult>| {
         r.as_ref()
             .is_ok_and(|r| r.certificate.constraint_violation <= spec.free.attitude_tolerance)
@@ -1347,6 +1352,9 @@ fn from_plan(
     // a design tried before it
     let kept = |r: Result<FreeResult>, mirrored: bool, before_s: f64| {
         r.map(|mut r| {
+            if mirrored == ways[0].1 && scaled.is_some() {
+                r.seed = format!("{}{}", r.seed, crate::design::mirror::SCALED);
+            }
             if mirrored {
                 r.seed = format!("{}{}", r.seed, crate::design::mirror::MIRRORED);
             }
@@ -2702,14 +2710,32 @@ impl<'a> FreeDesign<'a> {
         };
         // from another start, the way round that leaves less to turn (one
         // way only: the stages are ranked against each other)
-        if let Some(mirrored) = crate::design::mirror::mirrored(self.spec, plan)
-            && crate::design::mirror::mirror_is_nearer(self.spec, plan, &mirrored)
-        {
-            let mut staged = stage(self.spec, &mirrored, name, self.nodes, observe);
-            staged.seed = format!("{name}{}", crate::design::mirror::MIRRORED);
-            return Ok(staged);
-        }
-        Ok(stage(self.spec, plan, name, self.nodes, observe))
+        // (and only as far as the start needs: near belly-down)
+        let mirrored = crate::design::mirror::mirrored(self.spec, plan)
+            .filter(|m| crate::design::mirror::mirror_is_nearer(self.spec, plan, m));
+        let way: &dyn ShapePlan = match &mirrored {
+            Some(m) => m,
+            None => plan,
+        };
+        let scaled = crate::design::mirror::scaled_to_the_turn(self.spec, way);
+        let mut staged = match &scaled {
+            Some(s) => stage(self.spec, s.as_ref(), name, self.nodes, observe),
+            None => stage(self.spec, way, name, self.nodes, observe),
+        };
+        staged.seed = format!(
+            "{name}{}{}",
+            if scaled.is_some() {
+                crate::design::mirror::SCALED
+            } else {
+                ""
+            },
+            if mirrored.is_some() {
+                crate::design::mirror::MIRRORED
+            } else {
+                ""
+            }
+        );
+        Ok(staged)
     }
 
     pub fn solve(self) -> Result<FreeResult> {

@@ -22,12 +22,24 @@ use nalgebra::{Matrix3, UnitQuaternion};
 /// image (`phased (mirrored)`).
 pub const MIRRORED: &str = " (mirrored)";
 
+/// The suffix of a seed's name where the design started from the seed
+/// turned only as far as the start needs ([`scaled_to_the_turn`]), before
+/// any [`MIRRORED`].
+pub const SCALED: &str = " (scaled to the turn)";
+
+/// Where the turn a start leaves is under this fraction of the seed's own
+/// half turn, the seed is scaled to it ([`scaled_to_the_turn`]): from a
+/// start rolled 176 deg, the seed's half turn is 176 deg from the 4 deg
+/// needed, and the design from it ended turning 356 deg at twenty times
+/// the peak of the 4 deg turn.
+const SCALE_BELOW: f64 = 0.5;
+
 /// A plan reflected through the plane of the spine and the belly: each
 /// shape coordinate multiplied by its sign ([`signs`]). For a body
 /// symmetric about that plane (the cylinders) it makes the same turn the
 /// other way; for another it is a start the design corrects.
 pub struct Mirrored<'a> {
-    pub plan: &'a dyn ShapePlan,
+    pub plan: Box<dyn ShapePlan + 'a>,
     pub signs: [f64; 2],
 }
 
@@ -50,6 +62,14 @@ impl ShapePlan for Mirrored<'_> {
 
     fn breaks(&self) -> Vec<f64> {
         self.plan.breaks()
+    }
+
+    fn turn_scaled(&self, k: f64) -> Option<Box<dyn ShapePlan>> {
+        let plan = self.plan.turn_scaled(k)?;
+        Some(Box::new(Mirrored {
+            plan,
+            signs: self.signs,
+        }))
     }
 }
 
@@ -80,7 +100,10 @@ pub fn signs(spec: &DesignSpec) -> Option<[f64; 2]> {
 
 /// `plan`'s mirror image for `spec`, if the shape has one ([`signs`]).
 pub fn mirrored<'a>(spec: &DesignSpec, plan: &'a dyn ShapePlan) -> Option<Mirrored<'a>> {
-    signs(spec).map(|signs| Mirrored { plan, signs })
+    signs(spec).map(|signs| Mirrored {
+        plan: Box::new(plan),
+        signs,
+    })
 }
 
 /// Whether the free-form design from `spec`'s start should start from
@@ -112,18 +135,47 @@ pub fn goes_the_long_way(spec: &DesignSpec, plan: &dyn ShapePlan) -> bool {
 /// points the belly down at touchdown after flying it (for a design that
 /// lands, its own turn). `None` when a flight fails.
 pub fn left_to_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
-    let at_rest = DesignSpec {
-        start: None,
-        ..spec.clone()
-    };
-    let own = crate::verify::simulate::kinematic_spec(&at_rest, plan).ok()?;
+    let own = own_turn(spec, plan)?;
     let flown = crate::verify::simulate::kinematic_spec(spec, plan).ok()?;
     let [w, x, y, z] = flown.final_attitude;
     let end: Matrix3<f64> = UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z))
         .to_rotation_matrix()
         .into_inner();
     let touchdown = rigid_turn(&spec.cat, &end, flown.final_body_momentum, spec.fall.margin);
-    Some(own.flip_deg.to_radians() + roll_to_belly_down(&touchdown))
+    Some(own + roll_to_belly_down(&touchdown))
+}
+
+/// `plan`'s own turn about the spine from rest, rad (signed, flown
+/// kinematically).
+fn own_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
+    let at_rest = DesignSpec {
+        start: None,
+        ..spec.clone()
+    };
+    let own = crate::verify::simulate::kinematic_spec(&at_rest, plan).ok()?;
+    Some(own.flip_deg.to_radians())
+}
+
+/// `plan` turned only as far as `spec`'s start needs this way round
+/// ([`left_to_turn`]) where that is under [`SCALE_BELOW`] of its own turn
+/// and its form allows ([`ShapePlan::turn_scaled`]): its twist scaled,
+/// exactly for a no-twist cat at constant bend (F1), once more by the
+/// turn's ratio where the flight says otherwise (the universal joint, F4).
+/// `None` where the seed serves as it is.
+pub fn scaled_to_the_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<Box<dyn ShapePlan>> {
+    let left = left_to_turn(spec, plan)?;
+    let own = own_turn(spec, plan)?;
+    if left * own <= 0.0 || left.abs() >= SCALE_BELOW * own.abs() {
+        return None;
+    }
+    let k = left / own;
+    let scaled = plan.turn_scaled(k)?;
+    match own_turn(spec, scaled.as_ref()) {
+        Some(t) if t * left > 0.0 && (t / left - 1.0).abs() > 1e-3 => {
+            plan.turn_scaled(k * left / t)
+        }
+        _ => Some(scaled),
+    }
 }
 
 /// The roll about the body's spine (A's `z`), in `(-pi, pi]`, after which
@@ -158,6 +210,32 @@ mod tests {
         assert_eq!(signs(&body("[0, 1, 0]", "[1, 0, 0]")), Some([1.0, -1.0]));
         assert_eq!(signs(&body("[0.6, 0.8, 0]", "[0, 1, 0]")), None);
         assert_eq!(signs(&body("[0, 1, 0]", "[0, 0, 1]")), Some([1.0, -1.0]));
+    }
+
+    /// F1: at constant bend the no-twist cat turns in proportion to the
+    /// twist, so the seed's twist scaled by `k` turns `k` half turns; the
+    /// seed scaled for a start rolled -170 deg turns the 10 deg left.
+    #[test]
+    fn a_scaled_twist_turns_in_proportion() {
+        let seed = |sets: &[String]| crate::test_support::spec_at("configs/seed.toml", sets);
+        let spec = seed(&[]);
+        let plan = crate::design::analytic::analytic_plan(&spec);
+        for k in [0.05, 0.3, 1.0] {
+            let turn = own_turn(&spec, &plan.twist_scaled(k)).unwrap();
+            assert!(
+                (turn.abs() - k * std::f64::consts::PI).abs() < 1e-7,
+                "{k}: {turn}"
+            );
+        }
+        // (rolled -170 deg the seed's own way is the nearer: 10 deg)
+        let rolled = seed(&["start.rotation_deg=[0, 0, -170]".to_string()]);
+        assert!(scaled_to_the_turn(&spec, &plan).is_none());
+        let scaled = scaled_to_the_turn(&rolled, &plan).expect("a smaller turn");
+        let own = own_turn(&rolled, scaled.as_ref()).unwrap().to_degrees();
+        let left = left_to_turn(&rolled, scaled.as_ref()).unwrap().to_degrees();
+        // its own turn is the whole turn: nothing left to roll after it
+        assert!((own.abs() - 10.0).abs() < 1e-5, "{own}");
+        assert!((left - own).abs() < 1e-5, "{left} {own}");
     }
 
     /// The roll found points the belly down for a body only rolled, and

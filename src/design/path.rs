@@ -273,10 +273,46 @@ pub struct PhasedPlan {
     pub durations: [f64; 3],
 }
 
+impl PhasedPlan {
+    /// The same plan with its twist circulating the bend direction `k`
+    /// times as far, on the same timing: at constant bend a no-twist cat
+    /// turns about its spine in proportion (F1), so a seed made for the
+    /// half turn becomes one for a smaller turn (`design::mirror`). The
+    /// unfold starts where the twist ends.
+    pub fn twist_scaled(&self, k: f64) -> PhasedPlan {
+        let paths = self.paths.map(|p| match p {
+            Path::Arc { bend, phi0, dphi } => Path::Arc {
+                bend,
+                phi0,
+                dphi: k * dphi,
+            },
+            line => line,
+        });
+        let mut plan = PhasedPlan {
+            paths,
+            ..self.clone()
+        };
+        if let (Path::Arc { bend, phi0, dphi }, Path::Line { to, .. }) =
+            (plan.paths[1], plan.paths[2])
+        {
+            let end = phi0 + dphi;
+            plan.paths[2] = Path::Line {
+                from: [bend * end.cos(), bend * end.sin()],
+                to,
+            };
+        }
+        plan
+    }
+}
+
 impl ShapePlan for PhasedPlan {
     fn phase_bounds(&self) -> Vec<f64> {
         let d = self.durations;
         vec![0.0, d[0], d[0] + d[1], d[0] + d[1] + d[2]]
+    }
+
+    fn turn_scaled(&self, k: f64) -> Option<Box<dyn ShapePlan>> {
+        Some(Box::new(self.twist_scaled(k)))
     }
 
     fn state_in(&self, i: usize, t: f64) -> ShapeState {

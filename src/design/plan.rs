@@ -64,6 +64,39 @@ pub trait ShapePlan {
         let s = self.state_in(i, t);
         inverse_dynamics(cat, s.q, s.qd, s.qdd)
     }
+    /// The plan turning the body `k` times as far about its spine, where
+    /// its form says how (a phased plan: its twist scaled, F1); by default
+    /// none. A seed made for the half turn then serves a start that needs
+    /// less (`design::mirror`).
+    fn turn_scaled(&self, _k: f64) -> Option<Box<dyn ShapePlan>> {
+        None
+    }
+}
+
+/// A borrowed plan is the plan (a wrapper such as a mirror image may hold
+/// either).
+impl<T: ShapePlan + ?Sized> ShapePlan for &T {
+    fn phase_bounds(&self) -> Vec<f64> {
+        (**self).phase_bounds()
+    }
+    fn state_in(&self, i: usize, t: f64) -> ShapeState {
+        (**self).state_in(i, t)
+    }
+    fn state(&self, t: f64) -> ShapeState {
+        (**self).state(t)
+    }
+    fn duration(&self) -> f64 {
+        (**self).duration()
+    }
+    fn breaks(&self) -> Vec<f64> {
+        (**self).breaks()
+    }
+    fn torque_in(&self, cat: &Cat, i: usize, t: f64) -> [f64; 2] {
+        (**self).torque_in(cat, i, t)
+    }
+    fn turn_scaled(&self, k: f64) -> Option<Box<dyn ShapePlan>> {
+        (**self).turn_scaled(k)
+    }
 }
 
 /// One row of a torque schedule (SI units; JSON names carry the units).
