@@ -731,6 +731,9 @@ fn cmd_sweep(
         say_lines(console::sweep::points(
             &cfg.name, spec, &points, threads, &written,
         ));
+        if let Some(note) = console::sweep::from_another_start(&cfg.start, &state.methods) {
+            say!("  {note}");
+        }
     }
     Ok(Status::of(warning.is_some()))
 }

@@ -109,6 +109,40 @@ pub fn columns(points: &[SweepPoint]) -> Vec<Column> {
         .collect()
 }
 
+/// What a sweep from a start other than upside down at rest says of its
+/// columns: the analytic and phased designs (of `methods`; peaks and least
+/// heights) are made for the start at rest and do not land from this one
+/// (`run` does not count them), the free-form designs are made for it.
+/// `None` at today's start.
+pub fn from_another_start(
+    start: &crate::config::StartConfig,
+    methods: &[String],
+) -> Option<String> {
+    if start.is_default() {
+        return None;
+    }
+    let rest: Vec<&str> = ["analytic", "phased"]
+        .into_iter()
+        .filter(|m| methods.iter().any(|x| x == m))
+        .collect();
+    let mut parts = vec![format!(
+        "from start.rotation_deg = {:?}, start.angular_velocity = {:?} rad/s",
+        start.rotation_deg, start.angular_velocity
+    )];
+    if !rest.is_empty() {
+        parts.push(format!(
+            "the {} columns are the designs made for the start at rest, which do not land from this start (`catflip run` does not count them)",
+            rest.join(" and "),
+        ));
+    }
+    if methods.iter().any(|x| x == "free") {
+        parts.push("the free-form columns are designed for this start".into());
+    }
+    let mut note = parts.join("; ");
+    note[..1].make_ascii_uppercase();
+    Some(format!("{note} (docs/model.md, section 8)."))
+}
+
 /// The warning of a sweep some of whose points have errors.
 pub fn partial_warning(points: &[SweepPoint]) -> Option<String> {
     let bad = points.iter().filter(|p| p.error.is_some()).count();

@@ -285,6 +285,11 @@ impl SweepState {
             self.shard,
             self.methods.join(", "),
         )];
+        let start = serde_json::from_value(self.config["start"].clone()).unwrap_or_default();
+        notes.extend(crate::console::sweep::from_another_start(
+            &start,
+            &self.methods,
+        ));
         if points.iter().any(|p| p.error.is_some()) {
             notes.push(
                 "A row's error names what failed there; a point whose method failed keeps the other methods' numbers."

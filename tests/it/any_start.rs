@@ -127,6 +127,35 @@ fn mirror_image_starts_need_the_same_peak_turning_the_shorter_way() {
     }
 }
 
+/// A start rolled nearer belly-down leaves a smaller turn, which needs less
+/// torque: the design turns only as far as that (the seed's twist scaled
+/// to it, F1). Before, from 176 and 179 deg the design started from the
+/// seed's half turn and ended turning 356 and 359 deg, at 0.595 and 0.598
+/// N m against 0.089 from 170 deg.
+#[test]
+fn a_start_nearer_belly_down_needs_less_torque_and_turns_the_rest() {
+    let mut last = f64::INFINITY;
+    for roll in [100.0, 140.0, 170.0, 176.0, 179.0] {
+        let set = format!("start.rotation_deg=[0, 0, {roll}]");
+        let (cfg, r) = design(&[&set]);
+        assert_eq!(r.status, ScpStatus::Converged, "{set}");
+        assert!(r.attitude_error_rad < 1e-6, "{set}");
+        let turn = catflip::design::mirror::left_to_turn(&cfg.design_spec(), &r.plan)
+            .unwrap()
+            .to_degrees();
+        assert!(
+            (turn.abs() - (180.0 - roll)).abs() < 0.5,
+            "{set}: turns {turn} deg"
+        );
+        assert!(
+            r.peak_torque_nm < last,
+            "{set}: {} N m, {last} from a start farther from belly-down",
+            r.peak_torque_nm
+        );
+        last = r.peak_torque_nm;
+    }
+}
+
 /// A roll about a level spine is within a no-twist cat's reach at rest (F1):
 /// a design that cannot land from it under a weak motor is the motors'
 /// answer (not possible in this fall, exit 4), not "cannot tilt its spine".
@@ -427,6 +456,43 @@ fn a_sweep_from_a_start_judges_its_points_as_run_does() {
     let p = &points[0];
     assert!(p["error"].is_null(), "{p}");
     assert_eq!(p["free_status"], "converged", "{p}");
+}
+
+/// A sweep's table and page from that start say which columns are made for
+/// the start at rest (the analytic and phased designs, which do not land
+/// from it) and which for the start; a sweep from rest says nothing of it.
+#[test]
+fn a_sweep_from_a_start_says_which_columns_are_made_for_it() {
+    let said = "the analytic and phased columns are the designs made for the start at rest";
+    let (dir, code, out, err) = from_a_spin("sweep", &["--set-range", "fall.height=10:10:1"]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert!(out.contains(said), "{out}");
+    assert!(
+        out.contains("the free-form columns are designed for this start"),
+        "{out}"
+    );
+    let set = std::fs::read_dir(dir.path().join("o/seed"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.is_dir())
+        .expect("the sweep's folder");
+    let page = std::fs::read_to_string(set.join("index.html")).unwrap();
+    assert!(page.contains(said), "{page}");
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let (code, out, err) = util::run(
+        &[
+            "sweep",
+            &seed,
+            "--set-range",
+            "fall.height=10:10:1",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert!(!out.contains("made for the start at rest"), "{out}");
 }
 
 /// Under a speed limit from that start, the least-height row is a free-form
