@@ -564,16 +564,32 @@ fn point(
         }
         if methods.free {
             // seeded by the phased design, or by the analytic plan when that failed
-            let fr = match (&ph, warm) {
-                (_, Some(w)) => crate::design::free::FreeDesign::new(&spec)
-                    .warm(w, before)
-                    .solve(),
-                (Ok(ph), None) => crate::design::free::FreeDesign::new(&spec)
+            let afresh = || match &ph {
+                Ok(ph) => crate::design::free::FreeDesign::new(&spec)
                     .from_plan(&ph.plan, "phased")
                     .solve(),
-                (Err(_), None) => crate::design::free::FreeDesign::new(&spec)
+                Err(_) => crate::design::free::FreeDesign::new(&spec)
                     .from_plan(&analytic_plan(&spec), "analytic")
                     .solve(),
+            };
+            let fr = match warm {
+                Some(w) => {
+                    let continued = crate::design::free::FreeDesign::new(&spec)
+                        .warm(w, before)
+                        .solve();
+                    // from another start the neighbour's way round may be
+                    // the long one here, or miss: designed afresh too (the
+                    // nearer way, `design::mirror`), the better kept
+                    let short = continued
+                        .as_ref()
+                        .is_ok_and(|r| crate::design::free::lands_the_short_way(&spec, r));
+                    if spec.is_default_start() || short {
+                        continued
+                    } else {
+                        crate::design::free::better(&spec, continued, afresh())
+                    }
+                }
+                None => afresh(),
             };
             match fr {
                 Ok(fr) => {

@@ -1344,10 +1344,6 @@ fn from_plan(
     if let Some(s) = &scaled {
         ways[0].0 = s.as_ref();
     }
-    let lands = |r: &Result<FreeResult>| {
-        r.as_ref()
-            .is_ok_and(|r| r.certificate.constraint_violation <= spec.free.attitude_tolerance)
-    };
     // the kept design names its seed as mirrored, and counts the time of
     // a design tried before it
     let kept = |r: Result<FreeResult>, mirrored: bool, before_s: f64| {
@@ -1369,25 +1365,57 @@ fn from_plan(
     // a design that lands the short way is kept; one that went more than
     // half a turn (the SCP may cross to the long way) is kept only if the
     // other way does no better
-    let long_way = |r: &FreeResult| crate::design::mirror::goes_the_long_way(spec, &r.plan);
-    if lands(&first) && !first.as_ref().is_ok_and(long_way) {
+    if first.as_ref().is_ok_and(|r| lands_the_short_way(spec, r)) {
         nearer.replay(observe);
         return kept(first, ways[0].1, 0.0);
     }
     let mut other = Recorded::default();
     let second = design(ways[1].0, &mut other);
     let second_s = clock.elapsed().as_secs_f64() - first_s;
-    let better = match (&first, &second) {
-        (Ok(a), Ok(b)) if lands(&first) => lands(&second) && b.objective_value < a.objective_value,
-        _ => lands(&second) || (second.is_ok() && first.is_err()),
-    };
-    // the nearer way's outcome unless the other lands (better), or fails less
-    if better {
+    // the nearer way's outcome unless the other is better
+    if is_better(spec, &first, &second) {
         other.replay(observe);
         return kept(second, ways[1].1, first_s);
     }
     nearer.replay(observe);
     kept(first, ways[0].1, second_s)
+}
+
+/// Whether a design meets its landing (the SCP's own constraints, within
+/// `free.attitude_tolerance`) without turning past half a turn: a design
+/// continued from a neighbour keeps the neighbour's way round, and where
+/// this fails the caller designs afresh, the nearer way
+/// ([`FreeDesign::from_plan`]), keeping the [`better`] of the two.
+pub fn lands_the_short_way(spec: &DesignSpec, r: &FreeResult) -> bool {
+    r.certificate.constraint_violation <= spec.free.attitude_tolerance
+        && !crate::design::mirror::goes_the_long_way(spec, &r.plan)
+}
+
+/// Whether `b` is a better design than `a` for one problem: it meets its
+/// landing where `a` does not, or both do and its objective is lower, or
+/// neither does and it misses by less; a design is better than a failure.
+fn is_better(spec: &DesignSpec, a: &Result<FreeResult>, b: &Result<FreeResult>) -> bool {
+    let key = |r: &Result<FreeResult>| {
+        r.as_ref().ok().map(|r| {
+            let miss = r.certificate.constraint_violation;
+            let misses = miss > spec.free.attitude_tolerance;
+            (misses, if misses { miss } else { r.objective_value })
+        })
+    };
+    match (key(a), key(b)) {
+        (Some(ka), Some(kb)) => kb.0.cmp(&ka.0).then(kb.1.total_cmp(&ka.1)).is_lt(),
+        (None, Some(_)) => true,
+        _ => false,
+    }
+}
+
+/// The better of two designs for one problem ([`is_better`]), `a` on a tie.
+pub fn better(
+    spec: &DesignSpec,
+    a: Result<FreeResult>,
+    b: Result<FreeResult>,
+) -> Result<FreeResult> {
+    if is_better(spec, &a, &b) { b } else { a }
 }
 
 /// An observer's events kept to be told later, to the observer of the
@@ -2373,6 +2401,9 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
                     {
                         // no height helps: the spine's tilt is out of its reach
                         "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
+                    } else if spec.has_momentum() && about_the_spine {
+                        // a spin about the spine tumbles nothing: the turn's timing failed
+                        "A spin about the spine turns the body about it, at |L| / I_3 held straight and slower bent (F10), and the design could not time that turn to land belly-down in the time the fall leaves; try a higher fall.height, or another seed (`catflip optimize --mode free --seed analytic`)"
                     } else if spec.has_momentum() {
                         "An end-over-end spin tumbles the spine about the momentum at |L| / I_1 or faster whatever the shape (F8); try a start closer to upside down at rest or a higher fall.height"
                     } else if spec.max_bend_deg.is_some() {

@@ -458,6 +458,45 @@ fn a_sweep_from_a_start_judges_its_points_as_run_does() {
     assert_eq!(p["free_status"], "converged", "{p}");
 }
 
+/// A sweep's design continued from its neighbour keeps the neighbour's way
+/// round: from a spin of 5 rad/s about the spine, continued from 1 m, the
+/// design at 2 m ended "cannot land" where `optimize` lands it. Where the
+/// continued design misses or goes the long way it is designed afresh too,
+/// and the better kept: the sweep's point is `optimize`'s design.
+#[test]
+fn a_sweep_from_a_spin_designs_afresh_where_the_continued_design_misses() {
+    let dir = util::temp_dir();
+    let seed = util::config_arg("seed");
+    let spin = "start.angular_velocity=[0,0,5]";
+    let (code, out, err) = util::run(
+        &[
+            "sweep",
+            &seed,
+            "--set",
+            spin,
+            "--set-range",
+            "fall.height=1:2:2",
+            "--methods",
+            "free",
+            "--json",
+            "--out",
+            "o",
+        ],
+        dir.path(),
+    );
+    assert_eq!(code, Some(0), "{out}{err}");
+    let points: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let at_2m = &points[1];
+    assert!(at_2m["error"].is_null(), "{at_2m}");
+    let (_, own) = design(&[spin, "fall.height=2"]);
+    let swept = at_2m["free_peak_nm"].as_f64().unwrap();
+    assert!(
+        (swept / own.peak_torque_nm - 1.0).abs() < 1e-3,
+        "{swept} against optimize's {}",
+        own.peak_torque_nm
+    );
+}
+
 /// A sweep's table and page from that start say which columns are made for
 /// the start at rest (the analytic and phased designs, which do not land
 /// from it) and which for the start; a sweep from rest says nothing of it.
