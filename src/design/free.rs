@@ -2027,7 +2027,8 @@ fn design_problem(
     }
     let z_scaled = std::mem::take(&mut res.z);
     res.z = problem.to_physical(&z_scaled);
-    let track = problem.release.map(|r| {
+    // (the momentum's torque needs the attitude: from a start at rest, none)
+    let track = problem.release.filter(|_| problem.spins()).map(|r| {
         crate::design::release::Track::new(
             r.in_seconds(problem.time_unit),
             &problem.cat,
