@@ -206,9 +206,10 @@ pub fn judge_analysis(spec: &DesignSpec, a: &Analysis) -> (Schedule, Verdict) {
         Status::ClosedForm,
         (a.peak_torque_nm, a.closed.bend_deg),
         Some(&schedule),
-        &Simulated::Flip {
+        &Simulated::Landing {
             flip_error_rad: a.flip_error_rad,
             tilt_deg: a.tilt_deg,
+            landing_error_deg: a.landing_error_deg,
         },
     );
     unfolded(&mut v);
@@ -380,6 +381,12 @@ impl Judged {
                 j.extend(f);
                 if let Some(h) = least_height_of_time_design(spec, self.design.plan().duration()) {
                     j.insert("least_height_m".into(), h.into());
+                }
+                // the written rows' motor use, as `run`'s summary gives it
+                let motor = usage(spec, &self.schedule);
+                j.insert("max_speed_rad_s".into(), motor.max_speed_rad_s.into());
+                if let Some(m) = motor.min_margin {
+                    j.insert("min_envelope_margin".into(), m.into());
                 }
             }
             crate::output::ensure_finite(&json, &DESIGN_FINITE)?;

@@ -369,8 +369,10 @@ impl Question {
         stages.end(clock, heights.as_ref().err());
         match heights {
             Ok(Some(h)) => {
-                q.phased_short = (!crate::design::least_height::fits(spec, h.phased_m))
-                    .then_some((h.phased_m, h.phased_verified));
+                // (a failed phased family: its own stage says why)
+                q.phased_short = (h.phased_error.is_none()
+                    && !crate::design::least_height::fits(spec, h.phased_m))
+                .then_some((h.phased_m, h.phased_verified));
                 q.fastest_free = h.free;
                 q.phased_bend = Some(h.phased_bend);
                 // its schedule becomes the least-height method (`settle`)

@@ -628,7 +628,9 @@ fn point(
         let limited = limited_cfg.design_spec();
         match height.heights(&limited, families) {
             Ok(Some(h)) => {
-                if methods.phased {
+                if let (true, Some(e)) = (methods.phased, &h.phased_error) {
+                    errors.push(format!("phased least height: {e}"));
+                } else if methods.phased {
                     p.least_height_phased_m = Some(h.phased_m);
                     if !h.phased_verified {
                         errors.push(

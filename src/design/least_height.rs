@@ -191,6 +191,10 @@ pub struct Heights {
     pub phased_verified: bool,
     /// The shortest free-form time design that verifies ([`verified`]).
     pub free: Option<FreeResult>,
+    /// Why the phased time design failed where a free-form design answers
+    /// instead (`phased_m` is then NaN): a failure of one family keeps the
+    /// other's answer.
+    pub phased_error: Option<String>,
 }
 
 /// The question's own height must not steer the answer: every design of
@@ -380,6 +384,7 @@ pub fn heights(
             phased_verified: false,
             answer,
             free: None,
+            phased_error: None,
         }));
     }
     let reference = reference(spec);
@@ -391,6 +396,7 @@ pub fn heights(
             phased_verified: answer.verified,
             answer,
             free: None,
+            phased_error: None,
         }));
     }
     let analytic_plan = crate::design::analytic::analytic_plan(&reference);
@@ -437,8 +443,16 @@ pub fn heights(
             .unwrap_or_else(|e| std::panic::resume_unwind(e));
         (phased, bound, candidates)
     });
+    let mut phased_error = None;
     let (mut answer, phased_bend) = match phased {
-        Some(phased) => phased?,
+        Some(Ok(phased)) => phased,
+        // the phased family failed (its twist search, a flight): a
+        // free-form design that verifies still answers
+        Some(Err(e)) if candidates.iter().any(|c| c.1.is_some()) => {
+            phased_error = Some(e.to_string());
+            (HeightAnswer::blank(spec), f64::NAN)
+        }
+        Some(Err(e)) => return Err(e),
         None => unless_verified(spec, &reference, &candidates)?,
     };
     // (the stall-only design's time scaling, F3, holds at zero momentum only:
@@ -449,6 +463,7 @@ pub fn heights(
         .filter(|_| !spec.has_momentum() && !torque_alone)
         .map(|t| crate::design::envelope::height_for(spec, t));
     let mut heights = concluded(spec, (answer, phased_bend), candidates);
+    heights.phased_error = phased_error;
     // the stall-only design is a local optimum too (on a coarse mesh): where
     // it is not below the answer it bounds nothing, and is not given
     let a = &mut heights.answer;
@@ -693,6 +708,7 @@ fn concluded(
         phased_bend,
         phased_verified,
         free: fastest.map(|(fr, _)| fr),
+        phased_error: None,
     }
 }
 
@@ -735,17 +751,10 @@ pub fn flies(spec: &DesignSpec, fr: &FreeResult, sim: &SimReport) -> bool {
             envelope_margin: usage.min_margin,
             line_margin: usage.min_line_margin,
         },
-        &if spec.is_default_start() {
-            Simulated::Flip {
-                flip_error_rad: sim.flip_error_rad,
-                tilt_deg: sim.tilt_deg,
-            }
-        } else {
-            Simulated::Landing {
-                flip_error_rad: sim.flip_error_rad,
-                tilt_deg: sim.tilt_deg,
-                landing_error_deg: sim.landing_error_deg,
-            }
+        &Simulated::Landing {
+            flip_error_rad: sim.flip_error_rad,
+            tilt_deg: sim.tilt_deg,
+            landing_error_deg: sim.landing_error_deg,
         },
     );
     v.within_limits() && v.flips()

@@ -67,6 +67,9 @@ pub struct Analysis {
     pub flip_deg: f64,
     pub flip_error_rad: f64,
     pub tilt_deg: f64,
+    /// The belly's angle from straight down at touchdown, deg: what the
+    /// verdict judges (the heading is free).
+    pub landing_error_deg: f64,
     pub momentum_drift_nms: f64,
     #[serde(skip)]
     pub plan: PhasedPlan,
@@ -90,6 +93,7 @@ pub fn analyze(spec: &DesignSpec, name: &str) -> Result<Analysis> {
         flip_deg: kin.flip_deg,
         flip_error_rad: kin.flip_error_rad,
         tilt_deg: kin.tilt_deg,
+        landing_error_deg: kin.landing_error_deg,
         momentum_drift_nms: kin.momentum_drift_nms,
         plan,
         kinematic: kin,

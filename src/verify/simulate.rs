@@ -161,7 +161,7 @@ fn failure(
         // with next to no torque the schedule is not what the integrator
         // cannot follow: the body is (halves of 1e4 and 1e-6 kg)
         OdeStatus::StepBudget if peak <= f64::MIN_POSITIVE.sqrt() => format!(
-            "the integrator used its {} steps per phase by t = {at:.6} s with next to no torque applied ({peak:.4e} N m): the body itself is too stiff to integrate at simulate.rtol = {:e} (halves of very different masses, lengths or radii?); check the cat's keys, or try simulate.rtol = 1e-8",
+            "the integrator used its {} steps per phase by t = {at:.6} s with next to no torque applied ({peak:.4e} N m): the body itself is too stiff to integrate at a relative tolerance of {:e} (halves of very different masses, lengths or radii, or a motor that turns a half about its own long axis?); check the cat's keys (simulate.rtol sets the tolerance of the simulations; the phased design's twist search integrates at 1e-11 whatever it is)",
             ode.max_steps, ode.rtol
         ),
         OdeStatus::StepBudget => format!(

@@ -458,6 +458,43 @@ fn a_sweep_from_a_start_judges_its_points_as_run_does() {
     assert_eq!(p["free_status"], "converged", "{p}");
 }
 
+/// `analyze` judges the analytic schedule from another start by its landing,
+/// as `run` does: from a start turned about the vertical alone (the heading
+/// is free) it lands, and is not flagged for a "tilt" of the spine from the
+/// reference pose; from a rolled start it misses the landing by the roll.
+/// Before, both were judged by the flip and the tilt (flagged from 30 deg of
+/// heading), and `analyze.json` had no landing error.
+#[test]
+fn analyze_judges_the_landing_from_another_start() {
+    let analyze = |set: &str| {
+        let dir = util::temp_dir();
+        let seed = util::config_arg("seed");
+        let (code, out, err) = util::run(
+            &["analyze", &seed, "--set", set, "--json", "--out", "o"],
+            dir.path(),
+        );
+        assert!(code.is_some(), "{err}");
+        let v: serde_json::Value =
+            serde_json::from_str(&out).unwrap_or_else(|_| panic!("{out}{err}"));
+        v
+    };
+    let heading = analyze("start.rotation_deg=[30, 0, 0]");
+    assert_eq!(heading["verdict"], "ok", "{heading}");
+    assert!(
+        heading["landing_error_deg"].as_f64().unwrap() < 1e-6,
+        "{heading}"
+    );
+    let rolled = analyze("start.rotation_deg=[0, 0, 20]");
+    assert!((rolled["landing_error_deg"].as_f64().unwrap() - 20.0).abs() < 1e-6);
+    assert!(
+        rolled["reason"]
+            .as_str()
+            .unwrap()
+            .contains("lands 20.000 deg from belly-down"),
+        "{rolled}"
+    );
+}
+
 /// A sweep's design continued from its neighbour keeps the neighbour's way
 /// round: from a spin of 5 rad/s about the spine, continued from 1 m, the
 /// design at 2 m ended "cannot land" where `optimize` lands it. Where the

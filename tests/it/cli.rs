@@ -273,6 +273,27 @@ fn run_json(args: &[&str], dir: &Path) -> serde_json::Value {
     serde_json::from_str(&out).unwrap()
 }
 
+/// Under motor limits `optimize`'s JSON gives the written rows' largest
+/// speed and smallest envelope margin, as `run`'s summary gives them for
+/// the same design (docs/configuration.md: every method reports them).
+#[test]
+fn optimize_reports_the_motor_use_as_run_does() {
+    let dir = temp_dir();
+    let cfg = configs().join("robot-universal.toml");
+    let cfg = cfg.to_str().unwrap();
+    let high = "fall.height=6";
+    let v = run_json(
+        &["optimize", cfg, "--mode", "phased", "--set", high],
+        dir.path(),
+    );
+    let s = run_json(&["run", cfg, "--set", high], dir.path());
+    let line = util::method_line(&s, "phased");
+    for key in ["max_speed_rad_s", "min_envelope_margin"] {
+        let (a, b) = (v[key].as_f64(), line[key].as_f64());
+        assert!(a.is_some() && a == b, "{key}: optimize {a:?}, run {b:?}");
+    }
+}
+
 #[test]
 fn optimize_phased_writes_schedule_and_summary_with_the_documented_keys() {
     let dir = temp_dir();

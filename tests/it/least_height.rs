@@ -387,3 +387,38 @@ fn a_time_design_continues_from_its_neighbours_schedule_in_seconds() {
     );
     assert!(fr.scp_iterations <= 15, "{} iterations", fr.scp_iterations);
 }
+
+/// A failure of the phased family keeps the free-form answer: a robot whose
+/// second motor turns its front half about its own long axis (the phased
+/// design's bend-and-twist path cannot use it: its twist search's flight
+/// fails) got no answer at all, the least-height stage failing with the
+/// phased design's error. Now the free-form time design answers, verified
+/// by its flight, and only the phased row fails.
+#[test]
+fn a_failed_phased_family_keeps_the_free_form_answer() {
+    let dir = crate::util::temp_dir();
+    let config = dir.path().join("twist.toml");
+    std::fs::write(
+        &config,
+        "name = \"twist\"\n[cat]\njoint = \"universal\"\n\
+         [body.rear]\nmass = 0.6\ncom = [0.0, 0.0, 0.0]\ninertia = [1.2e-3, 1.1e-3, 3.0e-4, 0.0, 0.0, 0.0]\njoint = [0.0, 0.0, 0.11]\naxis = [1.0, 0.0, 0.0]\n\
+         [body.front]\nmass = 0.35\ncom = [0.0, 0.0, 0.08]\ninertia = [5.0e-4, 4.5e-4, 1.5e-4, 0.0, 0.0, 0.0]\njoint = [0.0, 0.0, 0.0]\naxis = [0.0, 0.0, 1.0]\n\
+         [fall]\nheight = 1.5\nmargin = 0.1\n[limits]\nmax_torque = 1.5\nno_load_speed = 6.3\n",
+    )
+    .unwrap();
+    let (code, out, err) = crate::util::run(
+        &["run", config.to_str().unwrap(), "--json", "--out", "o"],
+        dir.path(),
+    );
+    // not possible from 1.5 m, and said so with the height it is possible from
+    assert_eq!(code, Some(4), "{err}");
+    let summary: serde_json::Value = serde_json::from_str(&out).unwrap();
+    let answer = &summary["answer"];
+    let least = answer["least_height_m"].as_f64().unwrap_or(f64::NAN);
+    assert!(least.is_finite() && least > 1.5, "{answer}");
+    assert_eq!(answer["possible"], false, "{answer}");
+    assert_eq!(
+        crate::util::method_line(&summary, "phased")["verdict"],
+        "failed"
+    );
+}
