@@ -234,11 +234,12 @@ RIDING_FACTOR = 5.0
 def pd_tolerance(tol_deg, default_deg, method, riding_factor=1.0):
     """The checked PD replay's tolerance for one method of summary.json, deg:
     --tol-deg when given, else the engine's default, `riding_factor` times that
-    for a schedule that rides the torque-speed line."""
+    for a schedule that rides the torque-speed line or leaves it (a negative
+    margin: both simulators clip it to the line, and ride it)."""
     if tol_deg is not None:
         return tol_deg
     margin = method.get("min_envelope_margin")
-    riding = margin is not None and 0 <= margin < RIDING_MARGIN
+    riding = margin is not None and margin < RIDING_MARGIN
     return default_deg * (riding_factor if riding else 1.0)
 
 

@@ -312,7 +312,12 @@ impl Config {
                 expected,
             } if cfg.body.is_some() && key.starts_with("cat.") => Error::Invalid {
                 expected: format!(
-                    "{expected} (with [body], `{key}` is a half's equivalent cylinder, computed from body.rear / body.front or the robot file: change those)"
+                    "{expected} (with [body], `{key}` is a half's equivalent cylinder, computed from body.rear / body.front or the robot file: change those{})",
+                    if key == "cat.length" {
+                        "; it is twice the halves' mean reach from centre of mass to joint, |body.rear.joint - body.rear.com| and |body.front.joint - body.front.com|, in metres"
+                    } else {
+                        ""
+                    }
                 ),
                 key,
                 value,
@@ -421,10 +426,21 @@ impl Config {
                 "must be > 0 rad/s (the speed at which the motor's torque falls to 0)",
             )?;
             if self.limits.max_torque.is_none() {
+                // a robot file's joints may carry effort="0" or no <limit>:
+                // read as no torque limit, which is why none is known
+                let file = self.body.as_ref().and_then(|b| {
+                    b.urdf
+                        .as_ref()
+                        .map(|_| "body.urdf")
+                        .or(b.mjcf.as_ref().map(|_| "body.mjcf"))
+                });
                 return Err(Error::Invalid {
                     key: "limits.no_load_speed".into(),
                     value: format!("{w}"),
-                    expected: "needs limits.max_torque too: the torque-speed line runs from max_torque at rest to 0 at no_load_speed".into(),
+                    expected: format!(
+                        "needs limits.max_torque too: the torque-speed line runs from max_torque at rest to 0 at no_load_speed{}",
+                        file.map(|f| format!(" ({f} gives no torque limit: its joints' effort is 0 or missing, which catflip reads as none; set limits.max_torque to the motors' stall torque)")).unwrap_or_default()
+                    ),
                 });
             }
         }

@@ -450,6 +450,12 @@ impl Origin {
         };
         if !p.outcome.lands() && cfg.motor().is_limited() {
             p.least_height_m = least_height(&cfg);
+            if p.least_height_m.is_none() && p.note.is_none() {
+                p.note = Some(
+                    "no least drop height: no free-form time design from this start verified (landing within the motors) in any fall"
+                        .into(),
+                );
+            }
         }
         (p, kept)
     }

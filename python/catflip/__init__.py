@@ -130,7 +130,17 @@ def sweep(
     if values is None or isinstance(values, (str, bytes)):
         # (numpy reads None as NaN, which the key would refuse as a value)
         raise TypeError(f"values = {values!r}: give the values to sweep, a sequence of numbers")
-    values = [float(v) for v in np.asarray(values, dtype=float).ravel()]
+    try:
+        array = np.asarray(values, dtype=float)
+    except (TypeError, ValueError) as e:
+        raise ConfigError(
+            f"{key}: values = {values!r} are not numbers ({e}): sweep takes a numeric key and its values"
+        ) from None
+    if array.ndim != 1:
+        raise ConfigError(
+            f"{key}: values = {values!r} are not one sequence of numbers: sweep takes a numeric key, one value a point"
+        )
+    values = [float(v) for v in array]
     columns, csv = _sweep_columns(
         config, key, values, list(methods), threads, bool(least_height_only)
     )

@@ -692,3 +692,27 @@ def test_a_least_time_design_continues_from_the_least_height_answer():
     assert d.duration <= answer.least_time_s * (1 + 1e-9)
     # a named seed still starts there
     assert catflip.design(cfg, "free", objective="time", seed="phased").to_dict()["seed"] == "phased"
+
+
+def test_the_replays_allow_a_schedule_clipped_to_the_line_its_riding_tolerance():
+    # a schedule beyond the motors (negative margin) is clipped to the line by both
+    # simulators and rides it, as one at its edge does: five times the tolerance
+    sys.path.insert(0, str(ROOT / "examples"))
+    try:
+        from replay_common import RIDING_MARGIN, pd_tolerance
+    finally:
+        sys.path.pop(0)
+    tol = lambda margin, given=None: pd_tolerance(given, 1e-3, {"min_envelope_margin": margin}, 5.0)
+    assert tol(None) == 1e-3
+    assert tol(0.5) == 1e-3
+    assert tol(RIDING_MARGIN / 2) == 5e-3
+    assert tol(-29.6) == 5e-3
+    assert tol(-29.6, given=2e-3) == 2e-3
+
+
+def test_a_sweep_of_values_that_are_not_numbers_is_a_config_error():
+    cfg = catflip.Config.from_toml(ROOT / "configs" / "seed.toml")
+    with pytest.raises(catflip.ConfigError, match=r"cat.joint: values = \['universal'\] are not numbers"):
+        catflip.sweep(cfg, "cat.joint", ["universal"], frame=False)
+    with pytest.raises(catflip.ConfigError, match=r"\[\[0, 0, 20\], \[0, 0, -20\]\]"):
+        catflip.sweep(cfg, "start.rotation_deg", [[0, 0, 20], [0, 0, -20]], frame=False)

@@ -107,7 +107,8 @@ pub fn bins(cfg: &Config, results: &[TrialResult], max_tilt_deg: f64) -> Vec<Bin
         .collect()
 }
 
-/// The page's note on the bins' trials: "spin 205, 198, ...; tilt ...".
+/// The page's note on how many trials each bin holds: "spin 205, 198, ...;
+/// tilt ..." (counts, not the trials' numbers the page lists elsewhere).
 pub fn bins_note(bins: &[Bins]) -> Option<String> {
     (!bins.is_empty()).then(|| {
         let each: Vec<String> = bins
@@ -118,7 +119,7 @@ pub fn bins_note(bins: &[Bins]) -> Option<String> {
             })
             .collect();
         format!(
-            "The figure's bins ({} equal parts of each perturbation's largest value, smallest first: at most {}, about {} trials each on average where the study has them) hold these trials: {}.",
+            "The figure's bins ({} equal parts of each perturbation's largest value, smallest first: at most {}, about {} trials each on average where the study has them) hold these numbers of trials, bin by bin: {}.",
             bins[0].trials.len(),
             MAX_BINS,
             TRIALS_PER_BIN,

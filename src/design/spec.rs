@@ -314,7 +314,18 @@ impl SimulateSettings {
             "simulate.flip_tolerance",
             self.flip_tolerance,
             self.flip_tolerance > 0.0 && self.flip_tolerance <= std::f64::consts::PI,
-            "must be in (0, pi] rad",
+            &format!(
+                "must be in (0, pi] rad{}",
+                if self.flip_tolerance > std::f64::consts::PI {
+                    format!(
+                        " (degrees? {} deg = {:.4} rad)",
+                        self.flip_tolerance,
+                        self.flip_tolerance.to_radians()
+                    )
+                } else {
+                    String::new()
+                }
+            ),
         )?;
         let n = self.samples_per_phase as f64;
         check(

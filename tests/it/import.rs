@@ -666,3 +666,27 @@ fn a_verdict_names_a_limit_where_the_robot_file_gave_it() {
         "{typed:?}"
     );
 }
+
+/// A URDF whose joints give `effort="0"` (exporters' "not given") has no
+/// torque limit, so a config that adds the torque-speed line's no-load
+/// speed is refused: the message says the file gave no effort, not only
+/// that the key is missing.
+#[test]
+fn a_urdf_without_effort_is_named_when_the_line_needs_the_stall_torque() {
+    let dir = temp_dir();
+    let text =
+        std::fs::read_to_string(util::config_path("box-robot").with_file_name("box-robot.urdf"))
+            .unwrap()
+            .replace("effort=\"1.4\"", "effort=\"0\"");
+    std::fs::write(dir.path().join("r.urdf"), text).unwrap();
+    let cfg = "name = \"r\"\n[fall]\nheight = 3.0\n[limits]\nno_load_speed = 5.969\n[body]\nurdf = \"r.urdf\"\n";
+    std::fs::write(dir.path().join("r.toml"), cfg).unwrap();
+    let e = Config::load(&dir.path().join("r.toml"), &[])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("limits.no_load_speed") && e.contains("needs limits.max_torque"),
+        "{e}"
+    );
+    assert!(e.contains("body.urdf gives no torque limit"), "{e}");
+}

@@ -519,6 +519,18 @@ height = 2.0
             "{c}: {err}"
         );
     }
+    // a tolerance typed in degrees: refused, the radians it would be named
+    refused(
+        &["analyze", &seed, "--set", "simulate.flip_tolerance=5"],
+        &["simulate.flip_tolerance", "degrees? 5 deg = 0.0873 rad"],
+    );
+    // a robot's joint typed in millimetres: refused under the equivalent
+    // cylinder's key, with the [body] keys that make it
+    let robot = config("box-robot");
+    refused(
+        &["analyze", &robot, "--set", "body.rear.joint=[0, 0, 110.0]"],
+        &["cat.length", "body.rear.joint - body.rear.com", "in metres"],
+    );
     // physically impossible: a radius above the length, halves that
     // intersect at the bend limit (the seed's halves allow 168.46 deg)
     refused(
@@ -1139,7 +1151,7 @@ fn an_interrupted_robustness_study_publishes_its_finished_trials_and_resumes_to_
     // each perturbation's bins (two for 40 trials), with the trials each
     // holds: all 40 of them
     let bins = page
-        .split("hold these trials: ")
+        .split("hold these numbers of trials, bin by bin: ")
         .nth(1)
         .and_then(|t| t.split('.').next())
         .unwrap_or_else(|| panic!("no bins' trials on the page: {page}"));
