@@ -2397,11 +2397,11 @@ fn infeasible(spec: &DesignSpec, solved: &Solved) -> crate::error::Error {
                         && !spine_level
                     {
                         // a spin about the spine does not tumble it (F10)
-                        "A spin about the spine turns the body about it (F10); the design did not level the pitched spine with it, and at zero momentum a no-twist cat cannot tilt its spine at all (F1); try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
+                        "A spin about the spine turns the body about it (F10); the design did not level the pitched spine with it, and at zero momentum a no-twist cat cannot tilt its spine at all (F1); a start whose spine is level; a universal joint (cat.joint = \"universal\") tilts it, but slowly (F4: the seed pitched 10 deg needs some 40 times the peak from rest)"
                     } else if spec.cat.joint == crate::model::Joint::NoTwist && !spec.has_momentum()
                     {
                         // no height helps: the spine's tilt is out of its reach
-                        "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; try the universal joint (cat.joint = \"universal\") or a start whose spine is level"
+                        "At zero momentum a no-twist cat cannot tilt its spine (F1: every bend circulation turns it about the spine), from any height; a start whose spine is level; a universal joint (cat.joint = \"universal\") tilts it, but slowly (F4: the seed pitched 10 deg needs some 40 times the peak from rest)"
                     } else if spec.has_momentum() && about_the_spine {
                         // a spin about the spine tumbles nothing: the turn's timing failed
                         "A spin about the spine turns the body about it, at |L| / I_3 held straight and slower bent (F10), and the design could not time that turn to land belly-down in the time the fall leaves; try a higher fall.height, or another seed (`catflip optimize --mode free --seed analytic`)"

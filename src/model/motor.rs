@@ -74,9 +74,15 @@ impl Motor {
             [-k * qd[0], -k * qd[1]]
         };
         match self.norm {
-            // (a speed that is not a number has no envelope: NaN, not a panic)
-            TorqueNorm::PerMotor if c.iter().any(|x| x.is_nan()) => [f64::NAN; 2],
-            TorqueNorm::PerMotor => [0, 1].map(|i| tau[i].clamp(c[i] - t, c[i] + t)),
+            // (a speed that is not a number has no envelope: NaN for that
+            // motor, not a panic; the other keeps its own)
+            TorqueNorm::PerMotor => [0, 1].map(|i| {
+                if c[i].is_nan() {
+                    f64::NAN
+                } else {
+                    tau[i].clamp(c[i] - t, c[i] + t)
+                }
+            }),
             TorqueNorm::Euclidean => {
                 let e = [tau[0] - c[0], tau[1] - c[1]];
                 let n = e[0].hypot(e[1]);
@@ -162,13 +168,23 @@ mod tests {
     }
 
     /// A speed that is not a number has no envelope: the torque given is
-    /// NaN under either norm, never a panic (a diverged state fed to a
-    /// controller reached `f64::clamp`'s).
+    /// NaN, never a panic (a diverged state fed to a controller reached
+    /// `f64::clamp`'s); per motor only that motor's (the other's limits are
+    /// its own), under the Euclidean norm both (one disc holds them).
     #[test]
     fn a_speed_that_is_not_a_number_gives_nan_not_a_panic() {
+        let t = servo(TorqueNorm::PerMotor).clip([0.5, 2.0], [f64::NAN, 0.0]);
+        assert!(t[0].is_nan(), "{t:?}");
+        assert_eq!(
+            t[1],
+            servo(TorqueNorm::PerMotor).clip([0.5, 2.0], [0.0, 0.0])[1]
+        );
         for norm in [TorqueNorm::PerMotor, TorqueNorm::Euclidean] {
             let t = servo(norm).clip([0.5, 0.5], [f64::NAN, 0.0]);
-            assert!(t.iter().all(|x| x.is_nan()), "{norm:?}: {t:?}");
+            assert!(t[0].is_nan(), "{norm:?}: {t:?}");
+            if norm == TorqueNorm::Euclidean {
+                assert!(t[1].is_nan(), "{t:?}");
+            }
             // a stall torque alone: the speed does not matter, whatever it is
             let stall = Motor {
                 no_load_speed: None,
