@@ -64,6 +64,43 @@ impl ShapePlan for CollocationPlan {
         }
     }
 
+    /// At an interior node of a grid whose acceleration jumps there
+    /// ([`Transcription::with_jumps`], never from a spinning start) the end
+    /// of the interval before it and the start of the one after.
+    fn step_at(
+        &self,
+        cat: &crate::model::Cat,
+        i: usize,
+        t: f64,
+    ) -> Option<[(ShapeState, [f64; 2]); 2]> {
+        if !self.tr.jumps || self.track.is_some() {
+            return None;
+        }
+        let b = self.phase_bounds();
+        let dur = b[i + 1] - b[i];
+        let s = (t - b[i]) / dur;
+        let h = self.tr.h();
+        let k = (s / h).round();
+        if (s - k * h).abs() > 1e-9 * h || k < 1.0 || k > (self.tr.nodes - 2) as f64 {
+            return None;
+        }
+        let side = |interval: usize, c: f64| {
+            let it = self.tr.interval(&self.z, i, interval).at(c);
+            let st = ShapeState {
+                q: it.q,
+                qd: it.v.map(|x| x / dur),
+                qdd: it.a.map(|x| x / (dur * dur)),
+                phase: Phase::ALL[i.min(2)],
+            };
+            (
+                st,
+                crate::model::dynamics::inverse_dynamics(cat, st.q, st.qd, st.qdd),
+            )
+        };
+        let k = k as usize;
+        Some([side(k - 1, 1.0), side(k, 0.0)])
+    }
+
     /// The inverse dynamics along the plan, with the momentum's part
     /// `g(q, q_dot, lambda)` when the plan starts with angular momentum.
     fn torque_in(&self, cat: &crate::model::Cat, i: usize, t: f64) -> [f64; 2] {

@@ -71,6 +71,13 @@ pub trait ShapePlan {
     fn turn_scaled(&self, _k: f64) -> Option<Box<dyn ShapePlan>> {
         None
     }
+    /// Where the torque steps at `t` inside phase `i` (a peak design's
+    /// nodes, `free.torque_jumps`), the state and torque just before it and
+    /// at it; by default none. A written schedule carries both as two rows
+    /// of one instant.
+    fn step_at(&self, _cat: &Cat, _i: usize, _t: f64) -> Option<[(ShapeState, [f64; 2]); 2]> {
+        None
+    }
 }
 
 /// A borrowed plan is the plan (a wrapper such as a mirror image may hold
@@ -96,6 +103,9 @@ impl<T: ShapePlan + ?Sized> ShapePlan for &T {
     }
     fn turn_scaled(&self, k: f64) -> Option<Box<dyn ShapePlan>> {
         (**self).turn_scaled(k)
+    }
+    fn step_at(&self, cat: &Cat, i: usize, t: f64) -> Option<[(ShapeState, [f64; 2]); 2]> {
+        (**self).step_at(cat, i, t)
     }
 }
 
@@ -131,26 +141,45 @@ impl Schedule {
     /// the start of the next, so that a torque jump there is kept exactly.
     pub fn sample(cat: &Cat, plan: &dyn ShapePlan, per_phase: usize) -> Schedule {
         let b = plan.phase_bounds();
+        let breaks = plan.breaks();
         let mut rows = Vec::with_capacity(3 * per_phase + 1);
+        let row = |s: ShapeState, tau: [f64; 2], t: f64| Row {
+            t,
+            phase: s.phase,
+            q: s.q,
+            qd: s.qd,
+            qdd: s.qdd,
+            tau,
+        };
         for i in 0..3 {
-            for k in 0..=per_phase {
-                // the phase's end is the next one's start to the bit, so the
-                // junction's two rows read back as one instant
-                let t = if k == per_phase {
-                    b[i + 1]
-                } else {
-                    b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64
-                };
-                let s = plan.state_in(i, t);
-                let tau = plan.torque_in(cat, i, t);
-                rows.push(Row {
-                    t,
-                    phase: s.phase,
-                    q: s.q,
-                    qd: s.qd,
-                    qdd: s.qdd,
-                    tau,
-                });
+            // the regular samples, and inside the phase the instants where
+            // the torque steps (two rows each: just before, and at it)
+            let mut times: Vec<(f64, bool)> = (0..=per_phase)
+                .map(|k| {
+                    // the phase's end is the next one's start to the bit, so
+                    // the junction's two rows read back as one instant
+                    let t = if k == per_phase {
+                        b[i + 1]
+                    } else {
+                        b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64
+                    };
+                    (t, false)
+                })
+                .collect();
+            times.extend(
+                breaks
+                    .iter()
+                    .filter(|&&t| t > b[i] && t < b[i + 1])
+                    .filter(|&&t| plan.step_at(cat, i, t).is_some())
+                    .map(|&t| (t, true)),
+            );
+            times.sort_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
+            times.dedup_by(|later, earlier| later.0 == earlier.0);
+            for (t, step) in times {
+                match plan.step_at(cat, i, t).filter(|_| step) {
+                    Some(sides) => rows.extend(sides.map(|(s, tau)| row(s, tau, t))),
+                    None => rows.push(row(plan.state_in(i, t), plan.torque_in(cat, i, t), t)),
+                }
             }
         }
         Schedule { rows }
@@ -300,12 +329,15 @@ impl Schedule {
             };
             if let Some(prev) = rows.last() {
                 let p: &Row = prev;
-                let ok = row.t > p.t || (row.t == p.t && row.phase > p.phase);
+                // an instant repeats where a phase begins, or once where the
+                // torque steps inside a phase
+                let twice = rows.len() >= 2 && rows[rows.len() - 2].t == p.t;
+                let ok = row.t > p.t || (row.t == p.t && (row.phase > p.phase || !twice));
                 if !ok || row.phase < p.phase {
                     return Err(bad(
                         n + 1,
                         format!(
-                            "time {} / phase {} after time {} / phase {}: times must increase, repeating only where a phase begins, and phases must come in the order fold, twist, unfold",
+                            "time {} / phase {} after time {} / phase {}: times must increase, repeating only where a phase begins or, once, where the torque steps, and phases must come in the order fold, twist, unfold",
                             row.t,
                             row.phase.name(),
                             p.t,
@@ -420,6 +452,20 @@ impl Schedule {
 /// A sampled schedule is itself a plan: cubic Hermite in `q` (from `q`, `q_dot`),
 /// linear in the recorded torque, which is the feed-forward.
 impl ShapePlan for Schedule {
+    /// The phase junctions, the end, and the instants where the torque
+    /// steps inside a phase (two rows of one time).
+    fn breaks(&self) -> Vec<f64> {
+        let mut out: Vec<f64> = self
+            .rows
+            .windows(2)
+            .filter(|w| w[0].t == w[1].t && w[0].phase == w[1].phase)
+            .map(|w| w[0].t)
+            .collect();
+        out.extend(&self.phase_bounds()[1..]);
+        out.sort_by(f64::total_cmp);
+        out
+    }
+
     fn phase_bounds(&self) -> Vec<f64> {
         let mut b = vec![self.rows[0].t];
         for p in [Phase::Twist, Phase::Unfold] {
