@@ -78,6 +78,9 @@ impl ShapePlan for CollocationPlan {
         }
         let b = self.phase_bounds();
         let dur = b[i + 1] - b[i];
+        if !(dur > 0.0) {
+            return None;
+        }
         let s = (t - b[i]) / dur;
         let h = self.tr.h();
         let k = (s / h).round();

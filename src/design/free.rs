@@ -1398,7 +1398,8 @@ fn is_better(spec: &DesignSpec, a: &Result<FreeResult>, b: &Result<FreeResult>) 
     let key = |r: &Result<FreeResult>| {
         r.as_ref().ok().map(|r| {
             let miss = r.certificate.constraint_violation;
-            let misses = miss > spec.free.attitude_tolerance;
+            // (a violation that is not a number misses)
+            let misses = !(miss <= spec.free.attitude_tolerance);
             (misses, if misses { miss } else { r.objective_value })
         })
     };

@@ -173,6 +173,11 @@ impl Schedule {
                     .filter(|&&t| plan.step_at(cat, i, t).is_some())
                     .map(|&t| (t, true)),
             );
+            // a regular sample on a step (to rounding: the two are computed
+            // apart, and the CSV prints nine decimals) gives way to the step
+            let near = (1e-6 * (b[i + 1] - b[i])).max(1e-8);
+            let steps: Vec<f64> = times.iter().filter(|x| x.1).map(|x| x.0).collect();
+            times.retain(|&(t, step)| step || steps.iter().all(|s| (t - s).abs() > near));
             times.sort_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
             times.dedup_by(|later, earlier| later.0 == earlier.0);
             for (t, step) in times {
@@ -329,6 +334,18 @@ impl Schedule {
             };
             if let Some(prev) = rows.last() {
                 let p: &Row = prev;
+                // a phase does not end on a step (its instant twice): its
+                // last interval would have no length
+                if row.phase > p.phase && ends_on_a_step(&rows) {
+                    return Err(bad(
+                        n,
+                        format!(
+                            "phase {} ends with its last time {} twice: a repeated instant inside a phase is a torque step, and a row of the phase must follow it",
+                            p.phase.name(),
+                            p.t
+                        ),
+                    ));
+                }
                 // an instant repeats where a phase begins, or once where the
                 // torque steps inside a phase
                 let twice = rows.len() >= 2 && rows[rows.len() - 2].t == p.t;
@@ -347,6 +364,12 @@ impl Schedule {
                 }
             }
             rows.push(row);
+        }
+        if ends_on_a_step(&rows) {
+            return Err(bad(
+                last_line,
+                "the last phase ends with its last time twice: a repeated instant inside a phase is a torque step, and a row of the phase must follow it".into(),
+            ));
         }
         let sched = Schedule { rows };
         for p in Phase::ALL {
@@ -447,6 +470,12 @@ impl Schedule {
             .min(n - 2);
         (r.start + k, t.clamp(rows[k].t, rows[k + 1].t))
     }
+}
+
+/// Whether the last two rows are one instant of one phase (a torque step
+/// with nothing after it in its phase).
+fn ends_on_a_step(rows: &[Row]) -> bool {
+    matches!(rows, [.., a, b] if a.t == b.t && a.phase == b.phase)
 }
 
 /// A sampled schedule is itself a plan: cubic Hermite in `q` (from `q`, `q_dot`),
@@ -560,6 +589,42 @@ mod tests {
         assert_eq!(line, twist + 3, "{msg}");
         assert!(
             msg.contains("phase unfold has 0 rows") && msg.contains("cut short"),
+            "{msg}"
+        );
+    }
+
+    /// An instant may repeat once inside a phase (a torque step), but a
+    /// phase may not end on one (its last interval would have no length:
+    /// the state read there was NaN), nor hold it three times.
+    #[test]
+    fn a_torque_step_is_an_instant_twice_inside_a_phase_never_at_its_end() {
+        let full = written();
+        let lines: Vec<&str> = full.lines().collect();
+        let with = |i: usize| {
+            let mut l = lines.clone();
+            l.insert(i, lines[i]);
+            l.join("\n")
+        };
+        // a step in the twist's middle reads back, its instant a break
+        let twist = lines.iter().position(|l| l.contains(",twist,")).unwrap();
+        let s = Schedule::from_csv(&with(twist + 5), "s.csv").unwrap();
+        let t: f64 = lines[twist + 5].split(',').next().unwrap().parse().unwrap();
+        assert!(s.breaks().contains(&t));
+        // three times is refused
+        let mut thrice = lines.clone();
+        thrice.insert(twist + 5, lines[twist + 5]);
+        thrice.insert(twist + 5, lines[twist + 5]);
+        assert!(
+            message(&thrice.join("\n"))
+                .1
+                .contains("times must increase")
+        );
+        // the fold's last row twice, and the file's last row twice
+        let (_, msg) = message(&with(twist - 1));
+        assert!(msg.contains("phase fold ends with its last time"), "{msg}");
+        let (_, msg) = message(&with(lines.len() - 1));
+        assert!(
+            msg.contains("the last phase ends with its last time twice"),
             "{msg}"
         );
     }

@@ -377,6 +377,34 @@ fn a_written_schedule_keeps_the_torque_steps_at_the_nodes() {
     );
 }
 
+/// Where a regular sample falls on a node where the torque steps (here
+/// every fifth sample: 200 a phase over 40 intervals) the step's two rows
+/// take its place: the written schedule reads back and flies. Before, the
+/// sample and the step, a rounding apart, printed as one instant three
+/// times, and `simulate --schedule` refused catflip's own file.
+#[test]
+fn a_schedule_whose_samples_fall_on_its_steps_reads_back() {
+    let dir = temp_dir();
+    let seed = configs().join("seed.toml");
+    let c = seed.to_str().unwrap();
+    let nodes = "free.nodes=41";
+    let (ok, _, err) = run_ok(&["run", c, "--set", nodes], dir.path());
+    assert!(ok, "{err}");
+    let csv = dir.path().join(format!("output/seed/run@{nodes}/free.csv"));
+    let (ok, out, err) = run_ok(
+        &[
+            "simulate",
+            c,
+            "--set",
+            nodes,
+            "--schedule",
+            csv.to_str().unwrap(),
+        ],
+        dir.path(),
+    );
+    assert!(ok, "{out}{err}");
+}
+
 /// Ball joint: positions are unit quaternions and the velocity column is the
 /// relative rate in the child frame, `2 Im(conj(q_k) q_k+1) / dt` between rows;
 /// pyBullet's file holds the same numbers with the quaternion as x y z w.
