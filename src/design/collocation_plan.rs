@@ -78,7 +78,7 @@ impl ShapePlan for CollocationPlan {
         }
         let b = self.phase_bounds();
         let dur = b[i + 1] - b[i];
-        if !(dur > 0.0) {
+        if dur.is_nan() || dur <= 0.0 {
             return None;
         }
         let s = (t - b[i]) / dur;

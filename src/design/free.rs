@@ -1399,7 +1399,7 @@ fn is_better(spec: &DesignSpec, a: &Result<FreeResult>, b: &Result<FreeResult>) 
         r.as_ref().ok().map(|r| {
             let miss = r.certificate.constraint_violation;
             // (a violation that is not a number misses)
-            let misses = !(miss <= spec.free.attitude_tolerance);
+            let misses = miss.is_nan() || miss > spec.free.attitude_tolerance;
             (misses, if misses { miss } else { r.objective_value })
         })
     };
