@@ -25,6 +25,20 @@ impl CollocationPlan {
     }
 }
 
+impl CollocationPlan {
+    /// The state at fraction `c` of interval `k` of phase `i`, the phase
+    /// lasting `dur` s (its rates in physical time).
+    fn on_interval(&self, i: usize, k: usize, c: f64, dur: f64) -> ShapeState {
+        let it = self.tr.interval(&self.z, i, k).at(c);
+        ShapeState {
+            q: it.q,
+            qd: it.v.map(|x| x / dur),
+            qdd: it.a.map(|x| x / (dur * dur)),
+            phase: Phase::ALL[i.min(2)],
+        }
+    }
+}
+
 impl ShapePlan for CollocationPlan {
     fn phase_bounds(&self) -> Vec<f64> {
         let mut b = vec![0.0];
@@ -55,13 +69,7 @@ impl ShapePlan for CollocationPlan {
         let h = self.tr.h();
         let k = ((s / h).floor() as usize).min(self.tr.nodes - 2);
         let c = ((s - k as f64 * h) / h).clamp(0.0, 1.0);
-        let it = self.tr.interval(&self.z, i, k).at(c);
-        ShapeState {
-            q: it.q,
-            qd: it.v.map(|x| x / dur),
-            qdd: it.a.map(|x| x / (dur * dur)),
-            phase: Phase::ALL[i.min(2)],
-        }
+        self.on_interval(i, k, c, dur)
     }
 
     /// At an interior node of a grid whose acceleration jumps there
@@ -88,13 +96,7 @@ impl ShapePlan for CollocationPlan {
             return None;
         }
         let side = |interval: usize, c: f64| {
-            let it = self.tr.interval(&self.z, i, interval).at(c);
-            let st = ShapeState {
-                q: it.q,
-                qd: it.v.map(|x| x / dur),
-                qdd: it.a.map(|x| x / (dur * dur)),
-                phase: Phase::ALL[i.min(2)],
-            };
+            let st = self.on_interval(i, interval, c, dur);
             (
                 st,
                 crate::model::dynamics::inverse_dynamics(cat, st.q, st.qd, st.qdd),

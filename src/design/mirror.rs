@@ -135,6 +135,12 @@ pub fn goes_the_long_way(spec: &DesignSpec, plan: &dyn ShapePlan) -> bool {
 /// points the belly down at touchdown after flying it (for a design that
 /// lands, its own turn). `None` when a flight fails.
 pub fn left_to_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
+    turns(spec, plan).map(|(_, left)| left)
+}
+
+/// `plan`'s own turn from rest and the turn it leaves from `spec`'s start
+/// ([`left_to_turn`]), rad.
+fn turns(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<(f64, f64)> {
     let own = own_turn(spec, plan)?;
     let flown = crate::verify::simulate::kinematic_spec(spec, plan).ok()?;
     let [w, x, y, z] = flown.final_attitude;
@@ -142,7 +148,7 @@ pub fn left_to_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
         .to_rotation_matrix()
         .into_inner();
     let touchdown = rigid_turn(&spec.cat, &end, flown.final_body_momentum, spec.fall.margin);
-    Some(own + roll_to_belly_down(&touchdown))
+    Some((own, own + roll_to_belly_down(&touchdown)))
 }
 
 /// `plan`'s own turn about the spine from rest, rad (signed, flown
@@ -163,8 +169,7 @@ fn own_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<f64> {
 /// turn's ratio where the flight says otherwise (the universal joint, F4).
 /// `None` where the seed serves as it is.
 pub fn scaled_to_the_turn(spec: &DesignSpec, plan: &dyn ShapePlan) -> Option<Box<dyn ShapePlan>> {
-    let left = left_to_turn(spec, plan)?;
-    let own = own_turn(spec, plan)?;
+    let (own, left) = turns(spec, plan)?;
     if left * own <= 0.0 || left.abs() >= SCALE_BELOW * own.abs() {
         return None;
     }

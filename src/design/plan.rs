@@ -152,40 +152,37 @@ impl Schedule {
             tau,
         };
         for i in 0..3 {
-            // the regular samples, and inside the phase the instants where
-            // the torque steps (two rows each: just before, and at it)
-            let mut times: Vec<(f64, bool)> = (0..=per_phase)
-                .map(|k| {
-                    // the phase's end is the next one's start to the bit, so
-                    // the junction's two rows read back as one instant
-                    let t = if k == per_phase {
-                        b[i + 1]
-                    } else {
-                        b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64
-                    };
-                    (t, false)
-                })
+            // inside the phase the instants where the torque steps, two
+            // rows each (just before, and at it)
+            let steps: Vec<_> = breaks
+                .iter()
+                .filter(|&&t| t > b[i] && t < b[i + 1])
+                .filter_map(|&t| plan.step_at(cat, i, t).map(|sides| (t, sides)))
                 .collect();
-            times.extend(
-                breaks
-                    .iter()
-                    .filter(|&&t| t > b[i] && t < b[i + 1])
-                    .filter(|&&t| plan.step_at(cat, i, t).is_some())
-                    .map(|&t| (t, true)),
-            );
             // a regular sample on a step (to rounding: the two are computed
             // apart, and the CSV prints nine decimals) gives way to the step
             let near = (1e-6 * (b[i + 1] - b[i])).max(1e-8);
-            let steps: Vec<f64> = times.iter().filter(|x| x.1).map(|x| x.0).collect();
-            times.retain(|&(t, step)| step || steps.iter().all(|s| (t - s).abs() > near));
-            times.sort_by(|x, y| x.0.total_cmp(&y.0).then(y.1.cmp(&x.1)));
-            times.dedup_by(|later, earlier| later.0 == earlier.0);
-            for (t, step) in times {
-                match plan.step_at(cat, i, t).filter(|_| step) {
-                    Some(sides) => rows.extend(sides.map(|(s, tau)| row(s, tau, t))),
-                    None => rows.push(row(plan.state_in(i, t), plan.torque_in(cat, i, t), t)),
-                }
-            }
+            let mut phase: Vec<Row> = (0..=per_phase)
+                .map(|k| {
+                    // the phase's end is the next one's start to the bit, so
+                    // the junction's two rows read back as one instant
+                    if k == per_phase {
+                        b[i + 1]
+                    } else {
+                        b[i] + (b[i + 1] - b[i]) * k as f64 / per_phase as f64
+                    }
+                })
+                .filter(|t| steps.iter().all(|(s, _)| (t - s).abs() > near))
+                .map(|t| row(plan.state_in(i, t), plan.torque_in(cat, i, t), t))
+                .collect();
+            phase.extend(
+                steps
+                    .iter()
+                    .flat_map(|&(t, sides)| sides.map(|(s, tau)| row(s, tau, t))),
+            );
+            // (stable: a step's two rows keep their order)
+            phase.sort_by(|x, y| x.t.total_cmp(&y.t));
+            rows.extend(phase);
         }
         Schedule { rows }
     }
